@@ -1,0 +1,30 @@
+#pragma once
+// Small value types shared by every layer of the solver.
+#include <Eigen/Core>
+#include <stdexcept>
+#include <string>
+
+namespace grip {
+
+using Vec2 = Eigen::Vector2d;
+using Mat2 = Eigen::Matrix2d;
+using Vector = Eigen::VectorXd;
+using Matrix = Eigen::MatrixXd;
+
+// Rotation by +90 degrees: the obstacle tangent is rot90(outward normal).
+inline Vec2 rot90(const Vec2& a) { return {-a.y(), a.x()}; }
+
+// Bad input: carries the JSON pointer of the offending scene value.
+class SceneError : public std::runtime_error {
+ public:
+  SceneError(std::string pointer, const std::string& detail)
+      : std::runtime_error(pointer + ": " + detail), pointer_(std::move(pointer)), detail_(detail) {}
+  const std::string& pointer() const { return pointer_; }
+  const std::string& detail() const { return detail_; }
+
+ private:
+  std::string pointer_;
+  std::string detail_;
+};
+
+}  // namespace grip
