@@ -1,0 +1,93 @@
+// grip: command line entry point.
+//   grip solve SCENE.json [--out RESULT.json] [--events EVENTS.ndjson]
+// Exit codes: 0 solved, 1 a step failed, 2 usage or scene error.
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <string>
+
+#include "solver/io/result.hpp"
+
+namespace {
+
+int usage() {
+  std::fprintf(stderr,
+               "usage: grip solve SCENE.json [--out RESULT.json] [--events EVENTS.ndjson]\n");
+  return 2;
+}
+
+int solve(int argc, char** argv) {
+  std::string scene_path, out_path, events_path;
+  for (int i = 2; i < argc; ++i) {
+    const std::string a = argv[i];
+    if ((a == "--out" || a == "--events") && i + 1 < argc)
+      (a == "--out" ? out_path : events_path) = argv[++i];
+    else if (!a.empty() && a[0] != '-' && scene_path.empty())
+      scene_path = a;
+    else
+      return usage();
+  }
+  if (scene_path.empty()) return usage();
+
+  grip::Scene scene;
+  try {
+    scene = grip::read_scene_file(scene_path);
+  } catch (const grip::SceneErrors& e) {
+    std::fprintf(stderr, "%s: invalid scene\n", scene_path.c_str());
+    for (const auto& issue : e.issues())
+      std::fprintf(stderr, "  %s: %s\n", issue.pointer.c_str(), issue.detail.c_str());
+    return 2;
+  }
+
+  std::ofstream events;
+  if (!events_path.empty()) {
+    events.open(events_path);
+    if (!events) {
+      std::fprintf(stderr, "cannot write %s\n", events_path.c_str());
+      return 2;
+    }
+  }
+  auto emit = [&](const nlohmann::json& ev) {
+    if (events.is_open()) events << ev.dump() << '\n';
+  };
+  std::printf("%5s %12s %6s %6s %6s %12s %7s %6s %6s %9s  %s\n", "step", "load_factor", "iters",
+              "passes", "newton", "||v||_2", "contact", "stick", "slip", "ms", "status");
+  grip::SteppingObserver observer;
+  observer.step_started = [&](int step, double lf) { emit(grip::step_started_event(step, lf)); };
+  observer.iteration = [&](const grip::IterationEvent& ev) { emit(grip::iteration_event(ev)); };
+  observer.step_finished = [&](const grip::StepRecord& rec) {
+    emit(grip::step_finished_event(rec));
+    const auto& last = rec.history.empty() ? grip::IterationEvent{} : rec.history.back();
+    std::printf("%5d %12.6g %6d %6d %6d %12.3e %7d %6d %6d %9.2f  %s\n", rec.index,
+                rec.load_factor, rec.solves, rec.passes, rec.newton_iterations, last.v2,
+                last.stick + last.slip, last.stick, last.slip, rec.seconds * 1e3,
+                rec.converged ? "converged" : rec.reason.c_str());
+    std::fflush(stdout);
+  };
+  const grip::RunResult run =
+      grip::run_load_steps(scene.problem, scene.load_factors, scene.params, observer);
+  emit(run.completed ? nlohmann::json{{"type", "job_finished"}}
+                     : nlohmann::json{{"type", "job_failed"}, {"reason", run.reason}});
+  std::printf("total: %ld contact iterations, %ld Newton iterations, %ld factorizations, %.3f s\n",
+              run.counters.solves, run.counters.newton_iterations, run.counters.factorizations,
+              run.seconds);
+  if (!out_path.empty()) {
+    std::ofstream out(out_path);
+    out << grip::result_json(scene, run).dump(1) << '\n';
+    if (!out) {
+      std::fprintf(stderr, "cannot write %s\n", out_path.c_str());
+      return 2;
+    }
+  }
+  if (!run.completed) std::fprintf(stderr, "%s\n", run.reason.c_str());
+  return run.completed ? 0 : 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2) return usage();
+  const std::string command = argv[1];
+  if (command == "solve") return solve(argc, argv);
+  return usage();
+}

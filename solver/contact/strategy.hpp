@@ -1,0 +1,85 @@
+#pragma once
+// Contact strategies: the paper's accelerated contact error vector scheme `cev` (ALGORITHM.md
+// sections 2-5, 8, 9) and `uzawa` (the same literal loop with n = 1 and a fixed alpha). Each
+// solves one load step given an equilibrium oracle, and reports every real solve to an
+// observer.
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "solver/solve/equilibrium.hpp"
+
+namespace grip {
+
+enum class ContactMethod { cev, uzawa };
+enum class ContactLoop { inner, paper };  // inner: section 5's default; paper: the literal loop
+enum class EpsilonSource { exact, warmup };
+
+// Acceleration level n: kInfinity = a Cholesky solve with the active block (default);
+// kAuto = the smallest n whose condition number reaches 1.1; otherwise 1, 2, ...
+inline constexpr int kAccelerationInfinity = 0;
+inline constexpr int kAccelerationAuto = -1;
+
+struct ContactParams {
+  ContactMethod method = ContactMethod::cev;
+  ContactLoop loop = ContactLoop::inner;
+  // ||v||_2 <= tolerance * (body's characteristic length) ends a step.
+  double tolerance = 1e-8;
+  int acceleration = kAccelerationInfinity;
+  EpsilonSource epsilon = EpsilonSource::exact;
+  int warmup_first = 3, warmup_last = 10;  // I and J of eq. 30
+  double warmup_alpha = 1.99;
+  double uzawa_alpha = 1.0;  // fixed alpha of the multiplier update
+  int max_iterations = 500;  // real solves per load step, all tau passes together
+  int max_inner_iterations = 2000;
+  int max_halvings = 40;  // halvings of the step inside the inner loop, or of alpha (paper)
+  int halvings_before_fallback = 4;  // paper loop: then n -> n - 1
+  int line_search_steps = 10;  // H of the line search along p -> prediction
+  int max_tau_passes = 30;
+  // Passes end when max |p_eta - p*| <= tau_tolerance * max |p_eta| (section 9: 1e-5 settles
+  // in a few passes; much tighter makes p* cycle at the precision ||v|| pins p to).
+  double tau_tolerance = 1e-5;
+  // Newton's displacement tolerance, as a fraction of the contact tolerance: the contact
+  // error has a floor of about ||K^-1|| x the Newton residual (section 9).
+  double newton_fraction = 1e-3;
+};
+
+struct IterationEvent {
+  int step = 0;           // load step, 1-based
+  int pass = 0;           // tau pass, 1-based
+  int m = 0;              // accepted update in this pass (0: the pass's starting solve)
+  int trials = 1;         // real solves this update took (rejected line-search trials too)
+  int inner_iterations = 0;
+  int halvings = 0;
+  int n = 0;              // acceleration level (0 = infinity)
+  double alpha = 0.0;
+  double v2 = 0.0, v_inf = 0.0;
+  int open = 0, stick = 0, slip = 0;
+  int newton_iterations = 0;
+  double elapsed_ms = 0.0;
+};
+using IterationObserver = std::function<void(const IterationEvent&)>;
+
+struct StepOutcome {
+  bool converged = false;
+  std::string reason;
+  Vector p;
+  Vector tau;
+  EquilibriumState state;
+  int passes = 0;
+  int solves = 0;
+  int newton_iterations = 0;
+  int inner_iterations = 0;
+  double v2 = 0.0;
+  std::string epsilon_used;  // "exact" or "warmup", where a finite n needed it
+  std::vector<IterationEvent> history;
+};
+
+// One load step: p_start is the previous step's force (the first guess), p_star its normal
+// part (the first pass's friction bound), q_guess the displacement to start Newton from.
+StepOutcome solve_contact_step(Equilibrium& equilibrium, const Vector& q_guess,
+                               const Vector& p_start, const Vector& p_star,
+                               const ContactParams& params, int step,
+                               const IterationObserver& observer);
+
+}  // namespace grip

@@ -1,0 +1,64 @@
+#pragma once
+// A deformable body model: internal force A(q), its tangent K(q), and the surface points
+// where contact candidates sit (eq. 1-3).
+#include <Eigen/SparseCore>
+#include <string>
+#include <vector>
+
+#include "solver/core/types.hpp"
+
+namespace grip {
+
+using Triplets = std::vector<Eigen::Triplet<double>>;
+
+// Named columns of per-site or per-element output values.
+struct FieldTable {
+  std::vector<std::string> names;
+  std::vector<std::vector<double>> rows;
+};
+
+// dx / dq for one degree of freedom: the point moves by `dx` per unit of q[dof].
+struct PointJacobianEntry {
+  int dof;
+  Vec2 dx;
+};
+
+// A point on the body's surface in the current configuration and its Jacobian. By virtual
+// work, a force f at the point is the generalized force J^T f (for a beam this includes the
+// moment of f about the node through the offset, eq. 3).
+struct SurfacePoint {
+  Vec2 x = Vec2::Zero();
+  std::vector<PointJacobianEntry> jacobian;
+};
+
+class Body {
+ public:
+  virtual ~Body() = default;
+  virtual int dof_count() const = 0;
+  // Length that one unit of each dof moves the body by (1 for translations, a length for
+  // rotations): makes Newton's displacement test unit-consistent.
+  virtual Vector dof_length_scales() const = 0;
+  // Adds the internal force A(q) into `force` (sized dof_count) and, if `tangent` is given,
+  // the triplets of dA/dq.
+  virtual void internal_force(const Vector& q, Vector& force, Triplets* tangent) const = 0;
+
+  // Sites that can carry a contact candidate (beam and membrane: the element end nodes).
+  virtual int site_count() const = 0;
+  // Reference (undeformed centre-line) position of a site.
+  virtual Vec2 site_reference(int site) const = 0;
+  // The surface point of `site` on side +1 (upper) or -1 (lower), at state q.
+  virtual SurfacePoint surface_point(const Vector& q, int site, int side) const = 0;
+  // Surface area that a site's contact force acts on (tributary length x width).
+  virtual double tributary_area(int site) const = 0;
+  // Characteristic length (size of the undeformed body): the scale of relative tolerances.
+  virtual double characteristic_length() const = 0;
+
+  // Output: deformed position and displacements per site; stresses or section forces per element.
+  virtual FieldTable site_fields(const Vector& q) const = 0;
+  virtual FieldTable element_fields(const Vector& q) const = 0;
+
+  // Bodies with history (plasticity) keep old/new state; commit after a converged step.
+  virtual void commit(const Vector& /*q*/) {}
+};
+
+}  // namespace grip

@@ -1,0 +1,147 @@
+#include "solver/elements/timoshenko_beam.hpp"
+
+#include <Eigen/Dense>
+#include <array>
+#include <cmath>
+#include <stdexcept>
+
+namespace grip {
+namespace {
+
+using Vec3 = Eigen::Vector3d;
+using Mat9 = Eigen::Matrix<double, 9, 9>;
+using Vec9 = Eigen::Matrix<double, 9, 1>;
+
+// Shape functions h (eq. B.3) and their x-derivatives b (eq. B.5) at phi in [-1, 1].
+Vec3 shape(double phi) { return {0.5 * (1 - phi), 0.5 * (1 + phi), 1 - phi * phi}; }
+Vec3 shape_dx(double phi, double L) { return Vec3(-1, 1, -4 * phi) / L; }
+
+struct Gauss {
+  std::vector<double> points, weights;
+};
+const Gauss kGauss2{{-1 / std::sqrt(3.0), 1 / std::sqrt(3.0)}, {1, 1}};
+const Gauss kGauss3{{-std::sqrt(0.6), 0, std::sqrt(0.6)}, {5.0 / 9, 8.0 / 9, 5.0 / 9}};
+
+}  // namespace
+
+TimoshenkoBeam::TimoshenkoBeam(std::vector<double> node_x, double y0, BeamSection section,
+                               Kinematics kinematics)
+    : x_(std::move(node_x)), y0_(y0), section_(section), kinematics_(kinematics) {
+  if (x_.size() < 2) throw std::invalid_argument("a beam needs at least two nodes");
+  for (size_t i = 1; i < x_.size(); ++i)
+    if (!(x_[i] > x_[i - 1])) throw std::invalid_argument("beam node abscissae must increase");
+  if (kinematics_ == Kinematics::finite)
+    throw std::invalid_argument("the beam supports linear and von_karman kinematics");
+}
+
+Vector TimoshenkoBeam::dof_length_scales() const {
+  Vector scale = Vector::Ones(dof_count());
+  const double L = characteristic_length();
+  for (int k = 0; k < node_count(); ++k) scale[node_dof(k, 2)] = L;
+  for (int e = 0; e < element_count(); ++e) scale[mid_dof(e, 2)] = L;
+  return scale;
+}
+
+void TimoshenkoBeam::internal_force(const Vector& q, Vector& force, Triplets* tangent) const {
+  const bool nonlinear = kinematics_ == Kinematics::von_karman;
+  const auto& s = section_;
+  for (int e = 0; e < element_count(); ++e) {
+    // Local order: u1 u2 uq | w1 w2 wq | t1 t2 tq.
+    std::array<int, 9> dofs{};
+    for (int c = 0; c < 3; ++c) {
+      dofs[3 * c + 0] = node_dof(e, c);
+      dofs[3 * c + 1] = node_dof(e + 1, c);
+      dofs[3 * c + 2] = mid_dof(e, c);
+    }
+    Vec9 ql;
+    for (int i = 0; i < 9; ++i) ql[i] = q[dofs[i]];
+    const Vec3 u = ql.segment<3>(0), w = ql.segment<3>(3), t = ql.segment<3>(6);
+    const double L = x_[e + 1] - x_[e];
+    Vec9 f = Vec9::Zero();
+    Mat9 K = Mat9::Zero();
+
+    // Axial and bending terms, 3-point Gauss.
+    for (size_t g = 0; g < kGauss3.points.size(); ++g) {
+      const double phi = kGauss3.points[g], dx = kGauss3.weights[g] * L / 2;
+      const Vec3 b = shape_dx(phi, L);
+      const double bw = nonlinear ? b.dot(w) : 0.0;
+      const double N = s.EA * (b.dot(u) + 0.5 * bw * bw);
+      const double M = s.EI * b.dot(t);
+      f.segment<3>(0) += dx * N * b;
+      f.segment<3>(3) += dx * N * bw * b;
+      f.segment<3>(6) += dx * M * b;
+      const Eigen::Matrix3d bb = b * b.transpose();
+      K.block<3, 3>(0, 0) += dx * s.EA * bb;
+      K.block<3, 3>(0, 3) += dx * s.EA * bw * bb;
+      K.block<3, 3>(3, 0) += dx * s.EA * bw * bb;
+      K.block<3, 3>(3, 3) += dx * (s.EA * bw * bw + (nonlinear ? N : 0.0)) * bb;
+      K.block<3, 3>(6, 6) += dx * s.EI * bb;
+    }
+    // Shear, 2-point (reduced) Gauss.
+    for (size_t g = 0; g < kGauss2.points.size(); ++g) {
+      const double phi = kGauss2.points[g], dx = kGauss2.weights[g] * L / 2;
+      const Vec3 b = shape_dx(phi, L), h = shape(phi);
+      const double Q = s.kGA * (b.dot(w) + h.dot(t));
+      f.segment<3>(3) += dx * Q * b;
+      f.segment<3>(6) += dx * Q * h;
+      K.block<3, 3>(3, 3) += dx * s.kGA * b * b.transpose();
+      K.block<3, 3>(3, 6) += dx * s.kGA * b * h.transpose();
+      K.block<3, 3>(6, 3) += dx * s.kGA * h * b.transpose();
+      K.block<3, 3>(6, 6) += dx * s.kGA * h * h.transpose();
+    }
+    for (int i = 0; i < 9; ++i) {
+      force[dofs[i]] += f[i];
+      if (tangent)
+        for (int j = 0; j < 9; ++j) tangent->emplace_back(dofs[i], dofs[j], K(i, j));
+    }
+  }
+}
+
+SurfacePoint TimoshenkoBeam::surface_point(const Vector& q, int site, int side) const {
+  const double z = side * section_.half_depth;
+  const int du = node_dof(site, 0), dw = node_dof(site, 1), dt = node_dof(site, 2);
+  SurfacePoint p;
+  p.x = {x_[site] + q[du] + z * q[dt], y0_ + z + q[dw]};
+  p.jacobian = {{du, Vec2::UnitX()}, {dw, Vec2::UnitY()}, {dt, z * Vec2::UnitX()}};
+  return p;
+}
+
+double TimoshenkoBeam::tributary_area(int site) const {
+  double length = 0.0;
+  if (site > 0) length += 0.5 * (x_[site] - x_[site - 1]);
+  if (site + 1 < node_count()) length += 0.5 * (x_[site + 1] - x_[site]);
+  return length * section_.width;
+}
+
+SectionForces TimoshenkoBeam::section_forces(const Vector& q, int e) const {
+  const double L = x_[e + 1] - x_[e];
+  Vec3 u, w, t;
+  for (int c = 0; c < 3; ++c) {
+    Vec3& v = c == 0 ? u : (c == 1 ? w : t);
+    v = {q[node_dof(e, c)], q[node_dof(e + 1, c)], q[mid_dof(e, c)]};
+  }
+  const Vec3 b = shape_dx(0.0, L), h = shape(0.0);
+  const double bw = kinematics_ == Kinematics::von_karman ? b.dot(w) : 0.0;
+  return {section_.EA * (b.dot(u) + 0.5 * bw * bw), section_.kGA * (b.dot(w) + h.dot(t)),
+          section_.EI * b.dot(t)};
+}
+
+FieldTable TimoshenkoBeam::site_fields(const Vector& q) const {
+  FieldTable t{{"x", "y", "u", "w", "theta"}, {}};
+  for (int k = 0; k < node_count(); ++k) {
+    const double u = q[node_dof(k, 0)], w = q[node_dof(k, 1)];
+    t.rows.push_back({x_[k] + u, y0_ + w, u, w, q[node_dof(k, 2)]});
+  }
+  return t;
+}
+
+FieldTable TimoshenkoBeam::element_fields(const Vector& q) const {
+  FieldTable t{{"N", "Q", "M"}, {}};
+  for (int e = 0; e < element_count(); ++e) {
+    const SectionForces f = section_forces(q, e);
+    t.rows.push_back({f.N, f.Q, f.M});
+  }
+  return t;
+}
+
+}  // namespace grip

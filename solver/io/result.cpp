@@ -1,0 +1,107 @@
+#include "solver/io/result.hpp"
+
+#include <cmath>
+
+#include "solver/contact/contact_error.hpp"
+
+namespace grip {
+
+using nlohmann::json;
+
+json iteration_event(const IterationEvent& ev) {
+  return {{"type", "iteration"}, {"step", ev.step}, {"pass", ev.pass}, {"m", ev.m},
+          {"trials", ev.trials}, {"inner_iterations", ev.inner_iterations},
+          {"halvings", ev.halvings}, {"n", ev.n == 0 ? json("inf") : json(ev.n)},
+          {"alpha", ev.alpha}, {"v2", ev.v2}, {"v_inf", ev.v_inf}, {"open", ev.open},
+          {"stick", ev.stick}, {"slip", ev.slip}, {"newton_iterations", ev.newton_iterations},
+          {"elapsed_ms", ev.elapsed_ms}};
+}
+
+json step_started_event(int step, double load_factor) {
+  return {{"type", "step_started"}, {"step", step}, {"load_factor", load_factor}};
+}
+
+json step_finished_event(const StepRecord& rec) {
+  json j = {{"type", "step_finished"}, {"step", rec.index}, {"load_factor", rec.load_factor},
+            {"converged", rec.converged}, {"tau_passes", rec.passes},
+            {"contact_iterations", rec.solves}, {"newton_iterations", rec.newton_iterations},
+            {"seconds", rec.seconds}};
+  if (!rec.converged) j["reason"] = rec.reason;
+  return j;
+}
+
+namespace {
+
+json table_json(const FieldTable& t, const char* index_name) {
+  json rows = json::array();
+  for (size_t i = 0; i < t.rows.size(); ++i) {
+    json row = {{index_name, i}};
+    for (size_t c = 0; c < t.names.size(); ++c) row[t.names[c]] = t.rows[i][c];
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+}  // namespace
+
+json step_json(const Problem& problem, const StepRecord& rec) {
+  const Body& body = *problem.body;
+  json j = step_finished_event(rec);
+  j.erase("type");
+  j["inner_iterations"] = rec.inner_iterations;
+  j["cuts"] = rec.cuts;
+  if (!rec.epsilon_used.empty()) j["epsilon"] = rec.epsilon_used;
+  json history = json::array();
+  for (const auto& ev : rec.history) {
+    json h = iteration_event(ev);
+    h.erase("type");
+    h.erase("step");
+    history.push_back(h);
+  }
+  j["history"] = history;
+  if (rec.state.q.size() == 0) return j;
+  j["nodes"] = table_json(body.site_fields(rec.state.q), "node");
+  j["elements"] = table_json(body.element_fields(rec.state.q), "element");
+  json obstacles = json::array();
+  for (const auto& o : problem.obstacles) {
+    const Vec2 off = o.offset(rec.load_factor);
+    obstacles.push_back({{"name", o.name}, {"offset", {off.x(), off.y()}}});
+  }
+  j["obstacles"] = obstacles;
+  if (rec.reactions.size()) {
+    json reactions = json::array();
+    for (const Constraint& c : problem.constraints)
+      reactions.push_back({{"dof", c.dof}, {"force", rec.reactions[c.dof]}});
+    j["reactions"] = reactions;
+  }
+  json points = json::array();
+  for (size_t i = 0; i < problem.candidates.size(); ++i) {
+    const Candidate& c = problem.candidates[i];
+    const PairedPoint& pp = rec.state.points[i];
+    const double area = body.tributary_area(c.site);
+    const double p_n = rec.p[c.eta], p_t = c.xi >= 0 ? rec.p[c.xi] : 0.0;
+    points.push_back({{"node", c.site}, {"obstacle", problem.obstacles[c.obstacle].name},
+                      {"x", pp.point.x.x()}, {"y", pp.point.x.y()},
+                      {"pair", {pp.projection.point.x(), pp.projection.point.y()}},
+                      {"normal", {pp.projection.normal.x(), pp.projection.normal.y()}},
+                      {"p_n", p_n}, {"p_t", p_t}, {"sigma_n", p_n / area}, {"sigma_t", p_t / area},
+                      {"gap", pp.projection.gap}, {"slip", c.xi >= 0 ? rec.state.s[c.xi] : 0.0},
+                      {"state", to_string(contact_state(problem, i, rec.p, rec.tau))}});
+  }
+  j["contact_points"] = points;
+  return j;
+}
+
+json result_json(const Scene& scene, const RunResult& run) {
+  json steps = json::array();
+  for (const auto& rec : run.steps) steps.push_back(step_json(scene.problem, rec));
+  return {{"scene", scene.effective},
+          {"summary",
+           {{"completed", run.completed}, {"reason", run.reason}, {"steps", run.steps.size()},
+            {"contact_iterations", run.counters.solves},
+            {"newton_iterations", run.counters.newton_iterations},
+            {"factorizations", run.counters.factorizations}, {"seconds", run.seconds}}},
+          {"steps", steps}};
+}
+
+}  // namespace grip

@@ -1,0 +1,19 @@
+#pragma once
+// Results and events as JSON (DESIGN.md vocabulary). Events are the same objects whether
+// written to an NDJSON file by `grip solve --events` or streamed by the service.
+#include <nlohmann/json.hpp>
+
+#include "solver/io/scene.hpp"
+
+namespace grip {
+
+nlohmann::json iteration_event(const IterationEvent& ev);
+nlohmann::json step_started_event(int step, double load_factor);
+nlohmann::json step_finished_event(const StepRecord& rec);
+
+// One step's fields: nodes, elements, reactions, contact points, obstacle positions.
+nlohmann::json step_json(const Problem& problem, const StepRecord& rec);
+// The whole result: the effective scene, a summary and every step.
+nlohmann::json result_json(const Scene& scene, const RunResult& run);
+
+}  // namespace grip

@@ -1,0 +1,39 @@
+#pragma once
+// Scene JSON -> typed problem: the one place where a scene's names become types. Every error
+// names the JSON pointer of the offending value; all errors are collected, not only the first.
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "solver/core/problem.hpp"
+#include "solver/solve/load_stepping.hpp"
+
+namespace grip {
+
+struct SceneIssue {
+  std::string pointer;  // JSON pointer of the offending value
+  std::string detail;   // a plain sentence
+};
+
+class SceneErrors : public std::runtime_error {
+ public:
+  explicit SceneErrors(std::vector<SceneIssue> issues);
+  const std::vector<SceneIssue>& issues() const { return issues_; }
+
+ private:
+  std::vector<SceneIssue> issues_;
+};
+
+struct Scene {
+  nlohmann::json effective;  // the scene with every default filled in
+  Problem problem;
+  std::vector<double> load_factors;
+  SteppingParams params;
+};
+
+// Throws SceneErrors listing every problem found.
+Scene read_scene(const nlohmann::json& scene);
+Scene read_scene_file(const std::string& path);
+
+}  // namespace grip

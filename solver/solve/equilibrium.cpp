@@ -1,0 +1,190 @@
+#include "solver/solve/equilibrium.hpp"
+
+#include <Eigen/Dense>
+#include <cmath>
+
+namespace grip {
+
+Equilibrium::Equilibrium(const Problem& problem, NewtonParams params)
+    : problem_(problem), params_(params) {
+  const int n = problem.body->dof_count();
+  free_index_.assign(n, 0);
+  for (const Constraint& c : problem.constraints) free_index_[c.dof] = -1;
+  for (int i = 0; i < n; ++i)
+    if (free_index_[i] == 0) free_index_[i] = free_count_++;
+  length_scales_ = problem.body->dof_length_scales();
+  zeta_previous_.assign(problem.candidates.size(), 0.0);
+}
+
+void Equilibrium::set_step(double load_factor, std::vector<double> zeta_previous) {
+  load_factor_ = load_factor;
+  zeta_previous_ = std::move(zeta_previous);
+}
+
+void Equilibrium::pair(const Vector& q, EquilibriumState& state) const {
+  const auto& cands = problem_.candidates;
+  state.points.resize(cands.size());
+  state.s = Vector::Zero(problem_.component_count);
+  state.enabled.assign(problem_.component_count, 0);
+  for (size_t i = 0; i < cands.size(); ++i) {
+    const Candidate& c = cands[i];
+    const ObstacleInstance& obstacle = problem_.obstacles[c.obstacle];
+    PairedPoint& pp = state.points[i];
+    pp.point = problem_.body->surface_point(q, c.site, c.side);
+    const Vec2 offset = obstacle.offset(load_factor_);
+    pp.projection = obstacle.shape->project(pp.point.x - offset);
+    pp.projection.point += offset;
+    pp.eta = -pp.projection.normal;
+    pp.xi = pp.projection.tangent;
+    state.s[c.eta] = -pp.projection.gap;
+    double eta_col = 0.0, xi_col = 0.0;
+    for (const auto& j : pp.point.jacobian) {
+      if (free_index_[j.dof] < 0) continue;
+      eta_col += std::abs(j.dx.dot(pp.eta));
+      xi_col += std::abs(j.dx.dot(pp.xi));
+    }
+    // A column of T that vanishes on the free dofs (a force on a support) is never active.
+    state.enabled[c.eta] = eta_col > 1e-12;
+    if (c.xi >= 0) {
+      state.s[c.xi] = obstacle.shape->zeta_difference(pp.projection.zeta, zeta_previous_[i]);
+      state.enabled[c.xi] = xi_col > 1e-12;
+    }
+  }
+}
+
+EquilibriumState Equilibrium::evaluate(const Vector& q) const {
+  EquilibriumState state;
+  state.q = q;
+  pair(q, state);
+  state.converged = true;
+  return state;
+}
+
+Vector Equilibrium::residual(const Vector& q, const EquilibriumState& paired, const Vector& p,
+                             Triplets* tangent) const {
+  Vector r = Vector::Zero(q.size());
+  problem_.body->internal_force(q, r, tangent);
+  r -= load_factor_ * problem_.load;
+  for (size_t i = 0; i < problem_.candidates.size(); ++i) {
+    const Candidate& c = problem_.candidates[i];
+    const PairedPoint& pp = paired.points[i];
+    const double p_eta = p[c.eta], p_xi = c.xi >= 0 ? p[c.xi] : 0.0;
+    if (p_eta == 0.0 && p_xi == 0.0) continue;
+    const Vec2 f = p_eta * pp.eta + p_xi * pp.xi;
+    for (const auto& j : pp.point.jacobian) r[j.dof] -= j.dx.dot(f);
+    if (!tangent) continue;
+    // f = -p_eta n + p_xi rot90(n): df/dx = (-p_eta I + p_xi R) dn/dx.
+    Mat2 R;
+    R << 0, -1, 1, 0;
+    const Mat2 df_dx = (-p_eta * Mat2::Identity() + p_xi * R) * pp.projection.dnormal_dx;
+    if (df_dx.isZero(0.0)) continue;
+    for (const auto& a : pp.point.jacobian)
+      for (const auto& b : pp.point.jacobian)
+        tangent->emplace_back(a.dof, b.dof, -a.dx.dot(df_dx * b.dx));
+  }
+  return r;
+}
+
+Eigen::SparseMatrix<double> Equilibrium::free_block(const Triplets& triplets) const {
+  Triplets reduced;
+  reduced.reserve(triplets.size());
+  for (const auto& t : triplets) {
+    const int i = free_index_[t.row()], j = free_index_[t.col()];
+    if (i >= 0 && j >= 0) reduced.emplace_back(i, j, t.value());
+  }
+  Eigen::SparseMatrix<double> K(free_count_, free_count_);
+  K.setFromTriplets(reduced.begin(), reduced.end());
+  return K;
+}
+
+EquilibriumState Equilibrium::solve(const Vector& q_guess, const Vector& p) {
+  ++counters_.solves;
+  EquilibriumState state;
+  state.q = q_guess;
+  for (const Constraint& c : problem_.constraints) state.q[c.dof] = load_factor_ * c.value;
+  const double body_length = problem_.body->characteristic_length();
+  Triplets triplets;
+  for (int it = 1; it <= params_.max_iterations; ++it) {
+    pair(state.q, state);
+    triplets.clear();
+    const Vector r = residual(state.q, state, p, &triplets);
+    Vector r_free(free_count_);
+    for (int i = 0; i < r.size(); ++i)
+      if (free_index_[i] >= 0) r_free[free_index_[i]] = r[i];
+    lu_.compute(free_block(triplets));
+    ++counters_.factorizations;
+    if (lu_.info() != Eigen::Success) {
+      state.reason = "singular tangent stiffness in Newton iteration " + std::to_string(it);
+      return state;
+    }
+    const Vector dq_free = lu_.solve(-r_free);
+    state.newton_iterations = it;
+    ++counters_.newton_iterations;
+    double step = 0.0;
+    for (int i = 0; i < state.q.size(); ++i) {
+      if (free_index_[i] < 0) continue;
+      const double d = dq_free[free_index_[i]];
+      state.q[i] += d;
+      step = std::max(step, std::abs(d) * length_scales_[i]);
+    }
+    if (!std::isfinite(step)) {
+      state.reason = "Newton produced a non-finite displacement";
+      return state;
+    }
+    if (step > params_.divergence_lengths * body_length) {
+      state.reason = "Newton diverged (correction of " + std::to_string(step) + " length units)";
+      return state;
+    }
+    if (step <= params_.displacement_tolerance) {
+      pair(state.q, state);
+      state.converged = true;
+      return state;
+    }
+  }
+  pair(state.q, state);
+  state.reason = "Newton did not converge in " + std::to_string(params_.max_iterations) + " iterations";
+  return state;
+}
+
+Matrix Equilibrium::free_t_matrix(const EquilibriumState& state) const {
+  Matrix T = Matrix::Zero(free_count_, problem_.component_count);
+  for (size_t i = 0; i < problem_.candidates.size(); ++i) {
+    const Candidate& c = problem_.candidates[i];
+    const PairedPoint& pp = state.points[i];
+    for (const auto& j : pp.point.jacobian) {
+      const int f = free_index_[j.dof];
+      if (f < 0) continue;
+      T(f, c.eta) += j.dx.dot(pp.eta);
+      if (c.xi >= 0) T(f, c.xi) += j.dx.dot(pp.xi);
+    }
+  }
+  return T;
+}
+
+Matrix Equilibrium::compliance(const EquilibriumState& state) {
+  Triplets triplets;
+  Vector force = Vector::Zero(state.q.size());
+  problem_.body->internal_force(state.q, force, &triplets);
+  lu_.compute(free_block(triplets));
+  ++counters_.factorizations;
+  const Matrix T = free_t_matrix(state);
+  if (lu_.info() != Eigen::Success) return Matrix::Zero(T.cols(), T.cols());
+  const Matrix X = lu_.solve(T);
+  const Matrix C = T.transpose() * X;
+  return 0.5 * (C + C.transpose());
+}
+
+Vector Equilibrium::reactions(const EquilibriumState& state, const Vector& p) const {
+  Vector r = residual(state.q, state, p, nullptr);
+  for (int i = 0; i < r.size(); ++i)
+    if (free_index_[i] >= 0) r[i] = 0.0;
+  return r;  // what the supports exert on the body: A - lambda F - T p at the fixed dofs
+}
+
+std::vector<double> Equilibrium::zetas(const EquilibriumState& state) const {
+  std::vector<double> z(state.points.size());
+  for (size_t i = 0; i < z.size(); ++i) z[i] = state.points[i].projection.zeta;
+  return z;
+}
+
+}  // namespace grip

@@ -1,0 +1,89 @@
+#pragma once
+// SOLVE(U, p) of ALGORITHM.md section 5: equilibrium of eq. 1-2 for given contact forces p,
+// by Newton's method with the pairing, T(u) and the stiffness of the follower contact load
+// d(T(u) p)/du re-evaluated at every iterate. Also the contact compliance C = T^T K^-1 T.
+#include <Eigen/SparseCore>
+#include <Eigen/SparseLU>
+#include <string>
+#include <vector>
+
+#include "solver/core/problem.hpp"
+
+namespace grip {
+
+struct NewtonParams {
+  int max_iterations = 40;
+  // Converged when the largest correction, in length units (rotations times the body's
+  // length), is below this. Set by the contact strategy from its tolerance.
+  double displacement_tolerance = 1e-10;
+  // Diverged when a correction exceeds this many body lengths.
+  double divergence_lengths = 10.0;
+};
+
+// The kinematics of one candidate at a state.
+struct PairedPoint {
+  SurfacePoint point;
+  Projection projection;  // in the obstacle's moved frame: point already translated
+  Vec2 eta, xi;           // eta = -normal (into the obstacle), xi = tangent
+};
+
+struct EquilibriumState {
+  Vector q;
+  Vector s;                   // (s_eta, s_xi) per component
+  std::vector<PairedPoint> points;
+  std::vector<char> enabled;  // component has a non-zero column of T on the free dofs
+  int newton_iterations = 0;
+  bool converged = false;
+  std::string reason;         // why Newton failed
+};
+
+struct EquilibriumCounters {
+  long solves = 0;            // calls of solve(): real equilibrium solves
+  long newton_iterations = 0;
+  long factorizations = 0;
+};
+
+class Equilibrium {
+ public:
+  Equilibrium(const Problem& problem, NewtonParams params);
+
+  // Sets the load factor (loads, prescribed dofs, obstacle positions) and the surface
+  // coordinates zeta of the last converged step that the slips s_xi are measured from.
+  void set_step(double load_factor, std::vector<double> zeta_previous);
+  double load_factor() const { return load_factor_; }
+
+  EquilibriumState solve(const Vector& q_guess, const Vector& p);
+  // The pairing and s at q, without solving (e.g. the reference configuration).
+  EquilibriumState evaluate(const Vector& q) const;
+  // C = T^T K^-1 T over all components, from the body's own tangent at state.q (symmetric).
+  Matrix compliance(const EquilibriumState& state);
+  // Residual forces at the fixed dofs (the reactions on the body), full dof vector.
+  Vector reactions(const EquilibriumState& state, const Vector& p) const;
+  // The surface coordinate of every candidate's pairing point (for the next step's slips).
+  std::vector<double> zetas(const EquilibriumState& state) const;
+
+  const Problem& problem() const { return problem_; }
+  const EquilibriumCounters& counters() const { return counters_; }
+  const NewtonParams& params() const { return params_; }
+  NewtonParams& params() { return params_; }
+
+ private:
+  void pair(const Vector& q, EquilibriumState& state) const;
+  // R = A(q) - lambda F - T p on all dofs; tangent of R (with the contact load stiffness).
+  Vector residual(const Vector& q, const EquilibriumState& paired, const Vector& p,
+                  Triplets* tangent) const;
+  Eigen::SparseMatrix<double> free_block(const Triplets& triplets) const;
+  Matrix free_t_matrix(const EquilibriumState& state) const;
+
+  const Problem& problem_;
+  NewtonParams params_;
+  double load_factor_ = 0.0;
+  std::vector<double> zeta_previous_;
+  std::vector<int> free_index_;  // dof -> free index, -1 if prescribed
+  int free_count_ = 0;
+  Vector length_scales_;
+  EquilibriumCounters counters_;
+  Eigen::SparseLU<Eigen::SparseMatrix<double>> lu_;
+};
+
+}  // namespace grip

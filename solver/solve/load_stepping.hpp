@@ -1,0 +1,50 @@
+#pragma once
+// Load stepping: the scene's load factors in order, each solved by the contact strategy,
+// with adaptive cutting of a failed increment. State (displacements, contact forces, the
+// surface coordinates that slips are measured from, body history) is committed only after
+// a step converges.
+#include <string>
+#include <vector>
+
+#include "solver/contact/strategy.hpp"
+
+namespace grip {
+
+struct SteppingParams {
+  ContactParams contact;
+  NewtonParams newton;
+  int max_cuts = 5;  // a failed increment is halved at most this many times in a row
+};
+
+struct StepRecord {
+  int index = 0;               // 1-based output step
+  double load_factor = 0.0;
+  bool converged = false;
+  std::string reason;
+  int cuts = 0;                // sub-increments this step needed beyond one
+  int passes = 0, solves = 0, newton_iterations = 0, inner_iterations = 0;
+  double seconds = 0.0;
+  std::string epsilon_used;
+  Vector p, tau, reactions;
+  EquilibriumState state;
+  std::vector<IterationEvent> history;
+};
+
+struct SteppingObserver {
+  std::function<void(int step, double load_factor)> step_started;
+  IterationObserver iteration;
+  std::function<void(const StepRecord&)> step_finished;
+};
+
+struct RunResult {
+  std::vector<StepRecord> steps;
+  bool completed = false;
+  std::string reason;
+  EquilibriumCounters counters;
+  double seconds = 0.0;
+};
+
+RunResult run_load_steps(Problem& problem, const std::vector<double>& load_factors,
+                         const SteppingParams& params, const SteppingObserver& observer = {});
+
+}  // namespace grip
