@@ -1,0 +1,84 @@
+#pragma once
+// Invariants every converged contact step must satisfy (eq. 9 and 12, equilibrium), checked
+// on the solver's own output.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <sstream>
+
+#include "solver/contact/contact_error.hpp"
+#include "solver/solve/load_stepping.hpp"
+
+namespace grip::testing {
+
+struct InvariantTolerances {
+  double length;        // absolute contact tolerance (tolerance x body length)
+  double tau_relative;  // the tau-pass tolerance: the cone holds to this, relative to max |p_n|
+};
+
+inline ::testing::AssertionResult step_invariants(const Problem& problem, const StepRecord& rec,
+                                                  const InvariantTolerances& tol) {
+  std::ostringstream why;
+  if (!rec.converged) return ::testing::AssertionFailure() << "step " << rec.index << " failed: " << rec.reason;
+  double max_pn = 0.0;
+  for (const Candidate& c : problem.candidates) max_pn = std::max(max_pn, std::abs(rec.p[c.eta]));
+  Vec2 total = Vec2::Zero();
+  double scale = 0.0;
+  for (size_t i = 0; i < problem.candidates.size(); ++i) {
+    const Candidate& c = problem.candidates[i];
+    const PairedPoint& pp = rec.state.points[i];
+    const double pn = rec.p[c.eta], pt = c.xi >= 0 ? rec.p[c.xi] : 0.0;
+    const double mu = problem.obstacles[c.obstacle].friction;
+    const double gap = pp.projection.gap;
+    if (!std::isfinite(pn) || !std::isfinite(pt) || !std::isfinite(gap))
+      why << " point " << i << " has a non-finite value;";
+    if (pn > 0) why << " point " << i << " pulls (p_n = " << pn << ");";
+    if (-gap > tol.length) why << " point " << i << " penetrates by " << -gap << ";";
+    if (pn < 0 && std::abs(gap) > tol.length) why << " point " << i << " presses with a gap " << gap << ";";
+    if (c.xi >= 0) {
+      if (std::abs(pt) > rec.tau[i] * (1 + 1e-9) + 1e-300)
+        why << " point " << i << " exceeds its friction bound: " << pt << " vs " << rec.tau[i] << ";";
+      if (std::abs(pt) > mu * (std::abs(pn) + tol.tau_relative * max_pn) * (1 + 1e-9))
+        why << " point " << i << " is outside the Coulomb cone: " << pt << " vs " << mu * std::abs(pn) << ";";
+      const double slip = rec.state.s[c.xi];
+      const ContactState st = contact_state(problem, i, rec.p, rec.tau);
+      if (st == ContactState::slip && std::abs(slip) > tol.length && pt * slip > 0)
+        why << " point " << i << " slides along its friction force;";
+      if (st == ContactState::stick && std::abs(slip) > tol.length)
+        why << " point " << i << " sticks but slips by " << slip << ";";
+    }
+    const Vec2 f = pn * pp.eta + pt * pp.xi;
+    total += f;
+    scale += f.norm();
+  }
+  // Equilibrium of the whole body: a rigid translation does no internal work.
+  const Vector applied = rec.load_factor * problem.load;
+  double ref = scale;
+  for (int axis = 0; axis < 2; ++axis) {
+    const Vector mode = problem.body->rigid_translation(axis == 0 ? Vec2::UnitX() : Vec2::UnitY());
+    ref += mode.cwiseAbs().dot(applied.cwiseAbs()) + mode.cwiseAbs().dot(rec.reactions.cwiseAbs());
+  }
+  for (int axis = 0; axis < 2; ++axis) {
+    const Vec2 d = axis == 0 ? Vec2::UnitX() : Vec2::UnitY();
+    const Vector mode = problem.body->rigid_translation(d);
+    const double sum = mode.dot(applied) + mode.dot(rec.reactions) + total.dot(d);
+    if (std::abs(sum) > 1e-7 * ref) why << " force balance along axis " << axis << " is off by " << sum << " of " << ref << ";";
+  }
+  const std::string s = why.str();
+  if (s.empty()) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << "step " << rec.index << ":" << s;
+}
+
+// Within each tau pass, the contact error falls at every accepted real solve.
+inline ::testing::AssertionResult monotone_contact_error(const StepRecord& rec) {
+  for (size_t k = 1; k < rec.history.size(); ++k) {
+    const auto& a = rec.history[k - 1];
+    const auto& b = rec.history[k];
+    if (b.pass == a.pass && b.m > 0 && b.v2 >= a.v2)
+      return ::testing::AssertionFailure() << "step " << rec.index << " pass " << b.pass << " m " << b.m
+                                           << ": ||v|| rose from " << a.v2 << " to " << b.v2;
+  }
+  return ::testing::AssertionSuccess();
+}
+
+}  // namespace grip::testing

@@ -1,0 +1,49 @@
+#pragma once
+// Loading the shipped example scenes in tests, with edits.
+#include <fstream>
+#include <functional>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "solver/io/scene.hpp"
+
+namespace grip::testing {
+
+inline nlohmann::json example_scene(const std::string& name) {
+  std::ifstream in(std::string(GRIP_SOURCE_DIR) + "/schemas/examples/" + name + ".json");
+  return nlohmann::json::parse(in);
+}
+
+struct Solved {
+  Scene scene;
+  RunResult run;
+};
+
+inline Solved solve_scene(const nlohmann::json& j) {
+  Solved s{read_scene(j), {}};
+  s.run = run_load_steps(s.scene.problem, s.scene.load_factors, s.scene.params);
+  return s;
+}
+
+}  // namespace grip::testing
+
+#include "tests/support/contact_checks.hpp"
+
+namespace grip::testing {
+
+inline InvariantTolerances tolerances_of(const Scene& scene) {
+  return {scene.params.contact.tolerance * scene.problem.body->characteristic_length(),
+          scene.params.contact.tau_tolerance};
+}
+
+// Every step converged, satisfies the contact invariants, and lowers ||v|| monotonically.
+inline void expect_every_step_sound(const Solved& s) {
+  EXPECT_TRUE(s.run.completed) << s.run.reason;
+  for (const StepRecord& rec : s.run.steps) {
+    EXPECT_TRUE(step_invariants(s.scene.problem, rec, tolerances_of(s.scene)));
+    EXPECT_TRUE(monotone_contact_error(rec));
+  }
+}
+
+}  // namespace grip::testing
