@@ -240,9 +240,9 @@ class StepSolver {
   bool paper_pass() {
     const bool uzawa = params_.method == ContactMethod::uzawa;
     if (!uzawa && needs_warmup() && !warmup()) return false;
-    int level = uzawa ? 1 : params_.acceleration;
     while (error_.norm2 > tol_) {
       if (!budget_left()) return false;
+      int level = uzawa ? 1 : params_.acceleration;  // each update starts at the chosen n
       const Matrix C = eq_.compliance(out_.state);
       const double v0 = error_.norm2;
       const ContactError e = error_;

@@ -53,6 +53,9 @@ class Body {
   // Characteristic length (size of the undeformed body): the scale of relative tolerances.
   virtual double characteristic_length() const = 0;
 
+  // The generalized displacement that translates the whole body by d.
+  virtual Vector rigid_translation(const Vec2& d) const = 0;
+
   // Output: deformed position and displacements per site; stresses or section forces per element.
   virtual FieldTable site_fields(const Vector& q) const = 0;
   virtual FieldTable element_fields(const Vector& q) const = 0;

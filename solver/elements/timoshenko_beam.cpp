@@ -126,6 +126,15 @@ SectionForces TimoshenkoBeam::section_forces(const Vector& q, int e) const {
           section_.EI * b.dot(t)};
 }
 
+Vector TimoshenkoBeam::rigid_translation(const Vec2& d) const {
+  Vector q = Vector::Zero(dof_count());
+  for (int k = 0; k < node_count(); ++k) {
+    q[node_dof(k, 0)] = d.x();
+    q[node_dof(k, 1)] = d.y();
+  }
+  return q;  // hierarchical mid values stay zero: they measure departure from linear
+}
+
 FieldTable TimoshenkoBeam::site_fields(const Vector& q) const {
   FieldTable t{{"x", "y", "u", "w", "theta"}, {}};
   for (int k = 0; k < node_count(); ++k) {

@@ -42,6 +42,7 @@ class TimoshenkoBeam final : public Body {
   double tributary_area(int site) const override;
   double characteristic_length() const override { return x_.back() - x_.front(); }
 
+  Vector rigid_translation(const Vec2& d) const override;
   FieldTable site_fields(const Vector& q) const override;
   FieldTable element_fields(const Vector& q) const override;
 
