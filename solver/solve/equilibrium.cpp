@@ -85,6 +85,10 @@ Vector Equilibrium::residual(const Vector& q, const EquilibriumState& paired, co
   return r;
 }
 
+Vector Equilibrium::residual(const Vector& q, const Vector& p, Triplets* tangent) const {
+  return residual(q, evaluate(q), p, tangent);
+}
+
 Eigen::SparseMatrix<double> Equilibrium::free_block(const Triplets& triplets) const {
   Triplets reduced;
   reduced.reserve(triplets.size());

@@ -57,6 +57,9 @@ class Equilibrium {
   EquilibriumState evaluate(const Vector& q) const;
   // C = T^T K^-1 T over all components, from the body's own tangent at state.q (symmetric).
   Matrix compliance(const EquilibriumState& state);
+  // R = A(q) - lambda F - T(q) p on every dof, and (if asked) the triplets of dR/dq, with
+  // the pairing evaluated at q.
+  Vector residual(const Vector& q, const Vector& p, Triplets* tangent) const;
   // Residual forces at the fixed dofs (the reactions on the body), full dof vector.
   Vector reactions(const EquilibriumState& state, const Vector& p) const;
   // The surface coordinate of every candidate's pairing point (for the next step's slips).
