@@ -45,6 +45,8 @@ class StepSolver {
       : eq_(eq), problem_(eq.problem()), params_(params), step_(step), observer_(obs),
         start_(Clock::now()) {
     tol_ = params.tolerance * problem_.body->characteristic_length();
+    is_normal_.assign(problem_.component_count, 0);
+    for (const Candidate& c : problem_.candidates) is_normal_[c.eta] = 1;
   }
 
   StepOutcome run(const Vector& q_guess, const Vector& p_start, const Vector& p_star_in) {
@@ -72,7 +74,9 @@ class StepSolver {
         change = std::max(change, std::abs(out_.p[c.eta] - p_star[c.eta]));
         scale = std::max(scale, std::abs(out_.p[c.eta]));
       }
-      if (change <= params_.tau_tolerance * scale) {
+      // ||v|| <= tol pins p only to about C_EE^-1 v_E: a change of p* below that is noise
+      // (section 9: a tighter test makes p* cycle).
+      if (change <= params_.tau_tolerance * scale || change <= force_precision()) {
         out_.converged = true;
         break;
       }
@@ -163,6 +167,22 @@ class StepSolver {
     }
     out_.epsilon_used = "exact";
     return smallest_eigenvalue(C1);
+  }
+
+  // The largest normal-force correction that the remaining contact error asks for.
+  double force_precision() {
+    if (error_.norm2 == 0.0) return 0.0;
+    const Matrix C = eq_.compliance(out_.state);
+    const std::vector<int> idx = active_indices(error_);
+    Vector v_e(idx.size());
+    for (size_t a = 0; a < idx.size(); ++a) v_e[a] = error_.v[idx[a]];
+    Eigen::LLT<Matrix> llt(block(C, idx));
+    if (llt.info() != Eigen::Success) return 0.0;
+    const Vector dp = llt.solve(v_e);
+    double largest = 0.0;
+    for (size_t a = 0; a < idx.size(); ++a)
+      if (is_normal_[idx[a]]) largest = std::max(largest, std::abs(dp[a]));
+    return largest;
   }
 
   // ---- the default loop (section 5): inner iterations on the linear model, one real solve
@@ -280,9 +300,10 @@ class StepSolver {
     return true;
   }
 
+  // The eq. 30 estimate is made once per step, in its first pass, and reused by later passes.
   bool needs_warmup() const {
     return params_.epsilon == EpsilonSource::warmup && params_.acceleration != kAccelerationInfinity &&
-           params_.acceleration != 1;
+           params_.acceleration != 1 && pass_ == 1;
   }
 
   // eq. 30: J iterations of n = 1, alpha = 1.99, each one real solve, to estimate epsbar_1.
@@ -301,8 +322,11 @@ class StepSolver {
       ++m_;
       emit(1, 0, 0, 1, params_.warmup_alpha);
     }
-    warmup_eps_ = warmup_epsilon(norms, params_.warmup_alpha, params_.warmup_first,
-                                 std::min<int>(params_.warmup_last, norms.size() - 1));
+    // Too short a history (the error vanished, or a trial failed) leaves the exact
+    // eigenvalue in charge.
+    const int last = static_cast<int>(norms.size()) - 1;
+    if (last >= params_.warmup_first)
+      warmup_eps_ = warmup_epsilon(norms, params_.warmup_alpha, params_.warmup_first, last);
     return true;
   }
 
@@ -355,6 +379,7 @@ class StepSolver {
   int pass_ = 0, m_ = 0;
   long solves_at_start_ = 0;
   double warmup_eps_ = 0.0;
+  std::vector<char> is_normal_;
   ContactError error_;
   StepOutcome out_;
 };
