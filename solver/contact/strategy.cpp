@@ -41,8 +41,9 @@ struct Direction {
 // One load step's state and the two loops that drive it.
 class StepSolver {
  public:
-  StepSolver(Equilibrium& eq, const ContactParams& params, int step, const IterationObserver& obs)
-      : eq_(eq), problem_(eq.problem()), params_(params), step_(step), observer_(obs),
+  StepSolver(Equilibrium& eq, const ContactParams& params, int step, const IterationObserver& obs,
+             const StopRequest& stop)
+      : eq_(eq), problem_(eq.problem()), params_(params), step_(step), observer_(obs), stop_(stop),
         start_(Clock::now()) {
     tol_ = params.tolerance * problem_.body->characteristic_length();
     is_normal_.assign(problem_.component_count, 0);
@@ -94,6 +95,7 @@ class StepSolver {
 
  private:
   bool fresh_solve(const Vector& q) {
+    if (!budget_left()) return false;
     EquilibriumState s = eq_.solve(q, out_.p);
     if (!s.converged) return fail("equilibrium solve failed: " + s.reason);
     accept(std::move(s), out_.p);
@@ -115,6 +117,10 @@ class StepSolver {
   }
 
   bool budget_left() {
+    if (stop_ && stop_()) {
+      out_.stopped = true;
+      return fail("stopped on request");
+    }
     if (eq_.counters().solves < solves_at_start_ + params_.max_iterations) return true;
     return fail("contact error " + std::to_string(error_.norm2) + " above tolerance " +
                 std::to_string(tol_) + " after " + std::to_string(params_.max_iterations) +
@@ -374,6 +380,7 @@ class StepSolver {
   const ContactParams& params_;
   int step_;
   const IterationObserver& observer_;
+  const StopRequest& stop_;
   Clock::time_point start_;
   double tol_ = 0.0;
   int pass_ = 0, m_ = 0;
@@ -389,8 +396,8 @@ class StepSolver {
 StepOutcome solve_contact_step(Equilibrium& equilibrium, const Vector& q_guess,
                                const Vector& p_start, const Vector& p_star,
                                const ContactParams& params, int step,
-                               const IterationObserver& observer) {
-  StepSolver solver(equilibrium, params, step, observer);
+                               const IterationObserver& observer, const StopRequest& stop) {
+  StepSolver solver(equilibrium, params, step, observer, stop);
   return solver.run(q_guess, p_start, p_star);
 }
 

@@ -59,9 +59,12 @@ struct IterationEvent {
   double elapsed_ms = 0.0;
 };
 using IterationObserver = std::function<void(const IterationEvent&)>;
+// Asked before every real solve; true stops the step at once (dismissal, a wall-time limit).
+using StopRequest = std::function<bool()>;
 
 struct StepOutcome {
   bool converged = false;
+  bool stopped = false;  // by the StopRequest, not by the numerics
   std::string reason;
   Vector p;
   Vector tau;
@@ -80,6 +83,6 @@ struct StepOutcome {
 StepOutcome solve_contact_step(Equilibrium& equilibrium, const Vector& q_guess,
                                const Vector& p_start, const Vector& p_star,
                                const ContactParams& params, int step,
-                               const IterationObserver& observer);
+                               const IterationObserver& observer, const StopRequest& stop = {});
 
 }  // namespace grip

@@ -56,6 +56,10 @@ class Body {
   // The generalized displacement that translates the whole body by d.
   virtual Vector rigid_translation(const Vec2& d) const = 0;
 
+  // Sites of each cell, for plots and VTK: pairs for lines, four corners (counter-clockwise)
+  // for quadrilaterals.
+  virtual std::vector<std::vector<int>> cells() const = 0;
+
   // Output: deformed position and displacements per site; stresses or section forces per element.
   virtual FieldTable site_fields(const Vector& q) const = 0;
   virtual FieldTable element_fields(const Vector& q) const = 0;

@@ -135,6 +135,12 @@ Vector TimoshenkoBeam::rigid_translation(const Vec2& d) const {
   return q;  // hierarchical mid values stay zero: they measure departure from linear
 }
 
+std::vector<std::vector<int>> TimoshenkoBeam::cells() const {
+  std::vector<std::vector<int>> c;
+  for (int e = 0; e < element_count(); ++e) c.push_back({e, e + 1});
+  return c;
+}
+
 FieldTable TimoshenkoBeam::site_fields(const Vector& q) const {
   FieldTable t{{"x", "y", "u", "w", "theta"}, {}};
   for (int k = 0; k < node_count(); ++k) {

@@ -96,6 +96,7 @@ json result_json(const Scene& scene, const RunResult& run) {
   json steps = json::array();
   for (const auto& rec : run.steps) steps.push_back(step_json(scene.problem, rec));
   return {{"scene", scene.effective},
+          {"mesh", {{"cells", scene.problem.body->cells()}}},
           {"summary",
            {{"completed", run.completed}, {"reason", run.reason}, {"steps", run.steps.size()},
             {"contact_iterations", run.counters.solves},

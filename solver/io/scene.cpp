@@ -6,12 +6,14 @@
 #include <optional>
 #include <sstream>
 
-#include "solver/elements/timoshenko_beam.hpp"
+#include "solver/io/scene_reader.hpp"
 
 namespace grip {
 namespace {
 
 using nlohmann::json;
+using scene_io::Reader;
+using scene_io::show;
 
 std::string join(const std::vector<SceneIssue>& issues) {
   std::ostringstream os;
@@ -19,167 +21,6 @@ std::string join(const std::vector<SceneIssue>& issues) {
     os << (i ? "\n" : "") << issues[i].pointer << ": " << issues[i].detail;
   return os.str();
 }
-
-std::string show(const json& j) {
-  std::string s = j.dump();
-  return s.size() > 40 ? s.substr(0, 37) + "..." : s;
-}
-
-// Reads values out of the (mutable) effective scene, writing defaults in and collecting
-// every problem with its JSON pointer.
-class Reader {
- public:
-  std::vector<SceneIssue> issues;
-
-  void error(const std::string& pointer, std::string detail) {
-    issues.push_back({pointer.empty() ? "/" : pointer, std::move(detail)});
-  }
-
-  // obj[key] as an object (created empty when absent and optional).
-  json* object(json& obj, const std::string& ptr, const char* key, bool required) {
-    const std::string p = ptr + "/" + key;
-    if (!obj.is_object()) return nullptr;
-    if (!obj.contains(key)) {
-      if (required) {
-        error(p, "is required");
-        return nullptr;
-      }
-      obj[key] = json::object();
-    }
-    if (!obj[key].is_object()) {
-      error(p, show(obj[key]) + " is not an object");
-      return nullptr;
-    }
-    return &obj[key];
-  }
-
-  json* array(json& obj, const std::string& ptr, const char* key, bool required) {
-    const std::string p = ptr + "/" + key;
-    if (!obj.is_object()) return nullptr;
-    if (!obj.contains(key)) {
-      if (required) {
-        error(p, "is required");
-        return nullptr;
-      }
-      obj[key] = json::array();
-    }
-    if (!obj[key].is_array()) {
-      error(p, show(obj[key]) + " is not an array");
-      return nullptr;
-    }
-    return &obj[key];
-  }
-
-  // A finite number; `fallback` fills it in when absent (required when no fallback).
-  double number(json& obj, const std::string& ptr, const char* key,
-                std::optional<double> fallback = std::nullopt) {
-    const std::string p = ptr + "/" + key;
-    if (!obj.is_object()) return fallback.value_or(0.0);
-    if (!obj.contains(key)) {
-      if (!fallback) {
-        error(p, "is required");
-        return 0.0;
-      }
-      obj[key] = *fallback;
-      return *fallback;
-    }
-    const json& v = obj[key];
-    if (!v.is_number()) {
-      error(p, show(v) + " is not a number");
-      return fallback.value_or(0.0);
-    }
-    const double d = v.get<double>();
-    if (!std::isfinite(d)) {
-      error(p, "is not finite");
-      return fallback.value_or(0.0);
-    }
-    return d;
-  }
-
-  double positive(json& obj, const std::string& ptr, const char* key,
-                  std::optional<double> fallback = std::nullopt) {
-    const double d = number(obj, ptr, key, fallback);
-    if (obj.is_object() && obj.contains(key) && obj[key].is_number() && !(d > 0))
-      error(ptr + "/" + key, show(obj[key]) + " is not positive");
-    return d;
-  }
-
-  int integer(json& obj, const std::string& ptr, const char* key, int lo, int hi,
-              std::optional<int> fallback = std::nullopt) {
-    const std::string p = ptr + "/" + key;
-    if (!obj.is_object()) return fallback.value_or(lo);
-    if (!obj.contains(key)) {
-      if (!fallback) {
-        error(p, "is required");
-        return lo;
-      }
-      obj[key] = *fallback;
-      return *fallback;
-    }
-    return integer_value(obj[key], p, lo, hi);
-  }
-
-  int integer_value(const json& v, const std::string& p, int lo, int hi) {
-    if (!v.is_number_integer()) {
-      error(p, show(v) + " is not an integer");
-      return lo;
-    }
-    const long long i = v.get<long long>();
-    if (i < lo || i > hi) {
-      error(p, std::to_string(i) + " is outside [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
-      return lo;
-    }
-    return static_cast<int>(i);
-  }
-
-  std::string choice(json& obj, const std::string& ptr, const char* key,
-                     const std::vector<std::string>& options, std::optional<std::string> fallback) {
-    const std::string p = ptr + "/" + key;
-    if (!obj.is_object()) return fallback.value_or(options.front());
-    if (!obj.contains(key)) {
-      if (!fallback) {
-        error(p, "is required (one of " + list(options) + ")");
-        return options.front();
-      }
-      obj[key] = *fallback;
-      return *fallback;
-    }
-    const json& v = obj[key];
-    if (v.is_string())
-      for (const auto& o : options)
-        if (v.get<std::string>() == o) return o;
-    error(p, show(v) + " is not one of " + list(options));
-    return fallback.value_or(options.front());
-  }
-
-  Vec2 vec2(json& obj, const std::string& ptr, const char* key,
-            std::optional<Vec2> fallback = std::nullopt) {
-    const std::string p = ptr + "/" + key;
-    if (!obj.is_object()) return Vec2::Zero();
-    if (!obj.contains(key)) {
-      if (!fallback) {
-        error(p, "is required ([x, y])");
-        return Vec2::Zero();
-      }
-      obj[key] = {fallback->x(), fallback->y()};
-      return *fallback;
-    }
-    const json& v = obj[key];
-    if (!v.is_array() || v.size() != 2 || !v[0].is_number() || !v[1].is_number()) {
-      error(p, show(v) + " is not a pair of numbers [x, y]");
-      return Vec2::Zero();
-    }
-    const Vec2 out(v[0].get<double>(), v[1].get<double>());
-    if (!out.allFinite()) error(p, "is not finite");
-    return out;
-  }
-
-  static std::string list(const std::vector<std::string>& options) {
-    std::string s;
-    for (size_t i = 0; i < options.size(); ++i) s += (i ? ", " : "") + ("\"" + options[i] + "\"");
-    return s;
-  }
-};
 
 // ---- obstacles
 
@@ -224,98 +65,6 @@ std::unique_ptr<Obstacle> read_shape(Reader& r, json& j, const std::string& ptr)
     r.error(ptr, e.what());
     return nullptr;
   }
-}
-
-// ---- the beam
-
-int beam_component(const std::string& name) { return name == "u" ? 0 : name == "w" ? 1 : 2; }
-
-void read_beam(Reader& r, json& body, Problem& problem) {
-  const std::string ptr = "/body";
-  const std::string kin = r.choice(body, ptr, "kinematics", {"von_karman", "linear"}, "von_karman");
-  json* mat = r.object(body, ptr, "material", true);
-  json* sec = r.object(body, ptr, "section", true);
-  json* mesh = r.object(body, ptr, "mesh", true);
-  double E = 0, nu = 0;
-  BeamSection section;
-  if (mat) {
-    E = r.positive(*mat, ptr + "/material", "young");
-    nu = r.number(*mat, ptr + "/material", "poisson", 0.3);
-    if (!(nu >= 0 && nu < 0.5))
-      r.error(ptr + "/material/poisson", show((*mat)["poisson"]) + " is not in [0, 0.5)");
-  }
-  if (sec) {
-    const double width = r.positive(*sec, ptr + "/section", "width");
-    const double depth = r.positive(*sec, ptr + "/section", "depth");
-    const double k = r.positive(*sec, ptr + "/section", "shear_factor", 5.0 / 6.0);
-    const double G = E / (2 * (1 + nu));
-    section = {E * width * depth, E * width * depth * depth * depth / 12, k * G * width * depth,
-               depth / 2, width};
-  }
-  std::vector<double> x;
-  Vec2 origin = Vec2::Zero();
-  if (mesh) {
-    origin = r.vec2(*mesh, ptr + "/mesh", "origin", Vec2::Zero());
-    const double length = r.positive(*mesh, ptr + "/mesh", "length");
-    const int elements = r.integer(*mesh, ptr + "/mesh", "elements", 1, 100000);
-    for (int i = 0; i <= elements; ++i) x.push_back(origin.x() + length * i / elements);
-  }
-  if (!r.issues.empty()) return;
-  auto beam = std::make_unique<TimoshenkoBeam>(
-      x, origin.y(), section, kin == "linear" ? Kinematics::linear : Kinematics::von_karman);
-  const int nodes = beam->node_count();
-  problem.load = Vector::Zero(beam->dof_count());
-
-  if (json* sup = r.array(body, ptr, "supports", false))
-    for (size_t i = 0; i < sup->size(); ++i) {
-      const std::string sp = ptr + "/supports/" + std::to_string(i);
-      json& s = (*sup)[i];
-      if (!s.is_object()) {
-        r.error(sp, "is not an object");
-        continue;
-      }
-      const int node = r.integer(s, sp, "node", 0, nodes - 1);
-      json* fix = r.array(s, sp, "fix", true);
-      json* values = r.object(s, sp, "values", false);
-      if (!fix) continue;
-      for (size_t c = 0; c < fix->size(); ++c) {
-        const json& comp = (*fix)[c];
-        if (!(comp == "u" || comp == "w" || comp == "theta")) {
-          r.error(sp + "/fix/" + std::to_string(c), show(comp) + " is not one of \"u\", \"w\", \"theta\"");
-          continue;
-        }
-        const std::string name = comp.get<std::string>();
-        double value = 0.0;
-        if (values && values->contains(name)) value = r.number(*values, sp + "/values", name.c_str());
-        problem.constraints.push_back({TimoshenkoBeam::node_dof(node, beam_component(name)), value});
-      }
-      if (values)
-        for (const auto& [name, v] : values->items()) {
-          bool fixed = false;
-          for (const auto& comp : *fix) fixed |= comp == name;
-          if (!fixed) r.error(sp + "/values/" + name, "is given but \"" + name + "\" is not in fix");
-        }
-    }
-
-  if (json* loads = r.array(body, ptr, "loads", false))
-    for (size_t i = 0; i < loads->size(); ++i) {
-      const std::string lp = ptr + "/loads/" + std::to_string(i);
-      json& l = (*loads)[i];
-      if (!l.is_object()) {
-        r.error(lp, "is not an object");
-        continue;
-      }
-      const int node = r.integer(l, lp, "node", 0, nodes - 1);
-      const Vec2 f = r.vec2(l, lp, "force", Vec2::Zero());
-      const double moment = r.number(l, lp, "moment", 0.0);
-      const std::string at = r.choice(l, lp, "at", {"centre", "upper", "lower"}, "centre");
-      const int side = at == "upper" ? 1 : at == "lower" ? -1 : 0;
-      // Virtual work of the force at its point of application (a moment through the offset).
-      const SurfacePoint sp = beam->surface_point(Vector::Zero(beam->dof_count()), node, side);
-      for (const auto& jac : sp.jacobian) problem.load[jac.dof] += jac.dx.dot(f);
-      problem.load[TimoshenkoBeam::node_dof(node, 2)] += moment;
-    }
-  problem.body = std::move(beam);
 }
 
 // ---- solver parameters
@@ -392,8 +141,16 @@ Scene read_scene(const nlohmann::json& input) {
   json& e = scene.effective;
   if (!e.is_object()) throw SceneErrors(std::vector<SceneIssue>{{"/", "a scene is a JSON object"}});
   if (json* body = r.object(e, "", "body", true)) {
-    const std::string model = r.choice(*body, "/body", "model", {"timoshenko_beam"}, std::nullopt);
-    if (model == "timoshenko_beam") read_beam(r, *body, scene.problem);
+    // The registry of body models: the scene's name -> its reader.
+    using ModelReader = void (*)(Reader&, json&, Problem&);
+    static const std::vector<std::pair<std::string, ModelReader>> models = {
+        {"timoshenko_beam", scene_io::read_timoshenko_beam},
+    };
+    std::vector<std::string> names;
+    for (const auto& m : models) names.push_back(m.first);
+    const std::string model = r.choice(*body, "/body", "model", names, std::nullopt);
+    for (const auto& m : models)
+      if (m.first == model && r.issues.empty()) m.second(r, *body, scene.problem);
   }
   if (json* obs = r.array(e, "", "obstacles", true)) {
     if (obs->empty()) r.error("/obstacles", "needs at least one obstacle");

@@ -38,7 +38,8 @@ RunResult run_load_steps(Problem& problem, const std::vector<double>& load_facto
       const Vector guess =
           last != 0.0 ? Vector(q + (q - q_before) * ((target - lambda) / last)) : q;
       eq.set_step(target, zeta);
-      StepOutcome out = solve_contact_step(eq, guess, p, p, params.contact, step, observer.iteration);
+      StepOutcome out = solve_contact_step(eq, guess, p, p, params.contact, step,
+                                           observer.iteration, observer.stop_requested);
       rec.passes += out.passes;
       rec.solves += out.solves;
       rec.newton_iterations += out.newton_iterations;
@@ -46,7 +47,8 @@ RunResult run_load_steps(Problem& problem, const std::vector<double>& load_facto
       rec.history.insert(rec.history.end(), out.history.begin(), out.history.end());
       if (!out.epsilon_used.empty()) rec.epsilon_used = out.epsilon_used;
       if (!out.converged) {
-        if (depth >= params.max_cuts) {
+        if (out.stopped) result.stopped = true;
+        if (depth >= params.max_cuts || out.stopped) {
           rec.reason = out.reason + (depth ? " (after " + std::to_string(depth) + " cuts of the increment)" : "");
           rec.p = out.p;
           rec.tau = out.tau;

@@ -33,12 +33,14 @@ struct StepRecord {
 struct SteppingObserver {
   std::function<void(int step, double load_factor)> step_started;
   IterationObserver iteration;
+  StopRequest stop_requested;  // checked before every real solve
   std::function<void(const StepRecord&)> step_finished;
 };
 
 struct RunResult {
   std::vector<StepRecord> steps;
   bool completed = false;
+  bool stopped = false;  // by the observer's stop request
   std::string reason;
   EquilibriumCounters counters;
   double seconds = 0.0;

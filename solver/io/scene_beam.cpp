@@ -1,0 +1,101 @@
+#include <cmath>
+
+#include "solver/elements/timoshenko_beam.hpp"
+#include "solver/io/scene_reader.hpp"
+
+namespace grip::scene_io {
+namespace {
+
+int beam_component(const std::string& name) { return name == "u" ? 0 : name == "w" ? 1 : 2; }
+
+}  // namespace
+
+void read_timoshenko_beam(Reader& r, json& body, Problem& problem) {
+  const std::string ptr = "/body";
+  const std::string kin = r.choice(body, ptr, "kinematics", {"von_karman", "linear"}, "von_karman");
+  json* mat = r.object(body, ptr, "material", true);
+  json* sec = r.object(body, ptr, "section", true);
+  json* mesh = r.object(body, ptr, "mesh", true);
+  double E = 0, nu = 0;
+  BeamSection section;
+  if (mat) {
+    E = r.positive(*mat, ptr + "/material", "young");
+    nu = r.number(*mat, ptr + "/material", "poisson", 0.3);
+    if (!(nu >= 0 && nu < 0.5))
+      r.error(ptr + "/material/poisson", show((*mat)["poisson"]) + " is not in [0, 0.5)");
+  }
+  if (sec) {
+    const double width = r.positive(*sec, ptr + "/section", "width");
+    const double depth = r.positive(*sec, ptr + "/section", "depth");
+    const double k = r.positive(*sec, ptr + "/section", "shear_factor", 5.0 / 6.0);
+    const double G = E / (2 * (1 + nu));
+    section = {E * width * depth, E * width * depth * depth * depth / 12, k * G * width * depth,
+               depth / 2, width};
+  }
+  std::vector<double> x;
+  Vec2 origin = Vec2::Zero();
+  if (mesh) {
+    origin = r.vec2(*mesh, ptr + "/mesh", "origin", Vec2::Zero());
+    const double length = r.positive(*mesh, ptr + "/mesh", "length");
+    const int elements = r.integer(*mesh, ptr + "/mesh", "elements", 1, 100000);
+    for (int i = 0; i <= elements; ++i) x.push_back(origin.x() + length * i / elements);
+  }
+  if (!r.issues.empty()) return;
+  auto beam = std::make_unique<TimoshenkoBeam>(
+      x, origin.y(), section, kin == "linear" ? Kinematics::linear : Kinematics::von_karman);
+  const int nodes = beam->node_count();
+  problem.load = Vector::Zero(beam->dof_count());
+
+  if (json* sup = r.array(body, ptr, "supports", false))
+    for (size_t i = 0; i < sup->size(); ++i) {
+      const std::string sp = ptr + "/supports/" + std::to_string(i);
+      json& s = (*sup)[i];
+      if (!s.is_object()) {
+        r.error(sp, "is not an object");
+        continue;
+      }
+      const int node = r.integer(s, sp, "node", 0, nodes - 1);
+      json* fix = r.array(s, sp, "fix", true);
+      json* values = r.object(s, sp, "values", false);
+      if (!fix) continue;
+      for (size_t c = 0; c < fix->size(); ++c) {
+        const json& comp = (*fix)[c];
+        if (!(comp == "u" || comp == "w" || comp == "theta")) {
+          r.error(sp + "/fix/" + std::to_string(c), show(comp) + " is not one of \"u\", \"w\", \"theta\"");
+          continue;
+        }
+        const std::string name = comp.get<std::string>();
+        double value = 0.0;
+        if (values && values->contains(name)) value = r.number(*values, sp + "/values", name.c_str());
+        problem.constraints.push_back({TimoshenkoBeam::node_dof(node, beam_component(name)), value});
+      }
+      if (values)
+        for (const auto& [name, v] : values->items()) {
+          bool fixed = false;
+          for (const auto& comp : *fix) fixed |= comp == name;
+          if (!fixed) r.error(sp + "/values/" + name, "is given but \"" + name + "\" is not in fix");
+        }
+    }
+
+  if (json* loads = r.array(body, ptr, "loads", false))
+    for (size_t i = 0; i < loads->size(); ++i) {
+      const std::string lp = ptr + "/loads/" + std::to_string(i);
+      json& l = (*loads)[i];
+      if (!l.is_object()) {
+        r.error(lp, "is not an object");
+        continue;
+      }
+      const int node = r.integer(l, lp, "node", 0, nodes - 1);
+      const Vec2 f = r.vec2(l, lp, "force", Vec2::Zero());
+      const double moment = r.number(l, lp, "moment", 0.0);
+      const std::string at = r.choice(l, lp, "at", {"centre", "upper", "lower"}, "centre");
+      const int side = at == "upper" ? 1 : at == "lower" ? -1 : 0;
+      // Virtual work of the force at its point of application (a moment through the offset).
+      const SurfacePoint sp = beam->surface_point(Vector::Zero(beam->dof_count()), node, side);
+      for (const auto& jac : sp.jacobian) problem.load[jac.dof] += jac.dx.dot(f);
+      problem.load[TimoshenkoBeam::node_dof(node, 2)] += moment;
+    }
+  problem.body = std::move(beam);
+}
+
+}  // namespace grip::scene_io

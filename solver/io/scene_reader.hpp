@@ -1,0 +1,182 @@
+#pragma once
+// Internal to solver/io: reads values out of the (mutable) effective scene, writes defaults
+// in, and collects every problem with the JSON pointer of its value. Each body model's
+// reader lives in its own scene_<model>.cpp.
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "solver/core/problem.hpp"
+#include "solver/io/scene.hpp"
+
+namespace grip::scene_io {
+
+using nlohmann::json;
+
+inline std::string show(const json& j) {
+  std::string s = j.dump();
+  return s.size() > 40 ? s.substr(0, 37) + "..." : s;
+}
+
+// Reads values out of the (mutable) effective scene, writing defaults in and collecting
+// every problem with its JSON pointer.
+class Reader {
+ public:
+  std::vector<SceneIssue> issues;
+
+  void error(const std::string& pointer, std::string detail) {
+    issues.push_back({pointer.empty() ? "/" : pointer, std::move(detail)});
+  }
+
+  // obj[key] as an object (created empty when absent and optional).
+  json* object(json& obj, const std::string& ptr, const char* key, bool required) {
+    const std::string p = ptr + "/" + key;
+    if (!obj.is_object()) return nullptr;
+    if (!obj.contains(key)) {
+      if (required) {
+        error(p, "is required");
+        return nullptr;
+      }
+      obj[key] = json::object();
+    }
+    if (!obj[key].is_object()) {
+      error(p, show(obj[key]) + " is not an object");
+      return nullptr;
+    }
+    return &obj[key];
+  }
+
+  json* array(json& obj, const std::string& ptr, const char* key, bool required) {
+    const std::string p = ptr + "/" + key;
+    if (!obj.is_object()) return nullptr;
+    if (!obj.contains(key)) {
+      if (required) {
+        error(p, "is required");
+        return nullptr;
+      }
+      obj[key] = json::array();
+    }
+    if (!obj[key].is_array()) {
+      error(p, show(obj[key]) + " is not an array");
+      return nullptr;
+    }
+    return &obj[key];
+  }
+
+  // A finite number; `fallback` fills it in when absent (required when no fallback).
+  double number(json& obj, const std::string& ptr, const char* key,
+                std::optional<double> fallback = std::nullopt) {
+    const std::string p = ptr + "/" + key;
+    if (!obj.is_object()) return fallback.value_or(0.0);
+    if (!obj.contains(key)) {
+      if (!fallback) {
+        error(p, "is required");
+        return 0.0;
+      }
+      obj[key] = *fallback;
+      return *fallback;
+    }
+    const json& v = obj[key];
+    if (!v.is_number()) {
+      error(p, show(v) + " is not a number");
+      return fallback.value_or(0.0);
+    }
+    const double d = v.get<double>();
+    if (!std::isfinite(d)) {
+      error(p, "is not finite");
+      return fallback.value_or(0.0);
+    }
+    return d;
+  }
+
+  double positive(json& obj, const std::string& ptr, const char* key,
+                  std::optional<double> fallback = std::nullopt) {
+    const double d = number(obj, ptr, key, fallback);
+    if (obj.is_object() && obj.contains(key) && obj[key].is_number() && !(d > 0))
+      error(ptr + "/" + key, show(obj[key]) + " is not positive");
+    return d;
+  }
+
+  int integer(json& obj, const std::string& ptr, const char* key, int lo, int hi,
+              std::optional<int> fallback = std::nullopt) {
+    const std::string p = ptr + "/" + key;
+    if (!obj.is_object()) return fallback.value_or(lo);
+    if (!obj.contains(key)) {
+      if (!fallback) {
+        error(p, "is required");
+        return lo;
+      }
+      obj[key] = *fallback;
+      return *fallback;
+    }
+    return integer_value(obj[key], p, lo, hi);
+  }
+
+  int integer_value(const json& v, const std::string& p, int lo, int hi) {
+    if (!v.is_number_integer()) {
+      error(p, show(v) + " is not an integer");
+      return lo;
+    }
+    const long long i = v.get<long long>();
+    if (i < lo || i > hi) {
+      error(p, std::to_string(i) + " is outside [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+      return lo;
+    }
+    return static_cast<int>(i);
+  }
+
+  std::string choice(json& obj, const std::string& ptr, const char* key,
+                     const std::vector<std::string>& options, std::optional<std::string> fallback) {
+    const std::string p = ptr + "/" + key;
+    if (!obj.is_object()) return fallback.value_or(options.front());
+    if (!obj.contains(key)) {
+      if (!fallback) {
+        error(p, "is required (one of " + list(options) + ")");
+        return options.front();
+      }
+      obj[key] = *fallback;
+      return *fallback;
+    }
+    const json& v = obj[key];
+    if (v.is_string())
+      for (const auto& o : options)
+        if (v.get<std::string>() == o) return o;
+    error(p, show(v) + " is not one of " + list(options));
+    return fallback.value_or(options.front());
+  }
+
+  Vec2 vec2(json& obj, const std::string& ptr, const char* key,
+            std::optional<Vec2> fallback = std::nullopt) {
+    const std::string p = ptr + "/" + key;
+    if (!obj.is_object()) return Vec2::Zero();
+    if (!obj.contains(key)) {
+      if (!fallback) {
+        error(p, "is required ([x, y])");
+        return Vec2::Zero();
+      }
+      obj[key] = {fallback->x(), fallback->y()};
+      return *fallback;
+    }
+    const json& v = obj[key];
+    if (!v.is_array() || v.size() != 2 || !v[0].is_number() || !v[1].is_number()) {
+      error(p, show(v) + " is not a pair of numbers [x, y]");
+      return Vec2::Zero();
+    }
+    const Vec2 out(v[0].get<double>(), v[1].get<double>());
+    if (!out.allFinite()) error(p, "is not finite");
+    return out;
+  }
+
+  static std::string list(const std::vector<std::string>& options) {
+    std::string s;
+    for (size_t i = 0; i < options.size(); ++i) s += (i ? ", " : "") + ("\"" + options[i] + "\"");
+    return s;
+  }
+};
+
+
+// Body model readers: fill problem.body, constraints and load from scene["body"].
+void read_timoshenko_beam(Reader& r, json& body, Problem& problem);
+
+}  // namespace grip::scene_io
