@@ -65,7 +65,7 @@ int solve(int argc, char** argv) {
     std::fflush(stdout);
   };
   const grip::RunResult run =
-      grip::run_load_steps(scene.problem, scene.load_factors, scene.params, observer);
+      grip::run_load_steps(scene.problem, scene.steps, scene.params, observer);
   emit(run.completed ? nlohmann::json{{"type", "job_finished"}}
                      : nlohmann::json{{"type", "job_failed"}, {"reason", run.reason}});
   std::printf("total: %ld contact iterations, %ld Newton iterations, %ld factorizations, %.3f s\n",

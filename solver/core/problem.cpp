@@ -14,7 +14,7 @@ void add_candidates(Problem& problem) {
       // The side whose outward surface normal (+y or -y) points toward the obstacle.
       const int side = (proj.point - x).y() >= 0 ? +1 : -1;
       Candidate c{site, side, o, next++};
-      if (obstacle.friction > 0) c.xi = next++;
+      if (obstacle.frictional || obstacle.friction > 0) c.xi = next++;
       problem.candidates.push_back(c);
     }
   }

@@ -10,18 +10,37 @@
 
 namespace grip {
 
+// Loads, prescribed displacements and obstacle motions belong to load cases; each load step
+// gives every case a factor (one case, "main", unless the scene has stages).
+using LoadFactors = std::vector<double>;
+
 struct ObstacleInstance {
   std::string name;
   std::unique_ptr<Obstacle> shape;
-  double friction = 0.0;                 // Coulomb coefficient (the paper's nu)
-  Vec2 translation = Vec2::Zero();       // prescribed translation at load factor 1, ramped
-  Vec2 offset(double load_factor) const { return load_factor * translation; }
+  // Coulomb coefficient (the paper's nu) in force at the current step: the load stepping
+  // sets it from the step's stage.
+  double friction = 0.0;
+  bool frictional = false;            // friction > 0 in some stage: tangential unknowns exist
+  std::vector<Vec2> translations;     // prescribed translation per load case at factor 1
+  Vec2 offset(const LoadFactors& factors) const {
+    Vec2 d = Vec2::Zero();
+    for (size_t k = 0; k < translations.size() && k < factors.size(); ++k) d += factors[k] * translations[k];
+    return d;
+  }
 };
 
-// A prescribed dof: its value at load factor 1, ramped (zero for a plain support).
+// A prescribed dof: its value at factor 1 of its load case (zero for a plain support).
 struct Constraint {
   int dof;
   double value = 0.0;
+  int load_case = 0;
+};
+
+// One load step's target: a factor per load case and the friction per obstacle.
+struct LoadStep {
+  LoadFactors factors;
+  std::vector<double> friction;
+  int stage = 0;
 };
 
 // A candidate contact point: a body site's surface point on `side`, paired with `obstacle`.
@@ -38,7 +57,13 @@ struct Problem {
   std::unique_ptr<Body> body;
   std::vector<ObstacleInstance> obstacles;
   std::vector<Constraint> constraints;
-  Vector load;  // generalized external force at load factor 1
+  std::vector<Vector> loads;  // generalized external force per load case at factor 1
+  // The generalized external force at the given factors.
+  Vector load(const LoadFactors& factors) const {
+    Vector f = Vector::Zero(body->dof_count());
+    for (size_t k = 0; k < loads.size() && k < factors.size(); ++k) f += factors[k] * loads[k];
+    return f;
+  }
   std::vector<Candidate> candidates;
   int component_count = 0;  // number of contact unknowns
 };

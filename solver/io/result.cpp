@@ -25,7 +25,7 @@ json step_finished_event(const StepRecord& rec) {
   json j = {{"type", "step_finished"}, {"step", rec.index}, {"load_factor", rec.load_factor},
             {"converged", rec.converged}, {"tau_passes", rec.passes},
             {"contact_iterations", rec.solves}, {"newton_iterations", rec.newton_iterations},
-            {"seconds", rec.seconds}};
+            {"seconds", rec.seconds}, {"stage", rec.stage}, {"factors", rec.factors}};
   if (!rec.converged) j["reason"] = rec.reason;
   return j;
 }
@@ -64,7 +64,7 @@ json step_json(const Problem& problem, const StepRecord& rec) {
   j["elements"] = table_json(body.element_fields(rec.state.q), "element");
   json obstacles = json::array();
   for (const auto& o : problem.obstacles) {
-    const Vec2 off = o.offset(rec.load_factor);
+    const Vec2 off = o.offset(rec.factors);
     obstacles.push_back({{"name", o.name}, {"offset", {off.x(), off.y()}}});
   }
   j["obstacles"] = obstacles;

@@ -108,7 +108,19 @@ void read_solver(Reader& r, json& scene, SteppingParams& params) {
   params.max_cuts = r.integer(*solver, sp, "max_cuts", 0, 30, params.max_cuts);
 }
 
-std::vector<double> read_steps(Reader& r, json& scene) {
+// One obstacle motion: a translation at factor 1 of its load case.
+void read_motion(Reader& r, json& m, const std::string& ptr, ObstacleInstance& inst) {
+  if (!m.is_object()) {
+    r.error(ptr, show(m) + " is not an object");
+    return;
+  }
+  const int load_case = r.load_case(m, ptr);
+  if (static_cast<int>(inst.translations.size()) <= load_case) inst.translations.resize(load_case + 1, Vec2::Zero());
+  inst.translations[load_case] += r.vec2(m, ptr, "translation", Vec2::Zero());
+}
+
+// Equal increments of one factor shared by every load case: `steps` as a count or a list.
+std::vector<double> read_step_factors(Reader& r, json& scene) {
   if (!scene.contains("steps")) scene["steps"] = 1;
   const json& s = scene["steps"];
   std::vector<double> factors;
@@ -127,6 +139,70 @@ std::vector<double> read_steps(Reader& r, json& scene) {
     r.error("/steps", show(s) + " is neither a step count nor a list of load factors");
   }
   return factors;
+}
+
+// The load path: without stages every case follows `steps`; with stages each stage ramps the
+// factors it names linearly from where the previous stage left them, with its own friction.
+std::vector<LoadStep> read_load_path(Reader& r, json& scene, std::vector<ObstacleInstance>& obstacles) {
+  std::vector<double> base_friction;
+  for (const auto& o : obstacles) base_friction.push_back(o.friction);
+  const size_t cases = r.cases.size();
+  std::vector<LoadStep> path;
+  if (!scene.contains("stages")) {
+    for (double f : read_step_factors(r, scene)) path.push_back({LoadFactors(cases, f), base_friction, 0});
+    return path;
+  }
+  if (scene.contains("steps")) r.error("/steps", "cannot be given together with stages (each stage has its steps)");
+  json* stages = r.array(scene, "", "stages", true);
+  if (!stages) return path;
+  if (stages->empty()) r.error("/stages", "needs at least one stage");
+  LoadFactors current(cases, 0.0);
+  long total = 0;
+  for (size_t i = 0; i < stages->size(); ++i) {
+    const std::string sp = "/stages/" + std::to_string(i);
+    json& st = (*stages)[i];
+    if (!st.is_object()) {
+      r.error(sp, "is not an object");
+      continue;
+    }
+    const int n = r.integer(st, sp, "steps", 1, 100000);
+    LoadFactors target = current;
+    if (json* f = r.object(st, sp, "factors", true))
+      for (auto& [name, v] : f->items()) {
+        size_t k = 0;
+        while (k < cases && r.cases[k] != name) ++k;
+        if (k == cases) {
+          r.error(sp + "/factors/" + name, "names no load case (cases: " + Reader::list(r.cases) + ")");
+          continue;
+        }
+        target[k] = r.number(*f, sp + "/factors", name.c_str());
+      }
+    std::vector<double> friction = base_friction;
+    if (json* fr = r.object(st, sp, "friction", false))
+      for (auto& [name, v] : fr->items()) {
+        size_t o = 0;
+        while (o < obstacles.size() && obstacles[o].name != name) ++o;
+        if (o == obstacles.size()) {
+          r.error(sp + "/friction/" + name, "names no obstacle");
+          continue;
+        }
+        friction[o] = r.number(*fr, sp + "/friction", name.c_str());
+        if (friction[o] < 0) r.error(sp + "/friction/" + name, "is negative");
+        if (friction[o] > 0) obstacles[o].frictional = true;
+      }
+    total += n;
+    if (total > 100000) {
+      r.error(sp + "/steps", "brings the step count above 100000");
+      break;
+    }
+    for (int k = 1; k <= n; ++k) {
+      LoadFactors f(cases);
+      for (size_t c = 0; c < cases; ++c) f[c] = current[c] + (target[c] - current[c]) * k / n;
+      path.push_back({f, friction, static_cast<int>(i)});
+    }
+    current = target;
+  }
+  return path;
 }
 
 }  // namespace
@@ -168,12 +244,20 @@ Scene read_scene(const nlohmann::json& input) {
       if (json* shape = r.object(o, op, "shape", true)) inst.shape = read_shape(r, *shape, op + "/shape");
       inst.friction = r.number(o, op, "friction", 0.0);
       if (inst.friction < 0) r.error(op + "/friction", show(o["friction"]) + " is negative");
-      if (json* motion = r.object(o, op, "motion", false))
-        inst.translation = r.vec2(*motion, op + "/motion", "translation", Vec2::Zero());
+      inst.frictional = inst.friction > 0;
+      if (!o.contains("motion")) o["motion"] = json::array();
+      if (o["motion"].is_array())
+        for (size_t m = 0; m < o["motion"].size(); ++m)
+          read_motion(r, o["motion"][m], op + "/motion/" + std::to_string(m), inst);
+      else
+        read_motion(r, o["motion"], op + "/motion", inst);
       scene.problem.obstacles.push_back(std::move(inst));
     }
   }
-  scene.load_factors = read_steps(r, e);
+  scene.steps = read_load_path(r, e, scene.problem.obstacles);
+  scene.load_cases = r.cases;
+  if (scene.problem.body)
+    for (size_t k = 0; k < r.cases.size(); ++k) scene_io::case_load(scene.problem, static_cast<int>(k));
   read_solver(r, e, scene.params);
   if (!r.issues.empty()) throw SceneErrors(std::move(r.issues));
   add_candidates(scene.problem);

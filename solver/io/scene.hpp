@@ -28,7 +28,8 @@ class SceneErrors : public std::runtime_error {
 struct Scene {
   nlohmann::json effective;  // the scene with every default filled in
   Problem problem;
-  std::vector<double> load_factors;
+  std::vector<std::string> load_cases;  // names, in the order of LoadStep::factors
+  std::vector<LoadStep> steps;
   SteppingParams params;
 };
 

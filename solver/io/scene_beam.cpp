@@ -44,7 +44,8 @@ void read_timoshenko_beam(Reader& r, json& body, Problem& problem) {
   auto beam = std::make_unique<TimoshenkoBeam>(
       x, origin.y(), section, kin == "linear" ? Kinematics::linear : Kinematics::von_karman);
   const int nodes = beam->node_count();
-  problem.load = Vector::Zero(beam->dof_count());
+  problem.body = std::move(beam);
+  const auto& body_model = static_cast<const TimoshenkoBeam&>(*problem.body);
 
   if (json* sup = r.array(body, ptr, "supports", false))
     for (size_t i = 0; i < sup->size(); ++i) {
@@ -55,6 +56,7 @@ void read_timoshenko_beam(Reader& r, json& body, Problem& problem) {
         continue;
       }
       const int node = r.integer(s, sp, "node", 0, nodes - 1);
+      const int load_case = r.load_case(s, sp);
       json* fix = r.array(s, sp, "fix", true);
       json* values = r.object(s, sp, "values", false);
       if (!fix) continue;
@@ -67,7 +69,7 @@ void read_timoshenko_beam(Reader& r, json& body, Problem& problem) {
         const std::string name = comp.get<std::string>();
         double value = 0.0;
         if (values && values->contains(name)) value = r.number(*values, sp + "/values", name.c_str());
-        problem.constraints.push_back({TimoshenkoBeam::node_dof(node, beam_component(name)), value});
+        problem.constraints.push_back({TimoshenkoBeam::node_dof(node, beam_component(name)), value, load_case});
       }
       if (values)
         for (const auto& [name, v] : values->items()) {
@@ -90,12 +92,12 @@ void read_timoshenko_beam(Reader& r, json& body, Problem& problem) {
       const double moment = r.number(l, lp, "moment", 0.0);
       const std::string at = r.choice(l, lp, "at", {"centre", "upper", "lower"}, "centre");
       const int side = at == "upper" ? 1 : at == "lower" ? -1 : 0;
+      Vector& load = case_load(problem, r.load_case(l, lp));
       // Virtual work of the force at its point of application (a moment through the offset).
-      const SurfacePoint sp = beam->surface_point(Vector::Zero(beam->dof_count()), node, side);
-      for (const auto& jac : sp.jacobian) problem.load[jac.dof] += jac.dx.dot(f);
-      problem.load[TimoshenkoBeam::node_dof(node, 2)] += moment;
+      const SurfacePoint sp = body_model.surface_point(Vector::Zero(load.size()), node, side);
+      for (const auto& jac : sp.jacobian) load[jac.dof] += jac.dx.dot(f);
+      load[TimoshenkoBeam::node_dof(node, 2)] += moment;
     }
-  problem.body = std::move(beam);
 }
 
 }  // namespace grip::scene_io

@@ -168,6 +168,23 @@ class Reader {
     return out;
   }
 
+  // Load cases by name, in order of first mention; "main" unless a value names another.
+  std::vector<std::string> cases{"main"};
+
+  // The load case named by obj["case"] (default "main"), registered on first mention.
+  int load_case(json& obj, const std::string& ptr) {
+    if (!obj.contains("case")) obj["case"] = "main";
+    if (!obj["case"].is_string()) {
+      error(ptr + "/case", show(obj["case"]) + " is not a string");
+      return 0;
+    }
+    const std::string name = obj["case"].get<std::string>();
+    for (size_t k = 0; k < cases.size(); ++k)
+      if (cases[k] == name) return static_cast<int>(k);
+    cases.push_back(name);
+    return static_cast<int>(cases.size()) - 1;
+  }
+
   static std::string list(const std::vector<std::string>& options) {
     std::string s;
     for (size_t i = 0; i < options.size(); ++i) s += (i ? ", " : "") + ("\"" + options[i] + "\"");
@@ -175,6 +192,13 @@ class Reader {
   }
 };
 
+
+// The load vector of a case, created (zero) on first use.
+inline Vector& case_load(Problem& problem, int load_case) {
+  while (static_cast<int>(problem.loads.size()) <= load_case)
+    problem.loads.push_back(Vector::Zero(problem.body->dof_count()));
+  return problem.loads[load_case];
+}
 
 // Body model readers: fill problem.body, constraints and load from scene["body"].
 void read_timoshenko_beam(Reader& r, json& body, Problem& problem);

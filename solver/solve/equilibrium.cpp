@@ -16,8 +16,8 @@ Equilibrium::Equilibrium(const Problem& problem, NewtonParams params)
   zeta_previous_.assign(problem.candidates.size(), 0.0);
 }
 
-void Equilibrium::set_step(double load_factor, std::vector<double> zeta_previous) {
-  load_factor_ = load_factor;
+void Equilibrium::set_step(LoadFactors factors, std::vector<double> zeta_previous) {
+  factors_ = std::move(factors);
   zeta_previous_ = std::move(zeta_previous);
 }
 
@@ -31,7 +31,7 @@ void Equilibrium::pair(const Vector& q, EquilibriumState& state) const {
     const ObstacleInstance& obstacle = problem_.obstacles[c.obstacle];
     PairedPoint& pp = state.points[i];
     pp.point = problem_.body->surface_point(q, c.site, c.side);
-    const Vec2 offset = obstacle.offset(load_factor_);
+    const Vec2 offset = obstacle.offset(factors_);
     pp.projection = obstacle.shape->project(pp.point.x - offset);
     pp.projection.point += offset;
     pp.eta = -pp.projection.normal;
@@ -64,7 +64,7 @@ Vector Equilibrium::residual(const Vector& q, const EquilibriumState& paired, co
                              Triplets* tangent) const {
   Vector r = Vector::Zero(q.size());
   problem_.body->internal_force(q, r, tangent);
-  r -= load_factor_ * problem_.load;
+  r -= problem_.load(factors_);
   for (size_t i = 0; i < problem_.candidates.size(); ++i) {
     const Candidate& c = problem_.candidates[i];
     const PairedPoint& pp = paired.points[i];
@@ -105,7 +105,8 @@ EquilibriumState Equilibrium::solve(const Vector& q_guess, const Vector& p) {
   ++counters_.solves;
   EquilibriumState state;
   state.q = q_guess;
-  for (const Constraint& c : problem_.constraints) state.q[c.dof] = load_factor_ * c.value;
+  for (const Constraint& c : problem_.constraints)
+    state.q[c.dof] = c.load_case < static_cast<int>(factors_.size()) ? factors_[c.load_case] * c.value : 0.0;
   const double body_length = problem_.body->characteristic_length();
   Triplets triplets;
   for (int it = 1; it <= params_.max_iterations; ++it) {

@@ -49,8 +49,8 @@ class Equilibrium {
 
   // Sets the load factor (loads, prescribed dofs, obstacle positions) and the surface
   // coordinates zeta of the last converged step that the slips s_xi are measured from.
-  void set_step(double load_factor, std::vector<double> zeta_previous);
-  double load_factor() const { return load_factor_; }
+  void set_step(LoadFactors factors, std::vector<double> zeta_previous);
+  const LoadFactors& factors() const { return factors_; }
 
   EquilibriumState solve(const Vector& q_guess, const Vector& p);
   // The pairing and s at q, without solving (e.g. the reference configuration).
@@ -80,7 +80,7 @@ class Equilibrium {
 
   const Problem& problem_;
   NewtonParams params_;
-  double load_factor_ = 0.0;
+  LoadFactors factors_;
   std::vector<double> zeta_previous_;
   std::vector<int> free_index_;  // dof -> free index, -1 if prescribed
   int free_count_ = 0;

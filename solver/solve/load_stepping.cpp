@@ -4,39 +4,59 @@
 #include <cmath>
 
 namespace grip {
+namespace {
 
-RunResult run_load_steps(Problem& problem, const std::vector<double>& load_factors,
+LoadFactors blend(const LoadFactors& from, const LoadFactors& to, double t) {
+  LoadFactors out(to.size());
+  for (size_t k = 0; k < to.size(); ++k) out[k] = (k < from.size() ? from[k] : 0.0) * (1 - t) + to[k] * t;
+  return out;
+}
+
+double distance(const LoadFactors& a, const LoadFactors& b) {
+  double d = 0.0;
+  for (size_t k = 0; k < a.size() && k < b.size(); ++k) d += (a[k] - b[k]) * (a[k] - b[k]);
+  return std::sqrt(d);
+}
+
+}  // namespace
+
+RunResult run_load_steps(Problem& problem, const std::vector<LoadStep>& steps,
                          const SteppingParams& params, const SteppingObserver& observer) {
   using Clock = std::chrono::steady_clock;
   const auto run_start = Clock::now();
   RunResult result;
   Equilibrium eq(problem, params.newton);
   const int ndof = problem.body->dof_count();
+  const size_t cases = steps.empty() ? 1 : steps.front().factors.size();
   Vector q = Vector::Zero(ndof), q_before = q;
   Vector p = Vector::Zero(problem.component_count);
-  double lambda = 0.0, lambda_before = 0.0;
-  eq.set_step(0.0, std::vector<double>(problem.candidates.size(), 0.0));
+  LoadFactors current(cases, 0.0), before = current;
+  eq.set_step(current, std::vector<double>(problem.candidates.size(), 0.0));
   std::vector<double> zeta = eq.zetas(eq.evaluate(q));
 
-  for (size_t k = 0; k < load_factors.size(); ++k) {
+  for (size_t k = 0; k < steps.size(); ++k) {
+    const LoadStep& target_step = steps[k];
     const int step = static_cast<int>(k) + 1;
     const auto step_start = Clock::now();
-    if (observer.step_started) observer.step_started(step, load_factors[k]);
+    for (size_t o = 0; o < target_step.friction.size() && o < problem.obstacles.size(); ++o)
+      problem.obstacles[o].friction = target_step.friction[o];
     StepRecord rec;
     rec.index = step;
-    rec.load_factor = load_factors[k];
-    // Sub-increments toward the target; a failure halves the remaining increment.
-    double increment = load_factors[k] - lambda;
+    rec.stage = target_step.stage;
+    rec.factors = target_step.factors;
+    rec.load_factor = target_step.factors.empty() ? 0.0 : target_step.factors.front();
+    if (observer.step_started) observer.step_started(step, rec.load_factor);
+    // Sub-increments toward the target; a failure halves the increment.
+    const LoadFactors from = current;
+    double done = 0.0, increment = 1.0;
     int depth = 0;
     while (true) {
-      const double target = std::abs(load_factors[k] - lambda) <= std::abs(increment) * (1 + 1e-12)
-                                ? load_factors[k]
-                                : lambda + increment;
+      const double t = std::min(1.0, done + increment);
+      const LoadFactors target = t == 1.0 ? target_step.factors : blend(from, target_step.factors, t);
       // Newton starts from the previous increment scaled to this one (section 9): a zero
       // guess would leave a membrane without transverse stiffness.
-      const double last = lambda - lambda_before;
-      const Vector guess =
-          last != 0.0 ? Vector(q + (q - q_before) * ((target - lambda) / last)) : q;
+      const double last = distance(current, before);
+      const Vector guess = last > 0 ? Vector(q + (q - q_before) * (distance(target, current) / last)) : q;
       eq.set_step(target, zeta);
       StepOutcome out = solve_contact_step(eq, guess, p, p, params.contact, step,
                                            observer.iteration, observer.stop_requested);
@@ -62,13 +82,14 @@ RunResult run_load_steps(Problem& problem, const std::vector<double>& load_facto
       }
       // Commit.
       q_before = q;
-      lambda_before = lambda;
+      before = current;
       q = out.state.q;
       p = out.p;
-      lambda = target;
+      current = target;
+      done = t;
       zeta = eq.zetas(out.state);
       problem.body->commit(q);
-      if (target == load_factors[k]) {
+      if (t == 1.0) {
         rec.converged = true;
         rec.p = out.p;
         rec.tau = out.tau;

@@ -18,7 +18,9 @@ struct SteppingParams {
 
 struct StepRecord {
   int index = 0;               // 1-based output step
-  double load_factor = 0.0;
+  int stage = 0;
+  double load_factor = 0.0;    // the first load case's factor
+  LoadFactors factors;         // every load case's factor
   bool converged = false;
   std::string reason;
   int cuts = 0;                // sub-increments this step needed beyond one
@@ -46,7 +48,7 @@ struct RunResult {
   double seconds = 0.0;
 };
 
-RunResult run_load_steps(Problem& problem, const std::vector<double>& load_factors,
+RunResult run_load_steps(Problem& problem, const std::vector<LoadStep>& steps,
                          const SteppingParams& params, const SteppingObserver& observer = {});
 
 }  // namespace grip

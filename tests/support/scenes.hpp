@@ -22,7 +22,7 @@ struct Solved {
 
 inline Solved solve_scene(const nlohmann::json& j) {
   Solved s{read_scene(j), {}};
-  s.run = run_load_steps(s.scene.problem, s.scene.load_factors, s.scene.params);
+  s.run = run_load_steps(s.scene.problem, s.scene.steps, s.scene.params);
   return s;
 }
 

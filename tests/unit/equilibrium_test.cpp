@@ -19,10 +19,10 @@ Problem beam_over(std::unique_ptr<Obstacle> shape, double friction) {
   auto beam = std::make_unique<TimoshenkoBeam>(
       x, 0.0, BeamSection{E * b * d, E * b * d * d * d / 12, 0.8 * E / 2.6 * b * d, d / 2, b},
       Kinematics::von_karman);
-  problem.load = Vector::Zero(beam->dof_count());
+  problem.loads = {Vector::Zero(beam->dof_count())};
   problem.constraints.push_back({0, 0.0});
   problem.body = std::move(beam);
-  problem.obstacles.push_back({"tool", std::move(shape), friction, Vec2(0.1, -0.05)});
+  problem.obstacles.push_back({"tool", std::move(shape), friction, true, {Vec2(0.1, -0.05)}});
   add_candidates(problem);
   return problem;
 }
@@ -40,7 +40,7 @@ TEST(EquilibriumTangent, IncludesTheFollowerContactLoadStiffness) {
     Problem problem = circle ? beam_over(make_circle({3, -10.3}, 10), 0.4)
                              : beam_over(make_profile({ArcPiece{{3, -10.3}, 10, 2.0, 1.0}}), 0.4);
     Equilibrium eq(problem, NewtonParams{});
-    eq.set_step(0.7, std::vector<double>(problem.candidates.size(), 0.3));
+    eq.set_step({0.7}, std::vector<double>(problem.candidates.size(), 0.3));
     std::mt19937 rng(3);
     std::uniform_real_distribution<double> u(-0.02, 0.02), f(-5, 5);
     Vector q(problem.body->dof_count());

@@ -99,12 +99,12 @@ TEST(TimoshenkoBeam, CantileverTipDeflectionMatchesClosedForm) {
                                                  Kinematics::linear);
     const BeamSection s = beam->section();
     const double P = 0.03 * s.EI / (L * L);  // a bending deflection of L / 100
-    problem.load = Vector::Zero(beam->dof_count());
-    problem.load[TimoshenkoBeam::node_dof(10, 1)] = -P;
+    problem.loads = {Vector::Zero(beam->dof_count())};
+    problem.loads[0][TimoshenkoBeam::node_dof(10, 1)] = -P;
     for (int c = 0; c < 3; ++c) problem.constraints.push_back({TimoshenkoBeam::node_dof(0, c), 0.0});
     problem.body = std::move(beam);
     Equilibrium eq(problem, NewtonParams{});
-    eq.set_step(1.0, {});
+    eq.set_step({1.0}, {});
     const EquilibriumState st = eq.solve(Vector::Zero(problem.body->dof_count()), Vector());
     ASSERT_TRUE(st.converged) << st.reason;
     const double expected = P * L * L * L / (3 * s.EI) + P * L / s.kGA;

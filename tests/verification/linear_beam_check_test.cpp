@@ -19,15 +19,15 @@ Problem section8_problem() {
   for (int i = 0; i <= 40; ++i) x.push_back(10.0 * i / 40);
   auto beam = std::make_unique<TimoshenkoBeam>(x, 0.0, BeamSection{1e4, 1e2, 1e6, 0.0, 1.0},
                                                Kinematics::linear);
-  problem.load = Vector::Zero(beam->dof_count());
+  problem.loads = {Vector::Zero(beam->dof_count())};
   for (int i = 1; i <= 40; ++i)
-    problem.load[TimoshenkoBeam::node_dof(i, 1)] = -2.0 * (i == 40 ? 0.125 : 0.25);
-  problem.load[TimoshenkoBeam::node_dof(40, 0)] = 30.0;
+    problem.loads[0][TimoshenkoBeam::node_dof(i, 1)] = -2.0 * (i == 40 ? 0.125 : 0.25);
+  problem.loads[0][TimoshenkoBeam::node_dof(40, 0)] = 30.0;
   for (int c = 0; c < 3; ++c) problem.constraints.push_back({TimoshenkoBeam::node_dof(0, c), 0.0});
   problem.body = std::move(beam);
   // The flat y = -0.002 x, solid below: travelled right to left.
   problem.obstacles.push_back(
-      {"flat", make_profile({SegmentPiece{{12, -0.024}, {-2, 0.004}}}), 0.3, Vec2::Zero()});
+      {"flat", make_profile({SegmentPiece{{12, -0.024}, {-2, 0.004}}}), 0.3, true, {}});
   add_candidates(problem);
   return problem;
 }
@@ -38,7 +38,7 @@ RunResult solve(Problem& problem, ContactParams contact) {
   contact.max_iterations = 2000;
   params.contact = contact;
   params.max_cuts = 0;
-  return run_load_steps(problem, {1.0}, params);
+  return run_load_steps(problem, {LoadStep{{1.0}, {0.3}, 0}}, params);
 }
 
 void expect_sound(const Problem& problem, const RunResult& run, const ContactParams& c) {
