@@ -29,6 +29,9 @@ struct PointJacobianEntry {
 struct SurfacePoint {
   Vec2 x = Vec2::Zero();
   std::vector<PointJacobianEntry> jacobian;
+  // The contact surface lies this far from x toward the obstacle (a membrane's half
+  // thickness about its mid-surface node); it shortens the gap and is frozen in T.
+  double clearance = 0.0;
 };
 
 class Body {
@@ -63,6 +66,19 @@ class Body {
   // Output: deformed position and displacements per site; stresses or section forces per element.
   virtual FieldTable site_fields(const Vector& q) const = 0;
   virtual FieldTable element_fields(const Vector& q) const = 0;
+
+  // A Newton start for a body that has no stiffness in its reference state (a flat membrane):
+  // given the prescribed values (and where they are prescribed), a displacement consistent
+  // with them. Default: the prescribed values, zero elsewhere.
+  virtual Vector start_guess(const Vector& prescribed, const std::vector<char>& /*is_prescribed*/) const {
+    return prescribed;
+  }
+
+  // Newton's trust region: the fraction (0, 1] of the correction dq at q that keeps the
+  // iterate on the physical branch (a membrane must not fold). Default: all of it.
+  virtual double newton_step_fraction(const Vector& /*q*/, const Vector& /*dq*/) const { return 1.0; }
+  // Why a converged state is not physical (empty if it is): e.g. a membrane in compression.
+  virtual std::string inadmissible(const Vector& /*q*/) const { return {}; }
 
   // Bodies with history (plasticity) keep old/new state; commit after a converged step.
   virtual void commit(const Vector& /*q*/) {}

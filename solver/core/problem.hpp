@@ -2,6 +2,7 @@
 // A contact problem in typed form: one deformable body, rigid obstacles, supports, loads, and
 // the contact candidates. Built from a scene by solver/io; solved by solver/solve.
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -53,6 +54,16 @@ struct Candidate {
   int xi = -1;
 };
 
+// A body with no stiffness in its reference state (a flat membrane) starts its first step
+// from a preliminary solve with one dof prescribed and no contact; the reaction there is the
+// starting force of the candidate at `site` on `obstacle` (ALGORITHM.md section 9).
+struct StartUp {
+  int dof;
+  double value;
+  int site;
+  int obstacle;
+};
+
 struct Problem {
   std::unique_ptr<Body> body;
   std::vector<ObstacleInstance> obstacles;
@@ -66,6 +77,7 @@ struct Problem {
   }
   std::vector<Candidate> candidates;
   int component_count = 0;  // number of contact unknowns
+  std::optional<StartUp> start;
 };
 
 // Pairs every site with every obstacle, on the surface side that faces the obstacle in the

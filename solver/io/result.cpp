@@ -60,8 +60,8 @@ json step_json(const Problem& problem, const StepRecord& rec) {
   }
   j["history"] = history;
   if (rec.state.q.size() == 0) return j;
-  j["nodes"] = table_json(body.site_fields(rec.state.q), "node");
-  j["elements"] = table_json(body.element_fields(rec.state.q), "element");
+  if (!rec.site_fields.rows.empty()) j["nodes"] = table_json(rec.site_fields, "node");
+  if (!rec.element_fields.rows.empty()) j["elements"] = table_json(rec.element_fields, "element");
   json obstacles = json::array();
   for (const auto& o : problem.obstacles) {
     const Vec2 off = o.offset(rec.factors);

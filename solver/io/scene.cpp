@@ -69,6 +69,46 @@ std::unique_ptr<Obstacle> read_shape(Reader& r, json& j, const std::string& ptr)
 
 // ---- solver parameters
 
+// solver.start: {"node", "component": "x" | "y", "value", "obstacle"} (ALGORITHM.md section 9):
+// the first step starts from a solve with that displacement prescribed and no contact.
+void read_start(Reader& r, json& scene, Problem& problem) {
+  const bool membrane = scene["body"].is_object() && scene["body"].value("model", "") == "rigid_plastic_membrane";
+  json* solver = r.object(scene, "", "solver", false);
+  if (!solver) return;
+  if (!solver->contains("start")) {
+    if (membrane)
+      r.error("/solver/start", "is required for a rigid_plastic_membrane: a flat sheet has no transverse "
+                                "stiffness, so its first step starts from a prescribed depth of one node "
+                                "(e.g. {\"node\": 0, \"component\": \"y\", \"value\": -1, \"obstacle\": \"punch\"})");
+    return;
+  }
+  json* st = r.object(*solver, "/solver", "start", true);
+  if (!st || !problem.body) return;
+  const std::string sp = "/solver/start";
+  const int node = r.integer(*st, sp, "node", 0, problem.body->site_count() - 1);
+  const std::string comp = r.choice(*st, sp, "component", {"x", "y"}, "y");
+  const double value = r.number(*st, sp, "value");
+  if (value == 0.0) r.error(sp + "/value", "must not be zero: the start needs a strained body");
+  int obstacle = -1;
+  if (!st->contains("obstacle") || !(*st)["obstacle"].is_string()) {
+    r.error(sp + "/obstacle", "is required: the name of the obstacle the node is pressed by");
+  } else {
+    for (size_t o = 0; o < problem.obstacles.size(); ++o)
+      if (problem.obstacles[o].name == (*st)["obstacle"]) obstacle = static_cast<int>(o);
+    if (obstacle < 0) r.error(sp + "/obstacle", show((*st)["obstacle"]) + " names no obstacle");
+  }
+  // The dof that moves the node along x or y.
+  const Vec2 dir = comp == "x" ? Vec2::UnitX() : Vec2::UnitY();
+  const SurfacePoint p = problem.body->surface_point(Vector::Zero(problem.body->dof_count()), node, 0);
+  int dof = -1;
+  for (const auto& j : p.jacobian)
+    if (j.dx.isApprox(dir)) dof = j.dof;
+  if (dof < 0) r.error(sp + "/component", "does not move node " + std::to_string(node) + " by itself");
+  for (const Constraint& c : problem.constraints)
+    if (c.dof == dof) r.error(sp + "/node", "that component of node " + std::to_string(node) + " is a support already");
+  if (dof >= 0 && obstacle >= 0) problem.start = StartUp{dof, value, node, obstacle};
+}
+
 void read_solver(Reader& r, json& scene, SteppingParams& params) {
   json* solver = r.object(scene, "", "solver", false);
   if (!solver) return;
@@ -221,6 +261,7 @@ Scene read_scene(const nlohmann::json& input) {
     using ModelReader = void (*)(Reader&, json&, Problem&);
     static const std::vector<std::pair<std::string, ModelReader>> models = {
         {"timoshenko_beam", scene_io::read_timoshenko_beam},
+        {"rigid_plastic_membrane", scene_io::read_rigid_plastic_membrane},
     };
     std::vector<std::string> names;
     for (const auto& m : models) names.push_back(m.first);
@@ -259,6 +300,7 @@ Scene read_scene(const nlohmann::json& input) {
   if (scene.problem.body)
     for (size_t k = 0; k < r.cases.size(); ++k) scene_io::case_load(scene.problem, static_cast<int>(k));
   read_solver(r, e, scene.params);
+  if (r.issues.empty()) read_start(r, e, scene.problem);
   if (!r.issues.empty()) throw SceneErrors(std::move(r.issues));
   add_candidates(scene.problem);
   return scene;

@@ -6,7 +6,6 @@
 namespace grip::scene_io {
 namespace {
 
-int beam_component(const std::string& name) { return name == "u" ? 0 : name == "w" ? 1 : 2; }
 
 }  // namespace
 
@@ -47,37 +46,7 @@ void read_timoshenko_beam(Reader& r, json& body, Problem& problem) {
   problem.body = std::move(beam);
   const auto& body_model = static_cast<const TimoshenkoBeam&>(*problem.body);
 
-  if (json* sup = r.array(body, ptr, "supports", false))
-    for (size_t i = 0; i < sup->size(); ++i) {
-      const std::string sp = ptr + "/supports/" + std::to_string(i);
-      json& s = (*sup)[i];
-      if (!s.is_object()) {
-        r.error(sp, "is not an object");
-        continue;
-      }
-      const int node = r.integer(s, sp, "node", 0, nodes - 1);
-      const int load_case = r.load_case(s, sp);
-      json* fix = r.array(s, sp, "fix", true);
-      json* values = r.object(s, sp, "values", false);
-      if (!fix) continue;
-      for (size_t c = 0; c < fix->size(); ++c) {
-        const json& comp = (*fix)[c];
-        if (!(comp == "u" || comp == "w" || comp == "theta")) {
-          r.error(sp + "/fix/" + std::to_string(c), show(comp) + " is not one of \"u\", \"w\", \"theta\"");
-          continue;
-        }
-        const std::string name = comp.get<std::string>();
-        double value = 0.0;
-        if (values && values->contains(name)) value = r.number(*values, sp + "/values", name.c_str());
-        problem.constraints.push_back({TimoshenkoBeam::node_dof(node, beam_component(name)), value, load_case});
-      }
-      if (values)
-        for (const auto& [name, v] : values->items()) {
-          bool fixed = false;
-          for (const auto& comp : *fix) fixed |= comp == name;
-          if (!fixed) r.error(sp + "/values/" + name, "is given but \"" + name + "\" is not in fix");
-        }
-    }
+  read_supports(r, body, ptr, nodes, {"u", "w", "theta"}, &TimoshenkoBeam::node_dof, problem);
 
   if (json* loads = r.array(body, ptr, "loads", false))
     for (size_t i = 0; i < loads->size(); ++i) {

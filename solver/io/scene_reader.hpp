@@ -200,7 +200,14 @@ inline Vector& case_load(Problem& problem, int load_case) {
   return problem.loads[load_case];
 }
 
+// body.supports: [{"node", "fix": [component names], "values": {name: value}, "case"}];
+// `dof(node, component index)` maps to the global dof.
+void read_supports(Reader& r, json& body, const std::string& ptr, int nodes,
+                   const std::vector<std::string>& components, int (*dof)(int, int),
+                   Problem& problem);
+
 // Body model readers: fill problem.body, constraints and load from scene["body"].
 void read_timoshenko_beam(Reader& r, json& body, Problem& problem);
+void read_rigid_plastic_membrane(Reader& r, json& body, Problem& problem);
 
 }  // namespace grip::scene_io

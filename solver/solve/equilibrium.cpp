@@ -5,11 +5,12 @@
 
 namespace grip {
 
-Equilibrium::Equilibrium(const Problem& problem, NewtonParams params)
-    : problem_(problem), params_(params) {
+Equilibrium::Equilibrium(const Problem& problem, NewtonParams params, std::vector<Constraint> extra)
+    : problem_(problem), params_(params), extra_(std::move(extra)) {
   const int n = problem.body->dof_count();
   free_index_.assign(n, 0);
   for (const Constraint& c : problem.constraints) free_index_[c.dof] = -1;
+  for (const Constraint& c : extra_) free_index_[c.dof] = -1;
   for (int i = 0; i < n; ++i)
     if (free_index_[i] == 0) free_index_[i] = free_count_++;
   length_scales_ = problem.body->dof_length_scales();
@@ -34,6 +35,7 @@ void Equilibrium::pair(const Vector& q, EquilibriumState& state) const {
     const Vec2 offset = obstacle.offset(factors_);
     pp.projection = obstacle.shape->project(pp.point.x - offset);
     pp.projection.point += offset;
+    pp.projection.gap -= pp.point.clearance;
     pp.eta = -pp.projection.normal;
     pp.xi = pp.projection.tangent;
     state.s[c.eta] = -pp.projection.gap;
@@ -101,12 +103,23 @@ Eigen::SparseMatrix<double> Equilibrium::free_block(const Triplets& triplets) co
   return K;
 }
 
+double Equilibrium::free_residual_norm(const Vector& q, const Vector& p) const {
+  EquilibriumState paired;
+  pair(q, paired);
+  const Vector r = residual(q, paired, p, nullptr);
+  double norm = 0.0;
+  for (int i = 0; i < r.size(); ++i)
+    if (free_index_[i] >= 0) norm += r[i] * r[i];
+  return std::sqrt(norm);
+}
+
 EquilibriumState Equilibrium::solve(const Vector& q_guess, const Vector& p) {
   ++counters_.solves;
   EquilibriumState state;
   state.q = q_guess;
   for (const Constraint& c : problem_.constraints)
     state.q[c.dof] = c.load_case < static_cast<int>(factors_.size()) ? factors_[c.load_case] * c.value : 0.0;
+  for (const Constraint& c : extra_) state.q[c.dof] = c.value;
   const double body_length = problem_.body->characteristic_length();
   Triplets triplets;
   for (int it = 1; it <= params_.max_iterations; ++it) {
@@ -125,13 +138,11 @@ EquilibriumState Equilibrium::solve(const Vector& q_guess, const Vector& p) {
     const Vector dq_free = lu_.solve(-r_free);
     state.newton_iterations = it;
     ++counters_.newton_iterations;
+    Vector dq = Vector::Zero(state.q.size());
+    for (int i = 0; i < state.q.size(); ++i)
+      if (free_index_[i] >= 0) dq[i] = dq_free[free_index_[i]];
     double step = 0.0;
-    for (int i = 0; i < state.q.size(); ++i) {
-      if (free_index_[i] < 0) continue;
-      const double d = dq_free[free_index_[i]];
-      state.q[i] += d;
-      step = std::max(step, std::abs(d) * length_scales_[i]);
-    }
+    for (int i = 0; i < state.q.size(); ++i) step = std::max(step, std::abs(dq[i]) * length_scales_[i]);
     if (!std::isfinite(step)) {
       state.reason = "Newton produced a non-finite displacement";
       return state;
@@ -141,10 +152,21 @@ EquilibriumState Equilibrium::solve(const Vector& q_guess, const Vector& p) {
       return state;
     }
     if (step <= params_.displacement_tolerance) {
+      state.q += dq;
       pair(state.q, state);
-      state.converged = true;
+      state.reason = problem_.body->inadmissible(state.q);
+      state.converged = state.reason.empty();
       return state;
     }
+    // Backtracking on the residual norm, inside the body's trust region: a strongly
+    // nonlinear law (the regularized rigid-plastic membrane) makes full steps overshoot.
+    double a = problem_.body->newton_step_fraction(state.q, dq);
+    const double r0 = r_free.norm();
+    for (int k = 0; k < params_.max_backtracks; ++k) {
+      if (free_residual_norm(state.q + a * dq, p) <= (1 - 1e-4 * a) * r0) break;
+      a *= 0.5;
+    }
+    state.q += a * dq;
   }
   pair(state.q, state);
   state.reason = "Newton did not converge in " + std::to_string(params_.max_iterations) + " iterations";

@@ -18,6 +18,8 @@ struct NewtonParams {
   double displacement_tolerance = 1e-10;
   // Diverged when a correction exceeds this many body lengths.
   double divergence_lengths = 10.0;
+  // Halvings of a Newton correction that does not lower the residual norm.
+  int max_backtracks = 8;
 };
 
 // The kinematics of one candidate at a state.
@@ -45,7 +47,8 @@ struct EquilibriumCounters {
 
 class Equilibrium {
  public:
-  Equilibrium(const Problem& problem, NewtonParams params);
+  // `extra` prescribes further dofs at absolute values (the start-up solve).
+  Equilibrium(const Problem& problem, NewtonParams params, std::vector<Constraint> extra = {});
 
   // Sets the load factor (loads, prescribed dofs, obstacle positions) and the surface
   // coordinates zeta of the last converged step that the slips s_xi are measured from.
@@ -66,6 +69,7 @@ class Equilibrium {
   std::vector<double> zetas(const EquilibriumState& state) const;
 
   const Problem& problem() const { return problem_; }
+  bool is_free(int dof) const { return free_index_[dof] >= 0; }
   const EquilibriumCounters& counters() const { return counters_; }
   const NewtonParams& params() const { return params_; }
   NewtonParams& params() { return params_; }
@@ -75,6 +79,7 @@ class Equilibrium {
   // R = A(q) - lambda F - T p on all dofs; tangent of R (with the contact load stiffness).
   Vector residual(const Vector& q, const EquilibriumState& paired, const Vector& p,
                   Triplets* tangent) const;
+  double free_residual_norm(const Vector& q, const Vector& p) const;
   Eigen::SparseMatrix<double> free_block(const Triplets& triplets) const;
   Matrix free_t_matrix(const EquilibriumState& state) const;
 
@@ -82,6 +87,7 @@ class Equilibrium {
   NewtonParams params_;
   LoadFactors factors_;
   std::vector<double> zeta_previous_;
+  std::vector<Constraint> extra_;
   std::vector<int> free_index_;  // dof -> free index, -1 if prescribed
   int free_count_ = 0;
   Vector length_scales_;

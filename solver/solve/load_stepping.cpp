@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <optional>
 
 namespace grip {
 namespace {
@@ -10,6 +11,39 @@ LoadFactors blend(const LoadFactors& from, const LoadFactors& to, double t) {
   LoadFactors out(to.size());
   for (size_t k = 0; k < to.size(); ++k) out[k] = (k < from.size() ? from[k] : 0.0) * (1 - t) + to[k] * t;
   return out;
+}
+
+// The start-up solve of a body without reference stiffness (Problem::start): returns the
+// displacement to start the first step's Newton from, and sets the starting contact force.
+std::optional<Vector> start_up(const Problem& problem, const SteppingParams& params,
+                               const LoadFactors& factors, const std::vector<double>& zeta,
+                               Vector& p, std::string& reason) {
+  const StartUp& st = *problem.start;
+  Equilibrium pre(problem, params.newton, {{st.dof, st.value, 0}});
+  pre.params().displacement_tolerance = params.contact.newton_fraction * params.contact.tolerance *
+                                        problem.body->characteristic_length();
+  pre.set_step(factors, zeta);
+  const int ndof = problem.body->dof_count();
+  Vector prescribed = Vector::Zero(ndof);
+  std::vector<char> mask(ndof, 0);
+  for (const Constraint& c : problem.constraints) mask[c.dof] = 1;
+  prescribed[st.dof] = st.value;
+  mask[st.dof] = 1;
+  const EquilibriumState s = pre.solve(problem.body->start_guess(prescribed, mask), p);
+  if (!s.converged) {
+    reason = "the start-up solve failed: " + s.reason;
+    return std::nullopt;
+  }
+  const Vector reaction = pre.reactions(s, p);
+  for (size_t i = 0; i < problem.candidates.size(); ++i) {
+    const Candidate& c = problem.candidates[i];
+    if (c.site != st.site || c.obstacle != st.obstacle) continue;
+    Vec2 f = Vec2::Zero();
+    for (const auto& j : s.points[i].point.jacobian)
+      if (j.dof == st.dof) f += reaction[st.dof] * j.dx;
+    p[c.eta] = std::min(0.0, f.dot(s.points[i].eta));
+  }
+  return s.q;
 }
 
 double distance(const LoadFactors& a, const LoadFactors& b) {
@@ -33,6 +67,14 @@ RunResult run_load_steps(Problem& problem, const std::vector<LoadStep>& steps,
   LoadFactors current(cases, 0.0), before = current;
   eq.set_step(current, std::vector<double>(problem.candidates.size(), 0.0));
   std::vector<double> zeta = eq.zetas(eq.evaluate(q));
+  std::optional<Vector> start_q;
+  if (problem.start) {
+    start_q = start_up(problem, params, current, zeta, p, result.reason);
+    if (!start_q) {
+      result.counters = eq.counters();
+      return result;
+    }
+  }
 
   for (size_t k = 0; k < steps.size(); ++k) {
     const LoadStep& target_step = steps[k];
@@ -56,7 +98,9 @@ RunResult run_load_steps(Problem& problem, const std::vector<LoadStep>& steps,
       // Newton starts from the previous increment scaled to this one (section 9): a zero
       // guess would leave a membrane without transverse stiffness.
       const double last = distance(current, before);
-      const Vector guess = last > 0 ? Vector(q + (q - q_before) * (distance(target, current) / last)) : q;
+      const Vector guess = start_q ? *start_q
+                           : last > 0 ? Vector(q + (q - q_before) * (distance(target, current) / last))
+                                      : q;
       eq.set_step(target, zeta);
       StepOutcome out = solve_contact_step(eq, guess, p, p, params.contact, step,
                                            observer.iteration, observer.stop_requested);
@@ -80,7 +124,16 @@ RunResult run_load_steps(Problem& problem, const std::vector<LoadStep>& steps,
         ++rec.cuts;
         continue;
       }
+      if (t == 1.0) {
+        rec.converged = true;
+        rec.p = out.p;
+        rec.tau = out.tau;
+        rec.reactions = eq.reactions(out.state, out.p);
+        rec.site_fields = problem.body->site_fields(out.state.q);
+        rec.element_fields = problem.body->element_fields(out.state.q);
+      }
       // Commit.
+      start_q.reset();
       q_before = q;
       before = current;
       q = out.state.q;
@@ -90,10 +143,6 @@ RunResult run_load_steps(Problem& problem, const std::vector<LoadStep>& steps,
       zeta = eq.zetas(out.state);
       problem.body->commit(q);
       if (t == 1.0) {
-        rec.converged = true;
-        rec.p = out.p;
-        rec.tau = out.tau;
-        rec.reactions = eq.reactions(out.state, out.p);
         rec.state = std::move(out.state);
         break;
       }

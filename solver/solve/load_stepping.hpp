@@ -29,6 +29,7 @@ struct StepRecord {
   std::string epsilon_used;
   Vector p, tau, reactions;
   EquilibriumState state;
+  FieldTable site_fields, element_fields;  // taken at the converged state, before commit
   std::vector<IterationEvent> history;
 };
 

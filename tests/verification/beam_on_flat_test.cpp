@@ -31,6 +31,7 @@ TEST(BeamOnFlat, ContactAndSupportCarryTheUniformLoad) {
   for (const std::string kin : {"linear", "von_karman"}) {
     const auto s = testing::solve_scene(beam_on_flat(kin));
     testing::expect_every_step_sound(s);
+    ASSERT_TRUE(s.run.completed) << kin;
     for (const StepRecord& rec : s.run.steps) {
       double contact_y = 0.0, friction = 0.0;
       for (size_t i = 0; i < s.scene.problem.candidates.size(); ++i) {

@@ -1,0 +1,201 @@
+#include "solver/elements/rigid_plastic_membrane.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace grip {
+
+double HillMaterial::plane_strain_factor() const {
+  return 0.5 * std::pow(2 * (1 + r), 1 / M) * std::pow(1 + std::pow(1 + 2 * r, -1 / (M - 1)), (M - 1) / M);
+}
+double HillMaterial::flow_stress(double eps_bar) const { return H * std::pow(eps_bar + a0, n); }
+double HillMaterial::hardening_slope(double eps_bar) const {
+  return n * H * std::pow(eps_bar + a0, n - 1);
+}
+
+RigidPlasticMembrane::RigidPlasticMembrane(std::vector<Vec2> nodes, double thickness,
+                                           HillMaterial material, double width)
+    : nodes_(std::move(nodes)), width_(width), material_(material),
+      c_(material.plane_strain_factor()), initial_thickness_(thickness) {
+  if (nodes_.size() < 2) throw std::invalid_argument("a membrane needs at least two nodes");
+  for (int e = 0; e < element_count(); ++e) {
+    const double L = (nodes_[e + 1] - nodes_[e]).norm();
+    if (!(L > 0)) throw std::invalid_argument("membrane element " + std::to_string(e) + " has zero length");
+    initial_length_.push_back(L);
+  }
+  eps_bar_.assign(element_count(), 0.0);
+  thickness_.assign(element_count(), thickness);
+  length_ = initial_length_;
+}
+
+RigidPlasticMembrane::ElementState RigidPlasticMembrane::element_state(const Vector& q, int e) const {
+  ElementState s;
+  const Vec2 xa = nodes_[e] + q.segment<2>(node_dof(e, 0));
+  const Vec2 xb = nodes_[e + 1] + q.segment<2>(node_dof(e + 1, 0));
+  s.l = (xb - xa).norm();
+  s.e = s.l > 0 ? Vec2((xb - xa) / s.l) : Vec2::UnitX();
+  const double L0 = length_[e], e0 = material_.regularization;
+  const double V = thickness_[e] * L0;  // volume per unit width, constant
+  s.d1 = std::log(std::max(s.l, 1e-300) / L0);
+  const double root = std::sqrt(c_ * c_ * s.d1 * s.d1 + e0 * e0);
+  s.deps = root - e0;
+  const double g = c_ * c_ * s.d1 / root;                 // d(deps)/d(d1)
+  const double g1 = c_ * c_ * e0 * e0 / (root * root * root);  // d2(deps)/d(d1)^2
+  const double eps = eps_bar_[e] + s.deps;
+  s.sigma = material_.flow_stress(eps);
+  s.tension = s.sigma * V * g / s.l;
+  s.dtension_dl = V * (material_.hardening_slope(eps) * g * g + s.sigma * (g1 - g)) / (s.l * s.l);
+  s.thickness = V / s.l;
+  return s;
+}
+
+void RigidPlasticMembrane::internal_force(const Vector& q, Vector& force, Triplets* tangent) const {
+  for (int e = 0; e < element_count(); ++e) {
+    const ElementState s = element_state(q, e);
+    const Vec2 f = width_ * s.tension * s.e;
+    force.segment<2>(node_dof(e, 0)) -= f;
+    force.segment<2>(node_dof(e + 1, 0)) += f;
+    if (!tangent) continue;
+    // d(T e)/dx_b = dT/dl e e^T + T / l (I - e e^T): stretch and the string's rotation.
+    const Mat2 ee = s.e * s.e.transpose();
+    const Mat2 k = width_ * (s.dtension_dl * ee + s.tension / s.l * (Mat2::Identity() - ee));
+    for (int i = 0; i < 2; ++i)
+      for (int j = 0; j < 2; ++j) {
+        tangent->emplace_back(node_dof(e, i), node_dof(e, j), k(i, j));
+        tangent->emplace_back(node_dof(e + 1, i), node_dof(e + 1, j), k(i, j));
+        tangent->emplace_back(node_dof(e, i), node_dof(e + 1, j), -k(i, j));
+        tangent->emplace_back(node_dof(e + 1, i), node_dof(e, j), -k(i, j));
+      }
+  }
+}
+
+SurfacePoint RigidPlasticMembrane::surface_point(const Vector& q, int site, int /*side*/) const {
+  SurfacePoint p;
+  p.x = nodes_[site] + q.segment<2>(node_dof(site, 0));
+  p.jacobian = {{node_dof(site, 0), Vec2::UnitX()}, {node_dof(site, 1), Vec2::UnitY()}};
+  double t = 0.0;
+  int n = 0;
+  for (int e : {site - 1, site}) {
+    if (e < 0 || e >= element_count()) continue;
+    const Vec2 xa = nodes_[e] + q.segment<2>(node_dof(e, 0));
+    const Vec2 xb = nodes_[e + 1] + q.segment<2>(node_dof(e + 1, 0));
+    t += thickness_[e] * length_[e] / std::max((xb - xa).norm(), 1e-300);
+    ++n;
+  }
+  p.clearance = 0.5 * t / n;
+  return p;
+}
+
+double RigidPlasticMembrane::tributary_area(int site) const {
+  double length = 0.0;
+  if (site > 0) length += 0.5 * length_[site - 1];
+  if (site < element_count()) length += 0.5 * length_[site];
+  return length * width_;
+}
+
+double RigidPlasticMembrane::characteristic_length() const {
+  double L = 0.0;
+  for (double l : initial_length_) L += l;
+  return L;
+}
+
+Vector RigidPlasticMembrane::rigid_translation(const Vec2& d) const {
+  Vector q(dof_count());
+  for (int k = 0; k < node_count(); ++k) q.segment<2>(node_dof(k, 0)) = d;
+  return q;
+}
+
+std::vector<std::vector<int>> RigidPlasticMembrane::cells() const {
+  std::vector<std::vector<int>> c;
+  for (int e = 0; e < element_count(); ++e) c.push_back({e, e + 1});
+  return c;
+}
+
+FieldTable RigidPlasticMembrane::site_fields(const Vector& q) const {
+  FieldTable t{{"x", "y", "ux", "uy"}, {}};
+  for (int k = 0; k < node_count(); ++k) {
+    const Vec2 u = q.segment<2>(node_dof(k, 0));
+    t.rows.push_back({nodes_[k].x() + u.x(), nodes_[k].y() + u.y(), u.x(), u.y()});
+  }
+  return t;
+}
+
+FieldTable RigidPlasticMembrane::element_fields(const Vector& q) const {
+  FieldTable t{{"s0", "x", "y", "major_strain", "thickness_strain", "thickness", "eps_bar",
+                "tension", "strain_increment"},
+               {}};
+  double s0 = 0.0;
+  for (int e = 0; e < element_count(); ++e) {
+    const ElementState s = element_state(q, e);
+    const Vec2 mid = 0.5 * (nodes_[e] + q.segment<2>(node_dof(e, 0)) + nodes_[e + 1] +
+                            q.segment<2>(node_dof(e + 1, 0)));
+    t.rows.push_back({s0 + 0.5 * initial_length_[e], mid.x(), mid.y(),
+                      std::log(s.l / initial_length_[e]), std::log(s.thickness / initial_thickness_),
+                      s.thickness, eps_bar_[e] + s.deps, s.tension, s.d1});
+    s0 += initial_length_[e];
+  }
+  return t;
+}
+
+Vector RigidPlasticMembrane::start_guess(const Vector& prescribed,
+                                         const std::vector<char>& is_prescribed) const {
+  // Each component interpolated linearly (in initial arc length) between the nodes where it
+  // is prescribed: a stretched, tensioned start instead of a slack flat sheet.
+  Vector q = prescribed;
+  std::vector<double> s(node_count(), 0.0);
+  for (int k = 1; k < node_count(); ++k) s[k] = s[k - 1] + initial_length_[k - 1];
+  for (int comp = 0; comp < 2; ++comp) {
+    std::vector<int> known;
+    for (int k = 0; k < node_count(); ++k)
+      if (is_prescribed[node_dof(k, comp)]) known.push_back(k);
+    if (known.empty()) continue;
+    for (int k = 0; k < node_count(); ++k) {
+      if (is_prescribed[node_dof(k, comp)]) continue;
+      size_t j = 0;
+      while (j < known.size() && known[j] < k) ++j;
+      const int lo = j == 0 ? known.front() : known[j - 1];
+      const int hi = j == known.size() ? known.back() : known[j];
+      const double ql = prescribed[node_dof(lo, comp)], qh = prescribed[node_dof(hi, comp)];
+      q[node_dof(k, comp)] = lo == hi ? ql : ql + (qh - ql) * (s[k] - s[lo]) / (s[hi] - s[lo]);
+    }
+  }
+  return q;
+}
+
+double RigidPlasticMembrane::newton_step_fraction(const Vector& q, const Vector& dq) const {
+  // At most 2 % of stretch and 0.1 rad of rotation per element and Newton iteration.
+  double worst = 0.0;
+  for (int e = 0; e < element_count(); ++e) {
+    const Vec2 xa = nodes_[e] + q.segment<2>(node_dof(e, 0));
+    const Vec2 xb = nodes_[e + 1] + q.segment<2>(node_dof(e + 1, 0));
+    const double l = (xb - xa).norm();
+    const Vec2 t = (xb - xa) / l;
+    const Vec2 d = dq.segment<2>(node_dof(e + 1, 0)) - dq.segment<2>(node_dof(e, 0));
+    worst = std::max({worst, std::abs(t.dot(d)) / (0.02 * l), std::abs(rot90(t).dot(d)) / (0.1 * l)});
+  }
+  return worst > 1 ? 1 / worst : 1.0;
+}
+
+std::string RigidPlasticMembrane::inadmissible(const Vector& q) const {
+  // A membrane carries no compression: the sheet would wrinkle. The regularized law gives
+  // a small compressive stiffness near a zero increment; allow ten times its scale.
+  for (int e = 0; e < element_count(); ++e) {
+    const ElementState s = element_state(q, e);
+    if (s.d1 < -10 * material_.regularization)
+      return "membrane element " + std::to_string(e) + " is compressed (stretch increment " +
+             std::to_string(s.d1) + "): the sheet would wrinkle";
+  }
+  return {};
+}
+
+void RigidPlasticMembrane::commit(const Vector& q) {
+  for (int e = 0; e < element_count(); ++e) {
+    const ElementState s = element_state(q, e);
+    eps_bar_[e] += s.deps;
+    thickness_[e] = s.thickness;
+    length_[e] = s.l;
+  }
+}
+
+}  // namespace grip

@@ -1,0 +1,67 @@
+#include "solver/elements/rigid_plastic_membrane.hpp"
+#include "solver/io/scene_reader.hpp"
+
+namespace grip::scene_io {
+
+// body: {"model": "rigid_plastic_membrane", "material": {r, M, H, a0, n, regularization},
+//        "thickness", "width", "mesh": {"origin", "length", "elements"} | {"nodes": [[x, y]...]},
+//        "supports": [{"node", "fix": ["x", "y"]}], "loads": [{"node", "force", "case"}]}
+void read_rigid_plastic_membrane(Reader& r, json& body, Problem& problem) {
+  const std::string ptr = "/body";
+  json* mat = r.object(body, ptr, "material", true);
+  json* mesh = r.object(body, ptr, "mesh", true);
+  HillMaterial m;
+  if (mat) {
+    const std::string mp = ptr + "/material";
+    m.r = r.positive(*mat, mp, "r", 1.0);
+    m.M = r.number(*mat, mp, "M", 2.0);
+    if (!(m.M > 1)) r.error(mp + "/M", show((*mat)["M"]) + " is not above 1");
+    m.H = r.positive(*mat, mp, "H");
+    m.a0 = r.positive(*mat, mp, "a0", 1e-4);
+    m.n = r.number(*mat, mp, "n");
+    if (!(m.n >= 0 && m.n < 1)) r.error(mp + "/n", show((*mat)["n"]) + " is not in [0, 1)");
+    m.regularization = r.positive(*mat, mp, "regularization", 1e-5);
+  }
+  const double thickness = r.positive(body, ptr, "thickness");
+  const double width = r.positive(body, ptr, "width", 1.0);
+  std::vector<Vec2> nodes;
+  if (mesh) {
+    const std::string mp = ptr + "/mesh";
+    if (mesh->contains("nodes")) {
+      json* list = r.array(*mesh, mp, "nodes", true);
+      if (list && list->size() < 2) r.error(mp + "/nodes", "needs at least two nodes");
+      if (list)
+        for (size_t i = 0; i < list->size(); ++i) {
+          json wrap = {{"p", (*list)[i]}};
+          nodes.push_back(r.vec2(wrap, mp + "/nodes", std::to_string(i).c_str()));
+        }
+      for (size_t i = 1; i < nodes.size(); ++i)
+        if ((nodes[i] - nodes[i - 1]).norm() == 0)
+          r.error(mp + "/nodes/" + std::to_string(i), "repeats the previous node (a zero-length element)");
+    } else {
+      const Vec2 origin = r.vec2(*mesh, mp, "origin", Vec2::Zero());
+      const double length = r.positive(*mesh, mp, "length");
+      const int elements = r.integer(*mesh, mp, "elements", 1, 100000);
+      for (int i = 0; i <= elements; ++i) nodes.push_back(origin + Vec2(length * i / elements, 0));
+    }
+  }
+  if (!r.issues.empty()) return;
+  problem.body = std::make_unique<RigidPlasticMembrane>(nodes, thickness, m, width);
+  const int count = static_cast<int>(nodes.size());
+  read_supports(r, body, ptr, count, {"x", "y"}, &RigidPlasticMembrane::node_dof, problem);
+  if (json* loads = r.array(body, ptr, "loads", false))
+    for (size_t i = 0; i < loads->size(); ++i) {
+      const std::string lp = ptr + "/loads/" + std::to_string(i);
+      json& l = (*loads)[i];
+      if (!l.is_object()) {
+        r.error(lp, "is not an object");
+        continue;
+      }
+      const int node = r.integer(l, lp, "node", 0, count - 1);
+      const Vec2 f = r.vec2(l, lp, "force", Vec2::Zero());
+      Vector& load = case_load(problem, r.load_case(l, lp));
+      load.segment<2>(RigidPlasticMembrane::node_dof(node, 0)) += f;
+    }
+}
+
+}  // namespace grip::scene_io
