@@ -1,18 +1,24 @@
 // grip: command line entry point.
 //   grip solve SCENE.json [--out RESULT.json] [--events EVENTS.ndjson]
-// Exit codes: 0 solved, 1 a step failed, 2 usage or scene error.
+//   grip serve [options]        the HTTP/JSON service (grip serve --help)
+//   grip healthcheck [--host H] [--port P]
+// Exit codes of solve: 0 solved, 1 a step failed, 2 usage or scene error.
 #include <cstdio>
 #include <fstream>
 #include <iostream>
 #include <string>
+#include <vector>
 
+#include "server/serve.hpp"
 #include "solver/io/result.hpp"
 
 namespace {
 
 int usage() {
   std::fprintf(stderr,
-               "usage: grip solve SCENE.json [--out RESULT.json] [--events EVENTS.ndjson]\n");
+               "usage: grip solve SCENE.json [--out RESULT.json] [--events EVENTS.ndjson]\n"
+               "       grip serve [options]   (grip serve --help)\n"
+               "       grip healthcheck [--host H] [--port P]\n");
   return 2;
 }
 
@@ -83,11 +89,30 @@ int solve(int argc, char** argv) {
   return run.completed ? 0 : 1;
 }
 
+int serve(int argc, char** argv) {
+  const std::vector<std::string> args(argv + 2, argv + argc);
+  if (!args.empty() && (args[0] == "--help" || args[0] == "-h")) {
+    std::fputs(grip::server::serve_usage().c_str(), stdout);
+    return 0;
+  }
+  grip::server::ServeConfig config;
+  try {
+    config = grip::server::read_serve_config(args);
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "grip serve: %s\n%s", e.what(), grip::server::serve_usage().c_str());
+    return 2;
+  }
+  return grip::server::serve(config);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   if (argc < 2) return usage();
   const std::string command = argv[1];
   if (command == "solve") return solve(argc, argv);
+  if (command == "serve") return serve(argc, argv);
+  if (command == "healthcheck")
+    return grip::server::healthcheck(std::vector<std::string>(argv + 2, argv + argc));
   return usage();
 }

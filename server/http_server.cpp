@@ -1,0 +1,724 @@
+#include "server/http_server.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "server/tar.hpp"
+#include "server/util.hpp"
+#include "solver/io/export_csv.hpp"
+#include "solver/io/export_vtk.hpp"
+#include "solver/io/scene.hpp"
+
+// After Eigen (through the solver's headers): httplib.h brings <resolv.h>, whose `_res`
+// macro breaks Eigen's headers.
+#include <httplib.h>
+
+namespace grip::server {
+
+using nlohmann::json;
+using httplib::Request;
+using httplib::Response;
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr const char* kProcessId = "contact2d";
+constexpr const char* kProblemJson = "application/problem+json";
+constexpr const char* kJson = "application/json";
+constexpr const char* kResultsRel = "http://www.opengis.net/def/rel/ogc/1.0/results";
+
+thread_local std::chrono::steady_clock::time_point request_start;
+
+// ---- responses
+
+json error_list(std::string detail, std::string pointer = "") {
+  return json::array({{{"pointer", std::move(pointer)}, {"detail", std::move(detail)}}});
+}
+
+// RFC 9457 problem details with grip's `errors[]` of {pointer, detail}.
+void problem(Response& res, const Request& req, int status, const std::string& slug,
+             const std::string& title, const std::string& detail, json errors = nullptr) {
+  if (errors.is_null() || errors.empty()) errors = error_list(detail);
+  const json body = {{"type", "urn:grip:problem:" + slug}, {"title", title},   {"status", status},
+                     {"detail", detail},                   {"instance", req.path}, {"errors", errors}};
+  res.status = status;
+  res.set_content(body.dump(), kProblemJson);
+}
+
+void send_json(Response& res, int status, const json& body) {
+  res.status = status;
+  res.set_content(body.dump(), kJson);
+}
+
+std::string lower(std::string s) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });
+  return s;
+}
+
+// A decimal integer >= 0, or nothing.
+std::optional<std::int64_t> parse_count(const std::string& s) {
+  if (s.empty() || s.size() > 18 || !std::all_of(s.begin(), s.end(), ::isdigit)) return std::nullopt;
+  return std::stoll(s);
+}
+
+bool safe_name(const std::string& s) {
+  return !s.empty() && s.size() < 100 && s[0] != '.' &&
+         std::all_of(s.begin(), s.end(), [](unsigned char c) { return std::isalnum(c) || c == '-' || c == '_' || c == '.'; });
+}
+
+std::optional<std::string> read_file(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  if (!in) return std::nullopt;
+  std::ostringstream os;
+  os << in.rdbuf();
+  return os.str();
+}
+
+// Opaque list cursor: the creation order to continue below, hex with a version prefix.
+std::string encode_cursor(std::int64_t before) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "c1%llx", static_cast<unsigned long long>(before));
+  return buf;
+}
+
+std::optional<std::int64_t> decode_cursor(const std::string& c) {
+  if (c.size() < 3 || c.size() > 18 || c.compare(0, 2, "c1") != 0) return std::nullopt;
+  if (!std::all_of(c.begin() + 2, c.end(), ::isxdigit)) return std::nullopt;
+  return static_cast<std::int64_t>(std::stoull(c.substr(2), nullptr, 16));
+}
+
+std::string job_path(const std::string& id) { return "/v1/jobs/" + id; }
+
+json job_document(const JobView& v) {
+  const JobRecord& r = v.record;
+  json doc = {{"jobID", r.id},          {"processID", kProcessId}, {"type", "process"},
+              {"status", to_string(r.status)}, {"message", r.message}, {"created", r.created},
+              {"updated", r.updated},   {"nodes", r.nodes},        {"steps", r.steps},
+              {"attempts", r.attempts}};
+  if (!r.started.empty()) doc["started"] = r.started;
+  if (!r.finished.empty()) doc["finished"] = r.finished;
+  int percent = r.status == JobStatus::successful ? 100 : 0;
+  if (v.progress) {
+    const Progress& p = *v.progress;
+    if (r.steps > 0) percent = 100 * p.steps_done / r.steps;
+    doc["step"] = p.step;
+    doc["contact_error"] = p.contact_error;
+    doc["iterations"] = p.iterations;
+    char msg[96];
+    std::snprintf(msg, sizeof msg, "step %d of %d, ||v||_2 = %.3e", p.step, r.steps, p.contact_error);
+    doc["message"] = msg;
+  } else if (is_finished(r.status) && r.status != JobStatus::dismissed) {
+    doc["iterations"] = r.iterations;
+    doc["solve_seconds"] = r.solve_seconds;
+  }
+  doc["progress"] = percent;
+  const std::string self = job_path(r.id);
+  json links = json::array({
+      {{"href", self}, {"rel", "self"}, {"type", kJson}, {"title", "this job"}},
+      {{"href", self + "/events"}, {"rel", "monitor"}, {"type", "text/event-stream"},
+       {"title", "events: replayed, then live"}},
+      {{"href", self + "/convergence"}, {"rel", "related"}, {"type", kJson},
+       {"title", "contact error history"}},
+  });
+  if (r.status == JobStatus::successful || r.status == JobStatus::failed)
+    links.push_back({{"href", self + "/result"}, {"rel", kResultsRel}, {"type", kJson},
+                     {"title", "result"}});
+  doc["links"] = links;
+  return doc;
+}
+
+}  // namespace
+
+struct HttpServer::Impl {
+  Impl(JobService& s, HttpOptions o, std::atomic<int>& streams)
+      : service(s), options(std::move(o)), open_streams(streams) {}
+
+  JobService& service;
+  HttpOptions options;
+  std::atomic<int>& open_streams;
+  httplib::Server svr;
+  std::atomic<bool> stopping{false};
+  std::atomic<std::int64_t> requests{0};
+
+  // Registers a handler for every path pattern given.
+  template <class F>
+  void get(std::initializer_list<const char*> patterns, F handler) {
+    for (const char* p : patterns) svr.Get(p, handler);
+  }
+
+  void routes();
+  void hooks();
+
+  // ---- handlers
+  void submit(const Request& req, Response& res, bool ogc);
+  void list_jobs(const Request& req, Response& res);
+  void get_job(const Request& req, Response& res);
+  void dismiss(const Request& req, Response& res);
+  void events(const Request& req, Response& res);
+  void convergence(const Request& req, Response& res);
+  void result(const Request& req, Response& res);
+  void metrics(const Request& req, Response& res);
+  void process_description(const Request& req, Response& res);
+  void file_list(const Request& req, Response& res, const fs::path& dir, const std::string& suffix,
+                 const std::string& route);
+  void file(const Request& req, Response& res, const fs::path& dir, const std::string& suffix);
+
+  void not_found_job(const Request& req, Response& res, const std::string& id) {
+    problem(res, req, 404, "job-not-found", "Job not found", "no job with id '" + id + "'");
+  }
+};
+
+void HttpServer::Impl::hooks() {
+  const int threads = options.threads > 0 ? options.threads : options.max_streams + 32;
+  svr.new_task_queue = [threads] { return new httplib::ThreadPool(static_cast<size_t>(threads)); };
+  svr.set_payload_max_length(options.max_body_bytes);
+  svr.set_keep_alive_timeout(2);
+  svr.set_read_timeout(10);
+  svr.set_write_timeout(10);
+
+  svr.set_pre_routing_handler([this](const Request& req, Response& res) {
+    request_start = std::chrono::steady_clock::now();
+    ++requests;
+    if (!options.token || req.path == "/v1/health") return httplib::Server::HandlerResponse::Unhandled;
+    const std::string auth = req.get_header_value("Authorization");
+    const std::string prefix = "Bearer ";
+    if (auth.size() > prefix.size() && lower(auth.substr(0, prefix.size())) == "bearer " &&
+        equal_constant_time(auth.substr(prefix.size()), *options.token))
+      return httplib::Server::HandlerResponse::Unhandled;
+    res.set_header("WWW-Authenticate", "Bearer realm=\"grip\"");
+    problem(res, req, 401, "unauthorized", "Unauthorized",
+            auth.empty() ? "this server requires a bearer token (Authorization: Bearer ...)"
+                         : "the bearer token is not valid");
+    return httplib::Server::HandlerResponse::Handled;
+  });
+
+  // Errors that no handler described (unknown route, 413, unreadable request): a problem
+  // document. Bodies a handler already set are left alone.
+  svr.set_error_handler(httplib::Server::HandlerWithResponse([](const Request& req, Response& res) {
+    if (!res.body.empty()) return httplib::Server::HandlerResponse::Unhandled;
+    switch (res.status) {
+      case 404:
+        problem(res, req, 404, "not-found", "Not found", "no route " + req.method + " " + req.path);
+        break;
+      case 413:
+        problem(res, req, 413, "payload-too-large", "Payload too large",
+                "the request body is over this server's limit");
+        break;
+      default:
+        problem(res, req, res.status, "http-" + std::to_string(res.status),
+                res.status < 500 ? "Bad request" : "Server error",
+                "the request could not be served (" + std::to_string(res.status) + ")");
+    }
+    return httplib::Server::HandlerResponse::Handled;
+  }));
+
+  svr.set_exception_handler([](const Request& req, Response& res, std::exception_ptr ep) {
+    std::string what = "unknown exception";
+    try {
+      std::rethrow_exception(ep);
+    } catch (const std::exception& e) {
+      what = e.what();
+    } catch (...) {
+    }
+    spdlog::error("{} {}: {}", req.method, req.path, what);
+    res.headers.clear();
+    problem(res, req, 500, "internal-error", "Internal server error",
+            "the server failed to answer this request; it has been logged");
+  });
+
+  svr.set_logger([](const Request& req, const Response& res) {
+    const double ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - request_start).count();
+    const bool quiet = req.path == "/v1/health" || req.path == "/v1/ready" || req.path == "/v1/metrics";
+    spdlog::log(quiet ? spdlog::level::debug : spdlog::level::info, "{} {} {} {:.1f} ms",
+                req.method, req.path, res.status, ms);
+  });
+}
+
+void HttpServer::Impl::routes() {
+  // ---- service
+  svr.Get("/v1/health", [](const Request&, Response& res) { send_json(res, 200, {{"status", "ok"}}); });
+  svr.Get("/v1/ready", [this](const Request& req, Response& res) {
+    if (!service.ready()) {
+      res.set_header("Retry-After", "5");
+      return problem(res, req, 503, "not-ready", "Not ready",
+                     service.draining() ? "the server is shutting down" : "the server is starting");
+    }
+    service.stats();  // the store answers
+    send_json(res, 200, {{"status", "ready"}});
+  });
+  svr.Get("/v1/metrics", [this](const Request& req, Response& res) { metrics(req, res); });
+
+  // ---- landing page and OGC API - Processes
+  svr.Get("/", [](const Request&, Response& res) {
+    send_json(res, 200,
+              {{"title", "grip"},
+               {"description", "2D frictional contact solver service (contact error vector scheme)"},
+               {"links", json::array({{{"href", "/"}, {"rel", "self"}, {"type", kJson}},
+                                      {{"href", "/conformance"}, {"rel", "http://www.opengis.net/def/rel/ogc/1.0/conformance"}},
+                                      {{"href", "/processes"}, {"rel", "http://www.opengis.net/def/rel/ogc/1.0/processes"}},
+                                      {{"href", "/jobs"}, {"rel", "http://www.opengis.net/def/rel/ogc/1.0/job-list"}}})}});
+  });
+  svr.Get("/conformance", [](const Request&, Response& res) {
+    send_json(res, 200,
+              {{"conformsTo", {"http://www.opengis.net/spec/ogcapi-processes-1/1.0/conf/core",
+                               "http://www.opengis.net/spec/ogcapi-processes-1/1.0/conf/json",
+                               "http://www.opengis.net/spec/ogcapi-processes-1/1.0/conf/job-list",
+                               "http://www.opengis.net/spec/ogcapi-processes-1/1.0/conf/dismiss"}}});
+  });
+  get({"/processes", "/v1/processes"}, [](const Request&, Response& res) {
+    send_json(res, 200,
+              {{"processes",
+                {{{"id", kProcessId},
+                  {"title", "2D frictional contact"},
+                  {"version", "0.1.0"},
+                  {"jobControlOptions", {"async-execute"}},
+                  {"outputTransmission", {"value"}},
+                  {"links", {{{"href", "/processes/contact2d"}, {"rel", "self"}, {"type", kJson}}}}}}},
+               {"links", {{{"href", "/processes"}, {"rel", "self"}, {"type", kJson}}}}});
+  });
+  get({"/processes/contact2d", "/v1/processes/contact2d"},
+      [this](const Request& req, Response& res) { process_description(req, res); });
+  svr.Post("/processes/contact2d/execution",
+           [this](const Request& req, Response& res) { submit(req, res, true); });
+  svr.Post("/v1/processes/contact2d/execution",
+           [this](const Request& req, Response& res) { submit(req, res, true); });
+
+  // ---- jobs
+  svr.Post("/v1/jobs", [this](const Request& req, Response& res) { submit(req, res, false); });
+  get({"/v1/jobs", "/jobs"}, [this](const Request& req, Response& res) { list_jobs(req, res); });
+  get({R"(/v1/jobs/([^/]+))", R"(/jobs/([^/]+))"},
+      [this](const Request& req, Response& res) { get_job(req, res); });
+  svr.Delete(R"(/v1/jobs/([^/]+))", [this](const Request& req, Response& res) { dismiss(req, res); });
+  svr.Delete(R"(/jobs/([^/]+))", [this](const Request& req, Response& res) { dismiss(req, res); });
+  get({R"(/v1/jobs/([^/]+)/events)", R"(/jobs/([^/]+)/events)"},
+      [this](const Request& req, Response& res) { events(req, res); });
+  get({R"(/v1/jobs/([^/]+)/convergence)", R"(/jobs/([^/]+)/convergence)"},
+      [this](const Request& req, Response& res) { convergence(req, res); });
+  get({R"(/v1/jobs/([^/]+)/result)", R"(/jobs/([^/]+)/results?)"},
+      [this](const Request& req, Response& res) { result(req, res); });
+
+  // ---- schemas and examples
+  const fs::path schemas = options.schemas_dir;
+  svr.Get("/v1/schemas", [this, schemas](const Request& req, Response& res) {
+    file_list(req, res, schemas, ".schema.json", "/v1/schemas/");
+  });
+  svr.Get(R"(/v1/schemas/([^/]+))", [this, schemas](const Request& req, Response& res) {
+    file(req, res, schemas, ".schema.json");
+  });
+  svr.Get("/v1/examples", [this, schemas](const Request& req, Response& res) {
+    file_list(req, res, schemas / "examples", ".json", "/v1/examples/");
+  });
+  svr.Get(R"(/v1/examples/([^/]+))", [this, schemas](const Request& req, Response& res) {
+    file(req, res, schemas / "examples", ".json");
+  });
+}
+
+void HttpServer::Impl::submit(const Request& req, Response& res, bool ogc) {
+  const std::string type = lower(req.get_header_value("Content-Type"));
+  const std::string media = type.substr(0, type.find(';'));
+  auto trimmed = media;
+  trimmed.erase(std::remove_if(trimmed.begin(), trimmed.end(), ::isspace), trimmed.end());
+  if (trimmed != "application/json" &&
+      !(trimmed.size() > 5 && trimmed.compare(trimmed.size() - 5, 5, "+json") == 0)) {
+    res.set_header("Accept-Post", "application/json");
+    return problem(res, req, 415, "unsupported-media-type", "Unsupported media type",
+                   "a scene is submitted as application/json, not '" +
+                       (media.empty() ? std::string("(none)") : media) + "'");
+  }
+  json body;
+  try {
+    body = json::parse(req.body);
+  } catch (const json::parse_error& e) {
+    return problem(res, req, 400, "malformed-json", "Malformed JSON",
+                   "the body is not JSON: " + std::string(e.what()),
+                   error_list("parse error at byte " + std::to_string(e.byte) + ": " + e.what()));
+  }
+  // OGC execute request: {"inputs": {"scene": {...}}} (or the scene's fields as inputs).
+  std::string prefix;
+  json scene = std::move(body);
+  if (ogc && scene.is_object() && scene.contains("inputs") && scene["inputs"].is_object()) {
+    json inputs = scene["inputs"];
+    if (inputs.contains("scene")) {
+      scene = inputs["scene"];
+      prefix = "/inputs/scene";
+    } else {
+      scene = std::move(inputs);
+      prefix = "/inputs";
+    }
+  }
+  std::optional<std::string> key;
+  if (req.has_header("Idempotency-Key")) {
+    key = req.get_header_value("Idempotency-Key");
+    if (key->empty() || key->size() > 255)
+      return problem(res, req, 400, "bad-idempotency-key", "Bad Idempotency-Key",
+                     "Idempotency-Key must have 1 to 255 characters");
+  }
+  try {
+    const SubmitResult r = service.submit(scene, key);
+    res.set_header("Location", job_path(r.job.record.id));
+    if (r.replayed) res.set_header("Idempotent-Replayed", "true");
+    send_json(res, 201, job_document(r.job));
+  } catch (const SceneErrors& e) {
+    json errors = json::array();
+    for (const auto& issue : e.issues())
+      errors.push_back({{"pointer", prefix + (issue.pointer == "/" ? "" : issue.pointer)},
+                        {"detail", issue.detail}});
+    problem(res, req, 422, "invalid-scene", "Invalid scene",
+            std::to_string(e.issues().size()) + " problem(s) in the scene", errors);
+  } catch (const QueueFull& e) {
+    res.set_header("Retry-After", std::to_string(e.retry_after_seconds));
+    problem(res, req, 503, "queue-full", "Queue full",
+            "the job queue is full; nothing was accepted; retry after " +
+                std::to_string(e.retry_after_seconds) + " s");
+  } catch (const ShuttingDown&) {
+    res.set_header("Retry-After", "10");
+    problem(res, req, 503, "shutting-down", "Shutting down",
+            "the server is shutting down; nothing was accepted");
+  } catch (const IdempotencyConflict& e) {
+    problem(res, req, 422, "idempotency-key-reused", "Idempotency-Key reused", e.what());
+  }
+}
+
+void HttpServer::Impl::list_jobs(const Request& req, Response& res) {
+  std::optional<JobStatus> status;
+  int limit = 50;
+  std::optional<std::int64_t> before;
+  if (req.has_param("status")) {
+    status = parse_job_status(req.get_param_value("status"));
+    if (!status)
+      return problem(res, req, 400, "bad-parameter", "Bad query parameter",
+                     "status must be accepted, running, successful, failed or dismissed");
+  }
+  if (req.has_param("limit")) {
+    const auto n = parse_count(req.get_param_value("limit"));
+    if (!n || *n < 1 || *n > 1000)
+      return problem(res, req, 400, "bad-parameter", "Bad query parameter",
+                     "limit must be an integer from 1 to 1000");
+    limit = static_cast<int>(*n);
+  }
+  if (req.has_param("cursor")) {
+    before = decode_cursor(req.get_param_value("cursor"));
+    if (!before)
+      return problem(res, req, 400, "bad-parameter", "Bad query parameter",
+                     "cursor is not one this server gave out");
+  }
+  JobPage page = service.list(status, limit, before);
+  json jobs = json::array();
+  for (const JobView& v : service.with_progress(std::move(page.jobs))) jobs.push_back(job_document(v));
+  const std::string base = req.path;
+  std::string query = "?limit=" + std::to_string(limit);
+  if (status) query += "&status=" + std::string(to_string(*status));
+  json links = json::array({{{"href", base + query}, {"rel", "self"}, {"type", kJson}}});
+  if (page.next_before)
+    links.push_back({{"href", base + query + "&cursor=" + encode_cursor(*page.next_before)},
+                     {"rel", "next"},
+                     {"type", kJson}});
+  send_json(res, 200, {{"jobs", jobs}, {"links", links}});
+}
+
+void HttpServer::Impl::get_job(const Request& req, Response& res) {
+  const std::string id = req.matches[1];
+  const auto view = service.job(id);
+  if (!view) return not_found_job(req, res, id);
+  send_json(res, 200, job_document(*view));
+}
+
+void HttpServer::Impl::dismiss(const Request& req, Response& res) {
+  const std::string id = req.matches[1];
+  const auto [outcome, view] = service.dismiss(id);
+  if (outcome == DismissOutcome::not_found || !view) return not_found_job(req, res, id);
+  json doc = job_document(*view);
+  if (outcome == DismissOutcome::removed) {
+    doc["message"] = "removed with its events and result";
+    doc["links"] = json::array();
+  }
+  send_json(res, 200, doc);
+}
+
+void HttpServer::Impl::events(const Request& req, Response& res) {
+  const std::string id = req.matches[1];
+  const bool ndjson = req.has_param("format") && req.get_param_value("format") == "ndjson";
+  if (req.has_param("format") && !ndjson && req.get_param_value("format") != "sse")
+    return problem(res, req, 400, "bad-parameter", "Bad query parameter", "format must be sse or ndjson");
+  std::int64_t after = 0;
+  for (const char* name : {"after", "last_event_id"})
+    if (req.has_param(name)) {
+      const auto n = parse_count(req.get_param_value(name));
+      if (!n) return problem(res, req, 400, "bad-parameter", "Bad query parameter",
+                             std::string(name) + " must be an event id (an integer >= 0)");
+      after = *n;
+    }
+  if (req.has_header("Last-Event-ID")) {
+    const auto n = parse_count(req.get_header_value("Last-Event-ID"));
+    if (!n) return problem(res, req, 400, "bad-last-event-id", "Bad Last-Event-ID",
+                           "Last-Event-ID must be an event id this server gave out");
+    after = *n;
+  }
+  if (!service.job(id)) return not_found_job(req, res, id);
+  if (service.draining()) {
+    res.set_header("Retry-After", "10");
+    return problem(res, req, 503, "shutting-down", "Shutting down", "the server is shutting down");
+  }
+  if (open_streams.fetch_add(1) >= options.max_streams) {
+    --open_streams;
+    res.set_header("Retry-After", "5");
+    return problem(res, req, 503, "too-many-streams", "Too many event streams",
+                   "this server has " + std::to_string(options.max_streams) +
+                       " event streams open; retry later or poll the job");
+  }
+  struct State {
+    std::int64_t last = 0;
+    std::chrono::steady_clock::time_point last_write;
+    bool first = true;
+  };
+  auto state = std::make_shared<State>();
+  state->last = after;
+  state->last_write = std::chrono::steady_clock::now();
+  res.set_header("Cache-Control", "no-cache");
+  res.set_header("X-Accel-Buffering", "no");
+  const auto heartbeat = options.heartbeat;
+  res.set_chunked_content_provider(
+      ndjson ? "application/x-ndjson" : "text/event-stream",
+      [this, id, state, ndjson, heartbeat](size_t, httplib::DataSink& sink) {
+        if (stopping || service.draining()) {
+          sink.done();
+          return true;
+        }
+        std::string out;
+        if (state->first && !ndjson) out = "retry: 1000\n\n";
+        state->first = false;
+        // Wait at most a second, so the server can stop promptly.
+        const auto now = std::chrono::steady_clock::now();
+        const auto until_ping = std::chrono::duration_cast<std::chrono::milliseconds>(
+            state->last_write + heartbeat - now);
+        const auto wait = std::clamp(until_ping, std::chrono::milliseconds(0), std::chrono::milliseconds(1000));
+        const EventBatch batch = service.wait_events(id, state->last, wait);
+        if (!batch.found) {
+          sink.done();
+          return true;
+        }
+        for (const StoredEvent& e : batch.events) {
+          if (ndjson) {
+            out += e.data;
+            out += '\n';
+          } else {
+            out += "id: " + std::to_string(e.seq) + "\nevent: " + e.type + "\ndata: " + e.data + "\n\n";
+          }
+          state->last = e.seq;
+        }
+        const auto after_wait = std::chrono::steady_clock::now();
+        if (out.empty() && after_wait - state->last_write >= heartbeat) out = ndjson ? "\n" : ": ping\n\n";
+        if (!out.empty()) {
+          if (!sink.write(out.data(), out.size())) return false;
+          state->last_write = after_wait;
+        }
+        if (batch.ended) sink.done();
+        return true;
+      },
+      [this](bool) { --open_streams; });
+}
+
+void HttpServer::Impl::convergence(const Request& req, Response& res) {
+  const std::string id = req.matches[1];
+  const auto view = service.job(id);
+  if (!view) return not_found_job(req, res, id);
+  std::vector<json> rows;
+  std::int64_t after = 0;
+  while (true) {
+    const auto batch = service.events(id, after, 5000, "iteration");
+    for (const StoredEvent& e : batch) {
+      json ev = json::parse(e.data);
+      ev.erase("type");
+      rows.push_back(std::move(ev));
+      after = e.seq;
+    }
+    if (batch.size() < 5000) break;
+  }
+  const std::string format = req.has_param("format") ? req.get_param_value("format") : "";
+  const bool csv = format == "csv" || (format.empty() && req.get_header_value("Accept").find("text/csv") != std::string::npos);
+  if (!format.empty() && format != "csv" && format != "json")
+    return problem(res, req, 400, "bad-parameter", "Bad query parameter", "format must be json or csv");
+  if (csv) {
+    res.set_header("Content-Disposition", "attachment; filename=\"convergence-" + id + ".csv\"");
+    res.set_content(objects_csv(rows), "text/csv; charset=utf-8");
+    return;
+  }
+  send_json(res, 200, {{"jobID", id}, {"status", to_string(view->record.status)}, {"iterations", rows}});
+}
+
+void HttpServer::Impl::result(const Request& req, Response& res) {
+  const std::string id = req.matches[1];
+  const auto view = service.job(id);
+  if (!view) return not_found_job(req, res, id);
+  const std::string format = req.has_param("format") ? req.get_param_value("format") : "json";
+  if (format != "json" && format != "csv" && format != "vtk")
+    return problem(res, req, 400, "bad-parameter", "Bad query parameter", "format must be json, csv or vtk");
+  const auto data = is_finished(view->record.status) ? service.result(id) : std::nullopt;
+  if (!data) {
+    if (!is_finished(view->record.status))
+      return problem(res, req, 404, "result-not-ready", "Result not ready",
+                     "job " + id + " is " + std::string(to_string(view->record.status)) +
+                         "; its result is ready when it has finished");
+    return problem(res, req, 404, "no-result", "No result",
+                   "job " + id + " is " + std::string(to_string(view->record.status)) + " and has no result");
+  }
+  if (format == "json") {
+    res.set_content(*data, kJson);
+    return;
+  }
+  const json doc = json::parse(*data);
+  if (format == "csv") {
+    const std::string table = req.has_param("table") ? req.get_param_value("table") : "nodes";
+    const auto& tables = result_csv_tables();
+    if (std::find(tables.begin(), tables.end(), table) == tables.end()) {
+      std::string names;
+      for (const auto& t : tables) names += (names.empty() ? "" : ", ") + t;
+      return problem(res, req, 400, "bad-parameter", "Bad query parameter", "table must be one of " + names);
+    }
+    res.set_header("Content-Disposition", "attachment; filename=\"" + table + "-" + id + ".csv\"");
+    res.set_content(result_csv(doc, table), "text/csv; charset=utf-8");
+    return;
+  }
+  const std::string stem = "grip-" + id.substr(0, 8);
+  if (req.has_param("step")) {
+    const auto step = parse_count(req.get_param_value("step"));
+    const size_t count = doc.contains("steps") ? doc["steps"].size() : 0;
+    if (!step || *step < 1 || static_cast<size_t>(*step) > count)
+      return problem(res, req, 400, "bad-parameter", "Bad query parameter",
+                     "step must be from 1 to " + std::to_string(count));
+    try {
+      res.set_header("Content-Disposition", "attachment; filename=\"" + stem + "_" + std::to_string(*step) + ".vtk\"");
+      res.set_content(step_legacy_vtk(doc, static_cast<size_t>(*step - 1)), "text/plain; charset=utf-8");
+    } catch (const std::invalid_argument& e) {
+      res.headers.erase("Content-Disposition");
+      return problem(res, req, 404, "no-step-fields", "No fields for this step", e.what());
+    }
+    return;
+  }
+  std::vector<std::pair<std::string, std::string>> files;
+  for (auto& f : result_vtk_files(doc, stem)) files.emplace_back(stem + "/" + f.name, std::move(f.content));
+  res.set_header("Content-Disposition", "attachment; filename=\"" + stem + "-vtk.tar\"");
+  res.set_content(tar_archive(files), "application/x-tar");
+}
+
+void HttpServer::Impl::metrics(const Request&, Response& res) {
+  const ServiceStats s = service.stats();
+  std::ostringstream os;
+  os << "# HELP grip_jobs Jobs in the store by status.\n# TYPE grip_jobs gauge\n";
+  for (JobStatus st : {JobStatus::accepted, JobStatus::running, JobStatus::successful,
+                       JobStatus::failed, JobStatus::dismissed}) {
+    const auto it = s.jobs.find(st);
+    os << "grip_jobs{status=\"" << to_string(st) << "\"} " << (it == s.jobs.end() ? 0 : it->second) << "\n";
+  }
+  os << "# HELP grip_queue_depth Accepted jobs waiting for a worker.\n# TYPE grip_queue_depth gauge\n"
+     << "grip_queue_depth " << s.queue_depth << "\n"
+     << "# HELP grip_jobs_running Jobs being solved now.\n# TYPE grip_jobs_running gauge\n"
+     << "grip_jobs_running " << s.running << "\n"
+     << "# HELP grip_workers Worker threads.\n# TYPE grip_workers gauge\n"
+     << "grip_workers " << s.workers << "\n"
+     << "# HELP grip_open_streams Open event streams.\n# TYPE grip_open_streams gauge\n"
+     << "grip_open_streams " << open_streams.load() << "\n"
+     << "# HELP grip_solve_seconds_total Solver wall time of runs finished by this process.\n"
+     << "# TYPE grip_solve_seconds_total counter\n"
+     << "grip_solve_seconds_total " << s.solve_seconds << "\n"
+     << "# HELP grip_contact_iterations_total Contact iterations of runs finished by this process.\n"
+     << "# TYPE grip_contact_iterations_total counter\n"
+     << "grip_contact_iterations_total " << s.iterations << "\n"
+     << "# HELP grip_events_stored_total Events stored by this process.\n"
+     << "# TYPE grip_events_stored_total counter\n"
+     << "grip_events_stored_total " << s.events << "\n"
+     << "# HELP grip_http_requests_total HTTP requests received by this process.\n"
+     << "# TYPE grip_http_requests_total counter\n"
+     << "grip_http_requests_total " << requests.load() << "\n";
+  res.set_content(os.str(), "text/plain; version=0.0.4; charset=utf-8");
+}
+
+void HttpServer::Impl::process_description(const Request&, Response& res) {
+  const fs::path dir = options.schemas_dir;
+  auto schema_of = [&](const char* name) -> json {
+    if (fs::exists(dir / (std::string(name) + ".schema.json")))
+      return {{"$ref", std::string("/v1/schemas/") + name}};
+    return {{"type", "object"}};
+  };
+  send_json(res, 200,
+            {{"id", kProcessId},
+             {"title", "2D frictional contact"},
+             {"description",
+              "Frictional contact of a deformable body against rigid obstacles, solved with the "
+              "accelerated contact error vector scheme; events stream every contact iteration."},
+             {"version", "0.1.0"},
+             {"jobControlOptions", {"async-execute"}},
+             {"outputTransmission", {"value"}},
+             {"inputs", {{"scene", {{"title", "Scene"}, {"description", "the scene (see /v1/examples)"},
+                                    {"minOccurs", 1}, {"maxOccurs", 1}, {"schema", schema_of("scene")}}}}},
+             {"outputs", {{"result", {{"title", "Result"}, {"schema", schema_of("result")}}}}},
+             {"links", {{{"href", "/processes/contact2d/execution"},
+                         {"rel", "http://www.opengis.net/def/rel/ogc/1.0/execute"},
+                         {"title", "execute (asynchronous)"}}}}});
+}
+
+void HttpServer::Impl::file_list(const Request&, Response& res, const fs::path& dir,
+                                 const std::string& suffix, const std::string& route) {
+  std::vector<std::string> names;
+  std::error_code ec;
+  for (const auto& entry : fs::directory_iterator(dir, ec)) {
+    const std::string f = entry.path().filename().string();
+    if (entry.is_regular_file() && f.size() > suffix.size() &&
+        f.compare(f.size() - suffix.size(), suffix.size(), suffix) == 0 &&
+        !(suffix == ".json" && f.find(".schema.json") != std::string::npos))
+      names.push_back(f.substr(0, f.size() - suffix.size()));
+  }
+  // The paper's two examples first, then the others by name.
+  auto rank = [](const std::string& n) { return n == "beam-on-cylinder" ? 0 : n == "sheet-stretching" ? 1 : 2; };
+  std::sort(names.begin(), names.end(), [&](const auto& a, const auto& b) {
+    return rank(a) != rank(b) ? rank(a) < rank(b) : a < b;
+  });
+  json items = json::array();
+  for (const auto& n : names) items.push_back({{"name", n}, {"href", route + n}});
+  send_json(res, 200, {{"items", items}});
+}
+
+void HttpServer::Impl::file(const Request& req, Response& res, const fs::path& dir, const std::string& suffix) {
+  std::string name = req.matches[1];
+  if (name.size() > suffix.size() && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0)
+    name.resize(name.size() - suffix.size());
+  const auto content = safe_name(name) ? read_file(dir / (name + suffix)) : std::nullopt;
+  if (!content) return problem(res, req, 404, "not-found", "Not found", "no document named '" + name + "'");
+  res.set_content(*content, suffix == ".schema.json" ? "application/schema+json" : kJson);
+}
+
+HttpServer::HttpServer(JobService& service, HttpOptions options)
+    : impl_(std::make_unique<Impl>(service, std::move(options), open_streams_)) {
+  impl_->hooks();
+  impl_->routes();
+}
+
+HttpServer::~HttpServer() { stop(); }
+
+int HttpServer::bind() {
+  const auto& o = impl_->options;
+  if (o.port == 0) {
+    port_ = impl_->svr.bind_to_any_port(o.host);
+    if (port_ <= 0) throw std::runtime_error("cannot bind " + o.host + " to any port");
+  } else {
+    if (!impl_->svr.bind_to_port(o.host, o.port))
+      throw std::runtime_error("cannot bind " + o.host + ":" + std::to_string(o.port));
+    port_ = o.port;
+  }
+  return port_;
+}
+
+void HttpServer::listen() { impl_->svr.listen_after_bind(); }
+
+void HttpServer::stop() {
+  impl_->stopping = true;
+  if (impl_->svr.is_running()) impl_->svr.stop();
+}
+
+}  // namespace grip::server

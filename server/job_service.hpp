@@ -1,0 +1,198 @@
+#pragma once
+// The job API under the HTTP layer: submit a scene, read a job, dismiss it, follow its events.
+// Plain C++, testable without sockets.
+//
+// Design:
+// - A bounded queue of accepted jobs and a pool of worker threads of its own; a worker runs
+//   one job at a time with run_load_steps. HTTP threads never solve.
+// - Events are numbered per job (seq = the SSE id) on the worker and handed to one writer
+//   thread that stores whatever has accumulated in one transaction (group commit) and then
+//   wakes the event readers. Readers only ever see stored events, so an id a client saw is
+//   never given to another event, whatever happens to the process.
+// - A job's final status, result and terminal event are stored in one transaction after all
+//   its other events; only then is it reported finished.
+// - Dismissal sets a flag that the run's stop request reads before every contact iteration.
+// - After a crash (start()): interrupted runs go back to accepted with their events discarded
+//   and their sequence continuing above the discarded ids; every accepted job is queued in
+//   creation order.
+#include <nlohmann/json.hpp>
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <thread>
+#include <unordered_map>
+#include <vector>
+
+#include "server/store.hpp"
+
+namespace grip::server {
+
+// Per-job limits. Nodes and steps are checked at submission (422); iterations and wall time
+// while the job runs (the job fails with the limit as its reason).
+struct JobLimits {
+  int max_nodes = 100000;                 // sites of the body
+  int max_steps = 10000;                  // load steps of the scene
+  std::int64_t max_iterations = 1000000;  // contact iterations (real solves), all steps together
+  double max_seconds = 3600.0;            // wall time of one run
+};
+
+struct ServiceOptions {
+  int workers = 0;           // 0: one per core
+  int queue_capacity = 256;  // accepted jobs waiting for a worker
+  JobLimits limits;
+  // Test and benchmark hook, called on the worker thread as each event is produced.
+  std::function<void(const std::string& job_id, std::int64_t seq)> event_tap;
+};
+
+// Submission refused because the queue is full; retry after `retry_after_seconds`.
+class QueueFull : public std::runtime_error {
+ public:
+  explicit QueueFull(int retry_after)
+      : std::runtime_error("the job queue is full"), retry_after_seconds(retry_after) {}
+  int retry_after_seconds;
+};
+
+// Submission refused while the service shuts down.
+class ShuttingDown : public std::runtime_error {
+ public:
+  ShuttingDown() : std::runtime_error("the service is shutting down") {}
+};
+
+// The idempotency key was used before with a different scene.
+class IdempotencyConflict : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Progress of a running job (not stored: a restarted run starts from zero).
+struct Progress {
+  int step = 0;             // step being solved, 1-based
+  int steps_done = 0;       // converged steps
+  double contact_error = 0.0;  // ||v||_2 of the last contact iteration
+  std::int64_t iterations = 0;  // contact iterations so far
+};
+
+struct JobView {
+  JobRecord record;
+  std::optional<Progress> progress;  // while running
+};
+
+struct SubmitResult {
+  JobView job;
+  bool replayed = false;  // an earlier submission with the same idempotency key
+};
+
+struct EventBatch {
+  bool found = true;  // false: no such job
+  std::vector<StoredEvent> events;
+  bool ended = false;  // the job's terminal event has been delivered (or was before `after`)
+};
+
+enum class DismissOutcome { not_found, dismissed, removed };
+
+struct ServiceStats {
+  std::size_t queue_depth = 0;
+  int running = 0;
+  int workers = 0;
+  double solve_seconds = 0.0;     // finished runs, this process
+  std::int64_t iterations = 0;    // contact iterations of finished runs, this process
+  std::int64_t events = 0;        // events stored, this process
+  std::map<JobStatus, std::int64_t> jobs;  // by status, from the store
+};
+
+bool is_terminal_event(const std::string& type);
+
+class JobService {
+ public:
+  JobService(Store& store, ServiceOptions options);
+  ~JobService();
+  JobService(const JobService&) = delete;
+  JobService& operator=(const JobService&) = delete;
+
+  // Recovers interrupted jobs, queues accepted ones, starts the writer and the workers.
+  void start();
+
+  // Validates and stores the scene, then queues it. Throws grip::SceneErrors (invalid scene
+  // or over a limit), QueueFull, ShuttingDown, IdempotencyConflict.
+  SubmitResult submit(const nlohmann::json& scene,
+                      const std::optional<std::string>& idempotency_key = std::nullopt);
+  std::optional<JobView> job(const std::string& id);
+  std::vector<JobView> with_progress(std::vector<JobRecord> records);
+  JobPage list(std::optional<JobStatus> status, int limit, std::optional<std::int64_t> before);
+
+  // Cancels a queued or running job (a running one stops before its next contact iteration),
+  // removes a finished one. The view is the job as dismissed or as it was before removal.
+  std::pair<DismissOutcome, std::optional<JobView>> dismiss(const std::string& id);
+
+  // Stored events with seq > after, waiting up to `wait` for some to arrive.
+  EventBatch wait_events(const std::string& id, std::int64_t after,
+                         std::chrono::milliseconds wait, int limit = 256);
+  std::vector<StoredEvent> events(const std::string& id, std::int64_t after, int limit,
+                                  std::string_view type = {});
+  std::optional<std::string> result(const std::string& id);
+
+  ServiceStats stats();
+  bool ready() const { return started_ && !draining_; }
+  const ServiceOptions& options() const { return options_; }
+
+  // Refuses new submissions and releases every event reader at once.
+  void begin_drain();
+  bool draining() const { return draining_; }
+  // Takes no more jobs from the queue, lets running jobs finish for up to `grace`, then stops
+  // them and puts them back to accepted (the next start runs them again).
+  void shutdown(std::chrono::milliseconds grace);
+
+ private:
+  struct ActiveJob;
+  void worker_loop();
+  void writer_loop();
+  void run_job(const std::shared_ptr<ActiveJob>& job);
+  void emit(const std::string& id, std::int64_t seq, const nlohmann::json& event);
+  void flush(const std::string& id, std::int64_t seq);
+  // Stores the outcome after all events, then forgets the active job.
+  void finish(const std::shared_ptr<ActiveJob>& job, JobOutcome outcome);
+  void forget(const std::string& id);
+  int retry_after_seconds() const;
+
+  Store& store_;
+  ServiceOptions options_;
+  std::atomic<bool> started_{false};
+  std::atomic<bool> draining_{false};
+
+  // Queue and active jobs.
+  mutable std::mutex mutex_;
+  std::condition_variable queue_cv_;
+  std::condition_variable idle_cv_;
+  std::deque<std::string> queue_;
+  std::unordered_map<std::string, std::shared_ptr<ActiveJob>> active_;
+  int reserved_ = 0;  // submissions past the capacity check, not yet queued
+  int running_ = 0;
+  bool stop_workers_ = false;
+  std::atomic<bool> abort_runs_{false};
+  std::vector<std::thread> workers_;
+  double solve_seconds_ = 0.0;
+  std::int64_t iterations_ = 0;
+  std::int64_t finished_runs_ = 0;
+
+  // Events: pending batch, committed sequence per active job, readers' wake-up.
+  std::mutex events_mutex_;
+  std::condition_variable writer_cv_;
+  std::condition_variable committed_cv_;
+  std::vector<NewEvent> pending_;
+  std::unordered_map<std::string, std::int64_t> committed_;
+  std::uint64_t generation_ = 0;
+  std::int64_t events_stored_ = 0;
+  bool stop_writer_ = false;
+  std::thread writer_;
+};
+
+}  // namespace grip::server

@@ -1,0 +1,16 @@
+#pragma once
+// Small helpers of the service: timestamps and job ids.
+#include <string>
+
+namespace grip::server {
+
+// Now as ISO 8601 UTC with milliseconds: 2025-01-31T12:34:56.789Z.
+std::string now_iso8601();
+
+// A random UUID v4: job ids are opaque and unguessable.
+std::string new_job_id();
+
+// Constant-time comparison (bearer tokens).
+bool equal_constant_time(const std::string& a, const std::string& b);
+
+}  // namespace grip::server
