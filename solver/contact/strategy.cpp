@@ -178,7 +178,7 @@ class StepSolver {
   // The largest normal-force correction that the remaining contact error asks for.
   double force_precision() {
     if (error_.norm2 == 0.0) return 0.0;
-    const Matrix C = eq_.compliance(out_.state);
+    const Matrix& C = eq_.compliance(out_.state);
     const std::vector<int> idx = active_indices(error_);
     Vector v_e(idx.size());
     for (size_t a = 0; a < idx.size(); ++a) v_e[a] = error_.v[idx[a]];
@@ -196,7 +196,7 @@ class StepSolver {
     if (needs_warmup() && !warmup()) return false;
     while (error_.norm2 > tol_) {
       if (!budget_left()) return false;
-      const Matrix C = eq_.compliance(out_.state);
+      const Matrix& C = eq_.compliance(out_.state);
       int inner = 0, halvings = 0, n_used = 0;
       double alpha_used = 1.0;
       const Vector pl = predict(C, inner, halvings, n_used, alpha_used);
@@ -227,6 +227,20 @@ class StepSolver {
     return true;
   }
 
+  // q(p + dp) - q(p) = (s + C dp / 2) . dp < 0, over the non-zeros of dp only.
+  static bool decreases_q(const Matrix& C, const Vector& s, const Vector& dp) {
+    std::vector<int> nz;
+    for (int j = 0; j < dp.size(); ++j)
+      if (dp[j] != 0.0) nz.push_back(j);
+    double change = 0.0;
+    for (int a : nz) {
+      double cdp = 0.0;
+      for (int b : nz) cdp += C(a, b) * dp[b];
+      change += (s[a] + 0.5 * cdp) * dp[a];
+    }
+    return change < 0;
+  }
+
   // eq. 13 iterated on s(p) = s + C (p - p0), accepted by the decrease of
   // q(p) = p.C.p/2 + (s - C p0).p; returns the predicted force.
   Vector predict(const Matrix& C, int& inner, int& halvings, int& n_used, double& alpha_used) {
@@ -246,7 +260,7 @@ class StepSolver {
         double a = 1.0;
         for (int k = 0; k <= params_.max_halvings; ++k, a *= 0.5) {
           dp = project_forces(problem_, pl, pl - a * dir.d, e, out_.tau) - pl;
-          if ((sl + 0.5 * C * dp).dot(dp) < 0) {
+          if (decreases_q(C, sl, dp)) {
             descended = true;
             n_used = dir.n;
             alpha_used = dir.alpha * a;
@@ -257,7 +271,8 @@ class StepSolver {
       }
       if (!descended) break;  // stationary on the model: the real solve decides
       pl += dp;
-      sl += C * dp;
+      for (int j = 0; j < dp.size(); ++j)  // dp is zero off the active set
+        if (dp[j] != 0.0) sl += C.col(j) * dp[j];
     }
     return pl;
   }
@@ -269,7 +284,7 @@ class StepSolver {
     while (error_.norm2 > tol_) {
       if (!budget_left()) return false;
       int level = uzawa ? 1 : params_.acceleration;  // each update starts at the chosen n
-      const Matrix C = eq_.compliance(out_.state);
+      const Matrix& C = eq_.compliance(out_.state);
       const double v0 = error_.norm2;
       const ContactError e = error_;
       bool accepted = false;
@@ -317,7 +332,7 @@ class StepSolver {
     std::vector<double> norms{error_.norm2};
     for (int m = 1; m <= params_.warmup_last && error_.norm2 > tol_; ++m) {
       if (!budget_left()) return false;
-      const Matrix C = eq_.compliance(out_.state);
+      const Matrix& C = eq_.compliance(out_.state);
       const Direction dir = direction(C, error_, 1, params_.warmup_alpha);
       if (!dir.ok) break;
       const Vector pt = project_forces(problem_, out_.p, out_.p - dir.d, error_, out_.tau);

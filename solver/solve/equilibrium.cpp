@@ -173,32 +173,37 @@ EquilibriumState Equilibrium::solve(const Vector& q_guess, const Vector& p) {
   return state;
 }
 
-Matrix Equilibrium::free_t_matrix(const EquilibriumState& state) const {
-  Matrix T = Matrix::Zero(free_count_, problem_.component_count);
+void Equilibrium::fill_t_matrix(const EquilibriumState& state) {
+  t_.setZero(free_count_, problem_.component_count);
   for (size_t i = 0; i < problem_.candidates.size(); ++i) {
     const Candidate& c = problem_.candidates[i];
     const PairedPoint& pp = state.points[i];
     for (const auto& j : pp.point.jacobian) {
       const int f = free_index_[j.dof];
       if (f < 0) continue;
-      T(f, c.eta) += j.dx.dot(pp.eta);
-      if (c.xi >= 0) T(f, c.xi) += j.dx.dot(pp.xi);
+      t_(f, c.eta) += j.dx.dot(pp.eta);
+      if (c.xi >= 0) t_(f, c.xi) += j.dx.dot(pp.xi);
     }
   }
-  return T;
 }
 
-Matrix Equilibrium::compliance(const EquilibriumState& state) {
+const Matrix& Equilibrium::compliance(const EquilibriumState& state) {
   Triplets triplets;
   Vector force = Vector::Zero(state.q.size());
   problem_.body->internal_force(state.q, force, &triplets);
   lu_.compute(free_block(triplets));
   ++counters_.factorizations;
-  const Matrix T = free_t_matrix(state);
-  if (lu_.info() != Eigen::Success) return Matrix::Zero(T.cols(), T.cols());
-  const Matrix X = lu_.solve(T);
-  const Matrix C = T.transpose() * X;
-  return 0.5 * (C + C.transpose());
+  fill_t_matrix(state);
+  if (lu_.info() != Eigen::Success) {
+    c_.setZero(t_.cols(), t_.cols());
+    return c_;
+  }
+  x_ = lu_.solve(t_);
+  // T has two or three non-zeros per column: its sparse transpose makes T^T X cheap.
+  const Eigen::SparseMatrix<double> ts = t_.sparseView();
+  c_.noalias() = ts.transpose() * x_;
+  c_ = 0.5 * (c_ + c_.transpose()).eval();
+  return c_;
 }
 
 Vector Equilibrium::reactions(const EquilibriumState& state, const Vector& p) const {

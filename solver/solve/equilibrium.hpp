@@ -59,7 +59,8 @@ class Equilibrium {
   // The pairing and s at q, without solving (e.g. the reference configuration).
   EquilibriumState evaluate(const Vector& q) const;
   // C = T^T K^-1 T over all components, from the body's own tangent at state.q (symmetric).
-  Matrix compliance(const EquilibriumState& state);
+  // The reference stays valid until the next call (the storage is reused).
+  const Matrix& compliance(const EquilibriumState& state);
   // R = A(q) - lambda F - T(q) p on every dof, and (if asked) the triplets of dR/dq, with
   // the pairing evaluated at q.
   Vector residual(const Vector& q, const Vector& p, Triplets* tangent) const;
@@ -81,7 +82,7 @@ class Equilibrium {
                   Triplets* tangent) const;
   double free_residual_norm(const Vector& q, const Vector& p) const;
   Eigen::SparseMatrix<double> free_block(const Triplets& triplets) const;
-  Matrix free_t_matrix(const EquilibriumState& state) const;
+  void fill_t_matrix(const EquilibriumState& state);
 
   const Problem& problem_;
   NewtonParams params_;
@@ -93,6 +94,7 @@ class Equilibrium {
   Vector length_scales_;
   EquilibriumCounters counters_;
   Eigen::SparseLU<Eigen::SparseMatrix<double>> lu_;
+  Matrix t_, x_, c_;  // compliance work storage, reused: large blocks, no allocation per call
 };
 
 }  // namespace grip
