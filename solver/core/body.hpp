@@ -49,6 +49,10 @@ class Body {
   virtual int site_count() const = 0;
   // Reference (undeformed centre-line) position of a site.
   virtual Vec2 site_reference(int site) const = 0;
+  // The node that carries a site: its row of site_fields and its index in cells. The site
+  // itself where every node is a site (beam, membrane); a node of the contact boundary for
+  // the continuum, whose sites are a subset of its nodes.
+  virtual int site_node(int site) const { return site; }
   // The surface point of `site` on side +1 (upper) or -1 (lower), at state q.
   virtual SurfacePoint surface_point(const Vector& q, int site, int side) const = 0;
   // Surface area that a site's contact force acts on (tributary length x width).
@@ -58,6 +62,18 @@ class Body {
 
   // The generalized displacement that translates the whole body by d.
   virtual Vector rigid_translation(const Vec2& d) const = 0;
+  // An infinitesimal rigid rotation by one radian about the origin (empty if the model has
+  // none): with the translations, the motions that supports must remove.
+  virtual Vector rigid_rotation() const { return {}; }
+
+  // What the model simulates, for the result's effects block; a constant tangent lets one
+  // factorization serve every solve.
+  struct Traits {
+    bool geometric_nonlinearity = true;
+    bool plasticity = false;
+    bool constant_tangent = false;
+  };
+  virtual Traits traits() const { return {}; }
 
   // Sites of each cell, for plots and VTK: pairs for lines, four corners (counter-clockwise)
   // for quadrilaterals.

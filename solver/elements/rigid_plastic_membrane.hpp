@@ -50,7 +50,10 @@ class RigidPlasticMembrane final : public Body {
   SurfacePoint surface_point(const Vector& q, int site, int side) const override;
   double tributary_area(int site) const override;
   double characteristic_length() const override;
+  // No rigid_rotation: a membrane has no bending stiffness, so every transverse motion of a
+  // flat sheet is free until tension stiffens it; solver.start handles that state.
   Vector rigid_translation(const Vec2& d) const override;
+  Traits traits() const override { return {true, true, false}; }
   std::vector<std::vector<int>> cells() const override;
   FieldTable site_fields(const Vector& q) const override;
   FieldTable element_fields(const Vector& q) const override;

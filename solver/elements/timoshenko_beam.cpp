@@ -135,6 +135,22 @@ Vector TimoshenkoBeam::rigid_translation(const Vec2& d) const {
   return q;  // hierarchical mid values stay zero: they measure departure from linear
 }
 
+Vector TimoshenkoBeam::rigid_rotation() const {
+  // u = -y, w = x at the centre line; theta = -dw/dx = -1.
+  Vector q = Vector::Zero(dof_count());
+  for (int k = 0; k < node_count(); ++k) {
+    q[node_dof(k, 0)] = -y0_;
+    q[node_dof(k, 1)] = x_[k];
+    q[node_dof(k, 2)] = -1.0;
+  }
+  return q;
+}
+
+Body::Traits TimoshenkoBeam::traits() const {
+  const bool linear = kinematics_ == Kinematics::linear;
+  return {!linear, false, linear};
+}
+
 std::vector<std::vector<int>> TimoshenkoBeam::cells() const {
   std::vector<std::vector<int>> c;
   for (int e = 0; e < element_count(); ++e) c.push_back({e, e + 1});

@@ -43,6 +43,8 @@ class TimoshenkoBeam final : public Body {
   double characteristic_length() const override { return x_.back() - x_.front(); }
 
   Vector rigid_translation(const Vec2& d) const override;
+  Vector rigid_rotation() const override;
+  Traits traits() const override;
   std::vector<std::vector<int>> cells() const override;
   FieldTable site_fields(const Vector& q) const override;
   FieldTable element_fields(const Vector& q) const override;

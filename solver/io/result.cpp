@@ -92,10 +92,38 @@ json step_json(const Problem& problem, const StepRecord& rec) {
   return j;
 }
 
+json effects_json(const Scene& scene, const RunResult& run) {
+  const Problem& problem = scene.problem;
+  const Body::Traits traits = problem.body->traits();
+  bool friction = false, moving = false;
+  int tangential = 0;
+  for (const auto& o : problem.obstacles) {
+    friction |= o.frictional;
+    for (const Vec2& t : o.translations) moving |= t.norm() > 0;
+  }
+  for (const Candidate& c : problem.candidates) tangential += c.xi >= 0;
+  long passes = 0;
+  for (const auto& rec : run.steps) passes += rec.passes;
+  return {{"friction", friction},
+          {"geometric_nonlinearity", traits.geometric_nonlinearity},
+          {"plasticity", traits.plasticity},
+          {"moving_obstacles", moving},
+          {"constant_tangent", traits.constant_tangent},
+          {"contact_candidates", problem.candidates.size()},
+          {"contact_unknowns", problem.component_count},
+          {"unknowns_per_contact_point", tangential > 0 ? 2 : 1},
+          {"counters",
+           {{"factorizations", run.counters.factorizations},
+            {"equilibrium_solves", run.counters.solves},
+            {"newton_iterations", run.counters.newton_iterations},
+            {"tau_passes", passes}}}};
+}
+
 json result_json(const Scene& scene, const RunResult& run) {
   json steps = json::array();
   for (const auto& rec : run.steps) steps.push_back(step_json(scene.problem, rec));
   return {{"scene", scene.effective},
+          {"effects", effects_json(scene, run)},
           {"mesh", {{"cells", scene.problem.body->cells()}}},
           {"summary",
            {{"completed", run.completed}, {"reason", run.reason}, {"steps", run.steps.size()},

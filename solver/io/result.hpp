@@ -13,6 +13,9 @@ nlohmann::json step_finished_event(const StepRecord& rec);
 
 // One step's fields: nodes, elements, reactions, contact points, obstacle positions.
 nlohmann::json step_json(const Problem& problem, const StepRecord& rec);
+// What was simulated (friction, nonlinearity, plasticity, moving obstacles, contact unknowns)
+// and the work it took (factorizations, equilibrium solves).
+nlohmann::json effects_json(const Scene& scene, const RunResult& run);
 // The whole result: the effective scene, a summary and every step.
 nlohmann::json result_json(const Scene& scene, const RunResult& run);
 

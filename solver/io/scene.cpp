@@ -1,5 +1,6 @@
 #include "solver/io/scene.hpp"
 
+#include <Eigen/LU>
 #include <cmath>
 #include <fstream>
 #include <numbers>
@@ -107,6 +108,46 @@ void read_start(Reader& r, json& scene, Problem& problem) {
   for (const Constraint& c : problem.constraints)
     if (c.dof == dof) r.error(sp + "/node", "that component of node " + std::to_string(node) + " is a support already");
   if (dof >= 0 && obstacle >= 0) problem.start = StartUp{dof, value, node, obstacle};
+}
+
+std::string format_point(const Vec2& p) {
+  std::ostringstream os;
+  os << "(" << p.x() << ", " << p.y() << ")";
+  return os.str();
+}
+
+// ALGORITHM.md section 7: the scheme solves equilibrium for given contact forces, so the
+// supports alone must remove every rigid-body motion. Names each motion left free.
+void check_rigid_modes(Reader& r, const Problem& problem) {
+  const Body& body = *problem.body;
+  const double L = body.characteristic_length();
+  std::vector<Vector> modes = {body.rigid_translation(Vec2::UnitX()), body.rigid_translation(Vec2::UnitY())};
+  if (const Vector rot = body.rigid_rotation(); rot.size()) modes.push_back(rot / L);  // scaled to a length
+  std::vector<int> fixed;
+  for (const Constraint& c : problem.constraints) fixed.push_back(c.dof);
+  Matrix R = Matrix::Zero(std::max<size_t>(fixed.size(), 1), modes.size());
+  for (size_t i = 0; i < fixed.size(); ++i)
+    for (size_t m = 0; m < modes.size(); ++m) R(i, m) = modes[m][fixed[i]];
+  Eigen::FullPivLU<Matrix> lu(R);
+  lu.setThreshold(1e-9);
+  const Matrix free = lu.kernel();
+  if (lu.rank() == static_cast<Eigen::Index>(modes.size())) return;
+  for (Eigen::Index k = 0; k < free.cols(); ++k) {
+    Vector c = free.col(k).normalized();
+    const double omega = c.size() > 2 ? c[2] / L : 0.0;
+    std::string motion;
+    if (std::abs(omega) * L < 1e-9) {
+      const Vec2 d = Vec2(c[0], c[1]).normalized();
+      motion = std::abs(d.y()) < 1e-9 ? "translate along x" : std::abs(d.x()) < 1e-9 ? "translate along y"
+                                                                                   : "translate along " + format_point(d);
+    } else {
+      motion = "rotate about " + format_point(Vec2(-c[1] / omega, c[0] / omega));
+    }
+    r.error("/body/supports", "leave the body free to " + motion +
+                                  ": contact cannot hold it, since the contact scheme solves equilibrium for "
+                                  "given contact forces (ALGORITHM.md section 7); fix a component that this "
+                                  "motion moves, or drive the body by a prescribed displacement");
+  }
 }
 
 void read_solver(Reader& r, json& scene, SteppingParams& params) {
@@ -262,6 +303,7 @@ Scene read_scene(const nlohmann::json& input) {
     static const std::vector<std::pair<std::string, ModelReader>> models = {
         {"timoshenko_beam", scene_io::read_timoshenko_beam},
         {"rigid_plastic_membrane", scene_io::read_rigid_plastic_membrane},
+        {"continuum", scene_io::read_continuum},
     };
     std::vector<std::string> names;
     for (const auto& m : models) names.push_back(m.first);
@@ -300,6 +342,7 @@ Scene read_scene(const nlohmann::json& input) {
   if (scene.problem.body)
     for (size_t k = 0; k < r.cases.size(); ++k) scene_io::case_load(scene.problem, static_cast<int>(k));
   read_solver(r, e, scene.params);
+  if (r.issues.empty() && scene.problem.body) check_rigid_modes(r, scene.problem);
   if (r.issues.empty()) read_start(r, e, scene.problem);
   if (!r.issues.empty()) throw SceneErrors(std::move(r.issues));
   add_candidates(scene.problem);

@@ -14,6 +14,7 @@ Equilibrium::Equilibrium(const Problem& problem, NewtonParams params, std::vecto
   for (int i = 0; i < n; ++i)
     if (free_index_[i] == 0) free_index_[i] = free_count_++;
   length_scales_ = problem.body->dof_length_scales();
+  constant_tangent_ = problem.body->traits().constant_tangent;
   zeta_previous_.assign(problem.candidates.size(), 0.0);
 }
 
@@ -125,17 +126,24 @@ EquilibriumState Equilibrium::solve(const Vector& q_guess, const Vector& p) {
   for (int it = 1; it <= params_.max_iterations; ++it) {
     pair(state.q, state);
     triplets.clear();
-    const Vector r = residual(state.q, state, p, &triplets);
+    const Vector r = residual(state.q, state, p, constant_tangent_ ? nullptr : &triplets);
     Vector r_free(free_count_);
     for (int i = 0; i < r.size(); ++i)
       if (free_index_[i] >= 0) r_free[free_index_[i]] = r[i];
-    lu_.compute(free_block(triplets));
-    ++counters_.factorizations;
-    if (lu_.info() != Eigen::Success) {
-      state.reason = "singular tangent stiffness in Newton iteration " + std::to_string(it);
-      return state;
+    if (constant_tangent_) {
+      if (!factorize_body_tangent(state.q)) {
+        state.reason = "singular stiffness: the supports do not hold the body";
+        return state;
+      }
+    } else {
+      lu_.compute(free_block(triplets));
+      ++counters_.factorizations;
+      if (lu_.info() != Eigen::Success) {
+        state.reason = "singular tangent stiffness in Newton iteration " + std::to_string(it);
+        return state;
+      }
     }
-    const Vector dq_free = lu_.solve(-r_free);
+    const Vector dq_free = constant_tangent_ ? Vector(body_lu_.solve(-r_free)) : Vector(lu_.solve(-r_free));
     state.newton_iterations = it;
     ++counters_.newton_iterations;
     Vector dq = Vector::Zero(state.q.size());
@@ -187,18 +195,24 @@ void Equilibrium::fill_t_matrix(const EquilibriumState& state) {
   }
 }
 
-const Matrix& Equilibrium::compliance(const EquilibriumState& state) {
+bool Equilibrium::factorize_body_tangent(const Vector& q) {
+  if (constant_tangent_ && body_factorized_) return body_lu_.info() == Eigen::Success;
   Triplets triplets;
-  Vector force = Vector::Zero(state.q.size());
-  problem_.body->internal_force(state.q, force, &triplets);
-  lu_.compute(free_block(triplets));
+  Vector force = Vector::Zero(q.size());
+  problem_.body->internal_force(q, force, &triplets);
+  body_lu_.compute(free_block(triplets));
   ++counters_.factorizations;
+  body_factorized_ = true;
+  return body_lu_.info() == Eigen::Success;
+}
+
+const Matrix& Equilibrium::compliance(const EquilibriumState& state) {
   fill_t_matrix(state);
-  if (lu_.info() != Eigen::Success) {
+  if (!factorize_body_tangent(state.q)) {
     c_.setZero(t_.cols(), t_.cols());
     return c_;
   }
-  x_ = lu_.solve(t_);
+  x_ = body_lu_.solve(t_);
   // T has two or three non-zeros per column: its sparse transpose makes T^T X cheap.
   const Eigen::SparseMatrix<double> ts = t_.sparseView();
   c_.noalias() = ts.transpose() * x_;

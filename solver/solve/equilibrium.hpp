@@ -93,6 +93,12 @@ class Equilibrium {
   int free_count_ = 0;
   Vector length_scales_;
   EquilibriumCounters counters_;
+  // The body's own tangent, factorized once when it is constant (linear kinematics): then
+  // Newton is a modified Newton on it and the compliance reuses it.
+  bool factorize_body_tangent(const Vector& q);
+  bool constant_tangent_ = false;
+  bool body_factorized_ = false;
+  Eigen::SparseLU<Eigen::SparseMatrix<double>> body_lu_;
   Eigen::SparseLU<Eigen::SparseMatrix<double>> lu_;
   Matrix t_, x_, c_;  // compliance work storage, reused: large blocks, no allocation per call
 };

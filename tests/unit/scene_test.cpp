@@ -1,0 +1,140 @@
+// Reading scenes: every error with the JSON pointer of its value, all of them collected;
+// defaults filled in; only the effects a scene calls for are built.
+#include <gtest/gtest.h>
+
+#include "solver/io/result.hpp"
+#include "tests/support/scenes.hpp"
+
+namespace grip {
+namespace {
+
+using nlohmann::json;
+using testing::example_scene;
+
+std::vector<SceneIssue> issues_of(const json& scene) {
+  try {
+    read_scene(scene);
+  } catch (const SceneErrors& e) {
+    return e.issues();
+  }
+  return {};
+}
+
+bool has(const std::vector<SceneIssue>& issues, const std::string& pointer, const std::string& words = "") {
+  for (const auto& i : issues)
+    if (i.pointer == pointer && i.detail.find(words) != std::string::npos) return true;
+  return false;
+}
+
+TEST(SceneReader, CollectsEveryErrorWithItsPointer) {
+  json j = example_scene("beam-on-cylinder");
+  j["body"]["material"]["poisson"] = 0.62;
+  j["body"]["section"]["depth"] = -2;
+  j["obstacles"][0]["shape"]["radius"] = "fifty";
+  j["obstacles"][0]["friction"] = -0.1;
+  j["steps"] = 0;
+  const auto issues = issues_of(j);
+  EXPECT_TRUE(has(issues, "/body/material/poisson", "0.62")) ;
+  EXPECT_TRUE(has(issues, "/body/section/depth", "not positive"));
+  EXPECT_TRUE(has(issues, "/obstacles/0/shape/radius", "not a number"));
+  EXPECT_TRUE(has(issues, "/obstacles/0/friction", "negative"));
+  EXPECT_TRUE(has(issues, "/steps"));
+  EXPECT_GE(issues.size(), 5u);
+}
+
+TEST(SceneReader, NamesTheRigidMotionThatSupportsLeaveFree) {
+  json pinned = example_scene("beam-on-cylinder");
+  pinned["body"]["supports"] = json::array({{{"node", 0}, {"fix", {"u", "w"}}}});
+  const auto a = issues_of(pinned);
+  ASSERT_EQ(a.size(), 1u);
+  EXPECT_TRUE(has(a, "/body/supports", "rotate about (0, 0)"));
+
+  json sliding = example_scene("beam-on-cylinder");
+  sliding["body"]["supports"] = json::array({{{"node", 0}, {"fix", {"w", "theta"}}}});
+  EXPECT_TRUE(has(issues_of(sliding), "/body/supports", "translate along x"));
+
+  json loose = example_scene("beam-on-cylinder");
+  loose["body"].erase("supports");
+  EXPECT_EQ(issues_of(loose).size(), 3u);  // two translations and a rotation
+
+  json sheet = example_scene("sheet-stretching");  // pole x and clamp x, y hold the sheet
+  EXPECT_TRUE(issues_of(sheet).empty());
+}
+
+TEST(SceneReader, MembraneNeedsAStart) {
+  json j = example_scene("sheet-stretching");
+  j["solver"].erase("start");
+  EXPECT_TRUE(has(issues_of(j), "/solver/start", "no transverse stiffness"));
+  j = example_scene("sheet-stretching");
+  j["solver"]["start"]["obstacle"] = "anvil";
+  EXPECT_TRUE(has(issues_of(j), "/solver/start/obstacle", "anvil"));
+}
+
+TEST(SceneReader, StagesNameKnownCasesAndObstacles) {
+  json j = example_scene("beam-on-cylinder");
+  j.erase("steps");
+  j["stages"] = json::array({{{"steps", 2}, {"factors", {{"main", 1}}}, {"friction", {{"cylinder", 0}}}},
+                             {{"steps", 3}, {"factors", {{"shear", 1}}}, {"friction", {{"anvil", 0.1}}}}});
+  const auto issues = issues_of(j);
+  EXPECT_TRUE(has(issues, "/stages/1/factors/shear", "names no load case"));
+  EXPECT_TRUE(has(issues, "/stages/1/friction/anvil", "names no obstacle"));
+}
+
+TEST(SceneReader, StagesRampTheirCasesFromWherePreviousStagesLeftThem) {
+  json j = example_scene("beam-on-cylinder");
+  j.erase("steps");
+  j["stages"] = json::array({{{"steps", 2}, {"factors", {{"main", 1}}}}, {{"steps", 4}, {"factors", {{"main", 0}}}, {"friction", {{"cylinder", 0.5}}}}});
+  const Scene s = read_scene(j);
+  ASSERT_EQ(s.steps.size(), 6u);
+  const std::vector<double> expected = {0.5, 1.0, 0.75, 0.5, 0.25, 0.0};
+  for (size_t k = 0; k < 6; ++k) {
+    EXPECT_DOUBLE_EQ(s.steps[k].factors[0], expected[k]);
+    EXPECT_DOUBLE_EQ(s.steps[k].friction[0], k < 2 ? 0.2 : 0.5);
+  }
+}
+
+TEST(SceneReader, FillsDefaultsIntoTheEffectiveScene) {
+  json j = example_scene("beam-on-cylinder");
+  j.erase("solver");
+  const Scene s = read_scene(j);
+  EXPECT_EQ(s.effective["solver"]["contact"]["method"], "cev");
+  EXPECT_EQ(s.effective["solver"]["contact"]["tolerance"], 1e-8);
+  EXPECT_EQ(s.effective["body"]["section"]["shear_factor"], 5.0 / 6.0);
+  EXPECT_EQ(s.effective["obstacles"][0]["motion"], json::array());
+  // The effective scene reads back to the same problem.
+  const Scene again = read_scene(s.effective);
+  EXPECT_EQ(again.effective, s.effective);
+}
+
+// Only the effects a scene calls for: no friction means no tangential unknowns and a single
+// tau pass per step; linear kinematics means one factorization of the stiffness.
+TEST(SceneEffects, FrictionlessHasHalfTheUnknownsAndNoTauPasses) {
+  json frictionless = example_scene("beam-on-cylinder");
+  frictionless["obstacles"][0]["friction"] = 0;
+  const auto a = testing::solve_scene(example_scene("beam-on-cylinder"));
+  const auto b = testing::solve_scene(frictionless);
+  const json ea = effects_json(a.scene, a.run), eb = effects_json(b.scene, b.run);
+  EXPECT_EQ(ea["unknowns_per_contact_point"], 2);
+  EXPECT_EQ(eb["unknowns_per_contact_point"], 1);
+  EXPECT_EQ(2 * eb["contact_unknowns"].get<int>(), ea["contact_unknowns"].get<int>());
+  EXPECT_EQ(eb["counters"]["tau_passes"], 20);  // one per step
+  EXPECT_GT(ea["counters"]["tau_passes"].get<int>(), 20);
+  EXPECT_TRUE(ea["friction"]);
+  EXPECT_FALSE(eb["friction"]);
+  EXPECT_TRUE(ea["geometric_nonlinearity"]);
+}
+
+TEST(SceneEffects, LinearKinematicsFactorizesOnce) {
+  json j = example_scene("beam-on-cylinder");
+  j["body"]["kinematics"] = "linear";
+  const auto s = testing::solve_scene(j);
+  ASSERT_TRUE(s.run.completed) << s.run.reason;
+  const json e = effects_json(s.scene, s.run);
+  EXPECT_FALSE(e["geometric_nonlinearity"]);
+  EXPECT_TRUE(e["constant_tangent"]);
+  EXPECT_EQ(e["counters"]["factorizations"], 1);
+  EXPECT_GT(e["counters"]["equilibrium_solves"].get<int>(), 20);
+}
+
+}  // namespace
+}  // namespace grip
