@@ -1,15 +1,43 @@
 #include "solver/core/problem.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
 namespace grip {
 
-void add_candidates(Problem& problem) {
+namespace {
+
+// The obstacle positions to test reach at: the start, and along each stretch of the path
+// (motions are linear in the factors, so a few samples per stretch follow it closely).
+std::vector<LoadFactors> sampled_path(const std::vector<LoadStep>& path) {
+  std::vector<LoadFactors> samples;
+  if (path.empty()) return samples;
+  samples.push_back(LoadFactors(path.front().factors.size(), 0.0));
+  const size_t stride = std::max<size_t>(1, path.size() / 256);
+  for (size_t k = 0; k < path.size(); ++k)
+    if (k % stride == 0 || k + 1 == path.size() || path[k].stage != path[std::min(k + 1, path.size() - 1)].stage)
+      samples.push_back(path[k].factors);
+  return samples;
+}
+
+}  // namespace
+
+void add_candidates(Problem& problem, const std::vector<LoadStep>& path, double reach) {
   problem.candidates.clear();
   int next = 0;
   const Body& body = *problem.body;
+  const std::vector<LoadFactors> samples = sampled_path(path);
   for (int o = 0; o < static_cast<int>(problem.obstacles.size()); ++o) {
     const ObstacleInstance& obstacle = problem.obstacles[o];
     for (int site = 0; site < body.site_count(); ++site) {
       const Vec2 x = body.site_reference(site);
+      if (reach > 0 && !samples.empty()) {
+        double nearest = std::numeric_limits<double>::infinity();
+        for (const LoadFactors& f : samples)
+          nearest = std::min(nearest, std::abs(obstacle.shape->project(x - obstacle.offset(f)).gap));
+        if (nearest > reach) continue;
+      }
       const Projection proj = obstacle.shape->project(x);
       // The side whose outward surface normal (+y or -y) points toward the obstacle.
       const int side = (proj.point - x).y() >= 0 ? +1 : -1;

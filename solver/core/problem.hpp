@@ -82,6 +82,10 @@ struct Problem {
 
 // Pairs every site with every obstacle, on the surface side that faces the obstacle in the
 // reference configuration; tangential unknowns only where the obstacle has friction.
-void add_candidates(Problem& problem);
+//
+// With a load path and a reach: a site is paired with an obstacle only if the obstacle comes
+// within `reach` of the site's reference position somewhere along the path (an obstacle that
+// cannot reach the body contributes no candidates). reach <= 0: every site is paired.
+void add_candidates(Problem& problem, const std::vector<LoadStep>& path = {}, double reach = 0.0);
 
 }  // namespace grip

@@ -44,36 +44,40 @@ json table_json(const FieldTable& t, const char* index_name) {
 
 }  // namespace
 
-json step_json(const Problem& problem, const StepRecord& rec) {
+json step_json(const Problem& problem, const StepRecord& rec, const OutputOptions& output) {
   const Body& body = *problem.body;
   json j = step_finished_event(rec);
   j.erase("type");
   j["inner_iterations"] = rec.inner_iterations;
   j["cuts"] = rec.cuts;
   if (!rec.epsilon_used.empty()) j["epsilon"] = rec.epsilon_used;
-  json history = json::array();
-  for (const auto& ev : rec.history) {
-    json h = iteration_event(ev);
-    h.erase("type");
-    h.erase("step");
-    history.push_back(h);
+  if (output.wants("history")) {
+    json history = json::array();
+    for (const auto& ev : rec.history) {
+      json h = iteration_event(ev);
+      h.erase("type");
+      h.erase("step");
+      history.push_back(h);
+    }
+    j["history"] = history;
   }
-  j["history"] = history;
-  if (rec.state.q.size() == 0) return j;
-  if (!rec.site_fields.rows.empty()) j["nodes"] = table_json(rec.site_fields, "node");
-  if (!rec.element_fields.rows.empty()) j["elements"] = table_json(rec.element_fields, "element");
+  // A step whose fields were not recorded keeps only its summary.
+  if (rec.state.q.size() == 0 || rec.site_fields.rows.empty()) return j;
+  if (output.wants("nodes")) j["nodes"] = table_json(rec.site_fields, "node");
+  if (output.wants("elements")) j["elements"] = table_json(rec.element_fields, "element");
   json obstacles = json::array();
   for (const auto& o : problem.obstacles) {
     const Vec2 off = o.offset(rec.factors);
     obstacles.push_back({{"name", o.name}, {"offset", {off.x(), off.y()}}});
   }
   j["obstacles"] = obstacles;
-  if (rec.reactions.size()) {
+  if (rec.reactions.size() && output.wants("reactions")) {
     json reactions = json::array();
     for (const Constraint& c : problem.constraints)
       reactions.push_back({{"dof", c.dof}, {"force", rec.reactions[c.dof]}});
     j["reactions"] = reactions;
   }
+  if (!output.wants("contact_points")) return j;
   json points = json::array();
   for (size_t i = 0; i < problem.candidates.size(); ++i) {
     const Candidate& c = problem.candidates[i];
@@ -121,7 +125,7 @@ json effects_json(const Scene& scene, const RunResult& run) {
 
 json result_json(const Scene& scene, const RunResult& run) {
   json steps = json::array();
-  for (const auto& rec : run.steps) steps.push_back(step_json(scene.problem, rec));
+  for (const auto& rec : run.steps) steps.push_back(step_json(scene.problem, rec, scene.output));
   return {{"scene", scene.effective},
           {"effects", effects_json(scene, run)},
           {"mesh", {{"cells", scene.problem.body->cells()}}},

@@ -12,7 +12,8 @@ nlohmann::json step_started_event(int step, double load_factor);
 nlohmann::json step_finished_event(const StepRecord& rec);
 
 // One step's fields: nodes, elements, reactions, contact points, obstacle positions.
-nlohmann::json step_json(const Problem& problem, const StepRecord& rec);
+// Fields only where the step was recorded (see SteppingParams::record_fields) and wanted.
+nlohmann::json step_json(const Problem& problem, const StepRecord& rec, const OutputOptions& output = {});
 // What was simulated (friction, nonlinearity, plasticity, moving obstacles, contact unknowns)
 // and the work it took (factorizations, equilibrium solves).
 nlohmann::json effects_json(const Scene& scene, const RunResult& run);

@@ -168,6 +168,9 @@ void read_solver(Reader& r, json& scene, SteppingParams& params) {
     c.max_tau_passes = r.integer(*contact, cp, "max_tau_passes", 1, 1000, c.max_tau_passes);
     c.tau_tolerance = r.positive(*contact, cp, "tau_tolerance", c.tau_tolerance);
     c.uzawa_alpha = r.positive(*contact, cp, "uzawa_alpha", c.uzawa_alpha);
+    // 0: the body's characteristic length (written back as 0, meaning "automatic").
+    params.contact_reach = r.number(*contact, cp, "reach", 0.0);
+    if (params.contact_reach < 0) r.error(cp + "/reach", "is negative");
     if (json* acc = r.object(*contact, cp, "acceleration", false)) {
       const std::string ap = cp + "/acceleration";
       if (!acc->contains("n")) (*acc)["n"] = "inf";
@@ -187,6 +190,40 @@ void read_solver(Reader& r, json& scene, SteppingParams& params) {
   if (json* newton = r.object(*solver, sp, "newton", false))
     params.newton.max_iterations = r.integer(*newton, sp + "/newton", "max_iterations", 1, 1000, params.newton.max_iterations);
   params.max_cuts = r.integer(*solver, sp, "max_cuts", 0, 30, params.max_cuts);
+}
+
+// output: {"steps": "all" | "last" | [step numbers, 1-based], "fields": [...]}.
+void read_output(Reader& r, json& scene, Scene& out) {
+  json* output = r.object(scene, "", "output", false);
+  if (!output) return;
+  const size_t n = out.steps.size();
+  if (!output->contains("steps")) (*output)["steps"] = "all";
+  const json& steps = (*output)["steps"];
+  if (steps == "all") {
+    out.params.record_fields.clear();
+  } else if (steps == "last") {
+    out.params.record_fields.assign(n, 0);
+    if (n) out.params.record_fields.back() = 1;
+  } else if (steps.is_array()) {
+    out.params.record_fields.assign(n, 0);
+    for (size_t i = 0; i < steps.size(); ++i) {
+      const int k = r.integer_value(steps[i], "/output/steps/" + std::to_string(i), 1, static_cast<int>(std::max<size_t>(n, 1)));
+      if (n) out.params.record_fields[k - 1] = 1;
+    }
+  } else {
+    r.error("/output/steps", show(steps) + " is not \"all\", \"last\" or a list of step numbers");
+  }
+  if (!output->contains("fields")) (*output)["fields"] = OutputOptions::kAllFields;
+  json* fields = r.array(*output, "/output", "fields", false);
+  if (!fields) return;
+  out.output.fields.clear();
+  for (size_t i = 0; i < fields->size(); ++i) {
+    const json& f = (*fields)[i];
+    if (f.is_string() && std::find(OutputOptions::kAllFields.begin(), OutputOptions::kAllFields.end(), f.get<std::string>()) != OutputOptions::kAllFields.end())
+      out.output.fields.push_back(f.get<std::string>());
+    else
+      r.error("/output/fields/" + std::to_string(i), show(f) + " is not one of " + Reader::list(OutputOptions::kAllFields));
+  }
 }
 
 // One obstacle motion: a translation at factor 1 of its load case.
@@ -342,10 +379,13 @@ Scene read_scene(const nlohmann::json& input) {
   if (scene.problem.body)
     for (size_t k = 0; k < r.cases.size(); ++k) scene_io::case_load(scene.problem, static_cast<int>(k));
   read_solver(r, e, scene.params);
+  read_output(r, e, scene);
   if (r.issues.empty() && scene.problem.body) check_rigid_modes(r, scene.problem);
   if (r.issues.empty()) read_start(r, e, scene.problem);
   if (!r.issues.empty()) throw SceneErrors(std::move(r.issues));
-  add_candidates(scene.problem);
+  const double reach = scene.params.contact_reach > 0 ? scene.params.contact_reach
+                                                      : scene.problem.body->characteristic_length();
+  add_candidates(scene.problem, scene.steps, reach);
   return scene;
 }
 

@@ -2,6 +2,7 @@
 // Scene JSON -> typed problem: the one place where a scene's names become types. Every error
 // names the JSON pointer of the offending value; all errors are collected, not only the first.
 #include <nlohmann/json.hpp>
+#include <algorithm>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -25,12 +26,23 @@ class SceneErrors : public std::runtime_error {
   std::vector<SceneIssue> issues_;
 };
 
+// What the result keeps: fields only for the chosen steps, and only the chosen kinds.
+struct OutputOptions {
+  static inline const std::vector<std::string> kAllFields = {"nodes", "elements", "contact_points",
+                                                             "reactions", "history"};
+  std::vector<std::string> fields = kAllFields;
+  bool wants(const std::string& field) const {
+    return std::find(fields.begin(), fields.end(), field) != fields.end();
+  }
+};
+
 struct Scene {
   nlohmann::json effective;  // the scene with every default filled in
   Problem problem;
   std::vector<std::string> load_cases;  // names, in the order of LoadStep::factors
   std::vector<LoadStep> steps;
-  SteppingParams params;
+  SteppingParams params;  // params.record_fields: the steps whose fields are kept
+  OutputOptions output;
 };
 
 // Throws SceneErrors listing every problem found.

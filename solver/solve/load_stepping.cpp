@@ -129,8 +129,10 @@ RunResult run_load_steps(Problem& problem, const std::vector<LoadStep>& steps,
         rec.p = out.p;
         rec.tau = out.tau;
         rec.reactions = eq.reactions(out.state, out.p);
-        rec.site_fields = problem.body->site_fields(out.state.q);
-        rec.element_fields = problem.body->element_fields(out.state.q);
+        if (params.record_fields.empty() || params.record_fields[k]) {
+          rec.site_fields = problem.body->site_fields(out.state.q);
+          rec.element_fields = problem.body->element_fields(out.state.q);
+        }
       }
       // Commit.
       start_q.reset();

@@ -14,6 +14,11 @@ struct SteppingParams {
   ContactParams contact;
   NewtonParams newton;
   int max_cuts = 5;  // a failed increment is halved at most this many times in a row
+  // An obstacle pairs with a site only if it comes this close over the load path (length;
+  // 0: the body's characteristic length). Read by the scene layer when building candidates.
+  double contact_reach = 0.0;
+  // Steps whose fields (nodes, elements) are kept; empty: every step.
+  std::vector<char> record_fields;
 };
 
 struct StepRecord {

@@ -138,3 +138,40 @@ TEST(SceneEffects, LinearKinematicsFactorizesOnce) {
 
 }  // namespace
 }  // namespace grip
+
+namespace grip {
+namespace {
+
+TEST(SceneEffects, AnObstacleThatCannotReachTheBodyHasNoCandidates) {
+  json j = testing::example_scene("beam-on-cylinder");
+  j["obstacles"].push_back({{"name", "far"}, {"shape", {{"type", "circle"}, {"centre", {0, 500}}, {"radius", 1}}}});
+  j["obstacles"].push_back({{"name", "arriving"},
+                            {"shape", {{"type", "circle"}, {"centre", {15, 500}}, {"radius", 1}}},
+                            {"motion", {{"translation", {0, -495}}}}});
+  const Scene s = read_scene(j);
+  int far = 0, arriving = 0;
+  for (const Candidate& c : s.problem.candidates) {
+    far += s.problem.obstacles[c.obstacle].name == "far";
+    arriving += s.problem.obstacles[c.obstacle].name == "arriving";
+  }
+  EXPECT_EQ(far, 0);
+  EXPECT_EQ(arriving, 41);  // it comes down onto the beam over the steps
+}
+
+TEST(SceneEffects, OutputsNotRequestedAreNotComputedOrStored) {
+  json j = testing::example_scene("beam-on-cylinder");
+  j["steps"] = 4;
+  j["output"] = {{"steps", "last"}, {"fields", {"contact_points"}}};
+  const auto s = testing::solve_scene(j);
+  ASSERT_TRUE(s.run.completed);
+  const json r = result_json(s.scene, s.run);
+  for (size_t k = 0; k < 4; ++k) {
+    EXPECT_EQ(s.run.steps[k].site_fields.rows.empty(), k < 3);  // computed for the last step only
+    EXPECT_FALSE(r["steps"][k].contains("nodes"));
+    EXPECT_FALSE(r["steps"][k].contains("history"));
+    EXPECT_EQ(r["steps"][k].contains("contact_points"), k == 3);
+  }
+}
+
+}  // namespace
+}  // namespace grip
