@@ -1,0 +1,30 @@
+#pragma once
+// JSON Schema (draft 7) validation of grip's documents against the schemas in schemas/,
+// which the build embeds in the library (no file is read at run time). Every error is a
+// SceneIssue: the JSON pointer of the offending value ("/body/material/poisson"; "/" for
+// the document itself) and a plain sentence ("0.62 is not below 0.5"). All errors are
+// reported, sorted by pointer (array indices numerically), each once.
+//
+// The schemas may annotate a subschema with `errorMessage` (the ajv-errors keyword, ignored
+// by other validators): it replaces the generic sentence for that subschema's own failures.
+#include <nlohmann/json.hpp>
+#include <string_view>
+#include <vector>
+
+#include "solver/io/scene.hpp"
+
+namespace grip {
+
+enum class SchemaName { scene, event, result, job };
+
+// "scene", "event", "result", "job": the file is schemas/<name>.schema.json.
+std::string_view schema_file_stem(SchemaName which);
+
+// The schema as written in schemas/ (the text the build embedded).
+std::string_view schema_text(SchemaName which);
+
+// Errors of `document` against the schema; empty when it is valid. Thread-safe; the schemas
+// are parsed once, on first use.
+std::vector<SceneIssue> validate_against(const nlohmann::json& document, SchemaName which);
+
+}  // namespace grip
