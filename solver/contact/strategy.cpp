@@ -52,6 +52,7 @@ class StepSolver {
 
   StepOutcome run(const Vector& q_guess, const Vector& p_start, const Vector& p_star_in) {
     eq_.params().displacement_tolerance = params_.newton_fraction * tol_;
+    if (params_.method == ContactMethod::penalty) return run_penalty(q_guess, p_start);
     const long solves0 = eq_.counters().solves, newton0 = eq_.counters().newton_iterations;
     out_.p = p_start;
     Vector p_star = p_star_in;
@@ -94,6 +95,36 @@ class StepSolver {
   }
 
  private:
+  // The penalty baseline: one Newton solve with p = p(q); the contact error of eq. 10 (with
+  // tau = nu |p_eta|) measures how far the penalty answer is from the contact conditions.
+  StepOutcome run_penalty(const Vector& q_guess, const Vector& p_start) {
+    const long solves0 = eq_.counters().solves, newton0 = eq_.counters().newton_iterations;
+    PenaltyLaw law;
+    law.normal = params_.penalty_normal > 0 ? params_.penalty_normal
+                                            : params_.penalty_factor * eq_.stiffness_scale(q_guess);
+    law.tangential = params_.penalty_tangential > 0 ? params_.penalty_tangential : law.normal;
+    law.previous = p_start;
+    eq_.set_penalty(law);
+    EquilibriumState s = eq_.solve(q_guess, p_start);
+    eq_.set_penalty(std::nullopt);
+    pass_ = out_.passes = 1;
+    if (!s.converged) {
+      fail("equilibrium solve failed: " + s.reason);
+    } else {
+      Vector p_star = Vector::Zero(problem_.component_count);
+      for (const Candidate& c : problem_.candidates) p_star[c.eta] = s.p[c.eta];
+      out_.tau = friction_bounds(problem_, p_star);
+      const Vector p = s.p;
+      accept(std::move(s), p);
+      out_.converged = true;
+      emit(1, 0, 0, 0, 0.0);
+    }
+    out_.solves = static_cast<int>(eq_.counters().solves - solves0);
+    out_.newton_iterations = static_cast<int>(eq_.counters().newton_iterations - newton0);
+    out_.v2 = error_.norm2;
+    return std::move(out_);
+  }
+
   bool fresh_solve(const Vector& q) {
     if (!budget_left()) return false;
     EquilibriumState s = eq_.solve(q, out_.p);

@@ -1,6 +1,7 @@
 #pragma once
 // Contact strategies: the paper's accelerated contact error vector scheme `cev` (ALGORITHM.md
-// sections 2-5, 8, 9) and `uzawa` (the same literal loop with n = 1 and a fixed alpha). Each
+// sections 2-5, 8, 9), `uzawa` (the same literal loop with n = 1 and a fixed alpha), and the
+// `penalty` baseline (one Newton solve with a penalty law; its error falls as k grows). Each
 // solves one load step given an equilibrium oracle, and reports every real solve to an
 // observer.
 #include <functional>
@@ -11,7 +12,7 @@
 
 namespace grip {
 
-enum class ContactMethod { cev, uzawa };
+enum class ContactMethod { cev, uzawa, penalty };
 enum class ContactLoop { inner, paper };  // inner: section 5's default; paper: the literal loop
 enum class EpsilonSource { exact, warmup };
 
@@ -42,6 +43,11 @@ struct ContactParams {
   // Newton's displacement tolerance, as a fraction of the contact tolerance: the contact
   // error has a floor of about ||K^-1|| x the Newton residual (section 9).
   double newton_fraction = 1e-3;
+  // penalty: k_n and k_t (force / length); 0 means penalty_factor times the largest diagonal
+  // entry of the body's stiffness (k_t defaults to k_n).
+  double penalty_normal = 0.0;
+  double penalty_tangential = 0.0;
+  double penalty_factor = 1e3;
 };
 
 struct IterationEvent {

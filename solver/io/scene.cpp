@@ -158,8 +158,16 @@ void read_solver(Reader& r, json& scene, SteppingParams& params) {
   ContactParams& c = params.contact;
   if (contact) {
     const std::string cp = sp + "/contact";
-    const std::string method = r.choice(*contact, cp, "method", {"cev", "uzawa"}, "cev");
-    c.method = method == "uzawa" ? ContactMethod::uzawa : ContactMethod::cev;
+    const std::string method = r.choice(*contact, cp, "method", {"cev", "uzawa", "penalty"}, "cev");
+    c.method = method == "uzawa" ? ContactMethod::uzawa : method == "penalty" ? ContactMethod::penalty : ContactMethod::cev;
+    if (json* pen = r.object(*contact, cp, "penalty", false)) {
+      const std::string pp = cp + "/penalty";
+      c.penalty_normal = r.number(*pen, pp, "normal", 0.0);
+      c.penalty_tangential = r.number(*pen, pp, "tangential", 0.0);
+      c.penalty_factor = r.positive(*pen, pp, "factor", c.penalty_factor);
+      if (c.penalty_normal < 0) r.error(pp + "/normal", "is negative");
+      if (c.penalty_tangential < 0) r.error(pp + "/tangential", "is negative");
+    }
     c.tolerance = r.positive(*contact, cp, "tolerance", c.tolerance);
     if (c.tolerance >= 1) r.error(cp + "/tolerance", "is a relative tolerance and must be below 1");
     const std::string loop = r.choice(*contact, cp, "loop", {"inner", "paper"}, "inner");

@@ -63,8 +63,53 @@ EquilibriumState Equilibrium::evaluate(const Vector& q) const {
   return state;
 }
 
-Vector Equilibrium::residual(const Vector& q, const EquilibriumState& paired, const Vector& p,
+Vector Equilibrium::penalty_forces(const EquilibriumState& paired, Triplets* tangent) const {
+  const PenaltyLaw& law = *penalty_;
+  Vector p = Vector::Zero(problem_.component_count);
+  for (size_t i = 0; i < problem_.candidates.size(); ++i) {
+    const Candidate& c = problem_.candidates[i];
+    const PairedPoint& pp = paired.points[i];
+    if (!paired.enabled[c.eta] || paired.s[c.eta] <= 0) continue;
+    p[c.eta] = -law.normal * paired.s[c.eta];
+    // d(s_eta)/dx = eta^T, d(s_xi)/dx = zeta_rate xi^T.
+    Eigen::RowVector2d dpn = -law.normal * pp.eta.transpose(), dpt = Eigen::RowVector2d::Zero();
+    if (c.xi >= 0 && paired.enabled[c.xi]) {
+      const double mu = problem_.obstacles[c.obstacle].friction;
+      const double start = law.previous.size() ? law.previous[c.xi] : 0.0;
+      const double trial = start - law.tangential * paired.s[c.xi];
+      const double bound = mu * std::abs(p[c.eta]);
+      if (std::abs(trial) <= bound) {
+        p[c.xi] = trial;
+        dpt = -law.tangential * pp.projection.zeta_rate * pp.xi.transpose();
+      } else {  // slip: the return to the cone
+        const double sign = trial > 0 ? 1.0 : -1.0;
+        p[c.xi] = sign * bound;
+        dpt = -sign * mu * dpn;
+      }
+    }
+    if (!tangent) continue;
+    // d(T p)/dx from p's dependence on x; the residual carries it with a minus sign.
+    const Mat2 df_dx = pp.eta * dpn + pp.xi * dpt;
+    for (const auto& a : pp.point.jacobian)
+      for (const auto& b : pp.point.jacobian)
+        tangent->emplace_back(a.dof, b.dof, -a.dx.dot(df_dx * b.dx));
+  }
+  return p;
+}
+
+double Equilibrium::stiffness_scale(const Vector& q) const {
+  Triplets t;
+  Vector f = Vector::Zero(q.size());
+  problem_.body->internal_force(q, f, &t);
+  Vector diagonal = Vector::Zero(q.size());
+  for (const auto& e : t)
+    if (e.row() == e.col()) diagonal[e.row()] += e.value();
+  return diagonal.cwiseAbs().maxCoeff();
+}
+
+Vector Equilibrium::residual(const Vector& q, const EquilibriumState& paired, const Vector& p_given,
                              Triplets* tangent) const {
+  const Vector p = penalty_ ? penalty_forces(paired, tangent) : p_given;
   Vector r = Vector::Zero(q.size());
   problem_.body->internal_force(q, r, tangent);
   r -= problem_.load(factors_);
@@ -122,15 +167,17 @@ EquilibriumState Equilibrium::solve(const Vector& q_guess, const Vector& p) {
     state.q[c.dof] = c.load_case < static_cast<int>(factors_.size()) ? factors_[c.load_case] * c.value : 0.0;
   for (const Constraint& c : extra_) state.q[c.dof] = c.value;
   const double body_length = problem_.body->characteristic_length();
+  // The penalty law adds stiffness that changes with the contact state: no reuse then.
+  const bool reuse = constant_tangent_ && !penalty_;
   Triplets triplets;
   for (int it = 1; it <= params_.max_iterations; ++it) {
     pair(state.q, state);
     triplets.clear();
-    const Vector r = residual(state.q, state, p, constant_tangent_ ? nullptr : &triplets);
+    const Vector r = residual(state.q, state, p, reuse ? nullptr : &triplets);
     Vector r_free(free_count_);
     for (int i = 0; i < r.size(); ++i)
       if (free_index_[i] >= 0) r_free[free_index_[i]] = r[i];
-    if (constant_tangent_) {
+    if (reuse) {
       if (!factorize_body_tangent(state.q)) {
         state.reason = "singular stiffness: the supports do not hold the body";
         return state;
@@ -143,7 +190,7 @@ EquilibriumState Equilibrium::solve(const Vector& q_guess, const Vector& p) {
         return state;
       }
     }
-    const Vector dq_free = constant_tangent_ ? Vector(body_lu_.solve(-r_free)) : Vector(lu_.solve(-r_free));
+    const Vector dq_free = reuse ? Vector(body_lu_.solve(-r_free)) : Vector(lu_.solve(-r_free));
     state.newton_iterations = it;
     ++counters_.newton_iterations;
     Vector dq = Vector::Zero(state.q.size());
@@ -164,6 +211,7 @@ EquilibriumState Equilibrium::solve(const Vector& q_guess, const Vector& p) {
       pair(state.q, state);
       state.reason = problem_.body->inadmissible(state.q);
       state.converged = state.reason.empty();
+      state.p = penalty_ ? penalty_forces(state, nullptr) : p;
       return state;
     }
     // Backtracking on the residual norm, inside the body's trust region: a strongly

@@ -4,6 +4,7 @@
 // d(T(u) p)/du re-evaluated at every iterate. Also the contact compliance C = T^T K^-1 T.
 #include <Eigen/SparseCore>
 #include <Eigen/SparseLU>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -31,6 +32,7 @@ struct PairedPoint {
 
 struct EquilibriumState {
   Vector q;
+  Vector p;                   // the contact forces in equilibrium (given, or from the penalty law)
   Vector s;                   // (s_eta, s_xi) per component
   std::vector<PairedPoint> points;
   std::vector<char> enabled;  // component has a non-zero column of T on the free dofs
@@ -45,6 +47,14 @@ struct EquilibriumCounters {
   long factorizations = 0;
 };
 
+// The penalty baseline (strategy `penalty`): p_eta = -k_n <s_eta>, and a tangential spring
+// k_t on the incremental slip from the previous step's force, returned to the Coulomb cone.
+struct PenaltyLaw {
+  double normal = 0.0;      // k_n, force / length
+  double tangential = 0.0;  // k_t, force / length
+  Vector previous;          // the previous step's forces (the tangential springs start there)
+};
+
 class Equilibrium {
  public:
   // `extra` prescribes further dofs at absolute values (the start-up solve).
@@ -56,6 +66,10 @@ class Equilibrium {
   const LoadFactors& factors() const { return factors_; }
 
   EquilibriumState solve(const Vector& q_guess, const Vector& p);
+  // With a penalty law set, solve() ignores its p and finds p(q) from the law.
+  void set_penalty(std::optional<PenaltyLaw> law) { penalty_ = std::move(law); }
+  // The largest diagonal entry of the body's stiffness at q: a scale for penalty stiffnesses.
+  double stiffness_scale(const Vector& q) const;
   // The pairing and s at q, without solving (e.g. the reference configuration).
   EquilibriumState evaluate(const Vector& q) const;
   // C = T^T K^-1 T over all components, from the body's own tangent at state.q (symmetric).
@@ -80,6 +94,8 @@ class Equilibrium {
   // R = A(q) - lambda F - T p on all dofs; tangent of R (with the contact load stiffness).
   Vector residual(const Vector& q, const EquilibriumState& paired, const Vector& p,
                   Triplets* tangent) const;
+  // p(q) of the penalty law at a paired state, and (if asked) its stiffness triplets.
+  Vector penalty_forces(const EquilibriumState& paired, Triplets* tangent) const;
   double free_residual_norm(const Vector& q, const Vector& p) const;
   Eigen::SparseMatrix<double> free_block(const Triplets& triplets) const;
   void fill_t_matrix(const EquilibriumState& state);
@@ -89,6 +105,7 @@ class Equilibrium {
   LoadFactors factors_;
   std::vector<double> zeta_previous_;
   std::vector<Constraint> extra_;
+  std::optional<PenaltyLaw> penalty_;
   std::vector<int> free_index_;  // dof -> free index, -1 if prescribed
   int free_count_ = 0;
   Vector length_scales_;
