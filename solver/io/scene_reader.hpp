@@ -209,5 +209,6 @@ void read_supports(Reader& r, json& body, const std::string& ptr, int nodes,
 // Body model readers: fill problem.body, constraints and load from scene["body"].
 void read_timoshenko_beam(Reader& r, json& body, Problem& problem);
 void read_rigid_plastic_membrane(Reader& r, json& body, Problem& problem);
+void read_continuum(Reader& r, json& body, Problem& problem);
 
 }  // namespace grip::scene_io

@@ -1,0 +1,152 @@
+#include "solver/elements/continuum.hpp"
+
+#include <Eigen/Dense>
+#include <stdexcept>
+
+namespace grip {
+
+QuadShape quad_shape(ContinuumElement element) {
+  return element == ContinuumElement::q9 ? QuadShape::q9 : QuadShape::q4;
+}
+
+ContinuumBody::ContinuumBody(PlaneMesh mesh, const std::vector<int>& contact_set,
+                             std::shared_ptr<const PlaneMaterial> material, ContinuumOptions options)
+    : mesh_(std::move(mesh)), options_(options), shape_(quad_shape(options.element)),
+      material_(std::move(material)) {
+  if (options_.element == ContinuumElement::q4_bbar && options_.kinematics == ContinuumKinematics::finite)
+    throw std::invalid_argument("q4_bbar is implemented for linear kinematics (use q9 for finite strain)");
+  if (!(options_.thickness > 0)) throw std::invalid_argument("thickness must be positive");
+  const std::vector<MeshIssue> issues = check_mesh(mesh_, shape_);
+  if (!issues.empty())
+    throw std::invalid_argument((issues[0].element >= 0 ? "element " + std::to_string(issues[0].element)
+                                                        : "node " + std::to_string(issues[0].node)) +
+                                " " + issues[0].detail);
+  contact_ = boundary_part(mesh_, shape_, contact_set);
+  Vec2 lo = mesh_.nodes.front(), hi = lo;
+  for (const Vec2& x : mesh_.nodes) {
+    lo = lo.cwiseMin(x);
+    hi = hi.cwiseMax(x);
+  }
+  length_ = (hi - lo).norm();
+
+  const int n = quad_node_count(shape_);
+  for (const auto& el : mesh_.elements) {
+    ShapeGradients X(n, 2);
+    for (int a = 0; a < n; ++a) X.row(a) = mesh_.nodes[el[a]].transpose();
+    points_.push_back(quad_points(shape_, X, options_.thickness));
+    centroids_.push_back(quad_point(shape_, X, 0.0, 0.0, 0.0));
+    if (options_.element == ContinuumElement::q4_bbar) mean_dN_.push_back(mean_gradients(points_.back()));
+  }
+
+  if (options_.kinematics == ContinuumKinematics::linear) {
+    const Eigen::Matrix3d D = material_->small_strain().D;
+    for (int e = 0; e < element_count(); ++e) {
+      const Matrix Ke = small_strain_stiffness(points_[e], D, mean_gradient(e));
+      const auto& el = mesh_.elements[e];
+      for (int i = 0; i < 2 * n; ++i)
+        for (int j = 0; j < 2 * n; ++j)
+          linear_tangent_.emplace_back(node_dof(el[i / 2], i % 2), node_dof(el[j / 2], j % 2), Ke(i, j));
+    }
+    linear_K_.resize(dof_count(), dof_count());
+    linear_K_.setFromTriplets(linear_tangent_.begin(), linear_tangent_.end());
+  }
+}
+
+const ShapeGradients* ContinuumBody::mean_gradient(int e) const {
+  return mean_dN_.empty() ? nullptr : &mean_dN_[e];
+}
+
+ShapeGradients ContinuumBody::element_displacements(const Vector& q, int e) const {
+  const auto& el = mesh_.elements[e];
+  ShapeGradients u(el.size(), 2);
+  for (size_t a = 0; a < el.size(); ++a) u.row(a) << q[node_dof(el[a], 0)], q[node_dof(el[a], 1)];
+  return u;
+}
+
+void ContinuumBody::internal_force(const Vector& q, Vector& force, Triplets* tangent) const {
+  if (options_.kinematics == ContinuumKinematics::linear) {
+    force += linear_K_ * q;
+    if (tangent) tangent->insert(tangent->end(), linear_tangent_.begin(), linear_tangent_.end());
+    return;
+  }
+  Vector fe;
+  Matrix Ke;
+  for (int e = 0; e < element_count(); ++e) {
+    total_lagrangian(points_[e], element_displacements(q, e), *material_, fe, tangent ? &Ke : nullptr);
+    const auto& el = mesh_.elements[e];
+    const int m = static_cast<int>(fe.size());
+    for (int i = 0; i < m; ++i) {
+      const int gi = node_dof(el[i / 2], i % 2);
+      force[gi] += fe[i];
+      if (tangent)
+        for (int j = 0; j < m; ++j) tangent->emplace_back(gi, node_dof(el[j / 2], j % 2), Ke(i, j));
+    }
+  }
+}
+
+SurfacePoint ContinuumBody::surface_point(const Vector& q, int site, int /*side*/) const {
+  const int node = contact_.nodes[site];
+  const int dx = node_dof(node, 0), dy = node_dof(node, 1);
+  SurfacePoint p;
+  p.x = mesh_.nodes[node] + Vec2(q[dx], q[dy]);
+  p.jacobian = {{dx, Vec2::UnitX()}, {dy, Vec2::UnitY()}};
+  return p;
+}
+
+Vector ContinuumBody::rigid_translation(const Vec2& d) const {
+  Vector q(dof_count());
+  for (int k = 0; k < node_count(); ++k) q.segment<2>(2 * k) = d;
+  return q;
+}
+
+Vector ContinuumBody::rigid_rotation() const {
+  Vector q(dof_count());
+  for (int k = 0; k < node_count(); ++k) q.segment<2>(2 * k) = rot90(mesh_.nodes[k]);
+  return q;
+}
+
+Body::Traits ContinuumBody::traits() const {
+  const bool linear = options_.kinematics == ContinuumKinematics::linear;
+  return {.geometric_nonlinearity = !linear, .plasticity = false, .constant_tangent = linear};
+}
+
+std::vector<std::vector<int>> ContinuumBody::cells() const {
+  std::vector<std::vector<int>> c;
+  for (const auto& el : mesh_.elements) c.push_back({el[0], el[1], el[2], el[3]});
+  return c;
+}
+
+FieldTable ContinuumBody::site_fields(const Vector& q) const {
+  FieldTable t{{"x", "y", "ux", "uy"}, {}};
+  for (int k = 0; k < node_count(); ++k) {
+    const double ux = q[node_dof(k, 0)], uy = q[node_dof(k, 1)];
+    t.rows.push_back({mesh_.nodes[k].x() + ux, mesh_.nodes[k].y() + uy, ux, uy});
+  }
+  return t;
+}
+
+Eigen::Vector4d ContinuumBody::centroid_stress(const Vector& q, int e) const {
+  const ShapeGradients u = element_displacements(q, e);
+  const QuadPoint& c = centroids_[e];
+  if (options_.kinematics == ContinuumKinematics::linear) {
+    const MaterialResponse r = material_->small_strain();
+    Vector ue(2 * u.rows());
+    for (int a = 0; a < u.rows(); ++a) ue.segment<2>(2 * a) = u.row(a).transpose();
+    const Eigen::Vector3d eps = strain_matrix(c, mean_gradient(e)) * ue;
+    const Eigen::Vector3d s = r.D * eps;
+    return {s[0], s[1], s[2], r.dS33 * eps};
+  }
+  const Mat2 F = deformation_gradient(c, u);
+  return cauchy_stress(F, material_->response(0.5 * (F.transpose() * F - Mat2::Identity())));
+}
+
+FieldTable ContinuumBody::element_fields(const Vector& q) const {
+  FieldTable t{{"sxx", "syy", "sxy", "szz"}, {}};
+  for (int e = 0; e < element_count(); ++e) {
+    const Eigen::Vector4d s = centroid_stress(q, e);
+    t.rows.push_back({s[0], s[1], s[2], s[3]});
+  }
+  return t;
+}
+
+}  // namespace grip

@@ -1,0 +1,92 @@
+#pragma once
+// A plane continuum body: isoparametric quadrilaterals (quad_element.hpp) in plane strain or
+// plane stress, with an elastic law (plane_material.hpp).
+//   linear: small strain, sigma = D eps; K is constant, assembled once and reused.
+//   finite: total Lagrangian, S(E) of the law, exact tangent.
+// Elements: q4 (2 x 2 Gauss), q4_bbar (q4 with the mean dilatation of B-bar: for nu -> 1/2
+// in plane strain, linear kinematics), q9 (3 x 3 Gauss).
+//
+// Dofs: (ux, uy) per node, node after node. Contact sites are the nodes of the contact set
+// in order along the boundary (counter-clockwise round the body): a SUBSET of the nodes.
+// site_node(site) maps a site to its node; cells() and site_fields() index NODES (all of
+// them), so a site's row in site_fields is site_node(site). A site's surface point is the
+// node itself (no offset; `side` is ignored) and its contact force acts on the node's two
+// dofs. Tributary area = integral of the node's shape function over the contact sides x
+// thickness (half the adjacent side lengths for q4).
+#include <memory>
+#include <vector>
+
+#include "solver/core/body.hpp"
+#include "solver/elements/plane_mesh.hpp"
+
+namespace grip {
+
+enum class ContinuumElement { q4, q4_bbar, q9 };
+enum class ContinuumKinematics { linear, finite };
+
+struct ContinuumOptions {
+  ContinuumElement element = ContinuumElement::q4;
+  ContinuumKinematics kinematics = ContinuumKinematics::finite;
+  PlaneAnalysis analysis = PlaneAnalysis::plane_strain;
+  double thickness = 1.0;  // out-of-plane depth (plane strain: the length the results are per)
+};
+
+QuadShape quad_shape(ContinuumElement element);
+
+class ContinuumBody final : public Body {
+ public:
+  // The mesh must pass check_mesh; contact_set is a node set on the boundary (boundary_part).
+  // Throws std::invalid_argument otherwise, or for q4_bbar with finite kinematics.
+  ContinuumBody(PlaneMesh mesh, const std::vector<int>& contact_set,
+                std::shared_ptr<const PlaneMaterial> material, ContinuumOptions options);
+
+  int dof_count() const override { return 2 * node_count(); }
+  Vector dof_length_scales() const override { return Vector::Ones(dof_count()); }
+  void internal_force(const Vector& q, Vector& force, Triplets* tangent) const override;
+
+  int site_count() const override { return static_cast<int>(contact_.nodes.size()); }
+  int site_node(int site) const override { return contact_.nodes[site]; }
+  Vec2 site_reference(int site) const override { return mesh_.nodes[contact_.nodes[site]]; }
+  SurfacePoint surface_point(const Vector& q, int site, int side) const override;
+  double tributary_area(int site) const override { return contact_.lengths[site] * options_.thickness; }
+  double characteristic_length() const override { return length_; }
+
+  Vector rigid_translation(const Vec2& d) const override;
+  Vector rigid_rotation() const override;
+  Traits traits() const override;
+  std::vector<std::vector<int>> cells() const override;  // element corners (node ids)
+  // Per node: x, y (deformed), ux, uy.
+  FieldTable site_fields(const Vector& q) const override;
+  // Per element, at its centroid: Cauchy stress sxx, syy, sxy, szz.
+  FieldTable element_fields(const Vector& q) const override;
+
+  static int node_dof(int node, int component) { return 2 * node + component; }
+  int node_count() const { return static_cast<int>(mesh_.nodes.size()); }
+  int element_count() const { return static_cast<int>(mesh_.elements.size()); }
+  const PlaneMesh& mesh() const { return mesh_; }
+  const ContinuumOptions& options() const { return options_; }
+  // The contact sides (boundary sides spanned by the contact set).
+  const BoundaryPart& contact_surface() const { return contact_; }
+  // linear kinematics: K does not depend on q, so one factorization serves a whole step.
+  bool tangent_is_constant() const { return options_.kinematics == ContinuumKinematics::linear; }
+  // Cauchy stress (sxx, syy, sxy, szz) at the centroid of element e.
+  Eigen::Vector4d centroid_stress(const Vector& q, int e) const;
+
+ private:
+  ShapeGradients element_displacements(const Vector& q, int e) const;
+  const ShapeGradients* mean_gradient(int e) const;
+
+  PlaneMesh mesh_;
+  ContinuumOptions options_;
+  QuadShape shape_;
+  std::shared_ptr<const PlaneMaterial> material_;
+  BoundaryPart contact_;
+  double length_ = 0.0;
+  std::vector<std::vector<QuadPoint>> points_;  // per element, reference configuration
+  std::vector<QuadPoint> centroids_;
+  std::vector<ShapeGradients> mean_dN_;         // per element (q4_bbar)
+  Triplets linear_tangent_;                     // linear kinematics: the constant K
+  Eigen::SparseMatrix<double> linear_K_;
+};
+
+}  // namespace grip

@@ -1,0 +1,439 @@
+#include "solver/elements/plane_mesh.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <numbers>
+#include <numeric>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+namespace grip {
+namespace {
+
+const std::vector<std::vector<int>>& local_sides(QuadShape shape) {
+  static const std::vector<std::vector<int>> q4{{0, 1}, {1, 2}, {2, 3}, {3, 0}};
+  static const std::vector<std::vector<int>> q9{{0, 4, 1}, {1, 5, 2}, {2, 6, 3}, {3, 7, 0}};
+  return shape == QuadShape::q4 ? q4 : q9;
+}
+
+std::string point_text(const Vec2& p) {
+  std::ostringstream os;
+  os << "(" << p.x() << ", " << p.y() << ")";
+  return os.str();
+}
+
+// Integral of each node's shape function along a side (2 or 3 nodes), by 3-point Gauss.
+std::vector<double> side_weights(const PlaneMesh& mesh, const std::vector<int>& side) {
+  static const double g[3] = {-std::sqrt(0.6), 0.0, std::sqrt(0.6)}, w[3] = {5.0 / 9, 8.0 / 9, 5.0 / 9};
+  const bool quadratic = side.size() == 3;
+  std::vector<double> out(side.size(), 0.0);
+  for (int k = 0; k < 3; ++k) {
+    const double s = g[k];
+    std::vector<double> N, dN;
+    if (quadratic) {
+      N = {0.5 * s * (s - 1), 1 - s * s, 0.5 * s * (s + 1)};
+      dN = {s - 0.5, -2 * s, s + 0.5};
+    } else {
+      N = {0.5 * (1 - s), 0.5 * (1 + s)};
+      dN = {-0.5, 0.5};
+    }
+    Vec2 dx = Vec2::Zero();
+    for (size_t a = 0; a < side.size(); ++a) dx += dN[a] * mesh.nodes[side[a]];
+    for (size_t a = 0; a < side.size(); ++a) out[a] += w[k] * N[a] * dx.norm();
+  }
+  return out;
+}
+
+// Connected parts of the mesh (elements sharing a node): the part of each node, -1 if none.
+std::vector<int> node_parts(const PlaneMesh& mesh, int& count) {
+  std::vector<int> parent(mesh.nodes.size());
+  std::iota(parent.begin(), parent.end(), 0);
+  std::function<int(int)> root = [&](int i) { return parent[i] == i ? i : parent[i] = root(parent[i]); };
+  std::vector<char> used(mesh.nodes.size(), 0);
+  for (const auto& e : mesh.elements)
+    for (int a : e) {
+      used[a] = 1;
+      parent[root(a)] = root(e.front());
+    }
+  std::map<int, int> index;
+  std::vector<int> part(mesh.nodes.size(), -1);
+  for (size_t i = 0; i < part.size(); ++i)
+    if (used[i]) part[i] = index.emplace(root(static_cast<int>(i)), static_cast<int>(index.size())).first->second;
+  count = static_cast<int>(index.size());
+  return part;
+}
+
+// Coordinates from `focus` outward over `length`: n_fine divisions of the fine zone, then n_coarse
+// growing geometrically with the first matching the fine spacing.
+std::vector<double> one_sided(double length, double fine_length, int n_fine, int n_coarse) {
+  std::vector<double> x{0.0};
+  const double h = n_fine > 0 ? fine_length / n_fine : 0.0;
+  for (int k = 1; k <= n_fine; ++k) x.push_back(fine_length * k / n_fine);
+  const double rest = length - fine_length;
+  if (n_coarse == 0) return x;
+  // Growth r with h (r + r^2 + ... + r^n) = rest; h = 0 (no fine zone): uniform.
+  double r = 1.0;
+  if (h > 0) {
+    auto sum = [&](double g) {
+      double s = 0.0, p = 1.0;
+      for (int k = 0; k < n_coarse; ++k) s += (p *= g);
+      return h * s;
+    };
+    double lo = 1e-6, hi = 2.0;
+    while (sum(hi) < rest) hi *= 2;
+    for (int it = 0; it < 200; ++it) {
+      const double mid = 0.5 * (lo + hi);
+      (sum(mid) < rest ? lo : hi) = mid;
+    }
+    r = 0.5 * (lo + hi);
+  }
+  double step = h > 0 ? h : rest / n_coarse, pos = fine_length;
+  for (int k = 1; k <= n_coarse; ++k) {
+    if (h > 0) step *= r;
+    pos = k == n_coarse ? length : pos + step;
+    x.push_back(pos);
+  }
+  return x;
+}
+
+// Parameters of a q9 grid: the midpoints inserted between consecutive values.
+std::vector<double> refine_for(QuadShape shape, const std::vector<double>& v) {
+  if (shape == QuadShape::q4) return v;
+  std::vector<double> out;
+  for (size_t i = 0; i + 1 < v.size(); ++i) {
+    out.push_back(v[i]);
+    out.push_back(0.5 * (v[i] + v[i + 1]));
+  }
+  out.push_back(v.back());
+  return out;
+}
+
+// A structured mesh of ni x nj elements on a grid of (m ni + 1) x (m nj + 1) nodes (m = 1 for
+// q4, 2 for q9), node (I, J) at `at(I, J)`, I along the first and J along the second
+// direction (a right-handed pair gives counter-clockwise elements).
+PlaneMesh grid_mesh(int ni, int nj, QuadShape shape, const std::function<Vec2(int, int)>& at) {
+  const int m = shape == QuadShape::q4 ? 1 : 2, NI = m * ni + 1, NJ = m * nj + 1;
+  PlaneMesh mesh;
+  for (int J = 0; J < NJ; ++J)
+    for (int I = 0; I < NI; ++I) mesh.nodes.push_back(at(I, J));
+  auto id = [&](int I, int J) { return J * NI + I; };
+  for (int j = 0; j < nj; ++j)
+    for (int i = 0; i < ni; ++i) {
+      const int I = m * i, J = m * j;
+      if (shape == QuadShape::q4)
+        mesh.elements.push_back({id(I, J), id(I + 1, J), id(I + 1, J + 1), id(I, J + 1)});
+      else
+        mesh.elements.push_back({id(I, J), id(I + 2, J), id(I + 2, J + 2), id(I, J + 2), id(I + 1, J),
+                                 id(I + 2, J + 1), id(I + 1, J + 2), id(I, J + 1), id(I + 1, J + 1)});
+    }
+  return mesh;
+}
+
+// Grid node ids along an edge of the grid, from (I0, J0) in steps (dI, dJ), `count` nodes.
+std::vector<int> grid_line(int NI, int I0, int J0, int dI, int dJ, int count) {
+  std::vector<int> ids;
+  for (int k = 0; k < count; ++k) ids.push_back((J0 + k * dJ) * NI + I0 + k * dI);
+  return ids;
+}
+
+}  // namespace
+
+std::vector<MeshIssue> check_mesh(const PlaneMesh& mesh, QuadShape shape) {
+  std::vector<MeshIssue> issues;
+  const int n = quad_node_count(shape), nodes = static_cast<int>(mesh.nodes.size());
+  std::vector<char> used(mesh.nodes.size(), 0);
+  for (int e = 0; e < static_cast<int>(mesh.elements.size()); ++e) {
+    const auto& el = mesh.elements[e];
+    if (static_cast<int>(el.size()) != n) {
+      issues.push_back({e, -1, "has " + std::to_string(el.size()) + " nodes; a " +
+                                   (shape == QuadShape::q4 ? "q4" : "q9") + " element has " + std::to_string(n)});
+      continue;
+    }
+    bool ids_ok = true;
+    for (int a : el)
+      if (a < 0 || a >= nodes) {
+        issues.push_back({e, -1, "names node " + std::to_string(a) + ", which does not exist"});
+        ids_ok = false;
+      }
+    if (!ids_ok) continue;
+    for (int a : el) used[a] = 1;
+    if (std::set<int>(el.begin(), el.end()).size() != el.size()) {
+      issues.push_back({e, -1, "names a node twice"});
+      continue;
+    }
+    ShapeGradients X(n, 2);
+    for (int a = 0; a < n; ++a) X.row(a) = mesh.nodes[el[a]].transpose();
+    const double size2 = (X.colwise().maxCoeff() - X.colwise().minCoeff()).squaredNorm();
+    std::vector<Vec2> checks;
+    for (int a = 0; a < n; ++a) checks.push_back(quad_node_natural(shape, a));
+    for (const GaussPoint& g : quad_gauss_rule(shape)) checks.push_back({g.xi, g.eta});
+    for (const Vec2& c : checks) {
+      const double det = quad_point(shape, X, c.x(), c.y(), 1.0).detJ;
+      if (!(det > 1e-12 * size2)) {
+        issues.push_back({e, -1, std::string(det < 0 ? "is inverted or its nodes are not counter-clockwise"
+                                                     : "has zero area") +
+                                     " (det J = " + std::to_string(det) + " at xi, eta = " + point_text(c) + ")"});
+        break;
+      }
+    }
+  }
+  for (int i = 0; i < nodes; ++i)
+    if (!used[i]) issues.push_back({-1, i, "belongs to no element"});
+  return issues;
+}
+
+std::vector<std::vector<int>> boundary_sides(const PlaneMesh& mesh, QuadShape shape) {
+  std::map<std::pair<int, int>, std::pair<int, std::vector<int>>> seen;
+  for (const auto& el : mesh.elements)
+    for (const auto& local : local_sides(shape)) {
+      std::vector<int> side;
+      for (int a : local) side.push_back(el[a]);
+      const auto key = std::minmax(side.front(), side.back());
+      auto& entry = seen[key];
+      ++entry.first;
+      entry.second = side;
+    }
+  std::vector<std::vector<int>> sides;
+  for (const auto& [key, entry] : seen)
+    if (entry.first == 1) sides.push_back(entry.second);
+  return sides;
+}
+
+BoundaryPart boundary_part(const PlaneMesh& mesh, QuadShape shape, const std::vector<int>& set) {
+  std::vector<char> in(mesh.nodes.size(), 0);
+  for (int i : set) in.at(i) = 1;
+  BoundaryPart part;
+  std::map<int, int> next;  // along the boundary, body on the left
+  std::set<int> has_previous;
+  std::map<int, double> length;
+  for (const auto& side : boundary_sides(mesh, shape)) {
+    if (!std::all_of(side.begin(), side.end(), [&](int a) { return in[a] != 0; })) continue;
+    part.sides.push_back(side);
+    const std::vector<double> w = side_weights(mesh, side);
+    for (size_t a = 0; a < side.size(); ++a) length[side[a]] += w[a];
+    for (size_t a = 0; a + 1 < side.size(); ++a) {
+      next.emplace(side[a], side[a + 1]);
+      has_previous.insert(side[a + 1]);
+    }
+  }
+  for (int i : set)
+    if (!length.count(i))
+      throw std::invalid_argument("node " + std::to_string(i) +
+                                  " lies on no boundary side whose nodes all belong to the set");
+  // Runs start where no side leads in (then closed loops, at their smallest node).
+  std::vector<int> starts;
+  for (const auto& [node, l] : length)
+    if (!has_previous.count(node)) starts.push_back(node);
+  for (const auto& [node, l] : length) starts.push_back(node);
+  std::set<int> visited;
+  for (int s : starts)
+    for (int i = s; !visited.count(i);) {
+      visited.insert(i);
+      part.nodes.push_back(i);
+      part.lengths.push_back(length[i]);
+      const auto it = next.find(i);
+      if (it == next.end()) break;
+      i = it->second;
+    }
+  return part;
+}
+
+std::string free_rigid_motion(const PlaneMesh& mesh, const std::vector<char>& fixed_dof) {
+  int parts = 0;
+  const std::vector<int> part = node_parts(mesh, parts);
+  std::vector<std::string> found;
+  for (int k = 0; k < parts; ++k) {
+    // The part's centre and size scale the rotation mode.
+    Vec2 lo = Vec2::Constant(1e300), hi = -lo;
+    for (size_t i = 0; i < part.size(); ++i)
+      if (part[i] == k) {
+        lo = lo.cwiseMin(mesh.nodes[i]);
+        hi = hi.cwiseMax(mesh.nodes[i]);
+      }
+    const Vec2 c = 0.5 * (lo + hi);
+    const double L = std::max((hi - lo).norm(), 1e-300);
+    // Rows: the fixed dofs; columns: translation x, translation y, rotation about c.
+    Eigen::Matrix3d G = Eigen::Matrix3d::Zero();
+    for (size_t i = 0; i < part.size(); ++i) {
+      if (part[i] != k) continue;
+      const Vec2 r = (mesh.nodes[i] - c) / L;
+      for (int d = 0; d < 2; ++d) {
+        if (!fixed_dof[2 * i + d]) continue;
+        const Eigen::Vector3d row = d == 0 ? Eigen::Vector3d(1, 0, -r.y()) : Eigen::Vector3d(0, 1, r.x());
+        G += row * row.transpose();
+      }
+    }
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(G);
+    const double scale = std::max(1.0, eig.eigenvalues().maxCoeff());
+    std::vector<Eigen::Vector3d> null;
+    for (int m = 0; m < 3; ++m)
+      if (eig.eigenvalues()[m] <= 1e-10 * scale) null.push_back(eig.eigenvectors().col(m));
+    if (null.empty()) continue;
+    auto in_null = [&](const Eigen::Vector3d& v) {
+      Eigen::Vector3d p = Eigen::Vector3d::Zero();
+      for (const auto& nv : null) p += nv.dot(v) * nv;
+      return p;
+    };
+    std::vector<std::string> motions;
+    bool tx = false, ty = false;
+    if ((in_null(Eigen::Vector3d::UnitX()) - Eigen::Vector3d::UnitX()).norm() < 1e-6) {
+      motions.push_back("translate along x");
+      tx = true;
+    }
+    if ((in_null(Eigen::Vector3d::UnitY()) - Eigen::Vector3d::UnitY()).norm() < 1e-6) {
+      motions.push_back("translate along y");
+      ty = true;
+    }
+    if (static_cast<int>(null.size()) > static_cast<int>(tx) + static_cast<int>(ty)) {
+      Eigen::Vector3d v = in_null(Eigen::Vector3d::UnitZ());
+      if (v.norm() < 1e-6) v = null.front();
+      if (tx) v.x() = 0;
+      if (ty) v.y() = 0;
+      if (std::abs(v.z()) > 1e-6 * v.norm()) {
+        // a ex + b ey + w (rotation about c) is a rotation about c + L (-b, a) / w.
+        const Vec2 pivot = c + L * Vec2(-v.y(), v.x()) / v.z();
+        motions.push_back("rotate about " + point_text(pivot));
+      } else {
+        motions.push_back("translate along " + point_text(v.head<2>().normalized()));
+      }
+    }
+    std::string text;
+    for (size_t m = 0; m < motions.size(); ++m) text += (m ? m + 1 == motions.size() ? " and " : ", " : "") + motions[m];
+    if (parts > 1) text = "the part containing node " +
+                          std::to_string(std::find(part.begin(), part.end(), k) - part.begin()) + " can " + text;
+    found.push_back(text);
+  }
+  std::string all;
+  for (size_t m = 0; m < found.size(); ++m) all += (m ? "; " : "") + found[m];
+  return all;
+}
+
+std::vector<double> graded_divisions(double lo, double hi, int n, std::optional<double> focus,
+                                     const std::optional<Refinement>& refine) {
+  std::vector<double> x;
+  if (!refine || !focus) {
+    for (int k = 0; k <= n; ++k) x.push_back(lo + (hi - lo) * k / n);
+    return x;
+  }
+  const double f = std::clamp(*focus, lo, hi);
+  const double len[2] = {f - lo, hi - f};  // below and above the focus
+  int fine[2], coarse[2] = {0, 0};
+  double fine_len[2], coarse_len[2];
+  int coarse_total = n, sides_needing = 0;
+  for (int s = 0; s < 2; ++s) {
+    fine_len[s] = std::min(refine->extent, len[s]);
+    fine[s] = fine_len[s] > 0 ? std::max(1, static_cast<int>(std::lround(fine_len[s] / refine->size))) : 0;
+    coarse_len[s] = len[s] - fine_len[s];
+    coarse_total -= fine[s];
+    sides_needing += coarse_len[s] > 1e-12 * (hi - lo);
+  }
+  if (coarse_total < sides_needing)
+    throw std::invalid_argument(std::to_string(n) + " divisions cannot hold the refinement: it takes " +
+                                std::to_string(n - coarse_total) + " within the extent and " +
+                                std::to_string(sides_needing) + " more outside it");
+  const double total_coarse_len = coarse_len[0] + coarse_len[1];
+  if (sides_needing == 2) {
+    coarse[0] = std::clamp(static_cast<int>(std::lround(coarse_total * coarse_len[0] / total_coarse_len)), 1,
+                           coarse_total - 1);
+    coarse[1] = coarse_total - coarse[0];
+  } else if (sides_needing == 1) {
+    coarse[coarse_len[0] > coarse_len[1] ? 0 : 1] = coarse_total;
+  } else if (coarse_total > 0) {
+    throw std::invalid_argument("the refinement extent covers the whole length: give fewer divisions (" +
+                                std::to_string(n - coarse_total) + ")");
+  }
+  const std::vector<double> below = one_sided(len[0], fine_len[0], fine[0], coarse[0]);
+  const std::vector<double> above = one_sided(len[1], fine_len[1], fine[1], coarse[1]);
+  for (auto it = below.rbegin(); it != below.rend(); ++it) x.push_back(f - *it);
+  for (size_t k = 1; k < above.size(); ++k) x.push_back(f + above[k]);
+  x.front() = lo;
+  x.back() = hi;
+  return x;
+}
+
+PlaneMesh rectangle_mesh(const RectangleSpec& spec, QuadShape shape) {
+  const Vec2 o = spec.origin, s = spec.size;
+  const std::vector<double> x = refine_for(
+      shape, graded_divisions(o.x(), o.x() + s.x(), spec.nx, spec.towards.x(), spec.refine));
+  const std::vector<double> y = refine_for(
+      shape, graded_divisions(o.y(), o.y() + s.y(), spec.ny, spec.towards.y(), spec.refine));
+  PlaneMesh mesh = grid_mesh(spec.nx, spec.ny, shape, [&](int I, int J) { return Vec2(x[I], y[J]); });
+  const int NI = static_cast<int>(x.size()), NJ = static_cast<int>(y.size());
+  mesh.sets["bottom"] = grid_line(NI, 0, 0, 1, 0, NI);
+  mesh.sets["right"] = grid_line(NI, NI - 1, 0, 0, 1, NJ);
+  mesh.sets["top"] = grid_line(NI, NI - 1, NJ - 1, -1, 0, NI);
+  mesh.sets["left"] = grid_line(NI, 0, NJ - 1, 0, -1, NJ);
+  return mesh;
+}
+
+PlaneMesh half_disc_mesh(const HalfDiscSpec& spec, QuadShape shape) {
+  using std::numbers::pi;
+  if (spec.ns < 2 || spec.ns % 2) throw std::invalid_argument("ns must be even (a node sits at the pole)");
+  const double R = spec.radius;
+  // sigma: along the middle quarter of the arc (graded toward the pole); u: along the diameter
+  // (uniform); depth: from the arc toward the diameter (graded toward the arc).
+  const double quarter = pi * R / 4;
+  std::vector<double> sigma = graded_divisions(-quarter, quarter, spec.ns, 0.0, spec.refine);
+  for (double& v : sigma) v = (v + quarter) / (2 * quarter);
+  std::vector<double> depth = graded_divisions(0, R, spec.nt, 0.0, spec.refine);
+  for (double& v : depth) v /= R;
+  std::vector<double> u(spec.ns + 1), even(spec.nt + 1);
+  for (int i = 0; i <= spec.ns; ++i) u[i] = static_cast<double>(i) / spec.ns;
+  for (int j = 0; j <= spec.nt; ++j) even[j] = static_cast<double>(j) / spec.nt;
+  sigma = refine_for(shape, sigma);
+  u = refine_for(shape, u);
+  depth = refine_for(shape, depth);
+  even = refine_for(shape, even);
+  const Vec2 c = spec.centre;
+  auto on_circle = [&](double angle) { return Vec2(c + R * Vec2(std::cos(angle), std::sin(angle))); };
+  auto bottom = [&](double s) { return on_circle(1.25 * pi + 0.5 * pi * s); };  // 225 -> 315 degrees
+  auto top = [&](double s) { return Vec2(c + Vec2(-R + 2 * R * s, 0)); };
+  auto left = [&](double t) { return on_circle(1.25 * pi - 0.25 * pi * t); };   // 225 -> 180
+  auto right = [&](double t) { return on_circle(1.75 * pi + 0.25 * pi * t); };  // 315 -> 360
+  const Vec2 b0 = bottom(0), b1 = bottom(1), t0 = top(0), t1 = top(1);
+  auto at = [&](int I, int J) {
+    const double s = sigma[I], w = std::pow(std::sin(pi * s), 2);
+    // Rows crowd toward the arc near the pole only; at the ends they are evenly spaced.
+    const double t = w * depth[J] + (1 - w) * even[J];
+    const double v = (1 - t) * s + t * u[I];  // blends the two parametrizations of the ends
+    Vec2 p = (1 - t) * bottom(s) + t * top(u[I]) + (1 - v) * left(t) + v * right(t) -
+             ((1 - v) * (1 - t) * b0 + v * (1 - t) * b1 + (1 - v) * t * t0 + v * t * t1);
+    if (spec.facing_up) p.y() = 2 * c.y() - p.y();
+    return p;
+  };
+  PlaneMesh mesh = grid_mesh(spec.ns, spec.nt, shape, at);
+  const int NI = static_cast<int>(sigma.size()), NJ = static_cast<int>(depth.size());
+  std::vector<int> arc = grid_line(NI, 0, NJ - 1, 0, -1, NJ);
+  for (int id : grid_line(NI, 1, 0, 1, 0, NI - 1)) arc.push_back(id);
+  for (int id : grid_line(NI, NI - 1, 1, 0, 1, NJ - 1)) arc.push_back(id);
+  mesh.sets["diameter"] = grid_line(NI, 0, NJ - 1, 1, 0, NI);
+  mesh.sets["pole"] = {(NI - 1) / 2};
+  mesh.sets["centre"] = {(NJ - 1) * NI + (NI - 1) / 2};
+  if (spec.facing_up) {
+    // Mirroring turned the elements clockwise: reverse them (and the arc's direction).
+    for (auto& el : mesh.elements) {
+      std::swap(el[1], el[3]);
+      if (shape == QuadShape::q9) {
+        std::swap(el[4], el[7]);
+        std::swap(el[5], el[6]);
+      }
+    }
+    std::reverse(arc.begin(), arc.end());
+  }
+  mesh.sets["arc"] = arc;
+  if (spec.refine) {
+    // The arc nodes within the refinement's extent of the pole (measured along the arc).
+    const Vec2 pole = mesh.nodes[mesh.sets["pole"][0]] - c;
+    std::vector<int>& near = mesh.sets["arc_refined"];
+    for (int id : arc)
+      if (R * std::acos(std::clamp((mesh.nodes[id] - c).dot(pole) / (R * R), -1.0, 1.0)) <=
+          spec.refine->extent * (1 + 1e-9))
+        near.push_back(id);
+  }
+  return mesh;
+}
+
+}  // namespace grip

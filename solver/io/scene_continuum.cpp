@@ -1,0 +1,349 @@
+// body.model "continuum": plane quadrilaterals (solver/elements/continuum.hpp).
+//   "kinematics": "finite" (default) | "linear";  "analysis": "plane_strain" | "plane_stress"
+//   "element": "q4" | "q4_bbar" | "q9";  "thickness" (default 1)
+//   "material": {"young", "poisson", "law": "neo_hookean" | "saint_venant_kirchhoff"}
+//   "mesh": one of
+//     {"nodes": [[x, y], ...], "elements": [[n0, n1, n2, n3(, ...9)], ...], "sets": {name: [ids]}}
+//     {"rectangle": {"origin", "size", "divisions": [nx, ny], "refine": {"towards", "size", "extent"}}}
+//     {"half_disc": {"centre", "radius", "divisions": [ns, nt], "facing": "down" | "up",
+//                    "refine": {"size", "extent"}}}
+//   "contact_set": a node set on the boundary (default "bottom" for a rectangle, "arc" for a
+//     half-disc); its nodes are the contact candidates
+//   "supports": [{"set" | "node", "fix": ["x", "y"], "values": {"x", "y"}, "case"}]
+//   "loads": [{"set" | "node", "force": [fx, fy] (on each node) | "traction": [tx, ty] (per
+//     unit area of the set's boundary sides), "case"}]
+#include <map>
+#include <stdexcept>
+
+#include "solver/elements/continuum.hpp"
+#include "solver/io/scene_reader.hpp"
+
+namespace grip::scene_io {
+namespace {
+
+// [a, b] of integers in [lo, hi].
+std::optional<std::pair<int, int>> integer_pair(Reader& r, json& obj, const std::string& ptr, const char* key,
+                                                int lo, int hi) {
+  const std::string p = ptr + "/" + key;
+  if (!obj.contains(key)) {
+    r.error(p, "is required ([n1, n2])");
+    return std::nullopt;
+  }
+  const json& v = obj[key];
+  if (!v.is_array() || v.size() != 2) {
+    r.error(p, show(v) + " is not a pair of integers");
+    return std::nullopt;
+  }
+  const size_t before = r.issues.size();
+  const int a = r.integer_value(v[0], p + "/0", lo, hi), b = r.integer_value(v[1], p + "/1", lo, hi);
+  if (r.issues.size() > before) return std::nullopt;
+  return std::make_pair(a, b);
+}
+
+std::optional<Refinement> read_refinement(Reader& r, json& gen, const std::string& ptr, Vec2* towards) {
+  if (!gen.contains("refine")) return std::nullopt;
+  json* ref = r.object(gen, ptr, "refine", false);
+  if (!ref) return std::nullopt;
+  const std::string rp = ptr + "/refine";
+  Refinement out;
+  out.size = r.positive(*ref, rp, "size");
+  out.extent = r.positive(*ref, rp, "extent");
+  if (towards) *towards = r.vec2(*ref, rp, "towards");
+  return out;
+}
+
+std::optional<PlaneMesh> read_explicit_mesh(Reader& r, json& mesh, const std::string& ptr, QuadShape shape) {
+  PlaneMesh m;
+  json* nodes = r.array(mesh, ptr, "nodes", true);
+  json* elements = r.array(mesh, ptr, "elements", true);
+  const size_t before = r.issues.size();
+  if (nodes)
+    for (size_t i = 0; i < nodes->size(); ++i) {
+      const json& v = (*nodes)[i];
+      if (!v.is_array() || v.size() != 2 || !v[0].is_number() || !v[1].is_number())
+        r.error(ptr + "/nodes/" + std::to_string(i), show(v) + " is not a pair of numbers [x, y]");
+      else
+        m.nodes.emplace_back(v[0].get<double>(), v[1].get<double>());
+    }
+  if (elements)
+    for (size_t e = 0; e < elements->size(); ++e) {
+      const std::string ep = ptr + "/elements/" + std::to_string(e);
+      const json& v = (*elements)[e];
+      std::vector<int> el;
+      if (!v.is_array()) r.error(ep, show(v) + " is not an array of node ids");
+      else
+        for (size_t a = 0; a < v.size(); ++a)
+          el.push_back(r.integer_value(v[a], ep + "/" + std::to_string(a), 0, 1 << 30));
+      m.elements.push_back(el);
+    }
+  if (json* sets = r.object(mesh, ptr, "sets", false))
+    for (auto& [name, v] : sets->items()) {
+      const std::string sp = ptr + "/sets/" + name;
+      std::vector<int> ids;
+      if (!v.is_array()) r.error(sp, show(v) + " is not an array of node ids");
+      else
+        for (size_t k = 0; k < v.size(); ++k)
+          ids.push_back(r.integer_value(v[k], sp + "/" + std::to_string(k), 0,
+                                        std::max(0, static_cast<int>(m.nodes.size()) - 1)));
+      m.sets[name] = ids;
+    }
+  if (r.issues.size() > before) return std::nullopt;
+  if (m.elements.empty()) r.error(ptr + "/elements", "needs at least one element");
+  for (const MeshIssue& issue : check_mesh(m, shape))
+    r.error(issue.element >= 0 ? ptr + "/elements/" + std::to_string(issue.element)
+                               : ptr + "/nodes/" + std::to_string(issue.node),
+            (issue.element >= 0 ? "element " + std::to_string(issue.element) : "node " + std::to_string(issue.node)) +
+                " " + issue.detail);
+  if (r.issues.size() > before) return std::nullopt;
+  return m;
+}
+
+std::optional<PlaneMesh> read_generated_mesh(Reader& r, json& mesh, const std::string& ptr, QuadShape shape,
+                                             const std::string& kind) {
+  const std::string gp = ptr + "/" + kind;
+  json* gen = r.object(mesh, ptr, kind.c_str(), true);
+  if (!gen) return std::nullopt;
+  const size_t before = r.issues.size();
+  PlaneMesh m;
+  try {
+    if (kind == "rectangle") {
+      RectangleSpec spec;
+      spec.origin = r.vec2(*gen, gp, "origin", Vec2::Zero());
+      spec.size = r.vec2(*gen, gp, "size");
+      if (!(spec.size.x() > 0 && spec.size.y() > 0)) r.error(gp + "/size", "needs a positive width and height");
+      const auto div = integer_pair(r, *gen, gp, "divisions", 1, 2000);
+      spec.refine = read_refinement(r, *gen, gp, &spec.towards);
+      if (r.issues.size() > before || !div) return std::nullopt;
+      spec.nx = div->first;
+      spec.ny = div->second;
+      m = rectangle_mesh(spec, shape);
+    } else {
+      HalfDiscSpec spec;
+      spec.centre = r.vec2(*gen, gp, "centre", Vec2::Zero());
+      spec.radius = r.positive(*gen, gp, "radius");
+      const auto div = integer_pair(r, *gen, gp, "divisions", 1, 2000);
+      if (div && div->first % 2) r.error(gp + "/divisions/0", "must be even: a node sits at the pole");
+      spec.facing_up = r.choice(*gen, gp, "facing", {"down", "up"}, "down") == "up";
+      spec.refine = read_refinement(r, *gen, gp, nullptr);
+      if (r.issues.size() > before || !div) return std::nullopt;
+      spec.ns = div->first;
+      spec.nt = div->second;
+      m = half_disc_mesh(spec, shape);
+    }
+  } catch (const std::invalid_argument& e) {
+    r.error(gp + "/divisions", e.what());
+    return std::nullopt;
+  }
+  for (const MeshIssue& issue : check_mesh(m, shape)) {
+    r.error(gp, "generated element " + std::to_string(issue.element) + " " + issue.detail +
+                    ": soften the refinement or change the divisions");
+    break;
+  }
+  if (r.issues.size() > before) return std::nullopt;
+  return m;
+}
+
+// The nodes named by {"set": name} or {"node": id}; nullopt after an error.
+std::optional<std::vector<int>> read_target(Reader& r, json& obj, const std::string& ptr, const PlaneMesh& mesh) {
+  const bool by_set = obj.contains("set"), by_node = obj.contains("node");
+  if (by_set == by_node) {
+    r.error(ptr, "needs exactly one of \"set\" (a node set's name) and \"node\" (a node id)");
+    return std::nullopt;
+  }
+  if (by_node) {
+    const size_t before = r.issues.size();
+    const int node = r.integer(obj, ptr, "node", 0, static_cast<int>(mesh.nodes.size()) - 1);
+    if (r.issues.size() > before) return std::nullopt;
+    return std::vector<int>{node};
+  }
+  const json& name = obj["set"];
+  std::vector<std::string> names;
+  for (const auto& [n, ids] : mesh.sets) names.push_back(n);
+  if (!name.is_string() || !mesh.sets.count(name.get<std::string>())) {
+    r.error(ptr + "/set", show(name) + " names no node set (sets: " + Reader::list(names) + ")");
+    return std::nullopt;
+  }
+  return mesh.sets.at(name.get<std::string>());
+}
+
+void read_continuum_supports(Reader& r, json& body, const std::string& ptr, const PlaneMesh& mesh,
+                             Problem& problem) {
+  json* sup = r.array(body, ptr, "supports", false);
+  if (!sup) return;
+  std::map<int, std::pair<std::string, double>> fixed;  // dof -> (pointer of its support, value)
+  for (size_t i = 0; i < sup->size(); ++i) {
+    const std::string sp = ptr + "/supports/" + std::to_string(i);
+    json& s = (*sup)[i];
+    if (!s.is_object()) {
+      r.error(sp, "is not an object");
+      continue;
+    }
+    const auto nodes = read_target(r, s, sp, mesh);
+    const int load_case = r.load_case(s, sp);
+    json* fix = r.array(s, sp, "fix", true);
+    json* values = r.object(s, sp, "values", false);
+    if (!fix || !nodes) continue;
+    if (fix->empty()) r.error(sp + "/fix", "names no component (\"x\", \"y\")");
+    for (size_t c = 0; c < fix->size(); ++c) {
+      const json& comp = (*fix)[c];
+      if (!(comp == "x" || comp == "y")) {
+        r.error(sp + "/fix/" + std::to_string(c), show(comp) + " is not one of \"x\", \"y\"");
+        continue;
+      }
+      const std::string name = comp.get<std::string>();
+      const double value = values && values->contains(name) ? r.number(*values, sp + "/values", name.c_str()) : 0.0;
+      for (int node : *nodes) {
+        const int dof = ContinuumBody::node_dof(node, name == "x" ? 0 : 1);
+        const auto it = fixed.find(dof);
+        if (it != fixed.end()) {
+          // The same zero support twice (a corner in two sets) is harmless; two prescribed
+          // values of one dof are ambiguous.
+          if (value != 0.0 || it->second.second != 0.0)
+            r.error(sp + "/fix/" + std::to_string(c), "prescribes " + name + " of node " + std::to_string(node) +
+                                                          ", which " + it->second.first +
+                                                          " fixes already: give each dof one support");
+          continue;
+        }
+        fixed[dof] = {sp, value};
+        problem.constraints.push_back({dof, value, load_case});
+      }
+    }
+    if (values)
+      for (const auto& [name, v] : values->items()) {
+        bool listed = false;
+        for (const auto& comp : *fix) listed |= comp == name;
+        if (!listed) r.error(sp + "/values/" + name, "is given but \"" + name + "\" is not in fix");
+      }
+  }
+}
+
+void read_continuum_loads(Reader& r, json& body, const std::string& ptr, const PlaneMesh& mesh, QuadShape shape,
+                          Problem& problem, double thickness) {
+  json* loads = r.array(body, ptr, "loads", false);
+  if (!loads) return;
+  for (size_t i = 0; i < loads->size(); ++i) {
+    const std::string lp = ptr + "/loads/" + std::to_string(i);
+    json& l = (*loads)[i];
+    if (!l.is_object()) {
+      r.error(lp, "is not an object");
+      continue;
+    }
+    const auto nodes = read_target(r, l, lp, mesh);
+    const int load_case = r.load_case(l, lp);
+    const bool force = l.contains("force"), traction = l.contains("traction");
+    if (force == traction) {
+      r.error(lp, "needs exactly one of \"force\" (on each node) and \"traction\" (per unit area)");
+      continue;
+    }
+    const Vec2 f = r.vec2(l, lp, force ? "force" : "traction");
+    if (!nodes) continue;
+    Vector& load = case_load(problem, load_case);
+    if (force) {
+      for (int node : *nodes) load.segment<2>(2 * node) += f;
+      continue;
+    }
+    if (!l.contains("set")) {
+      r.error(lp + "/traction", "acts on the boundary sides of a set: give \"set\", not \"node\"");
+      continue;
+    }
+    try {
+      const BoundaryPart part = boundary_part(mesh, shape, *nodes);
+      for (size_t k = 0; k < part.nodes.size(); ++k)
+        load.segment<2>(2 * part.nodes[k]) += part.lengths[k] * thickness * f;
+    } catch (const std::invalid_argument& e) {
+      r.error(lp + "/set", e.what());
+    }
+  }
+}
+
+}  // namespace
+
+void read_continuum(Reader& r, json& body, Problem& problem) {
+  const std::string ptr = "/body";
+  const std::string kin = r.choice(body, ptr, "kinematics", {"finite", "linear"}, "finite");
+  const std::string analysis = r.choice(body, ptr, "analysis", {"plane_strain", "plane_stress"}, "plane_strain");
+  const std::string element = r.choice(body, ptr, "element", {"q4", "q4_bbar", "q9"}, "q4");
+  ContinuumOptions options;
+  options.kinematics = kin == "linear" ? ContinuumKinematics::linear : ContinuumKinematics::finite;
+  options.analysis = analysis == "plane_stress" ? PlaneAnalysis::plane_stress : PlaneAnalysis::plane_strain;
+  options.element = element == "q9" ? ContinuumElement::q9
+                    : element == "q4_bbar" ? ContinuumElement::q4_bbar : ContinuumElement::q4;
+  options.thickness = r.positive(body, ptr, "thickness", 1.0);
+  if (options.element == ContinuumElement::q4_bbar) {
+    if (options.kinematics == ContinuumKinematics::finite)
+      r.error(ptr + "/element", "\"q4_bbar\" (mean dilatation) is implemented for linear kinematics; "
+                                "for finite strain near incompressibility use \"q9\"");
+    if (options.analysis == PlaneAnalysis::plane_stress)
+      r.error(ptr + "/element", "\"q4_bbar\" is for plane strain: plane stress does not lock, use \"q4\"");
+  }
+  const QuadShape shape = quad_shape(options.element);
+
+  std::shared_ptr<const PlaneMaterial> material;
+  if (json* mat = r.object(body, ptr, "material", true)) {
+    const std::string mp = ptr + "/material";
+    const double young = r.positive(*mat, mp, "young");
+    const double poisson = r.number(*mat, mp, "poisson", 0.3);
+    if (!(poisson > -1 && poisson < 0.5)) r.error(mp + "/poisson", show((*mat)["poisson"]) + " is not in (-1, 0.5)");
+    const std::string law = r.choice(*mat, mp, "law", {"neo_hookean", "saint_venant_kirchhoff"}, "neo_hookean");
+    const PlaneAnalysis a = options.analysis;
+    if (law == "neo_hookean") material = std::make_shared<NeoHookeMaterial>(young, poisson, a);
+    else material = std::make_shared<HookeMaterial>(young, poisson, a);
+  }
+
+  std::optional<PlaneMesh> mesh;
+  std::string default_contact;
+  if (json* m = r.object(body, ptr, "mesh", true)) {
+    const std::string mp = ptr + "/mesh";
+    std::vector<std::string> kinds;
+    for (const char* k : {"nodes", "rectangle", "half_disc"})
+      if (m->contains(k)) kinds.push_back(k);
+    if (kinds.size() != 1) {
+      r.error(mp, "needs exactly one of \"nodes\" (with \"elements\"), \"rectangle\" and \"half_disc\"");
+    } else if (kinds[0] == "nodes") {
+      mesh = read_explicit_mesh(r, *m, mp, shape);
+    } else {
+      if (m->contains("sets")) r.error(mp + "/sets", "are generated for a " + kinds[0]);
+      mesh = read_generated_mesh(r, *m, mp, shape, kinds[0]);
+      default_contact = kinds[0] == "rectangle" ? "bottom" : "arc";
+    }
+  }
+  if (!mesh || !r.issues.empty()) return;
+
+  if (!body.contains("contact_set")) {
+    if (default_contact.empty()) {
+      r.error(ptr + "/contact_set", "is required: the name of the node set whose nodes can touch an obstacle");
+      return;
+    }
+    body["contact_set"] = default_contact;
+  }
+  const json& cs = body["contact_set"];
+  std::vector<std::string> names;
+  for (const auto& [n, ids] : mesh->sets) names.push_back(n);
+  if (!cs.is_string() || !mesh->sets.count(cs.get<std::string>())) {
+    r.error(ptr + "/contact_set", show(cs) + " names no node set (sets: " + Reader::list(names) + ")");
+    return;
+  }
+  try {
+    problem.body = std::make_unique<ContinuumBody>(*mesh, mesh->sets.at(cs.get<std::string>()), material, options);
+  } catch (const std::invalid_argument& e) {
+    r.error(ptr + "/contact_set", e.what());
+    return;
+  }
+
+  read_continuum_supports(r, body, ptr, *mesh, problem);
+  read_continuum_loads(r, body, ptr, *mesh, shape, problem, options.thickness);
+  if (!r.issues.empty()) return;
+  // ALGORITHM.md section 7: the contact forces are given to each equilibrium solve, so the
+  // supports alone must hold the body.
+  std::vector<char> fixed(problem.body->dof_count(), 0);
+  for (const Constraint& c : problem.constraints) fixed[c.dof] = 1;
+  const std::string free = free_rigid_motion(*mesh, fixed);
+  if (!free.empty())
+    r.error(ptr + "/supports",
+            "leave the body free to " + free +
+                ": contact alone cannot hold it, because each equilibrium solve takes the contact forces "
+                "as given. Prescribe the displacement of a boundary set to drive the body (the force is then "
+                "read from the reactions), or add supports");
+}
+
+}  // namespace grip::scene_io

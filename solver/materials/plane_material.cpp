@@ -1,0 +1,88 @@
+#include "solver/materials/plane_material.hpp"
+
+#include <Eigen/Dense>
+#include <cmath>
+
+namespace grip {
+namespace {
+
+using Vec3 = Eigen::Vector3d;
+using Mat3 = Eigen::Matrix3d;
+
+// The in-plane Voigt block of a(Ci (x) Ci) + b(Ci_ik Ci_jl + Ci_il Ci_jk) for symmetric Ci.
+Mat3 voigt_tangent(const Mat2& Ci, double a, double b) {
+  static const int I[3][2] = {{0, 0}, {1, 1}, {0, 1}};
+  Mat3 D;
+  for (int p = 0; p < 3; ++p)
+    for (int q = 0; q < 3; ++q) {
+      const int i = I[p][0], j = I[p][1], k = I[q][0], l = I[q][1];
+      D(p, q) = a * Ci(i, j) * Ci(k, l) + b * (Ci(i, k) * Ci(j, l) + Ci(i, l) * Ci(j, k));
+    }
+  return D;
+}
+
+Vec3 voigt(const Mat2& A) { return {A(0, 0), A(1, 1), A(0, 1)}; }
+
+}  // namespace
+
+HookeMaterial::HookeMaterial(double young, double poisson, PlaneAnalysis analysis)
+    : lame_(Lame::from(young, poisson)), analysis_(analysis) {
+  const double l = lame_.lambda, m = lame_.mu;
+  D_ << l + 2 * m, l, 0, l, l + 2 * m, 0, 0, 0, m;
+  if (analysis_ == PlaneAnalysis::plane_stress) D_.topLeftCorner<2, 2>().array() -= l * l / (l + 2 * m);
+}
+
+MaterialResponse HookeMaterial::response(const Mat2& E) const {
+  MaterialResponse r;
+  const Vec3 e(E(0, 0), E(1, 1), 2 * E(0, 1));
+  r.D = D_;
+  r.S = D_ * e;
+  const double l = lame_.lambda, m = lame_.mu;
+  if (analysis_ == PlaneAnalysis::plane_strain) {
+    r.dS33 << l, l, 0;
+    r.S33 = r.dS33 * e;
+  } else {
+    r.C33 = 1 - 2 * l / (l + 2 * m) * (e[0] + e[1]);  // 1 + 2 E33, E33 from S33 = 0
+  }
+  return r;
+}
+
+NeoHookeMaterial::NeoHookeMaterial(double young, double poisson, PlaneAnalysis analysis)
+    : lame_(Lame::from(young, poisson)), analysis_(analysis) {}
+
+MaterialResponse NeoHookeMaterial::response(const Mat2& E) const {
+  const double l = lame_.lambda, m = lame_.mu;
+  const Mat2 C = Mat2::Identity() + 2 * E;
+  const double d = C.determinant();
+  MaterialResponse r;
+  if (analysis_ == PlaneAnalysis::plane_stress) {
+    // S33 = 0: m (C33 - 1) + l ln J = 0 with ln J = (ln d + ln C33) / 2. In z = ln C33 the
+    // function is convex and increasing, so Newton from a point where it is >= 0 descends
+    // monotonically onto the root.
+    const double ln_d = std::log(d);
+    double z = std::max(0.0, -ln_d);
+    for (int it = 0; it < 60; ++it) {
+      const double h = m * (std::exp(z) - 1) + 0.5 * l * (ln_d + z);
+      const double dz = h / (m * std::exp(z) + 0.5 * l);
+      z -= dz;
+      if (std::abs(dz) <= 1e-15 * (1 + std::abs(z))) break;
+    }
+    r.C33 = std::exp(z);
+  }
+  const Mat2 Ci = C.inverse();
+  const double lnJ = 0.5 * std::log(d * r.C33);
+  const double b = m - l * lnJ;
+  r.S = voigt(m * (Mat2::Identity() - Ci) + l * lnJ * Ci);
+  r.D = voigt_tangent(Ci, l, b);
+  const Vec3 ci = voigt(Ci);
+  if (analysis_ == PlaneAnalysis::plane_strain) {
+    r.S33 = l * lnJ;
+    r.dS33 = l * ci.transpose();
+  } else {
+    // Condense E33 out: dS33 = 0 = l/C33 ci . dE + (l + 2 b)/C33^2 dE33.
+    r.D -= l * l / (l + 2 * b) * ci * ci.transpose();
+  }
+  return r;
+}
+
+}  // namespace grip

@@ -1,0 +1,69 @@
+#pragma once
+// Elastic laws for plane bodies, in total Lagrangian form: the second Piola-Kirchhoff stress S
+// and its tangent dS/dE from the in-plane Green-Lagrange strain E. Under small strain E is the
+// linear strain and S the Cauchy stress. Voigt order (11, 22, 12); strain vectors carry the
+// engineering shear 2 E12, so that S . dE is the work per unit reference volume.
+// Plane strain: E33 = 0, S33 follows. Plane stress: S33 = 0, E33 follows (condensed out of
+// the tangent). Units are the scene's: young in force / length^2.
+#include <Eigen/Core>
+#include <memory>
+
+#include "solver/core/types.hpp"
+
+namespace grip {
+
+enum class PlaneAnalysis { plane_strain, plane_stress };
+
+// Response of a law at one material point.
+struct MaterialResponse {
+  Eigen::Vector3d S = Eigen::Vector3d::Zero();   // (S11, S22, S12)
+  Eigen::Matrix3d D = Eigen::Matrix3d::Zero();   // dS/dE, with E as (E11, E22, 2 E12); symmetric
+  double S33 = 0.0;          // out-of-plane normal stress (zero in plane stress)
+  Eigen::RowVector3d dS33 = Eigen::RowVector3d::Zero();  // dS33/dE (zero in plane stress)
+  double C33 = 1.0;          // out-of-plane stretch squared (one in plane strain)
+};
+
+class PlaneMaterial {
+ public:
+  virtual ~PlaneMaterial() = default;
+  // The response to the in-plane Green-Lagrange strain E (symmetric 2x2).
+  virtual MaterialResponse response(const Mat2& E) const = 0;
+  // The small-strain law: the response at E = 0 (the same Hooke's law for every law here).
+  MaterialResponse small_strain() const { return response(Mat2::Zero()); }
+};
+
+// Lame constants from Young's modulus and Poisson's ratio (3D values: plane stress is
+// obtained by condensation, not by a modified lambda).
+struct Lame {
+  double lambda, mu;
+  static Lame from(double young, double poisson) {
+    return {young * poisson / ((1 + poisson) * (1 - 2 * poisson)), young / (2 * (1 + poisson))};
+  }
+};
+
+// Hooke's law S = D E; as a finite-strain law it is Saint Venant-Kirchhoff.
+class HookeMaterial final : public PlaneMaterial {
+ public:
+  HookeMaterial(double young, double poisson, PlaneAnalysis analysis);
+  MaterialResponse response(const Mat2& E) const override;
+
+ private:
+  Lame lame_;
+  PlaneAnalysis analysis_;
+  Eigen::Matrix3d D_;
+};
+
+// Compressible neo-Hookean: W = mu/2 (I1 - 3) - mu ln J + lambda/2 (ln J)^2, so
+// S = mu (I - C^-1) + lambda ln J C^-1 (3D); its small-strain limit is Hooke's law.
+// Plane stress solves S33 = 0 for C33 by Newton's method at every call.
+class NeoHookeMaterial final : public PlaneMaterial {
+ public:
+  NeoHookeMaterial(double young, double poisson, PlaneAnalysis analysis);
+  MaterialResponse response(const Mat2& E) const override;
+
+ private:
+  Lame lame_;
+  PlaneAnalysis analysis_;
+};
+
+}  // namespace grip
