@@ -1,0 +1,629 @@
+"""PNG plots of a grip result (matplotlib, Agg backend; imported only by `plot`).
+
+Each figure function takes the result dict (GET /v1/jobs/{id}/result) and returns
+`(figure, data)`: `data` holds exactly the series handed to matplotlib, so that a test (or a
+user) can compare them with the result's numbers.
+
+    convergence(result)        ||v||_2 against contact iteration, log scale, one colour per step
+    shapes(result)             deformed shapes at several steps with the obstacles (Figs. 4, 6)
+    strain(result)             strain along the sheet (membrane; Fig. 5)
+    contact_stress(result, "normal" | "friction")   contact stress along the body (Figs. 7, 8)
+    load_deflection(result)    load against end deflection (bodies with loads; Fig. 9)
+
+`write_all(result, out_dir, prefix)` writes every figure that applies and returns
+{name: path}.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from typing import Dict, List, Optional, Sequence, Tuple
+
+_plt = None
+
+
+def pyplot():
+    """matplotlib.pyplot with the Agg backend (no display needed)."""
+    global _plt
+    if _plt is None:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        _plt = plt
+    return _plt
+
+
+# ---- reading the result
+
+
+def body_model(result: dict) -> str:
+    return result.get("scene", {}).get("body", {}).get("model", "")
+
+
+def units(result: dict) -> Dict[str, str]:
+    u = result.get("scene", {}).get("units") or {}
+    return {"force": u.get("force", ""), "length": u.get("length", "")}
+
+
+def _unit(text: str) -> str:
+    return f" [{text}]" if text else ""
+
+
+def stress_unit(result: dict) -> str:
+    u = units(result)
+    if u["force"] and u["length"]:
+        if (u["force"], u["length"]) == ("N", "mm"):
+            return "MPa"
+        return f"{u['force']}/{u['length']}²"
+    return ""
+
+
+def field_steps(result: dict) -> List[dict]:
+    """Steps whose fields (nodes) were recorded."""
+    return [s for s in result.get("steps", []) if s.get("nodes")]
+
+
+def find_step(result: dict, step: Optional[int]) -> dict:
+    """The step numbered `step` (1-based, as in the result), or the last one with fields."""
+    steps = field_steps(result)
+    if not steps:
+        raise ValueError("the result has no step with node fields")
+    if step is None:
+        return steps[-1]
+    for s in steps:
+        if s.get("step") == step:
+            return s
+    raise ValueError(f"the result has no fields for step {step}")
+
+
+def displacement_keys(result: dict) -> Tuple[str, str]:
+    """Names of the node displacement columns: (u, w) for a beam, (ux, uy) otherwise."""
+    steps = field_steps(result)
+    row = steps[0]["nodes"][0] if steps else {}
+    return ("u", "w") if "w" in row and "ux" not in row else ("ux", "uy")
+
+
+def node_xy(step: dict) -> Tuple[List[float], List[float]]:
+    return [n["x"] for n in step["nodes"]], [n["y"] for n in step["nodes"]]
+
+
+def initial_xy(result: dict, step: dict) -> Tuple[List[float], List[float]]:
+    """Undeformed node positions: deformed minus displacement."""
+    ku, kv = displacement_keys(result)
+    return ([n["x"] - n[ku] for n in step["nodes"]], [n["y"] - n[kv] for n in step["nodes"]])
+
+
+def characteristic_length(result: dict) -> float:
+    """The body length the contact tolerance is relative to (the mesh length; else the extent
+    of the undeformed nodes)."""
+    mesh = result.get("scene", {}).get("body", {}).get("mesh", {})
+    if isinstance(mesh.get("length"), (int, float)):
+        return float(mesh["length"])
+    steps = field_steps(result)
+    if not steps:
+        return 1.0
+    x0, y0 = initial_xy(result, steps[0])
+    return max(max(x0) - min(x0), max(y0) - min(y0)) or 1.0
+
+
+def tolerance(result: dict) -> Optional[float]:
+    """The absolute ||v||_2 tolerance: solver.contact.tolerance x the body length."""
+    tol = result.get("scene", {}).get("solver", {}).get("contact", {}).get("tolerance")
+    if not isinstance(tol, (int, float)):
+        return None
+    return float(tol) * characteristic_length(result)
+
+
+def moving_obstacle(result: dict) -> Optional[str]:
+    """Name of the first obstacle that moves over the run, if any."""
+    for s in result.get("steps", []):
+        for o in s.get("obstacles", []) or []:
+            if any(abs(v) > 0 for v in o.get("offset", [0, 0])):
+                return o["name"]
+    return None
+
+
+def total_load(result: dict) -> Tuple[float, Optional[int]]:
+    """|sum of load forces| at factor 1 and the node of the first load (None: no loads)."""
+    loads = result.get("scene", {}).get("body", {}).get("loads") or []
+    fx = sum(l.get("force", [0, 0])[0] for l in loads)
+    fy = sum(l.get("force", [0, 0])[1] for l in loads)
+    node = loads[0].get("node") if loads else None
+    return math.hypot(fx, fy), node
+
+
+def step_label(result: dict, step: dict) -> str:
+    """What a step means physically: the travel of the moving obstacle, or the load."""
+    u = units(result)
+    mover = moving_obstacle(result)
+    if mover:
+        for o in step.get("obstacles", []) or []:
+            if o["name"] == mover:
+                travel = math.hypot(*o["offset"])
+                return f"{mover} travel {travel:.3g}{' ' + u['length'] if u['length'] else ''}"
+    total, _ = total_load(result)
+    lf = step.get("load_factor", 0.0)
+    if total > 0:
+        return f"F = {lf * total:.4g}{' ' + u['force'] if u['force'] else ''}"
+    return f"load factor {lf:.3g}"
+
+
+def pick_steps(result: dict, count: Optional[int] = None) -> List[dict]:
+    """About five or six evenly spaced steps with fields, ending with the last."""
+    steps = field_steps(result)
+    n = len(steps)
+    if n == 0:
+        return []
+    if count is None:
+        count = next((c for c in (6, 5, 4) if n % c == 0), min(n, 5))
+    count = max(1, min(count, n))
+    picks = sorted({max(1, round(n * k / count)) for k in range(1, count + 1)})
+    return [steps[i - 1] for i in picks]
+
+
+# ---- obstacles
+
+
+def _arc_points(centre, radius, a0, a1, offset, n=200):
+    out_x, out_y = [], []
+    for k in range(n + 1):
+        a = math.radians(a0 + (a1 - a0) * k / n)
+        out_x.append(centre[0] + offset[0] + radius * math.cos(a))
+        out_y.append(centre[1] + offset[1] + radius * math.sin(a))
+    return out_x, out_y
+
+
+def obstacle_outline(shape: dict, offset: Sequence[float] = (0.0, 0.0)) -> Tuple[List[float], List[float]]:
+    """Points of an obstacle's surface (circle, segment, arc, profile), moved by `offset`."""
+    kind = shape.get("type")
+    if kind == "circle":
+        return _arc_points(shape["centre"], shape["radius"], 0.0, 360.0, offset, 360)
+    if kind == "segment":
+        a, b = shape["from"], shape["to"]
+        return [a[0] + offset[0], b[0] + offset[0]], [a[1] + offset[1], b[1] + offset[1]]
+    if kind == "arc":
+        a0, a1 = shape["start_angle"], shape["end_angle"]
+        if a1 < a0:
+            a1 += 360.0
+        return _arc_points(shape["centre"], shape["radius"], a0, a1, offset)
+    if kind == "profile":
+        xs: List[float] = []
+        ys: List[float] = []
+        for piece in shape.get("pieces", []):
+            px, py = obstacle_outline(piece, offset)
+            xs += px
+            ys += py
+        return xs, ys
+    return [], []
+
+
+def obstacle_offsets(step: Optional[dict]) -> Dict[str, List[float]]:
+    if not step:
+        return {}
+    return {o["name"]: list(o.get("offset", [0.0, 0.0])) for o in step.get("obstacles", []) or []}
+
+
+def draw_obstacles(ax, result: dict, step: Optional[dict], color="0.35", alpha=1.0, label=True,
+                   linestyle="-"):
+    """Draws every obstacle of the effective scene at the step's offsets; returns the lines."""
+    offsets = obstacle_offsets(step)
+    lines = []
+    for o in result.get("scene", {}).get("obstacles", []):
+        x, y = obstacle_outline(o.get("shape", {}), offsets.get(o.get("name"), (0.0, 0.0)))
+        if not x:
+            continue
+        (line,) = ax.plot(x, y, color=color, lw=1.2, alpha=alpha, linestyle=linestyle,
+                          label=o.get("name") if label else None)
+        lines.append(line)
+    return lines
+
+
+def _body_limits(ax, xs: Sequence[float], ys: Sequence[float], margin=0.12):
+    x0, x1 = min(xs), max(xs)
+    y0, y1 = min(ys), max(ys)
+    span = max(x1 - x0, y1 - y0, 1e-9)
+    ax.set_xlim(x0 - margin * span, x1 + margin * span)
+    ax.set_ylim(y0 - margin * span, y1 + margin * span)
+
+
+def beam_band(step: dict, obstacle: Optional[str] = None):
+    """For a beam: (lower, upper) surface polylines from the contact points (lower surface)
+    mirrored about the centre line; None when the points do not cover every node."""
+    nodes = step.get("nodes", [])
+    pts = [c for c in step.get("contact_points", []) or [] if obstacle in (None, c["obstacle"])]
+    by_node = {}
+    for c in pts:
+        by_node.setdefault(c["node"], c)
+    if len(by_node) != len(nodes):
+        return None
+    lower = [(by_node[i]["x"], by_node[i]["y"]) for i in range(len(nodes))]
+    upper = [(2 * n["x"] - lx, 2 * n["y"] - ly) for n, (lx, ly) in zip(nodes, lower)]
+    return lower, upper
+
+
+# ---- figures
+
+
+def convergence(result: dict, history: Optional[List[dict]] = None):
+    """||v||_2 against the contact iteration (counted over the whole run), log scale, one
+    colour per load step, with the tolerance line. Iterations with ||v||_2 = 0 (nothing in
+    contact) cannot be shown on a log scale: they are counted but not drawn.
+
+    `history`: the iteration events (GET .../convergence), when the result has no history.
+    data = {"steps": {k: {"iteration": [...], "v2": [...]}}, "tolerance": float | None,
+            "zero": number of iterations with ||v||_2 = 0}"""
+    plt = pyplot()
+    per_step: Dict[int, List[float]] = {}
+    if history is None:
+        for s in result.get("steps", []):
+            per_step[s["step"]] = [h["v2"] for h in s.get("history", []) or []]
+    else:
+        for h in history:
+            per_step.setdefault(h["step"], []).append(h["v2"])
+    fig, ax = plt.subplots(figsize=(8, 4.8))
+    cmap = plt.get_cmap("viridis")
+    count = 0
+    zero = 0
+    data = {"steps": {}, "tolerance": tolerance(result), "zero": 0}
+    nsteps = max(len(per_step), 1)
+    for idx, (k, values) in enumerate(sorted(per_step.items())):
+        it, v = [], []
+        for value in values:
+            count += 1
+            if value > 0:
+                it.append(count)
+                v.append(value)
+            else:
+                zero += 1
+        data["steps"][k] = {"iteration": it, "v2": v}
+        if v:
+            ax.plot(it, v, "-o", ms=2.5, lw=1.0, color=cmap(idx / max(nsteps - 1, 1)),
+                    label=f"step {k}", gid=f"step-{k}")
+    data["zero"] = zero
+    if data["tolerance"]:
+        ax.axhline(data["tolerance"], color="crimson", ls="--", lw=1.0, gid="tolerance",
+                   label=f"tolerance {data['tolerance']:.2e}")
+    ax.set_yscale("log")
+    ax.set_xlabel("contact iteration (whole run)")
+    ax.set_ylabel(r"$\|v\|_2$")
+    name = result.get("scene", {}).get("name", "")
+    ax.set_title(f"Contact error history{': ' + name if name else ''}")
+    ax.grid(True, which="both", alpha=0.25)
+    if nsteps <= 12:
+        ax.legend(fontsize=7, ncol=2)
+    else:
+        sm = plt.cm.ScalarMappable(cmap=cmap, norm=plt.Normalize(min(per_step), max(per_step)))
+        fig.colorbar(sm, ax=ax, label="load step")
+        if data["tolerance"]:
+            ax.legend(handles=[l for l in ax.get_lines() if l.get_gid() == "tolerance"], fontsize=8)
+    fig.tight_layout()
+    return fig, data
+
+
+def shapes(result: dict, steps: Optional[Sequence[int]] = None):
+    """Undeformed and deformed shapes at several steps, each with the obstacles at that step's
+    position (the paper's Figs. 4 and 6).
+
+    data = {"initial": {"x", "y"}, "steps": {k: {"x", "y", "offsets", "label"}}}"""
+    plt = pyplot()
+    chosen = pick_steps(result) if steps is None else [find_step(result, k) for k in steps]
+    if not chosen:
+        raise ValueError("the result has no step with node fields")
+    fig, ax = plt.subplots(figsize=(9, 6))
+    cmap = plt.get_cmap("plasma")
+    x0, y0 = initial_xy(result, chosen[0])
+    data = {"initial": {"x": x0, "y": y0}, "steps": {}}
+    ax.plot(x0, y0, color="0.6", ls="--", lw=1.2, label="undeformed", gid="initial")
+    draw_obstacles(ax, result, None, color="0.75", label=False, linestyle=":")
+    allx, ally = list(x0), list(y0)
+    for i, s in enumerate(chosen):
+        colour = cmap(0.1 + 0.8 * i / max(len(chosen) - 1, 1))
+        x, y = node_xy(s)
+        label = step_label(result, s)
+        data["steps"][s["step"]] = {"x": x, "y": y, "offsets": obstacle_offsets(s), "label": label}
+        if body_model(result) == "timoshenko_beam":
+            band = beam_band(s)
+            if band:  # the beam's lower and upper surfaces, thin
+                for surface in band:
+                    ax.plot([p[0] for p in surface], [p[1] for p in surface], color=colour,
+                            lw=0.6, alpha=0.7)
+        ax.plot(x, y, "-o", ms=2.5, lw=1.6, color=colour, label=label, gid=f"step-{s['step']}")
+        if moving_obstacle(result):
+            draw_obstacles(ax, result, s, color=colour, alpha=0.6, label=False)
+        allx += x
+        ally += y
+    if not moving_obstacle(result):
+        draw_obstacles(ax, result, chosen[-1])
+    else:
+        # The fixed obstacles once, in grey.
+        mover = moving_obstacle(result)
+        fixed = dict(result)
+        fixed["scene"] = dict(result["scene"])
+        fixed["scene"]["obstacles"] = [o for o in result["scene"]["obstacles"] if o["name"] != mover]
+        draw_obstacles(ax, fixed, chosen[-1])
+    _body_limits(ax, allx, ally)
+    ax.set_aspect("equal", adjustable="box")
+    u = units(result)
+    ax.set_xlabel("x" + _unit(u["length"]))
+    ax.set_ylabel("y" + _unit(u["length"]))
+    name = result.get("scene", {}).get("name", "")
+    ax.set_title(f"Deformed shapes{': ' + name if name else ''}")
+    ax.legend(fontsize=8, loc="best")
+    ax.grid(True, alpha=0.2)
+    fig.tight_layout()
+    return fig, data
+
+
+def strain(result: dict, step: Optional[int] = None):
+    """True strains along the sheet against the undeformed position s0 of each element
+    (membrane; the paper's Fig. 5 at punch travel 30 mm).
+
+    data = {"step", "s0", "major_strain", "thickness_strain", "peak": {"s0", "major_strain"}}"""
+    plt = pyplot()
+    s = find_step(result, step)
+    els = s.get("elements") or []
+    if not els or "major_strain" not in els[0]:
+        raise ValueError("the result has no membrane strains (elements.major_strain)")
+    s0 = [e["s0"] for e in els]
+    major = [e["major_strain"] for e in els]
+    thick = [e["thickness_strain"] for e in els]
+    k = max(range(len(major)), key=lambda i: major[i])
+    # The stretch where the strain is within 1 % of its peak (a plateau in a free wall).
+    near = [i for i, e in enumerate(major) if e >= major[k] - 0.01 * abs(major[k])]
+    data = {"step": s["step"], "label": step_label(result, s), "s0": s0, "major_strain": major,
+            "thickness_strain": thick,
+            "peak": {"s0": s0[k], "major_strain": major[k],
+                     "within_1_percent": [s0[near[0]], s0[near[-1]]]}}
+    fig, ax = plt.subplots(figsize=(8, 4.8))
+    ax.plot(s0, major, "-o", ms=3, color="tab:blue", label="major (meridional) true strain",
+            gid="major_strain")
+    ax.plot(s0, thick, "-s", ms=3, color="tab:orange", label="thickness true strain",
+            gid="thickness_strain")
+    ax.axhline(0, color="0.5", lw=0.6)
+    lo, hi = data["peak"]["within_1_percent"]
+    where = f"s0 = {s0[k]:.3g}" if lo == hi else f"s0 from {lo:.3g} to {hi:.3g}"
+    ax.annotate(f"peak {major[k]:.3f}, {where}", (s0[k], major[k]),
+                xytext=(10, 10), textcoords="offset points", fontsize=8,
+                arrowprops={"arrowstyle": "->", "lw": 0.8})
+    # Where each tool touches the sheet (points not open), as bands along s0.
+    _contact_bands(ax, result, s, s0, els)
+    u = units(result)
+    ax.set_xlabel("undeformed position along the sheet s0" + _unit(u["length"]))
+    ax.set_ylabel("true strain")
+    ax.set_title(f"Strain distribution, {data['label']}")
+    ax.grid(True, alpha=0.25)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    return fig, data
+
+
+def _contact_bands(ax, result, step, s0, els):
+    """Shades the undeformed stretch of the sheet in contact with each obstacle."""
+    nodes = step.get("nodes", [])
+    if len(nodes) != len(els) + 1:
+        return
+    # Node s0 from element mid-points (uniform or not): ends of each element.
+    node_s0 = [0.0] * len(nodes)
+    node_s0[0] = 2 * s0[0] - (s0[1] if len(s0) > 1 else 2 * s0[0])
+    node_s0[0] = max(node_s0[0], 0.0)
+    for i, m in enumerate(s0):
+        node_s0[i + 1] = 2 * m - node_s0[i]
+    colours = ["tab:green", "tab:red", "tab:purple", "tab:brown"]
+    for j, o in enumerate(result.get("scene", {}).get("obstacles", [])):
+        touching = sorted({c["node"] for c in step.get("contact_points", []) or []
+                           if c["obstacle"] == o["name"] and c["state"] != "open"})
+        if not touching:
+            continue
+        lo, hi = node_s0[touching[0]], node_s0[touching[-1]]
+        ax.axvspan(lo, hi, color=colours[j % len(colours)], alpha=0.08,
+                   label=f"in contact with {o['name']}")
+
+
+def contact_series(result: dict, step: dict, obstacle: str, key: str):
+    """Per contact point of `obstacle` in node order: undeformed position along the body (x0 of
+    the node), deformed point (x, y), normal, state and the value of `key`."""
+    x0, _ = initial_xy(result, step)
+    pts = sorted((c for c in step.get("contact_points", []) or [] if c["obstacle"] == obstacle),
+                 key=lambda c: c["node"])
+    return {"node": [c["node"] for c in pts], "x0": [x0[c["node"]] for c in pts],
+            "x": [c["x"] for c in pts], "y": [c["y"] for c in pts],
+            "normal": [c["normal"] for c in pts], "state": [c["state"] for c in pts],
+            key: [c[key] for c in pts]}
+
+
+def sign_changes(x: Sequence[float], values: Sequence[float], states: Sequence[str]) -> List[float]:
+    """Positions (mid-way between neighbours) where a stress changes sign among the points in
+    contact."""
+    idx = [i for i, st in enumerate(states) if st != "open" and values[i] != 0.0]
+    out = []
+    for a, b in zip(idx, idx[1:]):
+        if values[a] * values[b] < 0:
+            out.append(0.5 * (x[a] + x[b]))
+    return out
+
+
+def contact_stress(result: dict, component: str = "normal", step: Optional[int] = None):
+    """Normal (sigma_n) or frictional (sigma_t) contact stress, i.e. contact force / tributary
+    area, (top) drawn on the deformed shape with the obstacles and (bottom) along the body
+    against the undeformed position x0 of each point (the paper's Figs. 7 and 8).
+
+    On the shape, normal stress is drawn along the obstacle normal; frictional stress as arrows
+    along the force it puts on the body: f = p_t * xi with xi = rot90(n), the obstacle's
+    counter-clockwise tangent. Paper signs: sigma_n <= 0 presses.
+
+    data = {"step", "component", "obstacles": {name: {"x0", "sigma", "x", "y", "state",
+            "sign_changes": [x0...], "force_x": [...]}}}"""
+    plt = pyplot()
+    key = {"normal": "sigma_n", "friction": "sigma_t"}[component]
+    s = find_step(result, step)
+    names = [o["name"] for o in result.get("scene", {}).get("obstacles", [])]
+    data = {"step": s["step"], "label": step_label(result, s), "component": component,
+            "key": key, "obstacles": {}}
+    fig, (ax_shape, ax_line) = plt.subplots(2, 1, figsize=(9, 8.5),
+                                            gridspec_kw={"height_ratios": [1.25, 1]})
+    x, y = node_xy(s)
+    if body_model(result) == "timoshenko_beam":
+        band = beam_band(s)
+        if band:
+            lower, upper = band
+            poly = lower + upper[::-1]
+            ax_shape.fill([p[0] for p in poly], [p[1] for p in poly], color="tab:blue",
+                          alpha=0.2, lw=0)
+    ax_shape.plot(x, y, "-", color="tab:blue", lw=1.4, label="body (deformed)")
+    draw_obstacles(ax_shape, result, s)
+    allx, ally = list(x), list(y)
+    peak = max((abs(c[key]) for c in s.get("contact_points", []) or []), default=0.0)
+    span = max(max(x) - min(x), max(y) - min(y), 1e-9)
+    scale = 0.15 * span / peak if peak > 0 else 0.0
+    colours = ["tab:red", "tab:green", "tab:purple", "tab:brown"]
+    for j, name in enumerate(names):
+        ser = contact_series(result, s, name, key)
+        if not ser["node"]:
+            continue
+        col = colours[j % len(colours)]
+        sigma = ser[key]
+        tang = [(-n[1], n[0]) for n in ser["normal"]]
+        entry = {"x0": ser["x0"], "sigma": sigma, "x": ser["x"], "y": ser["y"],
+                 "node": ser["node"], "state": ser["state"],
+                 "sign_changes": sign_changes(ser["x0"], sigma, ser["state"])}
+        if component == "friction":
+            entry["force_x"] = [v * t[0] for v, t in zip(sigma, tang)]
+        data["obstacles"][name] = entry
+        ax_line.plot(ser["x0"], sigma, "-o", ms=3, color=col, label=f"{key} on {name}",
+                     gid=f"{key}-{name}")
+        act = [i for i, st in enumerate(ser["state"]) if st != "open"]
+        if not act or scale == 0.0:
+            continue
+        if component == "normal":
+            # Stress diagram: the surface pushed out along the normal by |sigma| (into the body).
+            dx = [ser["x"][i] - scale * abs(sigma[i]) * ser["normal"][i][0] for i in act]
+            dy = [ser["y"][i] - scale * abs(sigma[i]) * ser["normal"][i][1] for i in act]
+            for i, ex, ey in zip(act, dx, dy):
+                ax_shape.plot([ser["x"][i], ex], [ser["y"][i], ey], color=col, lw=0.8)
+            ax_shape.plot(dx, dy, "-", color=col, lw=1.2, label=f"|{key}| on {name}")
+            allx += dx
+            ally += dy
+        else:
+            u = [scale * sigma[i] * tang[i][0] for i in act]
+            v = [scale * sigma[i] * tang[i][1] for i in act]
+            ax_shape.quiver([ser["x"][i] for i in act], [ser["y"][i] for i in act], u, v,
+                            angles="xy", scale_units="xy", scale=1.0, color=col, width=0.003,
+                            label=f"friction on the body from {name}")
+            allx += [ser["x"][i] + du for i, du in zip(act, u)]
+            ally += [ser["y"][i] + dv for i, dv in zip(act, v)]
+        for xc in entry["sign_changes"]:
+            ax_line.axvline(xc, color=col, ls=":", lw=1.0)
+            ax_line.annotate(f"sign change at x0 = {xc:.3g}", (xc, 0), xytext=(5, 12),
+                             textcoords="offset points", fontsize=8, color=col)
+    _body_limits(ax_shape, allx, ally, margin=0.08)
+    ax_shape.set_aspect("equal", adjustable="box")
+    un = units(result)
+    su = stress_unit(result)
+    what = "Normal" if component == "normal" else "Frictional"
+    ax_shape.set_title(f"{what} contact stress on the deformed shape, {data['label']}")
+    ax_shape.set_xlabel("x" + _unit(un["length"]))
+    ax_shape.set_ylabel("y" + _unit(un["length"]))
+    ax_shape.legend(fontsize=8, loc="best")
+    ax_shape.grid(True, alpha=0.2)
+    ax_line.axhline(0, color="0.5", lw=0.6)
+    ax_line.set_xlabel("undeformed position x0" + _unit(un["length"]))
+    if component == "normal":
+        ax_line.set_ylabel(r"$\sigma_n$ (<= 0 presses)" + _unit(su))
+    else:
+        ax_line.set_ylabel(r"$\sigma_t$ (along $\xi$, ccw tangent of the obstacle)" + _unit(su))
+    ax_line.grid(True, alpha=0.25)
+    ax_line.legend(fontsize=8)
+    fig.tight_layout()
+    return fig, data
+
+
+def load_deflection(result: dict, node: Optional[int] = None):
+    """Load against the displacements of the loaded end (the paper's Fig. 9): the vertical
+    deflection -w (or -uy) and the horizontal -u (or -ux), from the unloaded origin.
+
+    data = {"node", "load": [0, ...], "deflection": [0, ...], "horizontal": [0, ...]}"""
+    plt = pyplot()
+    total, load_node = total_load(result)
+    steps = field_steps(result)
+    if total <= 0 or not steps:
+        raise ValueError("the scene has no loads: no load-deflection curve")
+    if node is None:
+        node = load_node if load_node is not None else len(steps[0]["nodes"]) - 1
+    ku, kv = displacement_keys(result)
+    load = [0.0] + [s["load_factor"] * total for s in steps]
+    defl = [0.0] + [-s["nodes"][node][kv] for s in steps]
+    horiz = [0.0] + [-s["nodes"][node][ku] for s in steps]
+    data = {"node": node, "load": load, "deflection": defl, "horizontal": horiz}
+    fig, ax = plt.subplots(figsize=(7, 5))
+    ax.plot(defl, load, "-o", ms=3, label=f"vertical  -{kv} (node {node})", gid="deflection")
+    ax.plot(horiz, load, "-s", ms=3, label=f"horizontal -{ku} (node {node})", gid="horizontal")
+    u = units(result)
+    ax.set_xlabel("end displacement" + _unit(u["length"]))
+    ax.set_ylabel("load F" + _unit(u["force"]))
+    ax.set_title("Load against end deflection")
+    ax.grid(True, alpha=0.25)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    return fig, data
+
+
+# ---- all at once
+
+FIGURES = ("convergence", "shapes", "strain", "contact_normal", "contact_friction",
+           "load_deflection")
+
+
+def applicable(result: dict) -> List[str]:
+    """The figures that this result can give."""
+    names = ["convergence"]
+    if not field_steps(result):
+        return names
+    names.append("shapes")
+    last = field_steps(result)[-1]
+    if (last.get("elements") or [{}])[0].get("major_strain") is not None:
+        names.append("strain")
+    if last.get("contact_points"):
+        names.append("contact_normal")
+        if any(c.get("sigma_t", 0) != 0 for c in last["contact_points"]) or any(
+                o.get("friction", 0) > 0 for o in result.get("scene", {}).get("obstacles", [])):
+            names.append("contact_friction")
+    if total_load(result)[0] > 0:
+        names.append("load_deflection")
+    return names
+
+
+def make(result: dict, name: str, history=None, step: Optional[int] = None):
+    if name == "convergence":
+        return convergence(result, history)
+    if name == "shapes":
+        return shapes(result)
+    if name == "strain":
+        return strain(result, step)
+    if name == "contact_normal":
+        return contact_stress(result, "normal", step)
+    if name == "contact_friction":
+        return contact_stress(result, "friction", step)
+    if name == "load_deflection":
+        return load_deflection(result)
+    raise ValueError(f"unknown figure {name!r}; figures: {', '.join(FIGURES)}")
+
+
+def write_all(result: dict, out_dir: str, prefix: str = "", names: Optional[Dict[str, str]] = None,
+              history=None, step: Optional[int] = None, dpi: int = 110):
+    """Writes each applicable figure as a PNG; returns {figure: (path, data)}.
+
+    `names` maps a figure to its file stem (default: prefix + figure)."""
+    plt = pyplot()
+    os.makedirs(out_dir, exist_ok=True)
+    written = {}
+    for name in applicable(result):
+        fig, data = make(result, name, history, step)
+        stem = (names or {}).get(name, prefix + name)
+        path = os.path.join(out_dir, stem + ".png")
+        fig.savefig(path, dpi=dpi)
+        plt.close(fig)
+        written[name] = (path, data)
+    return written
