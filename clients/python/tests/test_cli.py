@@ -1,0 +1,156 @@
+"""`python3 -m grip_client` against a live server: output, files and exit codes
+(0 success, 1 job failed, 2 usage or HTTP error with the problem's pointers)."""
+
+import json
+import os
+import re
+import tempfile
+import unittest
+
+import support
+from grip_client import Client
+
+
+def write_json(folder, name, doc):
+    path = os.path.join(folder, name)
+    with open(path, "w", encoding="utf-8") as f:
+        json.dump(doc, f)
+    return path
+
+
+class Cli(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = tempfile.TemporaryDirectory()
+        cls.client = support.client()
+        cls.small = write_json(cls.tmp.name, "small.json", support.small_beam())
+        cls.failing = write_json(cls.tmp.name, "failing.json", support.failing_beam())
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.tmp.cleanup()
+
+    def test_submit_watch_prints_a_line_per_iteration_and_a_bar_per_step(self):
+        p = support.cli("submit", self.small, "--watch")
+        self.assertEqual(p.returncode, 0, p.stderr)
+        lines = p.stdout.splitlines()
+        job_id = lines[0].strip()
+        events = list(self.client.job(job_id).events())
+        iterations = [e for e in events if e.type == "iteration"]
+        it_lines = [l for l in lines if "||v||" in l]
+        self.assertEqual(len(it_lines), len(iterations))
+        for line, ev in zip(it_lines, iterations):
+            self.assertIn(f"step {ev['step']}", line)
+            self.assertIn(f"m {ev['m']:>3}", line)
+            self.assertIn(f"||v|| {ev['v2']:.3e}", line)
+            self.assertIn(f"stick {ev['stick']}  slip {ev['slip']}", line)
+        done = [l for l in lines if "converged:" in l]
+        self.assertEqual(len(done), 4)
+        for k, line in enumerate(done, start=1):
+            self.assertIn(f"] {k}/4", line)
+            self.assertIn("#" * (5 * k) + "." * (20 - 5 * k) + "]", line)
+        self.assertEqual(lines[-1], "job finished: 4 of 4 steps")
+
+    def test_failed_job_exits_1(self):
+        p = support.cli("submit", self.failing, "--watch")
+        self.assertEqual(p.returncode, 1, p.stdout + p.stderr)
+        self.assertIn("job failed", p.stdout)
+        job_id = p.stdout.splitlines()[0].strip()
+        self.assertEqual(support.cli("watch", job_id).returncode, 1)
+        self.assertEqual(support.cli("status", job_id).returncode, 1)
+
+    def test_invalid_scene_exits_2_with_pointers(self):
+        scene = support.small_beam()
+        scene["body"]["mesh"]["elements"] = 0
+        scene["obstacles"][0]["friction"] = "high"
+        path = write_json(self.tmp.name, "invalid.json", scene)
+        p = support.cli("submit", path)
+        self.assertEqual(p.returncode, 2)
+        self.assertIn("422 Invalid scene", p.stderr)
+        self.assertRegex(p.stderr, r"(?m)^  /body/mesh/elements: ")
+        self.assertRegex(p.stderr, r"(?m)^  /obstacles/0/friction: ")
+
+    def test_usage_and_http_errors_exit_2(self):
+        self.assertEqual(support.cli().returncode, 2)
+        self.assertEqual(support.cli("submit").returncode, 2)
+        self.assertEqual(support.cli("submit", os.path.join(self.tmp.name, "none.json")).returncode, 2)
+        p = support.cli("status", "no-such-job")
+        self.assertEqual(p.returncode, 2)
+        self.assertIn("404 Job not found", p.stderr)
+        p = support.cli("sweep", self.small, "--set", "steps")
+        self.assertEqual(p.returncode, 2)
+        p = support.cli("list", env_extra={"GRIP_URL": "http://127.0.0.1:1"})
+        self.assertEqual(p.returncode, 2)
+        self.assertIn("cannot reach", p.stderr)
+
+    def test_status_list_result_dismiss(self):
+        job = self.client.submit(support.small_beam(steps=2))
+        job.wait()
+        p = support.cli("status", job.id)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        self.assertRegex(p.stdout, r"(?m)^status +successful$")
+        self.assertRegex(p.stdout, r"(?m)^steps +2$")
+        p = support.cli("status", job.id, "--json")
+        self.assertEqual(json.loads(p.stdout)["jobID"], job.id)
+
+        p = support.cli("list", "--status", "successful", "--limit", "500")
+        self.assertEqual(p.returncode, 0, p.stderr)
+        self.assertIn(job.id, p.stdout)
+
+        out = os.path.join(self.tmp.name, "result")
+        p = support.cli("result", job.id, "-o", out, "--format", "all")
+        self.assertEqual(p.returncode, 0, p.stderr)
+        with open(os.path.join(out, "result.json"), encoding="utf-8") as f:
+            self.assertEqual(json.load(f), job.result())
+        for t in ("steps", "nodes", "contact_points", "history"):
+            with open(os.path.join(out, t + ".csv"), encoding="utf-8") as f:
+                self.assertEqual(f.read(), job.result("csv", table=t))
+        pvd = [n for n in os.listdir(os.path.join(out, "vtk", "grip-" + job.id[:8]))
+               if n.endswith(".pvd")]
+        self.assertEqual(len(pvd), 1)
+
+        p = support.cli("dismiss", job.id)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        self.assertEqual(support.cli("status", job.id).returncode, 2)
+
+    def test_sweep_tabulates_outputs_of_each_variant(self):
+        p = support.cli("sweep", self.small, "--set", "obstacles.0.friction=0,0.3",
+                        "--set", "/steps=2,4", "--output", "steps.-1.nodes.-1.w",
+                        "--output", "summary.contact_iterations", "--json")
+        self.assertEqual(p.returncode, 0, p.stderr)
+        rows = json.loads(p.stdout)
+        self.assertEqual([(r["obstacles.0.friction"], r["/steps"]) for r in rows],
+                         [(0, 2), (0, 4), (0.3, 2), (0.3, 4)])
+        client = Client(support.server().url)
+        for r in rows:
+            self.assertEqual(r["status"], "successful")
+            result = client.job(r["jobID"]).result()
+            self.assertEqual(result["scene"]["obstacles"][0]["friction"], r["obstacles.0.friction"])
+            self.assertEqual(len(result["steps"]), r["/steps"])
+            self.assertEqual(r["steps.-1.nodes.-1.w"], result["steps"][-1]["nodes"][-1]["w"])
+            self.assertEqual(r["summary.contact_iterations"],
+                             result["summary"]["contact_iterations"])
+        # The text table has a header, a rule and one row per variant; CSV too.
+        csv_path = os.path.join(self.tmp.name, "sweep.csv")
+        p = support.cli("sweep", self.small, "--set", "obstacles.0.friction=0.1,0.2",
+                        "--output", "summary.steps", "--csv", csv_path)
+        self.assertEqual(p.returncode, 0, p.stderr)
+        lines = p.stdout.splitlines()
+        self.assertEqual(len(lines), 4)
+        self.assertTrue(re.match(r"obstacles\.0\.friction +status +summary\.steps +jobID", lines[0]))
+        self.assertRegex(lines[2], r"^0\.1 +successful +4 ")
+        with open(csv_path, encoding="utf-8") as f:
+            self.assertEqual(f.readline().strip(), "obstacles.0.friction,status,summary.steps,jobID")
+
+    def test_sweep_with_a_failing_variant_exits_1(self):
+        p = support.cli("sweep", self.small, "--set", "solver.newton.max_iterations=40,1",
+                        "--output", "summary.steps", "--json")
+        self.assertEqual(p.returncode, 1, p.stderr)
+        rows = json.loads(p.stdout)
+        self.assertEqual([r["status"] for r in rows], ["successful", "failed"])
+        self.assertEqual(rows[0]["summary.steps"], 4)
+        self.assertIsNone(rows[1]["summary.steps"])
+
+
+if __name__ == "__main__":
+    unittest.main()
