@@ -229,8 +229,10 @@ class Walker {
       out.push_back({s, root});
     } else {
       const std::string& tok = tokens[k];
-      if (value.is_object() && value.contains(tok)) {
-        const json& child = value[tok];
+      static const json absent;
+      if (value.is_object() || value.is_null()) {
+        // An absent key still has its subschemas (for its default).
+        const json& child = value.is_object() && value.contains(tok) ? value[tok] : absent;
         bool matched = false;
         if (s->contains("properties") && (*s)["properties"].contains(tok)) {
           collect((*s)["properties"][tok], root, child, tokens, k + 1, out, depth + 1);
@@ -619,6 +621,27 @@ std::string_view schema_file_stem(SchemaName which) {
 }
 
 std::string_view schema_text(SchemaName which) { return registry().get(schema_file_stem(which)).text; }
+
+std::optional<nlohmann::json> schema_default(const nlohmann::json& document, SchemaName which,
+                                             std::string_view pointer) {
+  Tokens tokens;
+  if (pointer != "/" && !pointer.empty()) {
+    if (pointer.front() != '/') throw std::invalid_argument("not a JSON pointer: " + std::string(pointer));
+    for (size_t at = 1; at <= pointer.size();) {
+      const size_t end = std::min(pointer.find('/', at), pointer.size());
+      std::string t;
+      for (size_t i = at; i < end; ++i)
+        if (pointer[i] == '~' && i + 1 < end) t += pointer[++i] == '1' ? '/' : '~';
+        else t += pointer[i];
+      tokens.push_back(t);
+      at = end + 1;
+    }
+  }
+  const Walker walker(registry());
+  for (const Located& l : walker.at(document, schema_file_stem(which), tokens))
+    if (l.schema->contains("default")) return (*l.schema)["default"];
+  return std::nullopt;
+}
 
 std::vector<SceneIssue> validate_against(const nlohmann::json& document, SchemaName which) {
   const std::string_view stem = schema_file_stem(which);

@@ -8,6 +8,7 @@
 // The schemas may annotate a subschema with `errorMessage` (the ajv-errors keyword, ignored
 // by other validators): it replaces the generic sentence for that subschema's own failures.
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string_view>
 #include <vector>
 
@@ -26,5 +27,11 @@ std::string_view schema_text(SchemaName which);
 // Errors of `document` against the schema; empty when it is valid. Thread-safe; the schemas
 // are parsed once, on first use.
 std::vector<SceneIssue> validate_against(const nlohmann::json& document, SchemaName which);
+
+// The `default` the schema gives the value at `pointer` of `document` (present or not), where
+// the subschemas that apply to it say one; nullopt otherwise. Conditions (a body's model, a
+// shape's type) are decided on `document`.
+std::optional<nlohmann::json> schema_default(const nlohmann::json& document, SchemaName which,
+                                             std::string_view pointer);
 
 }  // namespace grip
