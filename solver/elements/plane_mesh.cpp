@@ -157,9 +157,10 @@ std::vector<MeshIssue> check_mesh(const PlaneMesh& mesh, QuadShape shape) {
       if (a < 0 || a >= nodes) {
         issues.push_back({e, -1, "names node " + std::to_string(a) + ", which does not exist"});
         ids_ok = false;
+      } else {
+        used[a] = 1;  // even in a faulty element: one fault, one message
       }
     if (!ids_ok) continue;
-    for (int a : el) used[a] = 1;
     if (std::set<int>(el.begin(), el.end()).size() != el.size()) {
       issues.push_back({e, -1, "names a node twice"});
       continue;

@@ -1,0 +1,138 @@
+#pragma once
+// Contact tractions along the contact boundary of a converged step, and the readings that the
+// analytic contact benchmarks compare with their closed forms (Hertz, Cattaneo-Mindlin).
+// Positions are reference positions (x of the undeformed body): the closed forms are those of
+// linear elasticity, which does not tell the two apart, and a surface point's lateral
+// displacement (inward, of order (1 - 2 nu) P / E) would otherwise shift every reading.
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "solver/contact/contact_error.hpp"
+#include "solver/solve/load_stepping.hpp"
+
+namespace grip::testing {
+
+struct ContactNode {
+  double x = 0.0;                  // reference abscissa
+  double p_n = 0.0, p_t = 0.0;     // forces (p_n <= 0 presses)
+  double sigma_n = 0.0, sigma_t = 0.0;  // force / tributary area
+  ContactState state = ContactState::open;
+};
+
+// The candidates on `obstacle`, by increasing reference x.
+inline std::vector<ContactNode> contact_profile(const Problem& problem, const StepRecord& rec, int obstacle = 0) {
+  std::vector<ContactNode> nodes;
+  for (size_t i = 0; i < problem.candidates.size(); ++i) {
+    const Candidate& c = problem.candidates[i];
+    if (c.obstacle != obstacle) continue;
+    ContactNode n;
+    n.x = problem.body->site_reference(c.site).x();
+    n.p_n = rec.p[c.eta];
+    n.p_t = c.xi >= 0 ? rec.p[c.xi] : 0.0;
+    const double area = problem.body->tributary_area(c.site);
+    n.sigma_n = n.p_n / area;
+    n.sigma_t = n.p_t / area;
+    n.state = contact_state(problem, i, rec.p, rec.tau);
+    nodes.push_back(n);
+  }
+  std::sort(nodes.begin(), nodes.end(), [](const auto& a, const auto& b) { return a.x < b.x; });
+  return nodes;
+}
+
+// The resultant of the support reactions on the body.
+inline Vec2 reaction_resultant(const Problem& problem, const StepRecord& rec) {
+  return {problem.body->rigid_translation(Vec2::UnitX()).dot(rec.reactions),
+          problem.body->rigid_translation(Vec2::UnitY()).dot(rec.reactions)};
+}
+
+// Where a zone of nodes (contact, or stick) ends, on each side: `inner` is the last node in
+// the zone, `outer` the first node beyond it, and `edge` the zero of f^2 extrapolated linearly
+// from the last two nodes in the zone, where f is the quantity that vanishes like a square
+// root at the zone's end (the contact pressure at a smooth contact edge; the stick margin
+// mu |p| - |q| at a stick-slip boundary). Half-widths average the two sides.
+struct ZoneEnd {
+  double inner = 0.0, outer = 0.0, edge = 0.0;
+};
+struct Zone {
+  bool found = false;
+  ZoneEnd left, right;
+  double half_width() const { return 0.5 * (right.edge - left.edge); }
+  double midpoint_half_width() const {
+    return 0.25 * ((right.inner + right.outer) - (left.inner + left.outer));
+  }
+  // Does a zone of half-width w, centred like this one, end between the nodes on both sides
+  // (within `slack`)?
+  bool brackets(double w, double slack) const {
+    const double centre = 0.5 * (left.edge + right.edge);
+    return centre + w >= right.inner - slack && centre + w <= right.outer + slack &&
+           centre - w <= left.inner + slack && centre - w >= left.outer - slack;
+  }
+};
+
+template <class InZone, class Vanishing>
+Zone zone_of(const std::vector<ContactNode>& nodes, InZone in_zone, Vanishing f) {
+  Zone z;
+  int lo = -1, hi = -1;
+  for (int k = 0; k < static_cast<int>(nodes.size()); ++k)
+    if (in_zone(nodes[k])) {
+      if (lo < 0) lo = k;
+      hi = k;
+    }
+  if (lo < 1 || hi + 1 >= static_cast<int>(nodes.size()) || hi - lo < 2) return z;  // needs room on both sides
+  auto end = [&](int last, int prev, int beyond) {
+    ZoneEnd e{nodes[last].x, nodes[beyond].x, nodes[last].x};
+    const double fl = f(nodes[last]) * f(nodes[last]), fp = f(nodes[prev]) * f(nodes[prev]);
+    if (fp > fl) e.edge = nodes[last].x + fl * (nodes[last].x - nodes[prev].x) / (fp - fl);
+    e.edge = std::clamp(e.edge, std::min(e.inner, e.outer), std::max(e.inner, e.outer));
+    return e;
+  };
+  z.found = true;
+  z.left = end(lo, lo + 1, lo - 1);
+  z.right = end(hi, hi - 1, hi + 1);
+  return z;
+}
+
+// Hertz's semi-ellipse sigma_n^2 = p0^2 (1 - (x - xc)^2 / a^2), xc the centre of pressure,
+// fitted by least squares (in (x - xc)^2 and sigma_n^2) to the nodes that press: its
+// half-width and peak.
+struct EllipseFit {
+  double a = 0.0, p0 = 0.0;
+};
+inline EllipseFit fit_semi_ellipse(const std::vector<ContactNode>& nodes) {
+  double force = 0, moment = 0;
+  for (const auto& c : nodes) {
+    force += c.p_n;
+    moment += c.p_n * c.x;
+  }
+  const double xc = force != 0 ? moment / force : 0.0;
+  double n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0;
+  for (const auto& c : nodes) {
+    if (c.p_n >= 0) continue;
+    const double x = (c.x - xc) * (c.x - xc), y = c.sigma_n * c.sigma_n;
+    n += 1;
+    sx += x;
+    sy += y;
+    sxx += x * x;
+    sxy += x * y;
+  }
+  if (n < 3) return {};
+  const double slope = (n * sxy - sx * sy) / (n * sxx - sx * sx), intercept = (sy - slope * sx) / n;
+  if (!(slope < 0 && intercept > 0)) return {};
+  return {std::sqrt(-intercept / slope), std::sqrt(intercept)};
+}
+
+// The contact zone: nodes that press; the pressure vanishes like sqrt(a - |x|) at its edges.
+inline Zone contact_zone(const std::vector<ContactNode>& nodes) {
+  return zone_of(nodes, [](const ContactNode& n) { return n.p_n < 0; },
+                 [](const ContactNode& n) { return n.sigma_n; });
+}
+
+// The stick zone: nodes that stick; the margin mu |sigma_n| - |sigma_t| vanishes like
+// sqrt(c - |x|) at a Cattaneo-Mindlin stick-slip boundary.
+inline Zone stick_zone(const std::vector<ContactNode>& nodes, double mu) {
+  return zone_of(nodes, [](const ContactNode& n) { return n.state == ContactState::stick; },
+                 [mu](const ContactNode& n) { return mu * std::abs(n.sigma_n) - std::abs(n.sigma_t); });
+}
+
+}  // namespace grip::testing

@@ -1,0 +1,224 @@
+// Meshes of the plane continuum: the generators (areas, sets, grading), the checks of an
+// element, the boundary sides of a node set with their tributary lengths, and the naming of
+// free rigid motions.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <set>
+
+#include "solver/elements/plane_mesh.hpp"
+
+namespace grip {
+namespace {
+
+using std::numbers::pi;
+
+double area(const PlaneMesh& mesh, QuadShape shape) {
+  double a = 0.0;
+  for (const auto& el : mesh.elements) {
+    ShapeGradients X(el.size(), 2);
+    for (size_t k = 0; k < el.size(); ++k) X.row(k) = mesh.nodes[el[k]].transpose();
+    for (const QuadPoint& p : quad_points(shape, X, 1.0)) a += p.dV;
+  }
+  return a;
+}
+
+TEST(GradedDivisions, UniformWithoutRefinement) {
+  const auto x = graded_divisions(1.0, 3.0, 4, std::nullopt, std::nullopt);
+  ASSERT_EQ(x.size(), 5u);
+  for (int k = 0; k <= 4; ++k) EXPECT_DOUBLE_EQ(x[k], 1.0 + 0.5 * k);
+}
+
+TEST(GradedDivisions, FineZoneThenGeometricGrowth) {
+  const Refinement r{0.05, 0.5};
+  const auto x = graded_divisions(-2.0, 3.0, 40, 0.0, r);
+  ASSERT_EQ(x.size(), 41u);
+  EXPECT_DOUBLE_EQ(x.front(), -2.0);
+  EXPECT_DOUBLE_EQ(x.back(), 3.0);
+  bool focus_is_node = false;
+  for (size_t k = 1; k < x.size(); ++k) {
+    const double h = x[k] - x[k - 1], mid = 0.5 * (x[k] + x[k - 1]);
+    EXPECT_GT(h, 0);
+    if (std::abs(mid) < 0.5) EXPECT_NEAR(h, 0.05, 1e-12);  // the fine zone
+    if (std::abs(mid) > 0.5 && k + 1 < x.size()) {
+      const double next = x[k + 1] - x[k];  // growth away from the focus
+      if (mid > 0) EXPECT_GT(next, h * 0.999);
+      else EXPECT_LT(next, h * 1.001);
+    }
+    focus_is_node |= std::abs(x[k]) < 1e-12;
+  }
+  EXPECT_TRUE(focus_is_node);
+  EXPECT_THROW(graded_divisions(-2.0, 3.0, 20, 0.0, r), std::invalid_argument);  // 20 fine + 2 coarse needed
+}
+
+TEST(RectangleMesh, AreaSetsAndOrientation) {
+  for (QuadShape shape : {QuadShape::q4, QuadShape::q9}) {
+    RectangleSpec spec;
+    spec.origin = {-1, 2};
+    spec.size = {3, 1.5};
+    spec.nx = 10;
+    spec.ny = 6;
+    spec.refine = Refinement{0.1, 0.3};
+    spec.towards = {0.5, 3.5};
+    const PlaneMesh mesh = rectangle_mesh(spec, shape);
+    EXPECT_TRUE(check_mesh(mesh, shape).empty());
+    EXPECT_EQ(mesh.elements.size(), 60u);
+    EXPECT_NEAR(area(mesh, shape), 4.5, 1e-12);
+    for (int k : mesh.sets.at("bottom")) EXPECT_DOUBLE_EQ(mesh.nodes[k].y(), 2.0);
+    for (int k : mesh.sets.at("top")) EXPECT_DOUBLE_EQ(mesh.nodes[k].y(), 3.5);
+    for (int k : mesh.sets.at("left")) EXPECT_DOUBLE_EQ(mesh.nodes[k].x(), -1.0);
+    for (int k : mesh.sets.at("right")) EXPECT_DOUBLE_EQ(mesh.nodes[k].x(), 2.0);
+    EXPECT_EQ(mesh.sets.at("bottom").size(), shape == QuadShape::q4 ? 11u : 21u);
+    // Refined toward (0.5, 3.5): sides of 0.1 next to that point.
+    const auto& top = mesh.sets.at("top");
+    bool found = false;
+    for (size_t k = 1; k < top.size(); ++k) {
+      const Vec2 a = mesh.nodes[top[k - 1]], b = mesh.nodes[top[k]];
+      if (std::abs(std::max(a.x(), b.x()) - 0.5) < 1e-12) found = std::abs(std::abs(a.x() - b.x()) - (shape == QuadShape::q4 ? 0.1 : 0.05)) < 1e-12;
+    }
+    EXPECT_TRUE(found);
+  }
+}
+
+TEST(HalfDiscMesh, AreaArcAndRefinement) {
+  const double R = 2.0;
+  for (QuadShape shape : {QuadShape::q4, QuadShape::q9})
+    for (bool up : {false, true}) {
+      HalfDiscSpec spec;
+      spec.centre = {1, -1};
+      spec.radius = R;
+      spec.ns = 24;
+      spec.nt = 12;
+      spec.facing_up = up;
+      spec.refine = Refinement{0.03, 0.2};
+      const PlaneMesh mesh = half_disc_mesh(spec, shape);
+      ASSERT_TRUE(check_mesh(mesh, shape).empty()) << check_mesh(mesh, shape)[0].detail;
+      // q4: the half-disc less the segments that the chords of the arc cut off; q9 follows
+      // the arc to high order.
+      double segments = 0.0;
+      const auto& arc = mesh.sets.at("arc");
+      for (size_t k = 1; k < arc.size(); k += (shape == QuadShape::q4 ? 1 : 2)) {
+        const Vec2 a = mesh.nodes[arc[k - 1]] - spec.centre;
+        const Vec2 b = mesh.nodes[arc[shape == QuadShape::q4 ? k : k + 1]] - spec.centre;
+        const double theta = std::acos(std::clamp(a.dot(b) / (R * R), -1.0, 1.0));
+        segments += 0.5 * R * R * (theta - std::sin(theta));
+      }
+      if (shape == QuadShape::q4) EXPECT_NEAR(area(mesh, shape), pi * R * R / 2 - segments, 1e-12);
+      else EXPECT_LT(std::abs(area(mesh, shape) - pi * R * R / 2), 0.01 * segments);
+      for (int k : mesh.sets.at("arc")) EXPECT_NEAR((mesh.nodes[k] - spec.centre).norm(), R, 1e-12);
+      for (int k : mesh.sets.at("diameter")) EXPECT_NEAR(mesh.nodes[k].y(), -1.0, 1e-12);
+      const Vec2 pole = mesh.nodes[mesh.sets.at("pole")[0]];
+      EXPECT_NEAR((pole - Vec2(1, up ? 1 : -3)).norm(), 0.0, 1e-12);
+      EXPECT_NEAR((mesh.nodes[mesh.sets.at("centre")[0]] - spec.centre).norm(), 0.0, 1e-12);
+      // Near the pole the arc is divided at the requested size.
+      const auto& near = mesh.sets.at("arc_refined");
+      const int fine = shape == QuadShape::q4 ? 1 : 2;
+      EXPECT_EQ(static_cast<int>(near.size()), 2 * fine * 7 + 1);  // 0.2 / 0.03 -> 7 each side
+      for (int k : near) EXPECT_LE((mesh.nodes[k] - pole).norm(), 0.2 + 1e-9);
+      // Every arc node appears once.
+      EXPECT_EQ(std::set<int>(mesh.sets.at("arc").begin(), mesh.sets.at("arc").end()).size(),
+                mesh.sets.at("arc").size());
+    }
+  HalfDiscSpec odd;
+  odd.ns = 5;
+  EXPECT_THROW(half_disc_mesh(odd, QuadShape::q4), std::invalid_argument);
+}
+
+PlaneMesh unit_square(int n) {
+  RectangleSpec spec;
+  spec.nx = spec.ny = n;
+  return rectangle_mesh(spec, QuadShape::q4);
+}
+
+TEST(CheckMesh, NamesTheFaultyElementOrNode) {
+  PlaneMesh mesh = unit_square(2);
+  EXPECT_TRUE(check_mesh(mesh, QuadShape::q4).empty());
+  PlaneMesh inverted = mesh;
+  std::swap(inverted.elements[1][1], inverted.elements[1][3]);  // clockwise
+  auto issues = check_mesh(inverted, QuadShape::q4);
+  ASSERT_EQ(issues.size(), 1u);
+  EXPECT_EQ(issues[0].element, 1);
+  EXPECT_NE(issues[0].detail.find("inverted"), std::string::npos);
+  PlaneMesh flat = mesh;
+  flat.nodes[flat.elements[2][2]] = flat.nodes[flat.elements[2][1]];  // collapses element 2 (and 3)
+  issues = check_mesh(flat, QuadShape::q4);
+  ASSERT_FALSE(issues.empty());
+  EXPECT_EQ(issues[0].element, 2);
+  PlaneMesh bad = mesh;
+  bad.elements[0][2] = 99;
+  bad.elements[3][1] = bad.elements[3][0];
+  bad.nodes.push_back({5, 5});
+  issues = check_mesh(bad, QuadShape::q4);
+  ASSERT_EQ(issues.size(), 3u);
+  EXPECT_EQ(issues[0].element, 0);
+  EXPECT_NE(issues[0].detail.find("node 99"), std::string::npos);
+  EXPECT_EQ(issues[1].element, 3);
+  EXPECT_EQ(issues[2].node, 9);  // the extra node belongs to no element
+  EXPECT_FALSE(check_mesh(mesh, QuadShape::q9).empty());  // four nodes are not a q9
+}
+
+TEST(BoundaryPart, OrderedCounterClockwiseWithTributaryLengths) {
+  RectangleSpec spec;
+  spec.size = {4, 1};
+  spec.nx = 4;
+  spec.ny = 1;
+  for (QuadShape shape : {QuadShape::q4, QuadShape::q9}) {
+    const PlaneMesh mesh = rectangle_mesh(spec, shape);
+    // The bottom, given in a scrambled order, comes back left to right.
+    std::vector<int> set = mesh.sets.at("bottom");
+    std::reverse(set.begin(), set.end());
+    std::swap(set[1], set[3]);
+    const BoundaryPart part = boundary_part(mesh, shape, set);
+    ASSERT_EQ(part.nodes.size(), set.size());
+    for (size_t k = 1; k < part.nodes.size(); ++k)
+      EXPECT_LT(mesh.nodes[part.nodes[k - 1]].x(), mesh.nodes[part.nodes[k]].x());
+    double total = 0.0;
+    for (double l : part.lengths) total += l;
+    EXPECT_NEAR(total, 4.0, 1e-12);
+    if (shape == QuadShape::q4) {
+      EXPECT_NEAR(part.lengths.front(), 0.5, 1e-12);
+      EXPECT_NEAR(part.lengths[1], 1.0, 1e-12);
+    } else {  // Simpson's weights: 1/6, 2/3, 1/6 of each side
+      EXPECT_NEAR(part.lengths[0], 1.0 / 6, 1e-12);
+      EXPECT_NEAR(part.lengths[1], 2.0 / 3, 1e-12);
+      EXPECT_NEAR(part.lengths[2], 1.0 / 3, 1e-12);
+    }
+    // The top runs right to left (counter-clockwise round the body).
+    const BoundaryPart top = boundary_part(mesh, shape, mesh.sets.at("top"));
+    EXPECT_GT(mesh.nodes[top.nodes.front()].x(), mesh.nodes[top.nodes.back()].x());
+  }
+  const PlaneMesh mesh = rectangle_mesh(spec, QuadShape::q4);
+  EXPECT_THROW(boundary_part(mesh, QuadShape::q4, {0, 2}), std::invalid_argument);  // no side between them
+}
+
+TEST(FreeRigidMotion, NamesTheMotionsTheSupportsLeave) {
+  const PlaneMesh mesh = unit_square(2);  // nodes 0 1 2 / 3 4 5 / 6 7 8, 0 at (0, 0)
+  std::vector<char> fixed(18, 0);
+  EXPECT_EQ(free_rigid_motion(mesh, fixed), "translate along x, translate along y and rotate about (0.5, 0.5)");
+  for (int k : {0, 1, 2}) fixed[2 * k + 1] = 1;  // the bottom held vertically
+  EXPECT_EQ(free_rigid_motion(mesh, fixed), "translate along x");
+  std::fill(fixed.begin(), fixed.end(), 0);
+  fixed[0] = fixed[1] = 1;  // node 0 pinned
+  EXPECT_EQ(free_rigid_motion(mesh, fixed), "rotate about (0, 0)");
+  fixed[2 * 8 + 1] = 1;  // and node 8 held vertically
+  EXPECT_EQ(free_rigid_motion(mesh, fixed), "");
+  std::fill(fixed.begin(), fixed.end(), 0);
+  fixed[2 * 4] = 1;  // only the centre's x
+  EXPECT_EQ(free_rigid_motion(mesh, fixed), "translate along y and rotate about (0.5, 0.5)");
+  // Two separate squares: the one without supports is named.
+  PlaneMesh two = mesh;
+  for (const Vec2& x : mesh.nodes) two.nodes.push_back(x + Vec2(3, 0));
+  for (auto el : mesh.elements) {
+    for (int& a : el) a += 9;
+    two.elements.push_back(el);
+  }
+  std::vector<char> first(36, 0);
+  for (int k = 0; k < 9; ++k) first[2 * k] = first[2 * k + 1] = 1;
+  EXPECT_EQ(free_rigid_motion(two, first),
+            "the part containing node 9 can translate along x, translate along y and rotate about (3.5, 0.5)");
+}
+
+}  // namespace
+}  // namespace grip

@@ -1,0 +1,160 @@
+// Hertz line contact, plane strain: an elastic half-cylinder pressed onto a rigid flat by a
+// prescribed displacement of its diameter; the load P per unit thickness comes from the
+// reactions. Closed form: a = sqrt(4 P R / (pi E*)), p0 = 2 P / (pi a), E* = E / (1 - nu^2).
+// Read from the computed contact stresses (force / tributary area at each node): Hertz's
+// semi-ellipse fitted to them (a and p0), the peak nodal stress (p0), and the nodes between
+// which the contact ends (the closed-form edge must lie there).
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <numbers>
+
+#include "tests/support/contact_profile.hpp"
+#include "tests/support/scenes.hpp"
+
+namespace grip {
+namespace {
+
+using nlohmann::json;
+using namespace grip::testing;
+
+// The shipped scene with elements of `size` near the pole (the part beyond kept).
+json hertz(double size) {
+  json j = example_scene("hertz");
+  json& disc = j["body"]["mesh"]["half_disc"];
+  const int fine = static_cast<int>(std::lround(disc["refine"]["extent"].get<double>() / size));
+  disc["refine"]["size"] = size;
+  disc["divisions"] = {2 * fine + 24, fine + 12};
+  return j;
+}
+
+struct HertzReading {
+  double P = 0, a = 0, p0 = 0;  // closed form at the computed load
+  EllipseFit fit;               // fitted to the computed contact stresses
+  double peak = 0;              // largest nodal contact stress
+  Zone zone;                    // the nodes where contact ends
+  int nodes_in_contact = 0;
+  bool set_ends_open = false;   // the contact set reaches beyond the contact zone
+  double a_error() const { return fit.a / a - 1; }
+  double p0_error() const { return fit.p0 / p0 - 1; }
+  double peak_error() const { return peak / p0 - 1; }
+};
+
+HertzReading read_hertz(const Solved& s, const StepRecord& rec) {
+  const json& body = s.scene.effective["body"];
+  const double E = body["material"]["young"], nu = body["material"]["poisson"];
+  const double R = body["mesh"]["half_disc"]["radius"], t = body["thickness"];
+  const double Es = E / (1 - nu * nu);
+  HertzReading h;
+  h.P = -reaction_resultant(s.scene.problem, rec).y() / t;
+  h.a = std::sqrt(4 * h.P * R / (std::numbers::pi * Es));
+  h.p0 = 2 * h.P / (std::numbers::pi * h.a);
+  const auto nodes = contact_profile(s.scene.problem, rec);
+  h.fit = fit_semi_ellipse(nodes);
+  h.zone = contact_zone(nodes);
+  for (const auto& n : nodes) {
+    h.peak = std::max(h.peak, -n.sigma_n);
+    h.nodes_in_contact += n.p_n < 0;
+  }
+  h.set_ends_open = nodes.front().p_n == 0 && nodes.back().p_n == 0;
+  return h;
+}
+
+// The shipped scene: a / h = 10.
+TEST(Hertz, MatchesTheClosedFormOnAModerateMesh) {
+  const Solved s = solve_scene(example_scene("hertz"));
+  expect_every_step_sound(s);
+  for (const StepRecord& rec : s.run.steps) {
+    const HertzReading h = read_hertz(s, rec);
+    ASSERT_TRUE(h.zone.found);
+    EXPECT_TRUE(h.set_ends_open);
+    // The reactions carry what the contact forces carry.
+    double contact = 0.0;
+    for (const auto& n : contact_profile(s.scene.problem, rec)) contact -= n.p_n;
+    EXPECT_NEAR(h.P, contact, 1e-8 * h.P);
+    std::printf("step %d: P = %.2f N/mm; a = %.4f mm, fitted %+.2f %%; p0 = %.1f MPa, fitted %+.2f %%, "
+                "peak %+.2f %%; %d nodes touch\n",
+                rec.index, h.P, h.a, 100 * h.a_error(), h.p0, 100 * h.p0_error(), 100 * h.peak_error(),
+                h.nodes_in_contact);
+    EXPECT_LT(std::abs(h.a_error()), 0.02);
+    EXPECT_LT(std::abs(h.p0_error()), 0.02);
+    EXPECT_LT(std::abs(h.peak_error()), 0.02);
+    // The closed-form edge lies between the last node that touches and the first that does not.
+    EXPECT_TRUE(h.zone.brackets(h.a, 1e-9)) << "a = " << h.a;
+  }
+}
+
+// Three meshes, a / h of about 5, 10 and 21 near the contact: the errors fall.
+TEST(Hertz, ErrorFallsAsTheMeshIsRefined) {
+  std::vector<HertzReading> r;
+  std::printf("%7s %6s %9s %8s %9s %9s %9s %9s %7s %8s\n", "size", "a/h", "P", "a", "a err %", "p0",
+              "p0 err %", "peak err %", "solves", "seconds");
+  for (const double size : {0.1, 0.05, 0.025}) {
+    const Solved s = solve_scene(hertz(size));
+    expect_every_step_sound(s);
+    ASSERT_TRUE(s.run.completed);
+    r.push_back(read_hertz(s, s.run.steps.back()));
+    const HertzReading& h = r.back();
+    EXPECT_TRUE(h.set_ends_open);
+    EXPECT_TRUE(h.zone.brackets(h.a, 1e-9)) << "a = " << h.a;
+    std::printf("%7.3f %6.1f %9.2f %8.4f %+9.3f %9.1f %+9.3f %+9.3f %7ld %8.3f\n", size, h.a / size, h.P, h.a,
+                100 * h.a_error(), h.p0, 100 * h.p0_error(), 100 * h.peak_error(), s.run.counters.solves,
+                s.run.seconds);
+  }
+  for (size_t k = 1; k < r.size(); ++k) {
+    EXPECT_GT(std::abs(r[k - 1].a_error()), std::abs(r[k].a_error())) << "mesh " << k;
+    EXPECT_GT(std::abs(r[k - 1].p0_error()), std::abs(r[k].p0_error())) << "mesh " << k;
+  }
+  EXPECT_GT(std::abs(r.front().peak_error()), std::abs(r.back().peak_error()));
+  for (const auto& h : r) {
+    EXPECT_LT(std::abs(h.a_error()), 0.02);
+    EXPECT_LT(std::abs(h.p0_error()), 0.02);
+    EXPECT_LT(std::abs(h.peak_error()), 0.02);
+  }
+}
+
+// The two strategies converge to the same contact forces, within what the contact tolerance
+// pins them to (||v|| <= 1e-8 L x a nodal contact stiffness of about E h).
+TEST(Hertz, CevAndUzawaAgree) {
+  json j = hertz(0.1);
+  const Solved cev = solve_scene(j);
+  j["solver"]["contact"]["method"] = "uzawa";
+  j["solver"]["contact"]["max_iterations"] = 5000;
+  const Solved uzawa = solve_scene(j);
+  expect_every_step_sound(cev);
+  expect_every_step_sound(uzawa);
+  ASSERT_TRUE(cev.run.completed && uzawa.run.completed);
+  std::printf("real solves: cev %ld (%.3f s), uzawa %ld (%.3f s)\n", cev.run.counters.solves, cev.run.seconds,
+              uzawa.run.counters.solves, uzawa.run.seconds);
+  EXPECT_LT(cev.run.counters.solves * 10, uzawa.run.counters.solves);
+  for (size_t k = 0; k < cev.run.steps.size(); ++k) {
+    const Vector& a = cev.run.steps[k].p;
+    const Vector& b = uzawa.run.steps[k].p;
+    EXPECT_LT((a - b).lpNorm<Eigen::Infinity>(), 1e-4 * a.lpNorm<Eigen::Infinity>()) << "step " << k + 1;
+  }
+}
+
+// Small strain: linear and finite (neo-Hookean, total Lagrangian) kinematics agree.
+TEST(Hertz, LinearAndFiniteAgreeForSmallLoads) {
+  json j = hertz(0.03);
+  json& disc = j["body"]["mesh"]["half_disc"];
+  disc["refine"]["extent"] = 0.4;
+  disc["divisions"] = {2 * 13 + 16, 13 + 8};
+  j["body"]["supports"][0]["values"]["y"] = -0.01;  // a = 0.22 mm, contact strains of 0.5 %
+  const Solved lin = solve_scene(j);
+  j["body"]["kinematics"] = "finite";
+  const Solved fin = solve_scene(j);
+  expect_every_step_sound(lin);
+  expect_every_step_sound(fin);
+  ASSERT_TRUE(lin.run.completed && fin.run.completed);
+  const HertzReading a = read_hertz(lin, lin.run.steps.back()), b = read_hertz(fin, fin.run.steps.back());
+  std::printf("linear: P %.3f, a %.5f; finite: P %.3f, a %.5f\n", a.P, a.fit.a, b.P, b.fit.a);
+  EXPECT_NEAR(a.P, b.P, 2e-3 * a.P);
+  EXPECT_NEAR(a.fit.a, b.fit.a, 5e-3 * a.fit.a);
+  const Vector& pa = lin.run.steps.back().p;
+  const Vector& pb = fin.run.steps.back().p;
+  EXPECT_LT((pa - pb).lpNorm<Eigen::Infinity>(), 5e-3 * pa.lpNorm<Eigen::Infinity>());
+}
+
+}  // namespace
+}  // namespace grip
