@@ -5,6 +5,7 @@ packages=(
   build-essential cmake ninja-build pkg-config
   libeigen3-dev nlohmann-json3-dev libspdlog-dev libgtest-dev
   libcpp-httplib-dev libvalijson-dev libsqlite3-dev
+  python3 python3-matplotlib
 )
 missing=()
 for p in "${packages[@]}"; do
