@@ -19,12 +19,6 @@ std::vector<int> active_indices(const ContactError& e) {
   return idx;
 }
 
-Matrix block(const Matrix& C, const std::vector<int>& idx) {
-  Matrix B(idx.size(), idx.size());
-  for (size_t a = 0; a < idx.size(); ++a)
-    for (size_t b = 0; b < idx.size(); ++b) B(a, b) = C(idx[a], idx[b]);
-  return B;
-}
 
 double inf_norm(const Matrix& A) {
   return A.size() ? A.cwiseAbs().rowwise().sum().maxCoeff() : 0.0;
@@ -160,12 +154,12 @@ class StepSolver {
 
   // Direction of eq. 13 for the active block of v: n = infinity solves with C'_EE; a finite n
   // uses the polynomial accelerator (normalized, section 8); level 1 is the multiplier update.
-  Direction direction(const Matrix& C, const ContactError& err, int level, double alpha_fixed) {
+  Direction direction(const Compliance& C, const ContactError& err, int level, double alpha_fixed) {
     Direction dir;
     const std::vector<int> idx = active_indices(err);
     dir.d = Vector::Zero(err.v.size());
     if (idx.empty()) return dir;
-    const Matrix Cee = block(C, idx);
+    const Matrix Cee = C.sub(idx);
     Vector v_e(idx.size());
     for (size_t a = 0; a < idx.size(); ++a) v_e[a] = err.v[idx[a]];
     const double norm = inf_norm(Cee);
@@ -206,14 +200,32 @@ class StepSolver {
     return smallest_eigenvalue(C1);
   }
 
+  // The components that can take part in this iteration: every one with a force or a
+  // friction bound, and those of candidates penetrating or within a few per cent of the
+  // body's length of their obstacle. The others are frozen (a far point that the real solve
+  // brings into contact joins at the next iteration).
+  std::vector<int> relevant_components() const {
+    const double window = 0.05 * problem_.body->characteristic_length();
+    std::vector<int> out;
+    for (size_t i = 0; i < problem_.candidates.size(); ++i) {
+      const Candidate& c = problem_.candidates[i];
+      if (!out_.state.enabled[c.eta]) continue;
+      const bool near = out_.p[c.eta] < 0 || out_.tau[i] > 0 || out_.state.s[c.eta] > -window;
+      if (!near) continue;
+      out.push_back(c.eta);
+      if (c.xi >= 0 && out_.state.enabled[c.xi]) out.push_back(c.xi);
+    }
+    return out;
+  }
+
   // The largest normal-force correction that the remaining contact error asks for.
   double force_precision() {
     if (error_.norm2 == 0.0) return 0.0;
-    const Matrix& C = eq_.compliance(out_.state);
     const std::vector<int> idx = active_indices(error_);
+    const Compliance& C = eq_.compliance(out_.state, idx);
     Vector v_e(idx.size());
     for (size_t a = 0; a < idx.size(); ++a) v_e[a] = error_.v[idx[a]];
-    Eigen::LLT<Matrix> llt(block(C, idx));
+    Eigen::LLT<Matrix> llt(C.sub(idx));
     if (llt.info() != Eigen::Success) return 0.0;
     const Vector dp = llt.solve(v_e);
     double largest = 0.0;
@@ -227,7 +239,7 @@ class StepSolver {
     if (needs_warmup() && !warmup()) return false;
     while (error_.norm2 > tol_) {
       if (!budget_left()) return false;
-      const Matrix& C = eq_.compliance(out_.state);
+      const Compliance& C = eq_.compliance(out_.state, relevant_components());
       int inner = 0, halvings = 0, n_used = 0;
       double alpha_used = 1.0;
       const Vector pl = predict(C, inner, halvings, n_used, alpha_used);
@@ -259,7 +271,7 @@ class StepSolver {
   }
 
   // q(p + dp) - q(p) = (s + C dp / 2) . dp < 0, over the non-zeros of dp only.
-  static bool decreases_q(const Matrix& C, const Vector& s, const Vector& dp) {
+  static bool decreases_q(const Compliance& C, const Vector& s, const Vector& dp) {
     std::vector<int> nz;
     for (int j = 0; j < dp.size(); ++j)
       if (dp[j] != 0.0) nz.push_back(j);
@@ -274,7 +286,7 @@ class StepSolver {
 
   // eq. 13 iterated on s(p) = s + C (p - p0), accepted by the decrease of
   // q(p) = p.C.p/2 + (s - C p0).p; returns the predicted force.
-  Vector predict(const Matrix& C, int& inner, int& halvings, int& n_used, double& alpha_used) {
+  Vector predict(const Compliance& C, int& inner, int& halvings, int& n_used, double& alpha_used) {
     Vector pl = out_.p, sl = out_.state.s;
     const double target = std::min(0.1 * tol_, 1e-6 * error_.norm2);
     for (inner = 0; inner < params_.max_inner_iterations; ++inner) {
@@ -303,7 +315,9 @@ class StepSolver {
       if (!descended) break;  // stationary on the model: the real solve decides
       pl += dp;
       for (int j = 0; j < dp.size(); ++j)  // dp is zero off the active set
-        if (dp[j] != 0.0) sl += C.col(j) * dp[j];
+        if (dp[j] != 0.0)
+          for (size_t a = 0; a < C.position.size(); ++a)
+            if (C.position[a] >= 0 && C.position[j] >= 0) sl[a] += C.block(C.position[a], C.position[j]) * dp[j];
     }
     return pl;
   }
@@ -315,7 +329,7 @@ class StepSolver {
     while (error_.norm2 > tol_) {
       if (!budget_left()) return false;
       int level = uzawa ? 1 : params_.acceleration;  // each update starts at the chosen n
-      const Matrix& C = eq_.compliance(out_.state);
+      const Compliance& C = eq_.compliance(out_.state, relevant_components());
       const double v0 = error_.norm2;
       const ContactError e = error_;
       bool accepted = false;
@@ -363,7 +377,7 @@ class StepSolver {
     std::vector<double> norms{error_.norm2};
     for (int m = 1; m <= params_.warmup_last && error_.norm2 > tol_; ++m) {
       if (!budget_left()) return false;
-      const Matrix& C = eq_.compliance(out_.state);
+      const Compliance& C = eq_.compliance(out_.state, relevant_components());
       const Direction dir = direction(C, error_, 1, params_.warmup_alpha);
       if (!dir.ok) break;
       const Vector pt = project_forces(problem_, out_.p, out_.p - dir.d, error_, out_.tau);

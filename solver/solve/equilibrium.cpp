@@ -69,7 +69,12 @@ Vector Equilibrium::penalty_forces(const EquilibriumState& paired, Triplets* tan
   for (size_t i = 0; i < problem_.candidates.size(); ++i) {
     const Candidate& c = problem_.candidates[i];
     const PairedPoint& pp = paired.points[i];
-    if (!paired.enabled[c.eta] || paired.s[c.eta] <= 0) continue;
+    if (!paired.enabled[c.eta] || paired.s[c.eta] <= 0) {
+      if (tangent)  // zeros keep the tangent's pattern fixed
+        for (const auto& a : pp.point.jacobian)
+          for (const auto& b : pp.point.jacobian) tangent->emplace_back(a.dof, b.dof, 0.0);
+      continue;
+    }
     p[c.eta] = -law.normal * paired.s[c.eta];
     // d(s_eta)/dx = eta^T, d(s_xi)/dx = zeta_rate xi^T.
     Eigen::RowVector2d dpn = -law.normal * pp.eta.transpose(), dpt = Eigen::RowVector2d::Zero();
@@ -117,15 +122,14 @@ Vector Equilibrium::residual(const Vector& q, const EquilibriumState& paired, co
     const Candidate& c = problem_.candidates[i];
     const PairedPoint& pp = paired.points[i];
     const double p_eta = p[c.eta], p_xi = c.xi >= 0 ? p[c.xi] : 0.0;
-    if (p_eta == 0.0 && p_xi == 0.0) continue;
     const Vec2 f = p_eta * pp.eta + p_xi * pp.xi;
     for (const auto& j : pp.point.jacobian) r[j.dof] -= j.dx.dot(f);
     if (!tangent) continue;
-    // f = -p_eta n + p_xi rot90(n): df/dx = (-p_eta I + p_xi R) dn/dx.
+    // f = -p_eta n + p_xi rot90(n): df/dx = (-p_eta I + p_xi R) dn/dx. Emitted even when zero,
+    // so that the tangent's pattern stays the same from one iterate to the next.
     Mat2 R;
     R << 0, -1, 1, 0;
     const Mat2 df_dx = (-p_eta * Mat2::Identity() + p_xi * R) * pp.projection.dnormal_dx;
-    if (df_dx.isZero(0.0)) continue;
     for (const auto& a : pp.point.jacobian)
       for (const auto& b : pp.point.jacobian)
         tangent->emplace_back(a.dof, b.dof, -a.dx.dot(df_dx * b.dx));
@@ -137,17 +141,6 @@ Vector Equilibrium::residual(const Vector& q, const Vector& p, Triplets* tangent
   return residual(q, evaluate(q), p, tangent);
 }
 
-Eigen::SparseMatrix<double> Equilibrium::free_block(const Triplets& triplets) const {
-  Triplets reduced;
-  reduced.reserve(triplets.size());
-  for (const auto& t : triplets) {
-    const int i = free_index_[t.row()], j = free_index_[t.col()];
-    if (i >= 0 && j >= 0) reduced.emplace_back(i, j, t.value());
-  }
-  Eigen::SparseMatrix<double> K(free_count_, free_count_);
-  K.setFromTriplets(reduced.begin(), reduced.end());
-  return K;
-}
 
 double Equilibrium::free_residual_norm(const Vector& q, const Vector& p) const {
   EquilibriumState paired;
@@ -183,14 +176,14 @@ EquilibriumState Equilibrium::solve(const Vector& q_guess, const Vector& p) {
         return state;
       }
     } else {
-      lu_.compute(free_block(triplets));
       ++counters_.factorizations;
-      if (lu_.info() != Eigen::Success) {
+      if (!lu_.factorize(triplets, free_index_, free_count_, 1e-4)) {
         state.reason = "singular tangent stiffness in Newton iteration " + std::to_string(it);
         return state;
       }
     }
-    const Vector dq_free = reuse ? Vector(body_lu_.solve(-r_free)) : Vector(lu_.solve(-r_free));
+    const Vector rhs = -r_free;
+    const Vector dq_free = reuse ? body_lu_.solve(rhs) : lu_.solve(rhs);
     state.newton_iterations = it;
     ++counters_.newton_iterations;
     Vector dq = Vector::Zero(state.q.size());
@@ -229,42 +222,51 @@ EquilibriumState Equilibrium::solve(const Vector& q_guess, const Vector& p) {
   return state;
 }
 
-void Equilibrium::fill_t_matrix(const EquilibriumState& state) {
-  t_.setZero(free_count_, problem_.component_count);
+Matrix Compliance::sub(const std::vector<int>& components) const {
+  Matrix B(components.size(), components.size());
+  for (size_t a = 0; a < components.size(); ++a)
+    for (size_t b = 0; b < components.size(); ++b) B(a, b) = (*this)(components[a], components[b]);
+  return B;
+}
+
+void Equilibrium::fill_t_matrix(const EquilibriumState& state, const std::vector<int>& position) {
+  t_.setZero(free_count_, c_.block.rows());
   for (size_t i = 0; i < problem_.candidates.size(); ++i) {
     const Candidate& c = problem_.candidates[i];
     const PairedPoint& pp = state.points[i];
+    const int eta = position[c.eta], xi = c.xi >= 0 ? position[c.xi] : -1;
+    if (eta < 0 && xi < 0) continue;
     for (const auto& j : pp.point.jacobian) {
       const int f = free_index_[j.dof];
       if (f < 0) continue;
-      t_(f, c.eta) += j.dx.dot(pp.eta);
-      if (c.xi >= 0) t_(f, c.xi) += j.dx.dot(pp.xi);
+      if (eta >= 0) t_(f, eta) += j.dx.dot(pp.eta);
+      if (xi >= 0) t_(f, xi) += j.dx.dot(pp.xi);
     }
   }
 }
 
 bool Equilibrium::factorize_body_tangent(const Vector& q) {
-  if (constant_tangent_ && body_factorized_) return body_lu_.info() == Eigen::Success;
+  if (constant_tangent_ && body_factorized_) return body_lu_.ok();
   Triplets triplets;
   Vector force = Vector::Zero(q.size());
   problem_.body->internal_force(q, force, &triplets);
-  body_lu_.compute(free_block(triplets));
   ++counters_.factorizations;
   body_factorized_ = true;
-  return body_lu_.info() == Eigen::Success;
+  return body_lu_.factorize(triplets, free_index_, free_count_);
 }
 
-const Matrix& Equilibrium::compliance(const EquilibriumState& state) {
-  fill_t_matrix(state);
-  if (!factorize_body_tangent(state.q)) {
-    c_.setZero(t_.cols(), t_.cols());
-    return c_;
-  }
+const Compliance& Equilibrium::compliance(const EquilibriumState& state,
+                                          const std::vector<int>& components) {
+  c_.position.assign(problem_.component_count, -1);
+  for (size_t k = 0; k < components.size(); ++k) c_.position[components[k]] = static_cast<int>(k);
+  c_.block.setZero(components.size(), components.size());
+  if (components.empty() || !factorize_body_tangent(state.q)) return c_;
+  fill_t_matrix(state, c_.position);
   x_ = body_lu_.solve(t_);
   // T has two or three non-zeros per column: its sparse transpose makes T^T X cheap.
   const Eigen::SparseMatrix<double> ts = t_.sparseView();
-  c_.noalias() = ts.transpose() * x_;
-  c_ = 0.5 * (c_ + c_.transpose()).eval();
+  c_.block.noalias() = ts.transpose() * x_;
+  c_.block = 0.5 * (c_.block + c_.block.transpose()).eval();
   return c_;
 }
 

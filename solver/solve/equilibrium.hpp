@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "solver/core/problem.hpp"
+#include "solver/solve/free_block_solver.hpp"
 
 namespace grip {
 
@@ -55,6 +56,19 @@ struct PenaltyLaw {
   Vector previous;          // the previous step's forces (the tangential springs start there)
 };
 
+// The contact compliance C = T^T K^-1 T on a subset of the components (the ones that can
+// take part in this iteration); zero elsewhere.
+struct Compliance {
+  std::vector<int> position;  // component -> row of `block`, -1 where not computed
+  Matrix block;
+  double operator()(int a, int b) const {
+    const int i = position[a], j = position[b];
+    return i < 0 || j < 0 ? 0.0 : block(i, j);
+  }
+  // C restricted to the given components, in their order.
+  Matrix sub(const std::vector<int>& components) const;
+};
+
 class Equilibrium {
  public:
   // `extra` prescribes further dofs at absolute values (the start-up solve).
@@ -72,9 +86,9 @@ class Equilibrium {
   double stiffness_scale(const Vector& q) const;
   // The pairing and s at q, without solving (e.g. the reference configuration).
   EquilibriumState evaluate(const Vector& q) const;
-  // C = T^T K^-1 T over all components, from the body's own tangent at state.q (symmetric).
-  // The reference stays valid until the next call (the storage is reused).
-  const Matrix& compliance(const EquilibriumState& state);
+  // C = T^T K^-1 T over the given components, from the body's own tangent at state.q
+  // (symmetric). The reference stays valid until the next call (the storage is reused).
+  const Compliance& compliance(const EquilibriumState& state, const std::vector<int>& components);
   // R = A(q) - lambda F - T(q) p on every dof, and (if asked) the triplets of dR/dq, with
   // the pairing evaluated at q.
   Vector residual(const Vector& q, const Vector& p, Triplets* tangent) const;
@@ -97,8 +111,7 @@ class Equilibrium {
   // p(q) of the penalty law at a paired state, and (if asked) its stiffness triplets.
   Vector penalty_forces(const EquilibriumState& paired, Triplets* tangent) const;
   double free_residual_norm(const Vector& q, const Vector& p) const;
-  Eigen::SparseMatrix<double> free_block(const Triplets& triplets) const;
-  void fill_t_matrix(const EquilibriumState& state);
+  void fill_t_matrix(const EquilibriumState& state, const std::vector<int>& position);
 
   const Problem& problem_;
   NewtonParams params_;
@@ -115,9 +128,10 @@ class Equilibrium {
   bool factorize_body_tangent(const Vector& q);
   bool constant_tangent_ = false;
   bool body_factorized_ = false;
-  Eigen::SparseLU<Eigen::SparseMatrix<double>> body_lu_;
-  Eigen::SparseLU<Eigen::SparseMatrix<double>> lu_;
-  Matrix t_, x_, c_;  // compliance work storage, reused: large blocks, no allocation per call
+  FreeBlockSolver body_lu_;  // the body's own tangent (compliance, constant tangents)
+  FreeBlockSolver lu_;       // Newton's tangent, with the contact terms
+  Matrix t_, x_;  // compliance work storage, reused
+  Compliance c_;
 };
 
 }  // namespace grip

@@ -1,0 +1,41 @@
+#pragma once
+// Factorizes the free-dof block of a tangent given as triplets, reusing the sparsity pattern
+// and the symbolic analysis while the triplet sequence repeats (it does from one Newton
+// iterate to the next: the assembly loops are fixed and contact terms are always emitted).
+// A symmetric block (the body's own tangent; Newton's without friction on curved tools) is
+// factorized by LDL^T, several times cheaper than the LU that an unsymmetric one needs.
+#include <Eigen/SparseCore>
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseLU>
+#include <vector>
+
+#include "solver/core/body.hpp"
+
+namespace grip {
+
+class FreeBlockSolver {
+ public:
+  // free_index: dof -> row of the free block, -1 for a prescribed dof.
+  // Returns false if the block is singular.
+  // near_symmetric_tolerance > 0: a block whose skew part is below that fraction of its
+  // largest entry is symmetrized (Newton's tangent with friction on a curved tool: the
+  // residual stays exact, so Newton still converges, and LDL^T serves).
+  bool factorize(const Triplets& triplets, const std::vector<int>& free_index, int free_count,
+                 double near_symmetric_tolerance = 0.0);
+  Vector solve(const Vector& b) const { return symmetric_ ? Vector(ldlt_.solve(b)) : Vector(lu_.solve(b)); }
+  Matrix solve(const Matrix& b) const { return symmetric_ ? Matrix(ldlt_.solve(b)) : Matrix(lu_.solve(b)); }
+  bool ok() const { return ok_; }
+
+ private:
+  Eigen::SparseMatrix<double> matrix_;
+  std::vector<int> rows_, cols_;  // the triplet sequence the pattern was built from
+  std::vector<int> slot_;         // triplet k -> index in matrix_.valuePtr(), -1 if dropped
+  std::vector<int> mirror_;        // value index -> index of its transpose entry
+  Eigen::SparseLU<Eigen::SparseMatrix<double>> lu_;
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt_;
+  bool lu_analysed_ = false, ldlt_analysed_ = false;
+  bool symmetric_ = false;
+  bool ok_ = false;
+};
+
+}  // namespace grip
