@@ -564,7 +564,7 @@ class Describer {
         return "has more than " + arg->dump() + " keys";
       case Failure::min_length:
         if (!arg) break;
-        return v + " is shorter than " + arg->dump() + " characters";
+        return *arg == 1 ? "is empty" : v + " is shorter than " + arg->dump() + " characters";
       case Failure::max_length:
         if (!arg) break;
         return v + " is longer than " + arg->dump() + " characters";
