@@ -379,8 +379,24 @@ class Job:
         return json.loads(data.decode("utf-8")) if format == "json" else data.decode("utf-8")
 
     def dismiss(self) -> dict:
-        """Cancels a queued or running job, removes a finished one; returns its document."""
+        """Cancels a queued or running job, removes a finished one; returns its document.
+
+        A cancel that reached the server while the job was finishing can leave it finished
+        (the server answers "dismissed" but keeps the job): then the removal is asked again."""
         self.doc = self.client.request("DELETE", self.path)
+        for _ in range(5):
+            if self.doc.get("status") != "dismissed" or self.doc.get("links") == []:
+                break  # removed (no links left), or not a cancel
+            try:
+                now = self.client.get(self.path)
+            except GripError as e:
+                if e.status == 404:
+                    break
+                raise
+            if now.get("status") not in ("successful", "failed"):
+                break  # really cancelled (or still stopping)
+            time.sleep(0.05)
+            self.doc = self.client.request("DELETE", self.path)
         return self.doc
 
 

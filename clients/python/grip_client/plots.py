@@ -288,7 +288,7 @@ def convergence(result: dict, history: Optional[List[dict]] = None):
                    label=f"tolerance {data['tolerance']:.2e}")
     ax.set_yscale("log")
     ax.set_xlabel("contact iteration (whole run)")
-    ax.set_ylabel(r"$\|v\|_2$")
+    ax.set_ylabel(r"$\Vert v \Vert_2$")
     name = result.get("scene", {}).get("name", "")
     ax.set_title(f"Contact error history{': ' + name if name else ''}")
     ax.grid(True, which="both", alpha=0.25)

@@ -93,6 +93,27 @@ class SubmitAndStream(unittest.TestCase):
         self.assertGreater(resumed_after, 0)
         self.assertLess(resumed_after, len(self.events))
 
+    def test_reconnect_mid_stream_of_a_running_job(self):
+        # A long job streamed live through the cutting proxy; dismissed after 40 events.
+        job = self.client.submit(support.long_sheet())
+        proxy = support.CuttingProxy(support.server().port, cut_after=1500)
+        got = []
+        try:
+            live = Client(proxy.url).job(job.id)
+            for ev in live.events():
+                got.append(ev)
+                if len(got) == 40:
+                    job.dismiss()
+        finally:
+            proxy.close()
+            if not job.finished:
+                job.status()
+        self.assertGreaterEqual(live.reconnects, 1)
+        self.assertEqual([e.id for e in got], list(range(1, len(got) + 1)))
+        self.assertGreater(len(got), 40)
+        self.assertEqual(got[-1].type, "job_failed")
+        self.assertEqual([e.data for e in got], [e.data for e in job.events()])
+
     def test_ndjson_and_sse_carry_the_same_events(self):
         body = self.client.get(f"/v1/jobs/{self.job.id}/events?format=ndjson", raw=True)
         lines = [json.loads(l) for l in body.decode().splitlines() if l.strip()]
