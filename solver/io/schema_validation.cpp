@@ -332,8 +332,6 @@ class Walker {
 
 // ---- plain sentences
 
-std::string number_text(const json& n) { return n.dump(); }
-
 std::string type_phrase(const json& type) {
   auto one = [](const std::string& t) -> std::string {
     if (t == "integer") return "an integer";
@@ -540,16 +538,16 @@ class Describer {
         return arg ? v + " is not " + arg->dump() : v + " is not the expected value";
       case Failure::minimum:
         if (!arg) break;
-        return *arg == 0 ? v + " is negative" : v + " is below " + number_text(*arg);
+        return *arg == 0 ? v + " is negative" : v + " is below " + arg->dump();
       case Failure::exclusive_minimum:
         if (!arg) break;
-        return *arg == 0 ? v + " is not positive" : v + " is not above " + number_text(*arg);
+        return *arg == 0 ? v + " is not positive" : v + " is not above " + arg->dump();
       case Failure::maximum:
         if (!arg) break;
-        return v + " is above " + number_text(*arg);
+        return v + " is above " + arg->dump();
       case Failure::exclusive_maximum:
         if (!arg) break;
-        return v + " is not below " + number_text(*arg);
+        return v + " is not below " + arg->dump();
       case Failure::min_items:
         if (!arg || !value) break;
         return "has " + items_text(value->size()) + "; at least " + arg->dump() + " needed";
@@ -573,7 +571,7 @@ class Describer {
         return v + " does not match " + arg->dump();
       case Failure::multiple_of:
         if (!arg) break;
-        return v + " is not a multiple of " + number_text(*arg);
+        return v + " is not a multiple of " + arg->dump();
       case Failure::unique_items:
         return "has equal items (" + description + ")";
       case Failure::one_of:

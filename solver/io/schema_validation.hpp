@@ -25,7 +25,7 @@ std::string_view schema_file_stem(SchemaName which);
 std::string_view schema_text(SchemaName which);
 
 // Errors of `document` against the schema; empty when it is valid. Thread-safe; the schemas
-// are parsed once, on first use.
+// are parsed once, on first use (std::logic_error if one was not embedded or does not parse).
 std::vector<SceneIssue> validate_against(const nlohmann::json& document, SchemaName which);
 
 // The `default` the schema gives the value at `pointer` of `document` (present or not), where
