@@ -122,7 +122,7 @@ TEST(Hertz, CevAndUzawaAgree) {
   j["solver"]["contact"]["max_iterations"] = 5000;
   const Solved uzawa = solve_scene(j);
   expect_every_step_sound(cev);
-  expect_every_step_sound(uzawa);
+  expect_every_step_sound_within(uzawa, 1e-3);
   ASSERT_TRUE(cev.run.completed && uzawa.run.completed);
   std::printf("real solves: cev %ld (%.3f s), uzawa %ld (%.3f s)\n", cev.run.counters.solves, cev.run.seconds,
               uzawa.run.counters.solves, uzawa.run.seconds);

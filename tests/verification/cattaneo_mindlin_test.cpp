@@ -1,0 +1,167 @@
+// Cattaneo-Mindlin partial slip, plane strain: the Hertz half-cylinder pressed without
+// friction onto a rigid flat, then sheared with friction by a sideways displacement of its
+// diameter. With P and Q from the reactions and a from Hertz, the closed form has a central
+// stick zone of half-width c = a sqrt(1 - Q / (mu P)) and the shear traction
+//   q(x) = mu p0 (sqrt(1 - x^2/a^2) - (c/a) sqrt(1 - x^2/c^2))   (the second term for |x| < c).
+// It neglects the coupling of normal and tangential tractions, which vanishes for an elastic
+// body on a rigid flat only as nu -> 1/2: so the check runs at nu = 0.49 with q4_bbar, and the
+// nu = 0.3 case is reported beside it without a closed-form assertion.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <numbers>
+
+#include "tests/support/contact_profile.hpp"
+#include "tests/support/scenes.hpp"
+
+namespace grip {
+namespace {
+
+using nlohmann::json;
+using namespace grip::testing;
+
+json cattaneo(double size) {
+  json j = example_scene("cattaneo-mindlin");
+  json& disc = j["body"]["mesh"]["half_disc"];
+  const int fine = static_cast<int>(std::lround(disc["refine"]["extent"].get<double>() / size));
+  disc["refine"]["size"] = size;
+  disc["divisions"] = {2 * fine + 16, fine + 8};
+  return j;
+}
+
+struct CattaneoReading {
+  double mu = 0, P = 0, Q = 0, a = 0, p0 = 0, c = 0;  // closed form at the computed loads
+  Zone stick;
+  double c_fe = 0;       // where the stick margin mu |sigma_n| - |sigma_t| vanishes
+  double c_nodes = 0;    // midway between the last sticking and the first slipping node
+  double traction_error = 0;  // RMS of sigma_t - q(x) over the contact, / (mu p0)
+  double contact_force = 0;   // sum of the tangential contact forces
+};
+
+CattaneoReading read_cattaneo(const Solved& s, const StepRecord& rec) {
+  const json& body = s.scene.effective["body"];
+  const double E = body["material"]["young"], nu = body["material"]["poisson"];
+  const double R = body["mesh"]["half_disc"]["radius"], t = body["thickness"];
+  CattaneoReading r;
+  r.mu = s.scene.steps[rec.index - 1].friction[0];
+  const Vec2 reaction = reaction_resultant(s.scene.problem, rec) / t;
+  r.P = -reaction.y();
+  r.Q = std::abs(reaction.x());
+  r.a = std::sqrt(4 * r.P * R * (1 - nu * nu) / (std::numbers::pi * E));
+  r.p0 = 2 * r.P / (std::numbers::pi * r.a);
+  r.c = r.mu > 0 && r.Q < r.mu * r.P ? r.a * std::sqrt(1 - r.Q / (r.mu * r.P)) : 0.0;
+  const auto nodes = contact_profile(s.scene.problem, rec);
+  r.stick = stick_zone(nodes, r.mu);
+  r.c_fe = r.stick.half_width();
+  r.c_nodes = r.stick.midpoint_half_width();
+  double force = 0, moment = 0, sum2 = 0;
+  int count = 0;
+  for (const auto& n : nodes) {
+    force += n.p_n;
+    moment += n.p_n * n.x;
+    r.contact_force += n.p_t;
+  }
+  const double xc = moment / force, sign = r.contact_force < 0 ? -1.0 : 1.0;
+  for (const auto& n : nodes) {
+    const double x = n.x - xc;
+    if (std::abs(x) >= r.a) continue;
+    double q = r.mu * r.p0 * std::sqrt(1 - x * x / (r.a * r.a));
+    if (std::abs(x) < r.c) q -= r.c / r.a * r.mu * r.p0 * std::sqrt(1 - x * x / (r.c * r.c));
+    sum2 += std::pow(n.sigma_t - sign * q, 2);
+    ++count;
+  }
+  r.traction_error = std::sqrt(sum2 / count) / (r.mu * r.p0);
+  return r;
+}
+
+void print(const CattaneoReading& r, int step) {
+  std::printf("step %d: P %.1f, Q %.1f, Q/(mu P) %.3f, a %.4f, c %.4f (c/a %.3f); stick zone c %.4f "
+              "(error %+.2f %% of a), between nodes %.4f (%+.2f %% of a); shear traction RMS error "
+              "%.2f %% of mu p0\n",
+              step, r.P, r.Q, r.Q / (r.mu * r.P), r.a, r.c, r.c / r.a, r.c_fe, 100 * (r.c_fe - r.c) / r.a,
+              r.c_nodes, 100 * (r.c_nodes - r.c) / r.a, 100 * r.traction_error);
+}
+
+// The shipped scene: nu = 0.49, q4_bbar, a / h = 20 near the contact.
+TEST(CattaneoMindlin, StickZoneMatchesTheClosedFormNearIncompressibility) {
+  const Solved s = solve_scene(example_scene("cattaneo-mindlin"));
+  expect_every_step_sound(s);
+  ASSERT_TRUE(s.run.completed);
+  const int pressed = 2;  // the frictionless stage
+  const CattaneoReading press = read_cattaneo(s, s.run.steps[pressed - 1]);
+  EXPECT_EQ(press.contact_force, 0.0);
+  std::printf("solves %ld, Newton iterations %ld, %.3f s\n", s.run.counters.solves,
+              s.run.counters.newton_iterations, s.run.seconds);
+  for (size_t k = pressed; k < s.run.steps.size(); ++k) {
+    const StepRecord& rec = s.run.steps[k];
+    const CattaneoReading r = read_cattaneo(s, rec);
+    print(r, rec.index);
+    ASSERT_TRUE(r.stick.found);
+    EXPECT_GT(r.Q, 0.2 * r.mu * r.P);
+    EXPECT_LT(r.Q, r.mu * r.P);
+    EXPECT_NEAR(std::abs(r.contact_force), r.Q, 1e-8 * r.P);
+    // Weak coupling at nu = 0.49: shearing hardly changes the normal load.
+    EXPECT_NEAR(r.P, press.P, 2e-3 * press.P);
+    EXPECT_LT(std::abs(r.c_fe - r.c), 0.03 * r.a);
+    // The closed-form boundary lies between the last sticking and first slipping nodes, to 3 % of a.
+    EXPECT_TRUE(r.stick.brackets(r.c, 0.03 * r.a));
+    EXPECT_LT(std::abs(r.c_nodes - r.c), 0.03 * r.a);
+    EXPECT_LT(r.traction_error, 0.03);
+  }
+}
+
+// nu = 0.3 (q4): the coupling is strong; reported, not asserted against the closed form.
+TEST(CattaneoMindlin, CompressibleCaseIsReportedBesideIt) {
+  json j = cattaneo(0.035);
+  j["body"]["material"]["poisson"] = 0.3;
+  j["body"]["element"] = "q4";
+  const Solved s = solve_scene(j);
+  expect_every_step_sound(s);
+  ASSERT_TRUE(s.run.completed);
+  const CattaneoReading press = read_cattaneo(s, s.run.steps[1]);
+  std::printf("nu = 0.3, pressed without friction, then sheared:\n");
+  for (size_t k = 2; k < s.run.steps.size(); ++k) {
+    const CattaneoReading r = read_cattaneo(s, s.run.steps[k]);
+    print(r, s.run.steps[k].index);
+    std::printf("  P changed by %+.2f %% while shearing\n", 100 * (r.P / press.P - 1));
+    EXPECT_LT(r.Q, r.mu * r.P);
+  }
+  // Friction already during the normal load: a central stick zone with no tangential load.
+  json f = j;
+  f["stages"][0].erase("friction");
+  f["stages"].erase(1);
+  const Solved pressed = solve_scene(f);
+  expect_every_step_sound(pressed);
+  ASSERT_TRUE(pressed.run.completed);
+  const CattaneoReading r = read_cattaneo(pressed, pressed.run.steps.back());
+  ASSERT_TRUE(r.stick.found);
+  std::printf("nu = 0.3, pressed with friction 0.3: central stick zone of half-width %.3f a "
+              "(net tangential force %.2g of P)\n",
+              r.c_fe / r.a, r.contact_force / r.P);
+}
+
+// The two strategies converge to the same contact forces and states (one press step, one
+// shear step, a / h = 8).
+TEST(CattaneoMindlin, CevAndUzawaAgree) {
+  json j = cattaneo(0.07);
+  j["stages"][0]["steps"] = 1;
+  j["stages"][1]["steps"] = 1;
+  const Solved cev = solve_scene(j);
+  j["solver"]["contact"]["method"] = "uzawa";
+  j["solver"]["contact"]["max_iterations"] = 5000;
+  const Solved uzawa = solve_scene(j);
+  expect_every_step_sound(cev);
+  expect_every_step_sound_within(uzawa, 1e-3);
+  ASSERT_TRUE(cev.run.completed && uzawa.run.completed);
+  std::printf("real solves: cev %ld (%.3f s), uzawa %ld (%.3f s)\n", cev.run.counters.solves, cev.run.seconds,
+              uzawa.run.counters.solves, uzawa.run.seconds);
+  for (size_t k = 0; k < cev.run.steps.size(); ++k) {
+    const StepRecord &a = cev.run.steps[k], &b = uzawa.run.steps[k];
+    EXPECT_LT((a.p - b.p).lpNorm<Eigen::Infinity>(), 1e-3 * a.p.lpNorm<Eigen::Infinity>()) << "step " << k + 1;
+    const auto na = contact_profile(cev.scene.problem, a), nb = contact_profile(uzawa.scene.problem, b);
+    for (size_t i = 0; i < na.size(); ++i) EXPECT_EQ(na[i].state, nb[i].state) << "step " << k + 1 << " node " << i;
+  }
+}
+
+}  // namespace
+}  // namespace grip

@@ -1,0 +1,127 @@
+// Contact patch test: a block of distorted elements, its top pushed down (prescribed), its
+// sides free, on a rigid frictionless flat. The state is homogeneous uniaxial compression, so
+// every bottom node carries the same contact stress, equal to the closed form:
+//   linear: E' delta / H with E' = E / (1 - nu^2) (plane strain) or E (plane stress);
+//   finite: the nominal stress P22 = lambda_y S22 of the neo-Hookean law at F = diag(lambda_x,
+//   lambda_y), lambda_y = 1 - delta / H and lambda_x such that S11 = 0.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <random>
+
+#include "solver/elements/continuum.hpp"
+#include "tests/support/contact_profile.hpp"
+#include "tests/support/scenes.hpp"
+
+namespace grip {
+namespace {
+
+using nlohmann::json;
+using namespace grip::testing;
+
+constexpr double kWidth = 3.0, kHeight = 2.0, kYoung = 1000.0, kPoisson = 0.3;
+
+// An explicit mesh of 4 x 3 elements with the interior nodes moved off the grid.
+json distorted_block(QuadShape shape) {
+  RectangleSpec spec;
+  spec.size = {kWidth, kHeight};
+  spec.nx = 4;
+  spec.ny = 3;
+  PlaneMesh mesh = rectangle_mesh(spec, shape);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> shift(-0.15, 0.15);
+  auto on_boundary = [](const Vec2& x) {
+    return std::abs(x.x()) < 1e-12 || std::abs(x.x() - kWidth) < 1e-12 || std::abs(x.y()) < 1e-12 ||
+           std::abs(x.y() - kHeight) < 1e-12;
+  };
+  for (Vec2& x : mesh.nodes)
+    if (!on_boundary(x)) x += Vec2(shift(rng), shift(rng));
+  if (shape == QuadShape::q9)  // straight sides, mid-side and centre nodes in their middles
+    for (const auto& el : mesh.elements) {
+      for (int m = 0; m < 4; ++m) mesh.nodes[el[4 + m]] = 0.5 * (mesh.nodes[el[m]] + mesh.nodes[el[(m + 1) % 4]]);
+      mesh.nodes[el[8]] = 0.25 * (mesh.nodes[el[0]] + mesh.nodes[el[1]] + mesh.nodes[el[2]] + mesh.nodes[el[3]]);
+    }
+  json nodes = json::array();
+  for (const Vec2& x : mesh.nodes) nodes.push_back({x.x(), x.y()});
+  return {{"nodes", nodes}, {"elements", mesh.elements},
+          {"sets", {{"bottom", mesh.sets["bottom"]}, {"top", mesh.sets["top"]}, {"corner", {mesh.sets["top"].back()}}}}};
+}
+
+json patch_scene(const std::string& element, const std::string& kinematics, const std::string& analysis,
+                 double delta) {
+  const QuadShape shape = element == "q9" ? QuadShape::q9 : QuadShape::q4;
+  return {{"body",
+           {{"model", "continuum"},
+            {"kinematics", kinematics},
+            {"analysis", analysis},
+            {"element", element},
+            {"thickness", 0.5},
+            {"material", {{"young", kYoung}, {"poisson", kPoisson}}},
+            {"mesh", distorted_block(shape)},
+            {"contact_set", "bottom"},
+            {"supports",
+             {{{"set", "top"}, {"fix", {"y"}}, {"values", {{"y", -delta}}}}, {{"set", "corner"}, {"fix", {"x"}}}}}}},
+          {"obstacles",
+           {{{"name", "flat"}, {"shape", {{"type", "segment"}, {"from", {10, 0}}, {"to", {-10, 0}}}}, {"friction", 0}}}},
+          {"steps", 2}};
+}
+
+// The nominal compressive stress of the homogeneous state, by the closed forms above.
+double closed_form(const std::string& kinematics, PlaneAnalysis analysis, double delta) {
+  const double ly = 1 - delta / kHeight;
+  if (kinematics == "linear")
+    return (analysis == PlaneAnalysis::plane_strain ? kYoung / (1 - kPoisson * kPoisson) : kYoung) * delta / kHeight;
+  const NeoHookeMaterial law(kYoung, kPoisson, analysis);
+  double lx = 1.0;
+  for (int it = 0; it < 50; ++it) {  // Newton on S11(lambda_x) = 0
+    Mat2 E = Mat2::Zero();
+    E(0, 0) = 0.5 * (lx * lx - 1);
+    E(1, 1) = 0.5 * (ly * ly - 1);
+    const MaterialResponse r = law.response(E);
+    const double step = r.S[0] / (r.D(0, 0) * lx);
+    lx -= step;
+    if (std::abs(step) < 1e-15) break;
+  }
+  Mat2 E = Mat2::Zero();
+  E(0, 0) = 0.5 * (lx * lx - 1);
+  E(1, 1) = 0.5 * (ly * ly - 1);
+  return -ly * law.response(E).S[1];
+}
+
+TEST(ContactPatch, UniformCompressionGivesUniformPressure) {
+  struct Case {
+    const char* element;
+    const char* kinematics;
+    const char* analysis;
+  };
+  const Case cases[] = {{"q4", "linear", "plane_strain"},   {"q4", "linear", "plane_stress"},
+                        {"q4_bbar", "linear", "plane_strain"}, {"q9", "linear", "plane_strain"},
+                        {"q4", "finite", "plane_strain"},   {"q4", "finite", "plane_stress"},
+                        {"q9", "finite", "plane_strain"},   {"q9", "finite", "plane_stress"}};
+  for (const Case& c : cases) {
+    SCOPED_TRACE(std::string(c.element) + " " + c.kinematics + " " + c.analysis);
+    // Finite strain at 5 % compression; the linear cases are exact at any size.
+    const double delta = std::string(c.kinematics) == "finite" ? 0.1 : 0.004;
+    const Solved s = solve_scene(patch_scene(c.element, c.kinematics, c.analysis, delta));
+    expect_every_step_sound(s);
+    ASSERT_TRUE(s.run.completed);
+    const PlaneAnalysis analysis =
+        std::string(c.analysis) == "plane_strain" ? PlaneAnalysis::plane_strain : PlaneAnalysis::plane_stress;
+    const StepRecord& last = s.run.steps.back();
+    const double expected = closed_form(c.kinematics, analysis, delta);
+    double worst = 0.0, mean = 0.0;
+    const auto nodes = contact_profile(s.scene.problem, last);
+    for (const auto& n : nodes) {
+      worst = std::max(worst, std::abs(-n.sigma_n - expected));
+      mean -= n.sigma_n / nodes.size();
+    }
+    std::printf("%-8s %-7s %-13s sigma_n %.9g, closed form %.9g, largest deviation %.2e relative\n", c.element,
+                c.kinematics, c.analysis, mean, expected, worst / expected);
+    EXPECT_LT(worst, 1e-9 * expected);
+    // The reactions carry the same: sigma times the bottom's area.
+    EXPECT_NEAR(-reaction_resultant(s.scene.problem, last).y(), expected * kWidth * 0.5, 1e-9 * expected * kWidth);
+  }
+}
+
+}  // namespace
+}  // namespace grip

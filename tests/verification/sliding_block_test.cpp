@@ -1,0 +1,109 @@
+// A block pressed onto a rigid flat by its top (a prescribed displacement), then sheared by
+// moving the flat: the tangential force Q (the x reaction at the top) stays below mu N while
+// part of the bottom sticks, and equals mu N (N the normal reaction) once the block slides.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+
+#include "tests/support/contact_profile.hpp"
+#include "tests/support/scenes.hpp"
+
+namespace grip {
+namespace {
+
+using nlohmann::json;
+using namespace grip::testing;
+
+struct BlockReading {
+  double N = 0, Q = 0, friction = 0;  // reactions; sum of the contact friction forces
+  int stick = 0, slip = 0, pressing = 0;
+};
+
+BlockReading read_block(const Solved& s, const StepRecord& rec) {
+  BlockReading b;
+  const Vec2 r = reaction_resultant(s.scene.problem, rec);
+  b.N = -r.y();
+  b.Q = std::abs(r.x());
+  for (const auto& n : contact_profile(s.scene.problem, rec)) {
+    b.friction += n.p_t;
+    b.stick += n.state == ContactState::stick;
+    b.slip += n.state == ContactState::slip;
+    b.pressing += n.p_n < 0;
+  }
+  return b;
+}
+
+void check_stick_then_slide(const Solved& s) {
+  expect_every_step_sound(s);
+  ASSERT_TRUE(s.run.completed);
+  const double mu = s.scene.effective["obstacles"][0]["friction"];
+  const double tau_tol = s.scene.params.contact.tau_tolerance;
+  bool slid = false, stuck = false;
+  std::printf("%5s %10s %10s %9s %6s %5s %7s\n", "step", "N", "Q", "Q/(mu N)", "stick", "slip", "solves");
+  for (const StepRecord& rec : s.run.steps) {
+    const BlockReading b = read_block(s, rec);
+    std::printf("%5d %10.3f %10.4f %9.6f %6d %5d %7d\n", rec.index, b.N, b.Q, b.Q / (mu * b.N), b.stick, b.slip,
+                rec.solves);
+    EXPECT_NEAR(std::abs(b.friction), b.Q, 1e-8 * b.N);  // the reactions balance the friction
+    if (rec.stage == 0) continue;
+    if (b.stick > 0) {
+      // Sticking: the friction force has not reached its bound.
+      EXPECT_LT(b.Q, mu * b.N * (1 - 1e-3)) << "step " << rec.index;
+      EXPECT_FALSE(slid) << "a sliding block sticks again at step " << rec.index;
+      stuck = true;
+    } else {
+      // Sliding: every pressing node slips (a corner may lift), and Q = mu N to the precision
+      // of the friction bound (tau passes).
+      EXPECT_EQ(b.slip, b.pressing);
+      EXPECT_NEAR(b.Q, mu * b.N, 2 * tau_tol * mu * b.N) << "step " << rec.index;
+      slid = true;
+    }
+  }
+  EXPECT_TRUE(stuck);
+  EXPECT_TRUE(slid);
+}
+
+TEST(SlidingBlock, SticksBelowMuNThenSlidesAtMuN) {
+  check_stick_then_slide(solve_scene(example_scene("sliding-block")));
+}
+
+TEST(SlidingBlock, FiniteKinematicsAndNineNodeElementsToo) {
+  json j = example_scene("sliding-block");
+  j["body"]["kinematics"] = "finite";
+  j["body"]["element"] = "q9";
+  j["body"]["mesh"]["rectangle"]["divisions"] = {10, 5};
+  check_stick_then_slide(solve_scene(j));
+}
+
+// cev and uzawa give the same forces, to what the contact tolerance pins them to (uzawa stops
+// just below it; a nodal contact stiffness of about E h = 4e5 N/mm times ||v|| of 2e-7 mm);
+// small strain, so linear and finite agree too.
+TEST(SlidingBlock, StrategiesAndKinematicsAgree) {
+  json j = example_scene("sliding-block");
+  j["body"]["mesh"]["rectangle"]["divisions"] = {10, 5};
+  j["stages"][1]["steps"] = 5;
+  const Solved cev = solve_scene(j);
+  json u = j;
+  u["solver"]["contact"]["method"] = "uzawa";
+  u["solver"]["contact"]["max_iterations"] = 5000;
+  const Solved uzawa = solve_scene(u);
+  json f = j;
+  f["body"]["kinematics"] = "finite";
+  const Solved finite = solve_scene(f);
+  expect_every_step_sound(cev);
+  expect_every_step_sound(finite);
+  expect_every_step_sound_within(uzawa, 1e-3);
+  ASSERT_TRUE(cev.run.completed && uzawa.run.completed && finite.run.completed);
+  std::printf("real solves: cev %ld, uzawa %ld, cev finite %ld\n", cev.run.counters.solves,
+              uzawa.run.counters.solves, finite.run.counters.solves);
+  for (size_t k = 0; k < cev.run.steps.size(); ++k) {
+    const Vector& p = cev.run.steps[k].p;
+    const double scale = p.lpNorm<Eigen::Infinity>();
+    EXPECT_LT((p - uzawa.run.steps[k].p).lpNorm<Eigen::Infinity>(), 1e-3 * scale) << "step " << k + 1;
+    // Strains of 2e-4: the finite-strain forces differ by about that, relative.
+    EXPECT_LT((p - finite.run.steps[k].p).lpNorm<Eigen::Infinity>(), 2e-3 * scale) << "step " << k + 1;
+  }
+}
+
+}  // namespace
+}  // namespace grip
