@@ -178,6 +178,7 @@ void HttpServer::Impl::hooks() {
   svr.new_task_queue = [threads] { return new httplib::ThreadPool(static_cast<size_t>(threads)); };
   svr.set_payload_max_length(options.max_body_bytes);
   svr.set_keep_alive_timeout(2);
+  svr.set_tcp_nodelay(true);  // events are small writes: no Nagle delay
   svr.set_read_timeout(10);
   svr.set_write_timeout(10);
 

@@ -22,6 +22,7 @@ struct JobService::ActiveJob {
   const std::string id;
   bool taken = false;  // by a worker (guarded by the service mutex)
   std::atomic<bool> dismissed{false};
+  std::atomic<std::int64_t> last_seq{0};  // the last event sequence number given out
   std::mutex progress_mutex;
   std::optional<Progress> progress;  // while running
 };
@@ -199,11 +200,13 @@ std::pair<DismissOutcome, std::optional<JobView>> JobService::dismiss(const std:
     store_.mark_dismissed(id, now_iso8601());
     if (queued) {
       // Never started: finish it here. Its worker (none) cannot.
+      // Never started, so no events are on their way: the stored last_seq is the last.
       JobOutcome o;
       o.status = JobStatus::dismissed;
       o.message = "dismissed before it started";
       o.finished = now_iso8601();
-      finish(active, std::move(o));
+      const auto rec = store_.job(id);
+      finish(active, std::move(o), rec ? rec->last_seq : 0);
     }
     spdlog::info("job {} dismissed ({})", id, queued ? "queued" : "running");
     auto view = job(id);
@@ -342,7 +345,18 @@ void JobService::worker_loop() {
     try {
       run_job(job);
     } catch (const std::exception& e) {
+      // Most likely the store failed; try to leave the job failed rather than running.
       spdlog::error("job {}: {}", job->id, e.what());
+      try {
+        JobOutcome o;
+        o.status = JobStatus::failed;
+        o.message = std::string("internal error: ") + e.what();
+        o.finished = now_iso8601();
+        finish(job, std::move(o), job->last_seq);
+      } catch (const std::exception& again) {
+        spdlog::error("job {} stays unfinished until the next start: {}", job->id, again.what());
+        forget(job->id);
+      }
     }
     {
       std::lock_guard lock(mutex_);
@@ -352,8 +366,10 @@ void JobService::worker_loop() {
   }
 }
 
-void JobService::emit(const std::string& id, std::int64_t seq, const json& event) {
-  if (options_.event_tap) options_.event_tap(id, seq);
+void JobService::emit(const std::shared_ptr<ActiveJob>& job, std::int64_t seq, const json& event) {
+  const std::string& id = job->id;
+  job->last_seq = seq;
+  if (options_.event_tap) options_.event_tap(id, seq, event);
   {
     std::lock_guard lock(events_mutex_);
     pending_.push_back({id, stored(seq, event)});
@@ -418,18 +434,9 @@ void JobService::forget(const std::string& id) {
   active_.erase(id);
 }
 
-void JobService::finish(const std::shared_ptr<ActiveJob>& job, JobOutcome outcome) {
-  const auto rec = store_.job(job->id);
-  std::int64_t last = rec ? rec->last_seq : 0;
-  {
-    // Events of this job still on their way to the store come first.
-    std::lock_guard lock(events_mutex_);
-    for (const auto& e : pending_)
-      if (e.job_id == job->id) last = std::max(last, e.event.seq);
-    auto it = committed_.find(job->id);
-    if (it != committed_.end()) last = std::max(last, it->second);
-  }
-  flush(job->id, last);
+void JobService::finish(const std::shared_ptr<ActiveJob>& job, JobOutcome outcome,
+                        std::int64_t last) {
+  flush(job->id, last);  // the job's events come first
   if (!outcome.terminal) {
     const json ev = outcome.status == JobStatus::successful
                         ? json{{"type", "job_finished"}}
@@ -459,7 +466,7 @@ void JobService::run_job(const std::shared_ptr<ActiveJob>& job) {
       o.status = JobStatus::dismissed;
       o.message = "dismissed before it started";
       o.finished = now_iso8601();
-      finish(job, std::move(o));
+      finish(job, std::move(o), rec->last_seq);
     } else {
       forget(id);
     }
@@ -467,6 +474,7 @@ void JobService::run_job(const std::shared_ptr<ActiveJob>& job) {
   }
   const auto rec = store_.job(id, true);
   std::int64_t seq = rec ? rec->last_seq : 0;
+  job->last_seq = seq;
   {
     std::lock_guard lock(events_mutex_);
     committed_[id] = std::max(committed_[id], seq);
@@ -486,7 +494,7 @@ void JobService::run_job(const std::shared_ptr<ActiveJob>& job) {
   }
   if (!scene) {
     outcome.finished = now_iso8601();
-    finish(job, std::move(outcome));
+    finish(job, std::move(outcome), seq);
     return;
   }
   const JobLimits& lim = options_.limits;
@@ -496,7 +504,7 @@ void JobService::run_job(const std::shared_ptr<ActiveJob>& job) {
     outcome.status = JobStatus::failed;
     outcome.message = "limit: the scene is over this service's node or step limit";
     outcome.finished = now_iso8601();
-    finish(job, std::move(outcome));
+    finish(job, std::move(outcome), seq);
     return;
   }
   {
@@ -509,19 +517,19 @@ void JobService::run_job(const std::shared_ptr<ActiveJob>& job) {
   enum class Stop { none, dismissed, shutdown, iterations, seconds } stop = Stop::none;
   SteppingObserver observer;
   observer.step_started = [&](int step, double load_factor) {
-    emit(id, ++seq, step_started_event(step, load_factor));
+    emit(job, ++seq, step_started_event(step, load_factor));
     std::lock_guard lock(job->progress_mutex);
     job->progress->step = step;
   };
   observer.iteration = [&](const IterationEvent& ev) {
     ++iterations;
-    emit(id, ++seq, iteration_event(ev));
+    emit(job, ++seq, iteration_event(ev));
     std::lock_guard lock(job->progress_mutex);
     job->progress->contact_error = ev.v2;
     job->progress->iterations = iterations;
   };
   observer.step_finished = [&](const StepRecord& step) {
-    emit(id, ++seq, step_finished_event(step));
+    emit(job, ++seq, step_finished_event(step));
     std::lock_guard lock(job->progress_mutex);
     if (step.converged) job->progress->steps_done = step.index;
   };
@@ -578,7 +586,7 @@ void JobService::run_job(const std::shared_ptr<ActiveJob>& job) {
   }
   const std::string status(to_string(outcome.status));
   const std::string message = outcome.message;
-  finish(job, std::move(outcome));
+  finish(job, std::move(outcome), seq);
   spdlog::info("job {} {} in {:.3f} s: {} contact iterations; {}", id, status, seconds, iterations,
                message);
 }

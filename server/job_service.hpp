@@ -49,8 +49,10 @@ struct ServiceOptions {
   int workers = 0;           // 0: one per core
   int queue_capacity = 256;  // accepted jobs waiting for a worker
   JobLimits limits;
-  // Test and benchmark hook, called on the worker thread as each event is produced.
-  std::function<void(const std::string& job_id, std::int64_t seq)> event_tap;
+  // Test and benchmark hook, called on the worker thread as each event is produced (before
+  // it is stored).
+  std::function<void(const std::string& job_id, std::int64_t seq, const nlohmann::json& event)>
+      event_tap;
 };
 
 // Submission refused because the queue is full; retry after `retry_after_seconds`.
@@ -156,10 +158,10 @@ class JobService {
   void worker_loop();
   void writer_loop();
   void run_job(const std::shared_ptr<ActiveJob>& job);
-  void emit(const std::string& id, std::int64_t seq, const nlohmann::json& event);
+  void emit(const std::shared_ptr<ActiveJob>& job, std::int64_t seq, const nlohmann::json& event);
   void flush(const std::string& id, std::int64_t seq);
-  // Stores the outcome after all events, then forgets the active job.
-  void finish(const std::shared_ptr<ActiveJob>& job, JobOutcome outcome);
+  // Stores the outcome after all events up to `last_seq`, then forgets the active job.
+  void finish(const std::shared_ptr<ActiveJob>& job, JobOutcome outcome, std::int64_t last_seq);
   void forget(const std::string& id);
   int retry_after_seconds() const;
 

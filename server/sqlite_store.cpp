@@ -158,6 +158,20 @@ bool SqliteStore::mark_dismissed(const std::string& id, const std::string& updat
 void SqliteStore::append_events(const std::vector<NewEvent>& events) {
   if (events.empty()) return;
   std::lock_guard lock(write_mutex_);
+  // Events commit without fsync: kill -9 cannot lose them (the WAL is in the OS's cache), and
+  // the next synchronous=FULL commit of the same WAL (a job's finish) makes them durable on
+  // disk before that job is reported finished. A running job's events are discarded at
+  // recovery anyway.
+  writer_->exec("PRAGMA synchronous=NORMAL");
+  struct Restore {
+    Database& db;
+    ~Restore() {
+      try {
+        db.exec("PRAGMA synchronous=FULL");
+      } catch (...) {
+      }
+    }
+  } restore{*writer_};
   Transaction tx(*writer_);
   auto ins = writer_->prepare("INSERT INTO events (job_id, seq, type, data) VALUES (?, ?, ?, ?)");
   auto seq = writer_->prepare("UPDATE jobs SET last_seq = max(last_seq, ?) WHERE id = ?");

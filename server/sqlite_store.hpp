@@ -1,7 +1,9 @@
 #pragma once
-// The embedded job store: one SQLite file in WAL mode with synchronous=FULL, so a commit
-// survives kill -9 and power loss. One connection writes and one reads (WAL lets reads run
-// beside a write); each is used under its own mutex.
+// The embedded job store: one SQLite file in WAL mode. Job changes commit with
+// synchronous=FULL (they survive kill -9 and power loss); event batches with NORMAL (they
+// survive kill -9, and the job's FULL finish makes them durable before it is reported). One
+// connection writes and one reads (WAL lets reads run beside a write), each under its own
+// mutex.
 #include <memory>
 #include <mutex>
 #include <string>

@@ -1,0 +1,139 @@
+// The job API without sockets: JobService over a SQLite store in a temporary folder.
+#include <gtest/gtest.h>
+
+#include <condition_variable>
+#include <mutex>
+
+// Eigen (through the solver) before httplib.h, whose <resolv.h> defines `_res`.
+#include "server/job_service.hpp"
+#include "server/sqlite_store.hpp"
+#include "solver/io/scene.hpp"
+// clang-format off
+#include "grip_process.hpp"
+// clang-format on
+
+namespace grip::testing {
+namespace {
+
+using server::EventBatch;
+using server::JobService;
+using server::JobStatus;
+using server::ServiceOptions;
+using server::SqliteStore;
+
+// Waits for a job to finish; its stored events.
+std::vector<server::StoredEvent> events_to_end(JobService& service, const std::string& id) {
+  std::vector<server::StoredEvent> all;
+  std::int64_t after = 0;
+  for (int rounds = 0; rounds < 10000; ++rounds) {
+    const EventBatch b = service.wait_events(id, after, std::chrono::milliseconds(1000));
+    EXPECT_TRUE(b.found);
+    for (const auto& e : b.events) {
+      all.push_back(e);
+      after = e.seq;
+    }
+    if (b.ended) return all;
+  }
+  ADD_FAILURE() << "no terminal event";
+  return all;
+}
+
+TEST(JobService, DismissalStopsARunningJobWithinOneIterationAndFreesTheWorker) {
+  TempDir dir;
+  SqliteStore store((dir.path() / "grip.sqlite").string());
+  std::mutex m;
+  std::string victim;
+  std::int64_t dismissed_at = 0;
+  JobService* self = nullptr;
+  ServiceOptions options;
+  options.workers = 1;
+  int iterations = 0;
+  // Dismiss from inside the run, at its fifth contact iteration: exact, no timing involved.
+  options.event_tap = [&](const std::string& id, std::int64_t seq, const nlohmann::json& ev) {
+    std::lock_guard lock(m);
+    if (id != victim || ev["type"] != "iteration" || ++iterations != 5) return;
+    dismissed_at = seq;
+    const auto [outcome, view] = self->dismiss(id);
+    EXPECT_EQ(outcome, server::DismissOutcome::dismissed);
+    EXPECT_EQ(view->record.status, JobStatus::dismissed);
+  };
+  JobService service(store, options);
+  self = &service;
+  service.start();
+  {
+    std::lock_guard lock(m);
+    victim = service.submit(beam_scene(40, 400)).job.record.id;
+  }
+  const std::string next = service.submit(beam_scene(10, 3)).job.record.id;
+  const auto events = events_to_end(service, victim);
+  ASSERT_GT(dismissed_at, 0);
+  int after_dismissal = 0;
+  for (const auto& e : events)
+    if (e.seq > dismissed_at && e.type == "iteration") ++after_dismissal;
+  EXPECT_LE(after_dismissal, 1);
+  EXPECT_EQ(events.back().type, "job_failed");
+  EXPECT_EQ(nlohmann::json::parse(events.back().data)["reason"], "dismissed");
+  EXPECT_EQ(service.job(victim)->record.status, JobStatus::dismissed);
+  EXPECT_FALSE(service.result(victim));
+  // The worker went on to the next job.
+  events_to_end(service, next);
+  EXPECT_EQ(service.job(next)->record.status, JobStatus::successful);
+}
+
+TEST(JobService, RecoveryRunsInterruptedJobsAgainAboveTheirOldEventIds) {
+  TempDir dir;
+  const std::string path = (dir.path() / "grip.sqlite").string();
+  const nlohmann::json scene = beam_scene(10, 3);
+  {
+    // A store as a crash leaves it: one job running with three events, one accepted.
+    SqliteStore store(path);
+    for (const char* id : {"a-running", "b-accepted"}) {
+      server::JobRecord rec;
+      rec.id = id;
+      rec.scene = scene.dump();
+      rec.created = rec.updated = "2025-01-01T00:00:00.000Z";
+      rec.steps = 3;
+      rec.nodes = 11;
+      store.insert_job(rec);
+    }
+    ASSERT_TRUE(store.start_job("a-running", "2025-01-01T00:00:01.000Z"));
+    std::vector<server::NewEvent> events;
+    for (int k = 1; k <= 3; ++k)
+      events.push_back({"a-running", {k, "step_started", R"({"type":"step_started","step":1,"load_factor":0.1})"}});
+    store.append_events(events);
+  }
+  SqliteStore store(path);
+  JobService service(store, ServiceOptions{});
+  service.start();
+  const auto events = events_to_end(service, "a-running");
+  ASSERT_FALSE(events.empty());
+  EXPECT_EQ(events.front().seq, 4);  // the interrupted run's ids are not given again
+  for (size_t i = 1; i < events.size(); ++i) EXPECT_EQ(events[i].seq, events[i - 1].seq + 1);
+  EXPECT_EQ(events.back().type, "job_finished");
+  EXPECT_EQ(service.job("a-running")->record.attempts, 2);
+  events_to_end(service, "b-accepted");
+  EXPECT_EQ(service.job("b-accepted")->record.status, JobStatus::successful);
+}
+
+TEST(JobService, InvalidScenesAndLimitsThrowWithPointers) {
+  TempDir dir;
+  SqliteStore store((dir.path() / "grip.sqlite").string());
+  ServiceOptions options;
+  options.limits.max_nodes = 20;
+  JobService service(store, options);
+  service.start();
+  try {
+    service.submit(beam_scene(30, 2));
+    FAIL() << "over the node limit";
+  } catch (const SceneErrors& e) {
+    ASSERT_EQ(e.issues().size(), 1u);
+    EXPECT_EQ(e.issues()[0].pointer, "/body/mesh");
+  }
+  nlohmann::json bad = beam_scene(10, 2);
+  bad["body"]["material"]["young"] = -1;
+  EXPECT_THROW(service.submit(bad), SceneErrors);
+  EXPECT_TRUE(service.list(std::nullopt, 10, std::nullopt).jobs.empty());  // nothing stored
+}
+
+}  // namespace
+}  // namespace grip::testing
