@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
-# Builds grip and runs its main job: solve the paper's beam example and print its step table.
+# Builds grip and starts the service on http://127.0.0.1:8080 with its SQLite file in ./data.
+# Flags after the script go to `grip serve` (bash scripts/run.sh --port 9000 --workers 4);
+# GRIP_* variables work too (./build/apps/grip serve --help lists them). Ctrl-C stops it.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release > /dev/null
 cmake --build build --target grip
-mkdir -p out
-./build/apps/grip solve schemas/examples/beam-on-cylinder.json \
-  --out out/beam-on-cylinder.result.json --events out/beam-on-cylinder.events.ndjson
+mkdir -p data
+exec ./build/apps/grip serve --db "${GRIP_DB:-data/grip.sqlite}" "$@"

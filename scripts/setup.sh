@@ -6,6 +6,7 @@ packages=(
   libeigen3-dev nlohmann-json3-dev libspdlog-dev libgtest-dev
   libcpp-httplib-dev libvalijson-dev libsqlite3-dev
   python3 python3-matplotlib
+  curl
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -1,0 +1,34 @@
+# grip service image: built on Debian 12 with the project's own setup script, run as a
+# non-root user with the job database on a volume.
+#   docker build -t grip .
+#   docker run -d -p 8080:8080 -v grip-data:/var/lib/grip --name grip grip
+#   docker stop grip     # SIGTERM: running jobs get --grace seconds (default 8) to finish
+FROM debian:12-slim AS build
+WORKDIR /src
+COPY scripts/setup.sh scripts/setup.sh
+RUN bash scripts/setup.sh && rm -rf /var/lib/apt/lists/*
+COPY . .
+RUN cmake -S . -B /build -G Ninja -DCMAKE_BUILD_TYPE=Release \
+ && cmake --build /build --target grip \
+ && strip /build/apps/grip
+
+FROM debian:12-slim
+RUN apt-get update -qq \
+ && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
+      libcpp-httplib0.11 libspdlog1.10 libfmt9 libsqlite3-0 \
+ && rm -rf /var/lib/apt/lists/* \
+ && useradd --system --uid 10001 --user-group --home-dir /var/lib/grip --create-home grip
+COPY --from=build /build/apps/grip /usr/local/bin/grip
+COPY --from=build /src/schemas /usr/local/share/grip/schemas
+ENV GRIP_HOST=0.0.0.0 \
+    GRIP_PORT=8080 \
+    GRIP_DB=/var/lib/grip/grip.sqlite \
+    GRIP_SCHEMAS=/usr/local/share/grip/schemas
+USER grip
+WORKDIR /var/lib/grip
+VOLUME /var/lib/grip
+EXPOSE 8080
+STOPSIGNAL SIGTERM
+HEALTHCHECK --interval=15s --timeout=5s --start-period=10s --retries=3 CMD ["grip", "healthcheck"]
+ENTRYPOINT ["grip"]
+CMD ["serve"]
