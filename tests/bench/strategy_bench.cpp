@@ -9,12 +9,13 @@
 // Numbers are reported, never asserted: the targets of the issue are printed as met or not.
 //
 //   grip_bench [--quick] [--out DIR] [--runs N] [--jobs N] [--budget MINUTES]
-//              [--run-seconds S] [--scenes a,b] [--source DIR]
+//              [--run-seconds S] [--scenes a,b] [--levels 0,1,2] [--source DIR] [--label TEXT]
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -22,15 +23,19 @@
 #include <limits>
 #include <map>
 #include <mutex>
+#include <numbers>
 #include <optional>
 #include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
 
+#include <time.h>
+
 #include <nlohmann/json.hpp>
 
 #include "solver/io/scene.hpp"
+#include "tests/support/contact_profile.hpp"
 #include "solver/solve/equilibrium.hpp"
 #include "solver/solve/load_stepping.hpp"
 
@@ -46,6 +51,20 @@ using Clock = std::chrono::steady_clock;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+// CPU time of the calling thread: less sensitive than wall time to other work on the machine.
+double thread_cpu_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+std::string load_average() {
+  std::ifstream in("/proc/loadavg");
+  std::string one, five, fifteen;
+  in >> one >> five >> fifteen;
+  return one + " " + five + " " + fifteen;
+}
 
 double median(std::vector<double> v) {
   if (v.empty()) return kNaN;
@@ -99,37 +118,77 @@ double peak_normal_stress(const Problem& problem, const StepRecord& rec) {
 struct SceneCase {
   std::string name;  // short name used in the CSV and the plots
   std::string file;  // schemas/examples/<file>.json
-  std::vector<std::string> mesh_labels;
-  std::function<json(json, int level)> with_mesh;
+  std::function<json(json, int level)> with_mesh;  // level 0, 1, 2: coarse to fine
+  std::function<std::string(const json&)> mesh_label;
   std::function<Quantities(const Scene&, const RunResult&)> measure;
-  // The closed-form answer for the measured run (empty: the reference is the finest mesh at
-  // the tightest tolerance).
+  // The closed-form values of the measured run where there are some (NaN elsewhere); the
+  // other quantities are compared with the finest mesh at the tightest tolerance.
   std::function<Quantities(const Scene&, const RunResult&)> closed_form;
-  std::string quantities;  // what force / peak / point / extent mean, for the report
-  std::string closed_form_note;  // what the closed form is, where there is one
+  std::string quantities;        // what force / peak / point / extent mean, for the report
+  std::string closed_form_note;  // which quantities have a closed form, and which
 };
 
-// The continuum scenes refine by scaling the shipped mesh's divisions (level 1 = as shipped).
-json scale_divisions(json j, double factor) {
-  json& mesh = j["body"]["mesh"];
-  for (const char* generator : {"rectangle", "half_disc"}) {
-    if (!mesh.contains(generator)) continue;
-    json& d = mesh[generator]["divisions"];
-    for (auto& v : d) v = std::max(1, static_cast<int>(std::lround(v.get<double>() * factor)));
-    if (mesh[generator].contains("refine")) mesh[generator]["refine"]["size"] = mesh[generator]["refine"]["size"].get<double>() / factor;
-  }
+// The continuum scenes (a half-disc refined near its pole) change the element size near the
+// contact by `factor`, keeping the rest of the mesh as shipped: divisions (2 f + c1, f + c2)
+// with f = extent / size elements across the refined zone (as tests/verification/hertz_test.cpp).
+json refine_half_disc(json j, double factor) {
+  json& disc = j["body"]["mesh"]["half_disc"];
+  const double size0 = disc["refine"]["size"], extent = disc["refine"]["extent"];
+  const int fine0 = static_cast<int>(std::lround(extent / size0));
+  const int c1 = disc["divisions"][0].get<int>() - 2 * fine0, c2 = disc["divisions"][1].get<int>() - fine0;
+  const double size = size0 * factor;
+  const int fine = static_cast<int>(std::lround(extent / size));
+  disc["refine"]["size"] = size;
+  disc["divisions"] = {2 * fine + c1, fine + c2};
   return j;
 }
 
-std::string continuum_mesh_label(const json& j) {
-  const json& mesh = j["body"]["mesh"];
-  for (const char* generator : {"rectangle", "half_disc"})
-    if (mesh.contains(generator)) {
-      const json& d = mesh[generator]["divisions"];
-      return std::to_string(d[0].get<int>()) + "x" + std::to_string(d[1].get<int>());
-    }
-  return "given";
+std::string half_disc_label(const json& j) {
+  const json& disc = j["body"]["mesh"]["half_disc"];
+  std::ostringstream s;
+  s << "h" << disc["refine"]["size"].get<double>() << " (" << disc["divisions"][0].get<int>() << "x"
+    << disc["divisions"][1].get<int>() << ")";
+  return s.str();
 }
+
+// A displacement component at the reference point (0, y) on the half-disc's axis, interpolated
+// linearly between the axis nodes: a field value that every mesh level can be read at.
+double axis_displacement(const Problem& problem, const StepRecord& rec, double y, const std::string& component) {
+  const auto x = column(rec.site_fields, "x"), yy = column(rec.site_fields, "y");
+  const auto ux = column(rec.site_fields, "ux"), uy = column(rec.site_fields, "uy");
+  const auto& u = component == "ux" ? ux : uy;
+  std::vector<std::pair<double, double>> axis;  // (reference y, displacement)
+  const double length = problem.body->characteristic_length();
+  for (size_t n = 0; n < x.size(); ++n)
+    if (std::abs(x[n] - ux[n]) < 1e-9 * length) axis.emplace_back(yy[n] - uy[n], u[n]);
+  std::sort(axis.begin(), axis.end());
+  for (size_t k = 1; k < axis.size(); ++k)
+    if (axis[k - 1].first <= y && y <= axis[k].first) {
+      const double t = (y - axis[k - 1].first) / (axis[k].first - axis[k - 1].first);
+      return (1 - t) * axis[k - 1].second + t * axis[k].second;
+    }
+  return kNaN;
+}
+
+struct HertzClosedForm {
+  double P = 0, Q = 0, a = 0, p0 = 0;
+};
+
+// P and Q per unit thickness from the support reactions, and Hertz's a and p0 at that P.
+HertzClosedForm hertz_closed_form(const Scene& sc, const StepRecord& rec) {
+  const json& body = sc.effective["body"];
+  const double E = body["material"]["young"], nu = body["material"]["poisson"];
+  const double R = body["mesh"]["half_disc"]["radius"], t = body["thickness"];
+  const Vec2 reaction = testing::reaction_resultant(sc.problem, rec);
+  HertzClosedForm h;
+  h.P = -reaction.y() / t;
+  h.Q = std::abs(reaction.x()) / t;
+  h.a = std::sqrt(4 * h.P * R * (1 - nu * nu) / (std::numbers::pi * E));
+  h.p0 = 2 * h.P / (std::numbers::pi * h.a);
+  return h;
+}
+
+double half_disc_radius(const Scene& sc) { return sc.effective["body"]["mesh"]["half_disc"]["radius"]; }
 
 std::vector<SceneCase> scene_cases() {
   std::vector<SceneCase> out;
@@ -137,7 +196,7 @@ std::vector<SceneCase> scene_cases() {
     SceneCase s;
     s.name = "beam";
     s.file = "beam-on-cylinder";
-    s.mesh_labels = {"20", "40", "80"};
+    s.mesh_label = [](const json& j) { return std::to_string(j["body"]["mesh"]["elements"].get<int>()); };
     s.with_mesh = [](json j, int level) {
       const int n = 20 << level;
       j["body"]["mesh"]["elements"] = n;
@@ -160,7 +219,7 @@ std::vector<SceneCase> scene_cases() {
     SceneCase s;
     s.name = "sheet";
     s.file = "sheet-stretching";
-    s.mesh_labels = {"30", "60", "120"};
+    s.mesh_label = [](const json& j) { return std::to_string(j["body"]["mesh"]["elements"].get<int>()); };
     s.with_mesh = [](json j, int level) {
       const int n = 30 << level;
       j["body"]["mesh"]["elements"] = n;
@@ -178,6 +237,71 @@ std::vector<SceneCase> scene_cases() {
     };
     s.quantities = "force: punch force (N per mm width); peak: peak major strain; "
                    "point: pole displacement (mm)";
+    out.push_back(std::move(s));
+  }
+  {
+    SceneCase s;
+    s.name = "hertz";
+    s.file = "hertz";
+    s.with_mesh = [](json j, int level) { return refine_half_disc(std::move(j), std::ldexp(2.0, -level)); };
+    s.mesh_label = half_disc_label;
+    s.measure = [](const Scene& sc, const RunResult& run) {
+      const StepRecord& last = run.steps.back();
+      const auto nodes = testing::contact_profile(sc.problem, last);
+      Quantities q;
+      q.peak = 0.0;
+      for (const auto& n : nodes) q.peak = std::max(q.peak, -n.sigma_n);
+      q.force = hertz_closed_form(sc, last).P;
+      q.point = -axis_displacement(sc.problem, last, -0.5 * half_disc_radius(sc), "uy");
+      const testing::EllipseFit fit = testing::fit_semi_ellipse(nodes);
+      q.extent = fit.a > 0 ? fit.a : kNaN;
+      return q;
+    };
+    s.closed_form = [](const Scene& sc, const RunResult& run) {
+      const HertzClosedForm h = hertz_closed_form(sc, run.steps.back());
+      Quantities q;
+      q.peak = h.p0;
+      q.extent = h.a;
+      return q;
+    };
+    s.quantities = "force: load P per unit thickness from the reactions (N/mm); peak: peak nodal normal "
+                   "contact stress (MPa); point: displacement on the axis at half the radius below the centre "
+                   "(mm); extent: contact half-width a from the semi-ellipse fitted to the nodal stresses (mm)";
+    s.closed_form_note = "closed form for peak (p0 = 2P/(pi a)) and extent (a = sqrt(4PR/(pi E*))) at the run's "
+                         "own P; force and point against the finest mesh";
+    out.push_back(std::move(s));
+  }
+  {
+    SceneCase s;
+    s.name = "cattaneo-mindlin";
+    s.file = "cattaneo-mindlin";
+    s.with_mesh = [](json j, int level) { return refine_half_disc(std::move(j), std::ldexp(2.0, -level)); };
+    s.mesh_label = half_disc_label;
+    s.measure = [](const Scene& sc, const RunResult& run) {
+      const StepRecord& last = run.steps.back();
+      const auto nodes = testing::contact_profile(sc.problem, last);
+      Quantities q;
+      q.peak = 0.0;
+      for (const auto& n : nodes) q.peak = std::max(q.peak, -n.sigma_n);
+      q.force = hertz_closed_form(sc, last).Q;
+      q.point = axis_displacement(sc.problem, last, -0.5 * half_disc_radius(sc), "ux");
+      const testing::Zone stick = testing::stick_zone(nodes, sc.problem.obstacles[0].friction);
+      q.extent = stick.found ? stick.half_width() : kNaN;
+      return q;
+    };
+    s.closed_form = [](const Scene& sc, const RunResult& run) {
+      const HertzClosedForm h = hertz_closed_form(sc, run.steps.back());
+      const double mu = sc.problem.obstacles[0].friction;
+      Quantities q;
+      q.peak = h.p0;
+      q.extent = h.a * std::sqrt(std::max(0.0, 1 - h.Q / (mu * h.P)));
+      return q;
+    };
+    s.quantities = "force: tangential load Q per unit thickness from the reactions (N/mm); peak: peak nodal "
+                   "normal contact stress (MPa); point: tangential displacement on the axis at half the radius "
+                   "below the centre (mm); extent: stick-zone half-width c (mm)";
+    s.closed_form_note = "closed form for peak (Hertz p0 at the run's own P) and extent (c = a sqrt(1 - Q/(mu P))); "
+                         "force and point against the finest mesh";
     out.push_back(std::move(s));
   }
   return out;
@@ -260,7 +384,8 @@ struct RunStats {
   // time ran out; skipped: not run.
   std::string status;
   std::string reason;
-  double seconds = kNaN;
+  double seconds = kNaN;      // wall time of run_load_steps
+  double cpu_seconds = kNaN;  // the thread's CPU time over the same call
   long solves = 0, newton = 0, factorizations = 0, inner = 0, passes = 0, cuts = 0;
   double max_v_rel = 0.0;  // the largest final ||v||_2 of a step, relative to the body's length
   Quantities q;
@@ -274,8 +399,10 @@ RunStats run_once(const SceneCase& sc, const json& scene_json, double wall_limit
   const auto t0 = Clock::now();
   bool timed_out = false;
   obs.stop_requested = [&] { return timed_out = seconds_since(t0) > wall_limit; };
+  const double cpu0 = thread_cpu_seconds();
   RunResult run = run_load_steps(scene.problem, scene.steps, scene.params, obs);
   RunStats st;
+  st.cpu_seconds = thread_cpu_seconds() - cpu0;
   st.seconds = run.seconds;
   st.solves = run.counters.solves;
   st.newton = run.counters.newton_iterations;
@@ -369,7 +496,7 @@ struct Row {
   double tolerance = 0.0;
   int runs = 0;
   RunStats stats;  // of the median run (counters and quantities are the same in every run)
-  double median_seconds = kNaN, min_seconds = kNaN;
+  double median_seconds = kNaN, min_seconds = kNaN, median_cpu_seconds = kNaN;
   Quantities error;
   double contact_seconds = kNaN, floor_seconds = kNaN, overhead_ratio = kNaN;
 };
@@ -403,9 +530,9 @@ std::string csv_text(std::string s) {
 }
 
 std::string join(const std::vector<int>& v) {
-  std::string out;
-  for (size_t i = 0; i < v.size(); ++i) out += (i ? ";" : "") + std::to_string(v[i]);
-  return out;
+  std::ostringstream out;
+  for (size_t i = 0; i < v.size(); ++i) out << (i ? ";" : "") << v[i];
+  return out.str();
 }
 
 void write_csv(const std::filesystem::path& path, std::vector<Row> rows) {
@@ -413,7 +540,8 @@ void write_csv(const std::filesystem::path& path, std::vector<Row> rows) {
     return std::tie(a.scene, a.level, a.strategy, b.tolerance) < std::tie(b.scene, b.level, b.strategy, a.tolerance);
   });
   std::ofstream out(path);
-  out << "scene,mesh,mesh_level,strategy,family,tolerance,runs,median_seconds,min_seconds,status,converged,"
+  out << "scene,mesh,mesh_level,strategy,family,tolerance,runs,median_seconds,min_seconds,median_cpu_seconds,"
+         "status,converged,"
          "contact_iterations,inner_iterations,tau_passes,cuts,newton_iterations,factorizations,max_contact_error,"
          "force,peak,point,extent,err_force,err_peak,err_point,err_extent,contact_seconds,equilibrium_seconds,"
          "overhead_ratio,step_solves,reason\n";
@@ -421,7 +549,7 @@ void write_csv(const std::filesystem::path& path, std::vector<Row> rows) {
     const RunStats& s = r.stats;
     out << r.scene << ',' << r.mesh << ',' << r.level << ',' << r.strategy << ',' << r.family << ','
         << csv_number(r.tolerance) << ',' << r.runs << ',' << csv_number(r.median_seconds) << ','
-        << csv_number(r.min_seconds) << ',' << s.status << ',' << (s.status == "ok" ? 1 : 0) << ',' << s.solves << ','
+        << csv_number(r.min_seconds) << ',' << csv_number(r.median_cpu_seconds) << ',' << s.status << ',' << (s.status == "ok" ? 1 : 0) << ',' << s.solves << ','
         << s.inner << ',' << s.passes << ',' << s.cuts << ',' << s.newton << ',' << s.factorizations << ','
         << csv_number(s.max_v_rel) << ',' << csv_number(s.q.force) << ',' << csv_number(s.q.peak) << ','
         << csv_number(s.q.point) << ',' << csv_number(s.q.extent) << ',' << csv_number(r.error.force) << ','
@@ -438,8 +566,10 @@ struct Options {
   int runs = 5;
   int jobs = 1;
   double budget_minutes = 40.0;
-  double run_seconds = 4.0;  // wall-time limit of one run
+  double run_seconds = 3.0;  // wall-time limit of one run
+  std::string label;         // what was measured (a commit), for machine.txt
   std::vector<std::string> scenes;
+  std::vector<int> levels;  // mesh levels to run (0 coarse .. 2 fine); empty: all
 };
 
 struct Task {
@@ -450,12 +580,13 @@ struct Task {
 
 class Bench {
  public:
-  explicit Bench(Options opt) : opt_(std::move(opt)), start_(Clock::now()) {}
+  explicit Bench(Options opt) : opt_(std::move(opt)), start_(Clock::now()), load_at_start_(load_average()) {}
 
   int run() {
     std::filesystem::create_directories(opt_.out);
     tolerances_ = opt_.quick ? std::vector<double>{1e-4, 1e-8} : std::vector<double>{1e-2, 1e-4, 1e-6, 1e-8, 1e-10};
     levels_ = opt_.quick ? std::vector<int>{0} : std::vector<int>{0, 1, 2};
+    if (!opt_.levels.empty()) levels_ = opt_.levels;
     const auto all_strategies = strategies(opt_.quick);
     for (const SceneCase& sc : scene_cases()) {
       if (!opt_.scenes.empty() && std::find(opt_.scenes.begin(), opt_.scenes.end(), sc.name) == opt_.scenes.end())
@@ -470,9 +601,13 @@ class Bench {
       cases_.push_back(sc);
     }
     for (const SceneCase& sc : cases_) reference(sc);
+    // The middle mesh first: the table and the plots read it, so a spent budget leaves holes
+    // only on the other meshes.
+    std::vector<int> order = levels_;
+    std::stable_sort(order.begin(), order.end(), [](int a, int b) { return (a == 1) > (b == 1); });
     std::vector<Task> tasks;
-    for (const SceneCase& sc : cases_)
-      for (int level : levels_)
+    for (int level : order)
+      for (const SceneCase& sc : cases_)
         for (const Strategy& st : all_strategies) tasks.push_back({&sc, level, &st});
     std::printf("%zu scene x mesh x strategy combinations, %zu tolerances each, %d runs, %d worker(s)\n",
                 tasks.size(), tolerances_.size(), opt_.runs, opt_.jobs);
@@ -486,6 +621,7 @@ class Bench {
     for (auto& t : pool) t.join();
     write_csv(opt_.out / "strategies.csv", rows_);
     write_scenes();
+    write_machine();
     std::printf("wrote %s (%zu rows) after %.0f s\n", (opt_.out / "strategies.csv").c_str(), rows_.size(),
                 seconds_since(start_));
     report_targets();
@@ -493,6 +629,8 @@ class Bench {
   }
 
  private:
+  std::string label(const SceneCase& sc, int level) const { return sc.mesh_label(sc.with_mesh(base_.at(sc.name), level)); }
+
   json scene_json(const SceneCase& sc, int level, const Strategy& st, double tol) const {
     json j = sc.with_mesh(base_.at(sc.name), level);
     json contact = st.contact;
@@ -503,22 +641,22 @@ class Bench {
     return j;
   }
 
-  // The reference answer of a scene without a closed form: the finest mesh at the tightest
-  // tolerance, with the default strategy (cev, n = inf, inner loop); a looser tolerance if
-  // that one fails.
+  // The reference answer: the finest mesh at the tightest tolerance, with the default strategy
+  // (cev, n = inf, inner loop), a looser tolerance if that one fails; a scene's closed forms
+  // replace it for the quantities they give.
   void reference(const SceneCase& sc) {
-    if (sc.closed_form) return;
-    const int level = levels_.back();
+    const int level = opt_.quick ? 0 : 2;  // the finest mesh of the matrix
     Strategy def;
     def.contact = {{"method", "cev"}};
     for (auto it = tolerances_.rbegin(); it != tolerances_.rend(); ++it) {
       const auto t0 = Clock::now();
       RunStats st = run_once(sc, scene_json(sc, level, def, *it), 20 * opt_.run_seconds);
       std::printf("reference %s: mesh %s, cev n = inf, tolerance %g: %s (%.2f s)\n", sc.name.c_str(),
-                  sc.mesh_labels[level].c_str(), *it, st.status.c_str(), seconds_since(t0));
+                  label(sc, level).c_str(), *it, st.status.c_str(), seconds_since(t0));
       if (st.status == "ok") {
         references_[sc.name] = st.q;
-        reference_note_[sc.name] = "finest mesh (" + sc.mesh_labels[level] + "), cev n = inf, tolerance " + csv_number(*it);
+        reference_note_[sc.name] = "finest mesh (" + label(sc, level) + "), cev n = inf, tolerance " + csv_number(*it);
+        if (sc.closed_form) reference_note_[sc.name] = sc.closed_form_note + " (" + reference_note_[sc.name] + ")";
         return;
       }
       std::printf("  %s\n", st.reason.c_str());
@@ -532,7 +670,7 @@ class Bench {
     for (double tol : tolerances_) {
       Row row;
       row.scene = sc.name;
-      row.mesh = sc.mesh_labels[task.level];
+      row.mesh = label(sc, task.level);
       row.level = task.level;
       row.strategy = st.name;
       row.family = st.family;
@@ -561,16 +699,18 @@ class Bench {
   void measure_row(const SceneCase& sc, int level, const Strategy& st, double tol, Row& row) {
     const json j = scene_json(sc, level, st, tol);
     std::vector<RunStats> runs;
-    std::vector<double> times;
+    std::vector<double> times, cpu;
     for (int r = 0; r < opt_.runs; ++r) {
       runs.push_back(run_once(sc, j, opt_.run_seconds));
       times.push_back(runs.back().seconds);
+      cpu.push_back(runs.back().cpu_seconds);
       const std::string& status = runs.back().status;
       if (status != "ok" && status != "not reached") break;  // a failure is not timed
     }
     row.runs = static_cast<int>(runs.size());
     row.median_seconds = median(times);
     row.min_seconds = *std::min_element(times.begin(), times.end());
+    row.median_cpu_seconds = median(cpu);
     // The run whose time is nearest the median carries the per-step times of the ratio.
     size_t mid = 0;
     for (size_t r = 0; r < runs.size(); ++r)
@@ -578,13 +718,15 @@ class Bench {
     row.stats = std::move(runs[mid]);
     if (row.stats.status == "ok" || row.stats.status == "not reached") {
       Quantities ref;
+      if (references_.count(sc.name)) ref = references_.at(sc.name);
       if (sc.closed_form) {
         Scene scene = read_scene(j);
         RunResult run;
         run.steps = row.stats.steps;
-        ref = sc.closed_form(scene, run);
-      } else if (references_.count(sc.name)) {
-        ref = references_.at(sc.name);
+        const Quantities exact = sc.closed_form(scene, run);
+        for (auto [mine, theirs] : {std::pair{&ref.force, exact.force}, {&ref.peak, exact.peak},
+                                    {&ref.point, exact.point}, {&ref.extent, exact.extent}})
+          if (std::isfinite(theirs)) *mine = theirs;
       }
       row.error = errors(row.stats.q, ref);
       const auto [contact, floor] = overhead(j, row.stats, std::max(1, std::min(opt_.runs, 5)));
@@ -601,13 +743,34 @@ class Bench {
     out << "scene,file,meshes,quantities,reference\n";
     for (const SceneCase& sc : cases_) {
       std::string meshes;
-      for (int level : levels_) meshes += (meshes.empty() ? "" : " / ") + sc.mesh_labels[level];
-      const std::string ref = sc.closed_form ? sc.closed_form_note
-                              : reference_note_.count(sc.name) ? reference_note_.at(sc.name)
-                                                                : "none: the reference run failed";
+      for (int level : levels_) meshes += (meshes.empty() ? "" : " / ") + label(sc, level);
+      const std::string ref = reference_note_.count(sc.name) ? reference_note_.at(sc.name)
+                              : sc.closed_form ? sc.closed_form_note + " (the finest-mesh run failed)"
+                                               : "none: the reference run failed";
       out << sc.name << ',' << sc.file << ',' << csv_text(meshes) << ',' << csv_text(sc.quantities) << ','
           << csv_text(ref) << '\n';
     }
+  }
+
+  // Where and how the numbers were taken: other work on the machine shows in the load.
+  void write_machine() const {
+    std::ofstream out(opt_.out / "machine.txt");
+    std::string cpu;
+    std::ifstream info("/proc/cpuinfo");
+    for (std::string line; std::getline(info, line);)
+      if (line.rfind("model name", 0) == 0) {
+        cpu = line.substr(line.find(':') + 2);
+        break;
+      }
+    const auto now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
+    char date[64];
+    std::strftime(date, sizeof date, "%Y-%m-%d %H:%M UTC", std::gmtime(&now));
+    if (!opt_.label.empty()) out << "measured: " << opt_.label << "\n";
+    out << "date: " << date << "\ncpu: " << cpu << " (" << std::thread::hardware_concurrency()
+        << " hardware threads)\nworkers: " << opt_.jobs << " (each run on one thread)\nruns per timing: " << opt_.runs
+        << "\nwall-time limit per run: " << opt_.run_seconds << " s\nload average (1, 5, 15 min) at start: "
+        << load_at_start_ << "\nload average at end: " << load_average()
+        << "\nduration: " << static_cast<int>(seconds_since(start_)) << " s\n";
   }
 
   const Row* find(const std::string& scene, int level, const std::string& strategy, double tol) const {
@@ -627,11 +790,11 @@ class Bench {
       const Row* uzawa = find(sc.name, level, "uzawa", tol);
       if (cev && uzawa)
         std::printf("  %s mesh %s: cev auto %ld contact iterations (%s), uzawa %ld (%s)\n", sc.name.c_str(),
-                    sc.mesh_labels[level].c_str(), cev->stats.solves, cev->stats.status.c_str(), uzawa->stats.solves,
+                    label(sc, level).c_str(), cev->stats.solves, cev->stats.status.c_str(), uzawa->stats.solves,
                     uzawa->stats.status.c_str());
       if (const Row* def = find(sc.name, level, "cev-inf", tol))
         std::printf("  %s mesh %s: cev n = inf %.1f ms, overhead ratio %.2f\n", sc.name.c_str(),
-                    sc.mesh_labels[level].c_str(), 1e3 * def->median_seconds, def->overhead_ratio);
+                    label(sc, level).c_str(), 1e3 * def->median_seconds, def->overhead_ratio);
     }
     for (const auto& [scene, level] : std::vector<std::pair<std::string, int>>{{"beam", 1}, {"sheet", 0}})
       if (const Row* def = find(scene, level, "cev-inf", tol))
@@ -643,6 +806,7 @@ class Bench {
 
   Options opt_;
   Clock::time_point start_;
+  std::string load_at_start_;
   std::vector<double> tolerances_;
   std::vector<int> levels_;
   std::vector<SceneCase> cases_;
@@ -680,6 +844,8 @@ int main(int argc, char** argv) {
         opt.run_seconds = 2.0;
       } else if (a == "--out") {
         opt.out = value(i);
+      } else if (a == "--label") {
+        opt.label = value(i);
       } else if (a == "--source") {
         opt.source = value(i);
       } else if (a == "--runs") {
@@ -692,10 +858,13 @@ int main(int argc, char** argv) {
         opt.run_seconds = std::stod(value(i));
       } else if (a == "--scenes") {
         opt.scenes = split(value(i));
+      } else if (a == "--levels") {
+        for (const std::string& l : split(value(i))) opt.levels.push_back(std::clamp(std::stoi(l), 0, 2));
       } else {
         std::fprintf(stderr,
                      "usage: grip_bench [--quick] [--out DIR] [--runs N] [--jobs N] [--budget MINUTES] "
-                     "[--run-seconds S] [--scenes beam,sheet,hertz,cattaneo-mindlin] [--source DIR]\n");
+                     "[--run-seconds S] [--scenes beam,sheet,hertz,cattaneo-mindlin] [--levels 0,1,2] "
+                     "[--source DIR] [--label TEXT]\n");
         return a == "--help" ? 0 : 2;
       }
     }
