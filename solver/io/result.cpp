@@ -84,7 +84,7 @@ json step_json(const Problem& problem, const StepRecord& rec, const OutputOption
     const PairedPoint& pp = rec.state.points[i];
     const double area = body.tributary_area(c.site);
     const double p_n = rec.p[c.eta], p_t = c.xi >= 0 ? rec.p[c.xi] : 0.0;
-    points.push_back({{"node", c.site}, {"obstacle", problem.obstacles[c.obstacle].name},
+    points.push_back({{"node", body.site_node(c.site)}, {"obstacle", problem.obstacles[c.obstacle].name},
                       {"x", pp.point.x.x()}, {"y", pp.point.x.y()},
                       {"pair", {pp.projection.point.x(), pp.projection.point.y()}},
                       {"normal", {pp.projection.normal.x(), pp.projection.normal.y()}},

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "solver/io/scene_reader.hpp"
+#include "solver/io/schema_validation.hpp"
 
 namespace grip {
 namespace {
@@ -333,10 +334,32 @@ std::vector<LoadStep> read_load_path(Reader& r, json& scene, std::vector<Obstacl
 
 }  // namespace
 
+Scene read_checked_scene(const nlohmann::json& input);
+
 SceneErrors::SceneErrors(std::vector<SceneIssue> issues)
     : std::runtime_error(join(issues)), issues_(std::move(issues)) {}
 
 Scene read_scene(const nlohmann::json& input) {
+  // Stage 1: the schema (types, ranges, unknown keys); stage 2: the readers' own checks
+  // (references, meshes, rigid motions). Both run, so every error is reported at once; a
+  // reader error under a value the schema already rejected is left out.
+  std::vector<SceneIssue> schema_issues = validate_against(input, SchemaName::scene);
+  if (schema_issues.empty()) return read_checked_scene(input);
+  try {
+    read_checked_scene(input);
+  } catch (const SceneErrors& e) {
+    for (const SceneIssue& issue : e.issues()) {
+      bool covered = false;
+      for (const SceneIssue& s : schema_issues)
+        covered |= issue.pointer == s.pointer || issue.pointer.rfind(s.pointer + "/", 0) == 0 ||
+                   s.pointer == "/";
+      if (!covered) schema_issues.push_back(issue);
+    }
+  }
+  throw SceneErrors(std::move(schema_issues));
+}
+
+Scene read_checked_scene(const nlohmann::json& input) {
   Reader r;
   Scene scene;
   scene.effective = input;
@@ -369,6 +392,9 @@ Scene read_scene(const nlohmann::json& input) {
       if (!o.contains("name")) o["name"] = "obstacle" + std::to_string(i);
       if (!o["name"].is_string()) r.error(op + "/name", "is not a string");
       else inst.name = o["name"].get<std::string>();
+      for (const auto& other : scene.problem.obstacles)
+        if (!inst.name.empty() && other.name == inst.name)
+          r.error(op + "/name", "\"" + inst.name + "\" names another obstacle already");
       if (json* shape = r.object(o, op, "shape", true)) inst.shape = read_shape(r, *shape, op + "/shape");
       inst.friction = r.number(o, op, "friction", 0.0);
       if (inst.friction < 0) r.error(op + "/friction", show(o["friction"]) + " is negative");

@@ -32,8 +32,9 @@ void read_rigid_plastic_membrane(Reader& r, json& body, Problem& problem) {
       if (list && list->size() < 2) r.error(mp + "/nodes", "needs at least two nodes");
       if (list)
         for (size_t i = 0; i < list->size(); ++i) {
-          json wrap = {{"p", (*list)[i]}};
-          nodes.push_back(r.vec2(wrap, mp + "/nodes", std::to_string(i).c_str()));
+          const std::string key = std::to_string(i);
+          json wrap = {{key, (*list)[i]}};
+          nodes.push_back(r.vec2(wrap, mp + "/nodes", key.c_str()));
         }
       for (size_t i = 1; i < nodes.size(); ++i)
         if ((nodes[i] - nodes[i - 1]).norm() == 0)

@@ -28,6 +28,12 @@ void read_supports(Reader& r, json& body, const std::string& ptr, int nodes,
           continue;
         }
         const std::string name = comp.get<std::string>();
+        bool repeated = false;
+        for (const Constraint& other : problem.constraints) repeated |= other.dof == dof(node, index);
+        if (repeated) {
+          r.error(sp + "/fix/" + std::to_string(c), "\"" + name + "\" of node " + std::to_string(node) + " is fixed already");
+          continue;
+        }
         double value = 0.0;
         if (values && values->contains(name)) value = r.number(*values, sp + "/values", name.c_str());
         problem.constraints.push_back({dof(node, index), value, load_case});
