@@ -166,23 +166,28 @@ std::optional<std::vector<int>> read_target(Reader& r, json& obj, const std::str
   return mesh.sets.at(name.get<std::string>());
 }
 
+// read(entry, pointer) for each entry of the optional array body[key]; entries that are not
+// objects are errors.
+template <class Read>
+void for_each_object(Reader& r, json& body, const std::string& ptr, const char* key, Read read) {
+  json* entries = r.array(body, ptr, key, false);
+  if (!entries) return;
+  for (size_t i = 0; i < entries->size(); ++i) {
+    const std::string p = ptr + "/" + key + "/" + std::to_string(i);
+    if ((*entries)[i].is_object()) read((*entries)[i], p);
+    else r.error(p, "is not an object");
+  }
+}
+
 void read_continuum_supports(Reader& r, json& body, const std::string& ptr, const PlaneMesh& mesh,
                              Problem& problem) {
-  json* sup = r.array(body, ptr, "supports", false);
-  if (!sup) return;
   std::map<int, std::pair<std::string, double>> fixed;  // dof -> (pointer of its support, value)
-  for (size_t i = 0; i < sup->size(); ++i) {
-    const std::string sp = ptr + "/supports/" + std::to_string(i);
-    json& s = (*sup)[i];
-    if (!s.is_object()) {
-      r.error(sp, "is not an object");
-      continue;
-    }
+  for_each_object(r, body, ptr, "supports", [&](json& s, const std::string& sp) {
     const auto nodes = read_target(r, s, sp, mesh);
     const int load_case = r.load_case(s, sp);
     json* fix = r.array(s, sp, "fix", true);
     json* values = r.object(s, sp, "values", false);
-    if (!fix || !nodes) continue;
+    if (!fix || !nodes) return;
     if (fix->empty()) r.error(sp + "/fix", "names no component (\"x\", \"y\")");
     for (size_t c = 0; c < fix->size(); ++c) {
       const json& comp = (*fix)[c];
@@ -214,37 +219,29 @@ void read_continuum_supports(Reader& r, json& body, const std::string& ptr, cons
         for (const auto& comp : *fix) listed |= comp == name;
         if (!listed) r.error(sp + "/values/" + name, "is given but \"" + name + "\" is not in fix");
       }
-  }
+  });
 }
 
 void read_continuum_loads(Reader& r, json& body, const std::string& ptr, const PlaneMesh& mesh, QuadShape shape,
                           Problem& problem, double thickness) {
-  json* loads = r.array(body, ptr, "loads", false);
-  if (!loads) return;
-  for (size_t i = 0; i < loads->size(); ++i) {
-    const std::string lp = ptr + "/loads/" + std::to_string(i);
-    json& l = (*loads)[i];
-    if (!l.is_object()) {
-      r.error(lp, "is not an object");
-      continue;
-    }
+  for_each_object(r, body, ptr, "loads", [&](json& l, const std::string& lp) {
     const auto nodes = read_target(r, l, lp, mesh);
     const int load_case = r.load_case(l, lp);
     const bool force = l.contains("force"), traction = l.contains("traction");
     if (force == traction) {
       r.error(lp, "needs exactly one of \"force\" (on each node) and \"traction\" (per unit area)");
-      continue;
+      return;
     }
     const Vec2 f = r.vec2(l, lp, force ? "force" : "traction");
-    if (!nodes) continue;
+    if (!nodes) return;
     Vector& load = case_load(problem, load_case);
     if (force) {
       for (int node : *nodes) load.segment<2>(2 * node) += f;
-      continue;
+      return;
     }
     if (!l.contains("set")) {
       r.error(lp + "/traction", "acts on the boundary sides of a set: give \"set\", not \"node\"");
-      continue;
+      return;
     }
     try {
       const BoundaryPart part = boundary_part(mesh, shape, *nodes);
@@ -253,7 +250,7 @@ void read_continuum_loads(Reader& r, json& body, const std::string& ptr, const P
     } catch (const std::invalid_argument& e) {
       r.error(lp + "/set", e.what());
     }
-  }
+  });
 }
 
 }  // namespace

@@ -6,13 +6,39 @@
 // displacement (inward, of order (1 - 2 nu) P / E) would otherwise shift every reading.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <numbers>
 #include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "solver/contact/contact_error.hpp"
 #include "solver/solve/load_stepping.hpp"
 #include "tests/support/scenes.hpp"
 
 namespace grip::testing {
+
+// A half-disc scene with elements of `size` within its refinement extent of the pole and
+// `coarse` divisions beyond it on each side and in depth.
+inline nlohmann::json with_pole_elements(nlohmann::json scene, double size, int coarse) {
+  nlohmann::json& disc = scene["body"]["mesh"]["half_disc"];
+  const int fine = static_cast<int>(std::lround(disc["refine"]["extent"].get<double>() / size));
+  disc["refine"]["size"] = size;
+  disc["divisions"] = {2 * (fine + coarse), fine + coarse};
+  return scene;
+}
+
+// Hertz's line contact of the half-disc of an effective scene's body (plane strain) under a
+// load P per unit thickness: half-width a = sqrt(4 P R / (pi E*)), peak p0 = 2 P / (pi a).
+struct HertzContact {
+  double P = 0.0, a = 0.0, p0 = 0.0;
+};
+inline HertzContact hertz_contact(const nlohmann::json& body, double P) {
+  const double E = body["material"]["young"], nu = body["material"]["poisson"];
+  const double R = body["mesh"]["half_disc"]["radius"];
+  const double a = std::sqrt(4 * P * R * (1 - nu * nu) / (std::numbers::pi * E));
+  return {P, a, 2 * P / (std::numbers::pi * a)};
+}
 
 struct ContactNode {
   double x = 0.0;                  // reference abscissa
@@ -148,6 +174,31 @@ inline void expect_every_step_sound_within(const Solved& s, double tau_relative)
     EXPECT_TRUE(step_invariants(s.scene.problem, rec, tol));
     EXPECT_TRUE(monotone_contact_error(rec));
   }
+}
+
+// The scene solved by cev and by uzawa (up to 5000 real solves a step): both converge at every
+// step (uzawa's cone held to 1e-3, as above), and each step's contact forces agree to
+// `relative` of the largest. uzawa stops just below the contact tolerance, which pins a force
+// only to about (nodal contact stiffness) x (tolerance x length).
+struct StrategyRuns {
+  Solved cev, uzawa;
+};
+inline StrategyRuns expect_strategies_agree(const nlohmann::json& scene, double relative) {
+  nlohmann::json u = scene;
+  u["solver"]["contact"]["method"] = "uzawa";
+  u["solver"]["contact"]["max_iterations"] = 5000;
+  StrategyRuns runs{solve_scene(scene), solve_scene(u)};
+  expect_every_step_sound(runs.cev);
+  expect_every_step_sound_within(runs.uzawa, 1e-3);
+  std::printf("real solves: cev %ld (%.3f s), uzawa %ld (%.3f s)\n", runs.cev.run.counters.solves,
+              runs.cev.run.seconds, runs.uzawa.run.counters.solves, runs.uzawa.run.seconds);
+  if (!runs.cev.run.completed || !runs.uzawa.run.completed) return runs;
+  for (size_t k = 0; k < runs.cev.run.steps.size(); ++k) {
+    const Vector& a = runs.cev.run.steps[k].p;
+    const Vector& b = runs.uzawa.run.steps[k].p;
+    EXPECT_LT((a - b).lpNorm<Eigen::Infinity>(), relative * a.lpNorm<Eigen::Infinity>()) << "step " << k + 1;
+  }
+  return runs;
 }
 
 }  // namespace grip::testing

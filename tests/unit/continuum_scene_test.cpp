@@ -138,15 +138,19 @@ TEST(ContinuumScene, UnsupportedBodyIsRejectedWithItsFreeMotion) {
 }
 
 TEST(ContinuumScene, SupportErrors) {
-  json j = block();
-  j["body"]["supports"].push_back(json::parse(R"({"set": "lid", "fix": ["x"]})"));
-  j["body"]["supports"].push_back(json::parse(R"({"node": 14, "fix": ["y", "z"], "values": {"y": 0.2}})"));
-  j["body"]["supports"].push_back(json::parse(R"({"node": 99, "fix": ["x"]})"));
-  const auto issues = issues_of(j);
-  EXPECT_TRUE(has_issue(issues, "/body/supports/1/set", "\"lid\" names no node set"));
-  EXPECT_TRUE(has_issue(issues, "/body/supports/2/fix/0", "prescribes y of node 14, which /body/supports/0 fixes already"));
-  EXPECT_TRUE(has_issue(issues, "/body/supports/2/fix/1", "\"z\" is not one of \"x\", \"y\""));
-  EXPECT_TRUE(has_issue(issues, "/body/supports/3/node", "99 is outside [0, 14]"));
+  // One faulty support per scene: a schema error elsewhere may hide the reader's own checks.
+  auto with_support = [](const char* support) {
+    json j = block();
+    j["body"]["supports"].push_back(json::parse(support));
+    return issues_of(j);
+  };
+  EXPECT_TRUE(has_issue(with_support(R"({"set": "lid", "fix": ["x"]})"), "/body/supports/1/set",
+                        "\"lid\" names no node set"));
+  EXPECT_TRUE(has_issue(with_support(R"({"node": 14, "fix": ["y"], "values": {"y": 0.2}})"), "/body/supports/1/fix/0",
+                        "prescribes y of node 14, which /body/supports/0 fixes already"));
+  EXPECT_TRUE(has_issue(with_support(R"({"node": 14, "fix": ["z"]})"), "/body/supports/1/fix/0",
+                        "\"z\" is not one of \"x\", \"y\""));
+  EXPECT_TRUE(has_issue(with_support(R"({"node": 99, "fix": ["x"]})"), "/body/supports/1/node", "99 is outside [0, 14]"));
   // The same zero support twice (a corner in two sets) is accepted.
   json k = block();
   k["body"]["supports"].push_back(json::parse(R"({"set": "right", "fix": ["x"]})"));
@@ -163,10 +167,10 @@ TEST(ContinuumScene, ElementAndRefinementErrors) {
   k["body"]["mesh"]["rectangle"]["refine"] = {{"towards", {2, 1}}, {"size", 0.1}, {"extent", 0.5}};
   EXPECT_TRUE(has_issue(issues_of(k), "/body/mesh/rectangle/divisions", "cannot hold the refinement"));
   json l = block();
-  l["body"]["loads"] = json::parse(R"([{"node": 3, "traction": [1, 0]}, {"set": "top"}])");
-  const auto issues = issues_of(l);
-  EXPECT_TRUE(has_issue(issues, "/body/loads/0/traction", "give \"set\", not \"node\""));
-  EXPECT_TRUE(has_issue(issues, "/body/loads/1", "needs exactly one of \"force\""));
+  l["body"]["loads"] = json::parse(R"([{"node": 3, "traction": [1, 0]}])");
+  EXPECT_TRUE(has_issue(issues_of(l), "/body/loads/0/traction", "give \"set\", not \"node\""));
+  l["body"]["loads"] = json::parse(R"([{"set": "top"}])");
+  EXPECT_TRUE(has_issue(issues_of(l), "/body/loads/0", "needs exactly one of \"force\""));
 }
 
 }  // namespace

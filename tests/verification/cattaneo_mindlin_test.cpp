@@ -9,7 +9,6 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
-#include <numbers>
 
 #include "tests/support/contact_profile.hpp"
 #include "tests/support/scenes.hpp"
@@ -20,14 +19,8 @@ namespace {
 using nlohmann::json;
 using namespace grip::testing;
 
-json cattaneo(double size) {
-  json j = example_scene("cattaneo-mindlin");
-  json& disc = j["body"]["mesh"]["half_disc"];
-  const int fine = static_cast<int>(std::lround(disc["refine"]["extent"].get<double>() / size));
-  disc["refine"]["size"] = size;
-  disc["divisions"] = {2 * fine + 16, fine + 8};
-  return j;
-}
+// The shipped scene with elements of `size` near the pole (8 divisions beyond, as shipped).
+json cattaneo(double size) { return with_pole_elements(example_scene("cattaneo-mindlin"), size, 8); }
 
 struct CattaneoReading {
   double mu = 0, P = 0, Q = 0, a = 0, p0 = 0, c = 0;  // closed form at the computed loads
@@ -40,15 +33,14 @@ struct CattaneoReading {
 
 CattaneoReading read_cattaneo(const Solved& s, const StepRecord& rec) {
   const json& body = s.scene.effective["body"];
-  const double E = body["material"]["young"], nu = body["material"]["poisson"];
-  const double R = body["mesh"]["half_disc"]["radius"], t = body["thickness"];
   CattaneoReading r;
   r.mu = s.scene.steps[rec.index - 1].friction[0];
-  const Vec2 reaction = reaction_resultant(s.scene.problem, rec) / t;
-  r.P = -reaction.y();
+  const Vec2 reaction = reaction_resultant(s.scene.problem, rec) / body["thickness"].get<double>();
+  const HertzContact hertz = hertz_contact(body, -reaction.y());
+  r.P = hertz.P;
   r.Q = std::abs(reaction.x());
-  r.a = std::sqrt(4 * r.P * R * (1 - nu * nu) / (std::numbers::pi * E));
-  r.p0 = 2 * r.P / (std::numbers::pi * r.a);
+  r.a = hertz.a;
+  r.p0 = hertz.p0;
   r.c = r.mu > 0 && r.Q < r.mu * r.P ? r.a * std::sqrt(1 - r.Q / (r.mu * r.P)) : 0.0;
   const auto nodes = contact_profile(s.scene.problem, rec);
   r.stick = stick_zone(nodes, r.mu);
@@ -146,18 +138,11 @@ TEST(CattaneoMindlin, CevAndUzawaAgree) {
   json j = cattaneo(0.07);
   j["stages"][0]["steps"] = 1;
   j["stages"][1]["steps"] = 1;
-  const Solved cev = solve_scene(j);
-  j["solver"]["contact"]["method"] = "uzawa";
-  j["solver"]["contact"]["max_iterations"] = 5000;
-  const Solved uzawa = solve_scene(j);
-  expect_every_step_sound(cev);
-  expect_every_step_sound_within(uzawa, 1e-3);
+  const StrategyRuns runs = expect_strategies_agree(j, 1e-3);
+  const Solved &cev = runs.cev, &uzawa = runs.uzawa;
   ASSERT_TRUE(cev.run.completed && uzawa.run.completed);
-  std::printf("real solves: cev %ld (%.3f s), uzawa %ld (%.3f s)\n", cev.run.counters.solves, cev.run.seconds,
-              uzawa.run.counters.solves, uzawa.run.seconds);
   for (size_t k = 0; k < cev.run.steps.size(); ++k) {
     const StepRecord &a = cev.run.steps[k], &b = uzawa.run.steps[k];
-    EXPECT_LT((a.p - b.p).lpNorm<Eigen::Infinity>(), 1e-3 * a.p.lpNorm<Eigen::Infinity>()) << "step " << k + 1;
     const auto na = contact_profile(cev.scene.problem, a), nb = contact_profile(uzawa.scene.problem, b);
     for (size_t i = 0; i < na.size(); ++i) EXPECT_EQ(na[i].state, nb[i].state) << "step " << k + 1 << " node " << i;
   }

@@ -7,7 +7,6 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
-#include <numbers>
 
 #include "tests/support/contact_profile.hpp"
 #include "tests/support/scenes.hpp"
@@ -18,15 +17,8 @@ namespace {
 using nlohmann::json;
 using namespace grip::testing;
 
-// The shipped scene with elements of `size` near the pole (the part beyond kept).
-json hertz(double size) {
-  json j = example_scene("hertz");
-  json& disc = j["body"]["mesh"]["half_disc"];
-  const int fine = static_cast<int>(std::lround(disc["refine"]["extent"].get<double>() / size));
-  disc["refine"]["size"] = size;
-  disc["divisions"] = {2 * fine + 24, fine + 12};
-  return j;
-}
+// The shipped scene with elements of `size` near the pole (12 divisions beyond, as shipped).
+json hertz(double size) { return with_pole_elements(example_scene("hertz"), size, 12); }
 
 struct HertzReading {
   double P = 0, a = 0, p0 = 0;  // closed form at the computed load
@@ -42,13 +34,11 @@ struct HertzReading {
 
 HertzReading read_hertz(const Solved& s, const StepRecord& rec) {
   const json& body = s.scene.effective["body"];
-  const double E = body["material"]["young"], nu = body["material"]["poisson"];
-  const double R = body["mesh"]["half_disc"]["radius"], t = body["thickness"];
-  const double Es = E / (1 - nu * nu);
+  const HertzContact closed = hertz_contact(body, -reaction_resultant(s.scene.problem, rec).y() / body["thickness"].get<double>());
   HertzReading h;
-  h.P = -reaction_resultant(s.scene.problem, rec).y() / t;
-  h.a = std::sqrt(4 * h.P * R / (std::numbers::pi * Es));
-  h.p0 = 2 * h.P / (std::numbers::pi * h.a);
+  h.P = closed.P;
+  h.a = closed.a;
+  h.p0 = closed.p0;
   const auto nodes = contact_profile(s.scene.problem, rec);
   h.fit = fit_semi_ellipse(nodes);
   h.zone = contact_zone(nodes);
@@ -116,30 +106,15 @@ TEST(Hertz, ErrorFallsAsTheMeshIsRefined) {
 // The two strategies converge to the same contact forces, within what the contact tolerance
 // pins them to (||v|| <= 1e-8 L x a nodal contact stiffness of about E h).
 TEST(Hertz, CevAndUzawaAgree) {
-  json j = hertz(0.1);
-  const Solved cev = solve_scene(j);
-  j["solver"]["contact"]["method"] = "uzawa";
-  j["solver"]["contact"]["max_iterations"] = 5000;
-  const Solved uzawa = solve_scene(j);
-  expect_every_step_sound(cev);
-  expect_every_step_sound_within(uzawa, 1e-3);
-  ASSERT_TRUE(cev.run.completed && uzawa.run.completed);
-  std::printf("real solves: cev %ld (%.3f s), uzawa %ld (%.3f s)\n", cev.run.counters.solves, cev.run.seconds,
-              uzawa.run.counters.solves, uzawa.run.seconds);
-  EXPECT_LT(cev.run.counters.solves * 10, uzawa.run.counters.solves);
-  for (size_t k = 0; k < cev.run.steps.size(); ++k) {
-    const Vector& a = cev.run.steps[k].p;
-    const Vector& b = uzawa.run.steps[k].p;
-    EXPECT_LT((a - b).lpNorm<Eigen::Infinity>(), 1e-4 * a.lpNorm<Eigen::Infinity>()) << "step " << k + 1;
-  }
+  const StrategyRuns runs = expect_strategies_agree(hertz(0.1), 1e-4);
+  EXPECT_LT(runs.cev.run.counters.solves * 10, runs.uzawa.run.counters.solves);
 }
 
 // Small strain: linear and finite (neo-Hookean, total Lagrangian) kinematics agree.
 TEST(Hertz, LinearAndFiniteAgreeForSmallLoads) {
-  json j = hertz(0.03);
-  json& disc = j["body"]["mesh"]["half_disc"];
-  disc["refine"]["extent"] = 0.4;
-  disc["divisions"] = {2 * 13 + 16, 13 + 8};
+  json j = example_scene("hertz");
+  j["body"]["mesh"]["half_disc"]["refine"]["extent"] = 0.4;
+  j = with_pole_elements(j, 0.03, 8);
   j["body"]["supports"][0]["values"]["y"] = -0.01;  // a = 0.22 mm, contact strains of 0.5 %
   const Solved lin = solve_scene(j);
   j["body"]["kinematics"] = "finite";
