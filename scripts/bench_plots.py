@@ -16,6 +16,7 @@ import csv
 import math
 import os
 import sys
+import textwrap
 
 import matplotlib
 
@@ -172,9 +173,10 @@ def plot_error_vs_time(rows, scenes, scene, out_dir):
     handles, labels = axes[0].get_legend_handles_labels()
     fig.legend(handles, labels, loc="center right", fontsize=6.5, ncol=1, frameon=False)
     reference = scenes.get(scene, {}).get("reference", "")
-    fig.suptitle(f"{SCENE_TITLES.get(scene, scene)}: mesh {mesh}, tolerances 1e-2 to 1e-10 along each line; "
-                 f"reference: {reference}", fontsize=8.5)
-    fig.subplots_adjust(left=0.07, right=0.80, bottom=0.12, top=0.86, wspace=0.22)
+    title = (f"{SCENE_TITLES.get(scene, scene)}: mesh {mesh}, tolerances 1e-2 to 1e-10 along each line. "
+             f"Reference: {reference}")
+    fig.suptitle(textwrap.fill(title, 170), fontsize=8)
+    fig.subplots_adjust(left=0.07, right=0.80, bottom=0.12, top=0.84, wspace=0.22)
     path = os.path.join(out_dir, f"error_vs_time_{scene}.png")
     fig.savefig(path, dpi=90)
     plt.close(fig)
