@@ -370,24 +370,17 @@ PlaneMesh rectangle_mesh(const RectangleSpec& spec, QuadShape shape) {
   return mesh;
 }
 
-PlaneMesh half_disc_mesh(const HalfDiscSpec& spec, QuadShape shape) {
+// The half-disc map with columns that fan out toward the diameter by `fan` (0: each column
+// meets the diameter at its own parameter along the arc; 1: the diameter divided evenly).
+PlaneMesh half_disc_grid(const HalfDiscSpec& spec, QuadShape shape, const std::vector<double>& sigma,
+                         const std::vector<double>& depth, double fan) {
   using std::numbers::pi;
-  if (spec.ns < 2 || spec.ns % 2) throw std::invalid_argument("ns must be even (a node sits at the pole)");
   const double R = spec.radius;
-  // sigma: along the middle quarter of the arc (graded toward the pole); u: along the diameter
-  // (uniform); depth: from the arc toward the diameter (graded toward the arc).
-  const double quarter = pi * R / 4;
-  std::vector<double> sigma = graded_divisions(-quarter, quarter, spec.ns, 0.0, spec.refine);
-  for (double& v : sigma) v = (v + quarter) / (2 * quarter);
-  std::vector<double> depth = graded_divisions(0, R, spec.nt, 0.0, spec.refine);
-  for (double& v : depth) v /= R;
   std::vector<double> u(spec.ns + 1), even(spec.nt + 1);
-  for (int i = 0; i <= spec.ns; ++i) u[i] = static_cast<double>(i) / spec.ns;
+  for (int i = 0; i <= spec.ns; ++i) u[i] = (1 - fan) * sigma[i] + fan * i / spec.ns;
   for (int j = 0; j <= spec.nt; ++j) even[j] = static_cast<double>(j) / spec.nt;
-  sigma = refine_for(shape, sigma);
-  u = refine_for(shape, u);
-  depth = refine_for(shape, depth);
-  even = refine_for(shape, even);
+  const std::vector<double> s_ = refine_for(shape, sigma), u_ = refine_for(shape, u);
+  const std::vector<double> d_ = refine_for(shape, depth), e_ = refine_for(shape, even);
   const Vec2 c = spec.centre;
   auto on_circle = [&](double angle) { return Vec2(c + R * Vec2(std::cos(angle), std::sin(angle))); };
   auto bottom = [&](double s) { return on_circle(1.25 * pi + 0.5 * pi * s); };  // 225 -> 315 degrees
@@ -395,17 +388,38 @@ PlaneMesh half_disc_mesh(const HalfDiscSpec& spec, QuadShape shape) {
   auto left = [&](double t) { return on_circle(1.25 * pi - 0.25 * pi * t); };   // 225 -> 180
   auto right = [&](double t) { return on_circle(1.75 * pi + 0.25 * pi * t); };  // 315 -> 360
   const Vec2 b0 = bottom(0), b1 = bottom(1), t0 = top(0), t1 = top(1);
-  auto at = [&](int I, int J) {
-    const double s = sigma[I], w = std::pow(std::sin(pi * s), 2);
+  return grid_mesh(spec.ns, spec.nt, shape, [&](int I, int J) {  // facing down
+    const double s = s_[I], w = std::pow(std::sin(pi * s), 2);
     // Rows crowd toward the arc near the pole only; at the ends they are evenly spaced.
-    const double t = w * depth[J] + (1 - w) * even[J];
-    const double v = (1 - t) * s + t * u[I];  // blends the two parametrizations of the ends
-    Vec2 p = (1 - t) * bottom(s) + t * top(u[I]) + (1 - v) * left(t) + v * right(t) -
+    const double t = w * d_[J] + (1 - w) * e_[J];
+    const double v = (1 - t) * s + t * u_[I];  // blends the parametrizations of bottom and top
+    Vec2 p = (1 - t) * bottom(s) + t * top(u_[I]) + (1 - v) * left(t) + v * right(t) -
              ((1 - v) * (1 - t) * b0 + v * (1 - t) * b1 + (1 - v) * t * t0 + v * t * t1);
-    if (spec.facing_up) p.y() = 2 * c.y() - p.y();
     return p;
-  };
-  PlaneMesh mesh = grid_mesh(spec.ns, spec.nt, shape, at);
+  });
+}
+
+PlaneMesh half_disc_mesh(const HalfDiscSpec& spec, QuadShape shape) {
+  using std::numbers::pi;
+  if (spec.ns < 2 || spec.ns % 2) throw std::invalid_argument("ns must be even (a node sits at the pole)");
+  const double R = spec.radius;
+  // sigma: along the middle quarter of the arc (graded toward the pole); depth: from the arc
+  // toward the diameter (graded toward the arc).
+  const double quarter = pi * R / 4;
+  std::vector<double> sigma = graded_divisions(-quarter, quarter, spec.ns, 0.0, spec.refine);
+  for (double& v : sigma) v = (v + quarter) / (2 * quarter);
+  std::vector<double> depth = graded_divisions(0, R, spec.nt, 0.0, spec.refine);
+  for (double& v : depth) v /= R;
+  // The columns fan out toward an evenly divided diameter as far as the elements stay valid
+  // (a strongly graded arc and an even diameter would cross columns near the ends).
+  PlaneMesh mesh;
+  for (const double fan : {1.0, 0.75, 0.5, 0.25, 0.0}) {
+    mesh = half_disc_grid(spec, shape, sigma, depth, fan);
+    if (fan == 0.0 || check_mesh(mesh, shape).empty()) break;
+  }
+  sigma = refine_for(shape, sigma);
+  depth = refine_for(shape, depth);
+  const Vec2 c = spec.centre;
   const int NI = static_cast<int>(sigma.size()), NJ = static_cast<int>(depth.size());
   std::vector<int> arc = grid_line(NI, 0, NJ - 1, 0, -1, NJ);
   for (int id : grid_line(NI, 1, 0, 1, 0, NI - 1)) arc.push_back(id);
@@ -414,7 +428,8 @@ PlaneMesh half_disc_mesh(const HalfDiscSpec& spec, QuadShape shape) {
   mesh.sets["pole"] = {(NI - 1) / 2};
   mesh.sets["centre"] = {(NJ - 1) * NI + (NI - 1) / 2};
   if (spec.facing_up) {
-    // Mirroring turned the elements clockwise: reverse them (and the arc's direction).
+    // Mirror; that turns the elements clockwise: reverse them (and the arc's direction).
+    for (Vec2& x : mesh.nodes) x.y() = 2 * c.y() - x.y();
     for (auto& el : mesh.elements) {
       std::swap(el[1], el[3]);
       if (shape == QuadShape::q9) {

@@ -82,6 +82,30 @@ TEST(RectangleMesh, AreaSetsAndOrientation) {
   }
 }
 
+// Strong refinements with few divisions beyond them stay valid (the columns fan out toward
+// the diameter only as far as they can).
+TEST(HalfDiscMesh, EveryElementIsValidOverARangeOfRefinements) {
+  int checked = 0;
+  for (const double size : {0.1, 0.02})
+    for (const double extent : {0.3, 0.66, 2.0})
+      for (const int coarse : {2, 8, 24})
+        for (const bool up : {false, true}) {
+          const int fine = static_cast<int>(std::lround(extent / size));
+          HalfDiscSpec spec;
+          spec.radius = 10;
+          spec.ns = 2 * (fine + coarse);
+          spec.nt = fine + coarse;
+          spec.facing_up = up;
+          spec.refine = Refinement{size, extent};
+          const PlaneMesh mesh = half_disc_mesh(spec, QuadShape::q4);
+          const auto issues = check_mesh(mesh, QuadShape::q4);
+          EXPECT_TRUE(issues.empty()) << "size " << size << " extent " << extent << " coarse " << coarse << ": "
+                                      << (issues.empty() ? "" : issues[0].detail);
+          ++checked;
+        }
+  EXPECT_EQ(checked, 36);
+}
+
 TEST(HalfDiscMesh, AreaArcAndRefinement) {
   const double R = 2.0;
   for (QuadShape shape : {QuadShape::q4, QuadShape::q9})
