@@ -2,8 +2,12 @@
 
 #include <spdlog/spdlog.h>
 
+#include <sys/socket.h>
+
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -144,6 +148,7 @@ struct HttpServer::Impl {
   httplib::Server svr;
   std::atomic<bool> stopping{false};
   std::atomic<std::int64_t> requests{0};
+  int listen_fd = -1;  // the listening socket, seen by the socket-options hook
 
   // Registers a handler for every path pattern given.
   template <class F>
@@ -179,6 +184,15 @@ void HttpServer::Impl::hooks() {
   svr.set_payload_max_length(options.max_body_bytes);
   svr.set_keep_alive_timeout(2);
   svr.set_tcp_nodelay(true);  // events are small writes: no Nagle delay
+  // Instead of the default options: SO_REUSEADDR only (the default's SO_REUSEPORT would let a
+  // second server bind the same port unnoticed), and the socket kept so that bind() can
+  // deepen the listen backlog, which httplib 0.11.4 fixes at 5: a burst of connections beyond
+  // it loses connections.
+  svr.set_socket_options([this](socket_t sock) {
+    int yes = 1;
+    ::setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+    if (listen_fd < 0) listen_fd = sock;
+  });
   svr.set_read_timeout(10);
   svr.set_write_timeout(10);
 
@@ -712,6 +726,9 @@ int HttpServer::bind() {
       throw std::runtime_error("cannot bind " + o.host + ":" + std::to_string(o.port));
     port_ = o.port;
   }
+  // Listening already: listen() again only changes the backlog.
+  if (impl_->listen_fd >= 0 && ::listen(impl_->listen_fd, SOMAXCONN) != 0)
+    spdlog::warn("cannot raise the listen backlog: {}", std::strerror(errno));
   return port_;
 }
 

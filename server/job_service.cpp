@@ -70,19 +70,22 @@ void JobService::start() {
   started_ = true;
 }
 
+std::optional<SubmitResult> JobService::replay(const std::optional<std::string>& key,
+                                              const std::string& scene) {
+  if (!key) return std::nullopt;
+  auto existing = store_.job_by_idempotency_key(*key);
+  if (!existing) return std::nullopt;
+  if (existing->scene != scene)
+    throw IdempotencyConflict("Idempotency-Key '" + *key + "' was used before with a different scene");
+  existing->scene.clear();
+  return SubmitResult{JobView{*existing, std::nullopt}, true};
+}
+
 SubmitResult JobService::submit(const json& scene_json,
                                 const std::optional<std::string>& idempotency_key) {
   if (draining_) throw ShuttingDown();
   const std::string canonical = scene_json.dump();
-  if (idempotency_key) {
-    if (auto existing = store_.job_by_idempotency_key(*idempotency_key)) {
-      if (existing->scene != canonical)
-        throw IdempotencyConflict("Idempotency-Key '" + *idempotency_key +
-                                  "' was used before with a different scene");
-      existing->scene.clear();
-      return {JobView{*existing, std::nullopt}, true};
-    }
-  }
+  if (auto earlier = replay(idempotency_key, canonical)) return *earlier;
   const Scene scene = read_scene(scene_json);  // throws SceneErrors
   const int nodes = scene.problem.body->site_count();
   const int steps = static_cast<int>(scene.steps.size());
@@ -122,14 +125,7 @@ SubmitResult JobService::submit(const json& scene_json,
       --reserved_;
     }
     // A concurrent submission with the same key won the race: answer as a replay.
-    if (idempotency_key)
-      if (auto existing = store_.job_by_idempotency_key(*idempotency_key)) {
-        if (existing->scene != canonical)
-          throw IdempotencyConflict("Idempotency-Key '" + *idempotency_key +
-                                    "' was used before with a different scene");
-        existing->scene.clear();
-        return {JobView{*existing, std::nullopt}, true};
-      }
+    if (auto earlier = replay(idempotency_key, canonical)) return *earlier;
     throw;
   }
   {

@@ -155,6 +155,8 @@ class JobService {
 
  private:
   struct ActiveJob;
+  // The earlier submission with this idempotency key, if any (same scene, else it throws).
+  std::optional<SubmitResult> replay(const std::optional<std::string>& key, const std::string& scene);
   void worker_loop();
   void writer_loop();
   void run_job(const std::shared_ptr<ActiveJob>& job);

@@ -163,7 +163,8 @@ class Api {
   std::string submit(const json& scene) const {
     auto r = post_json("/v1/jobs", scene.dump());
     if (!r || r->status != 201)
-      throw std::runtime_error("submit failed: " + (r ? std::to_string(r->status) + " " + r->body : std::string("no response")));
+      throw std::runtime_error("submit failed: " + (r ? std::to_string(r->status) + " " + r->body
+                                                      : "no response: " + httplib::to_string(r.error())));
     return json::parse(r->body).at("jobID");
   }
   json job(const std::string& id) const {
@@ -189,6 +190,18 @@ class Api {
   int port_;
   std::optional<std::string> token_;
 };
+
+// Polls /v1/metrics until the server counts `n` open event streams (a stream the client
+// dropped counts until the server's next write to it fails).
+inline bool wait_open_streams(const Api& api, int n) {
+  const std::string line = "grip_open_streams " + std::to_string(n) + "\n";
+  for (int tries = 0; tries < 3000; ++tries) {
+    auto r = api.get("/v1/metrics");
+    if (r && r->body.find(line) != std::string::npos) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  return false;
+}
 
 struct SseEvent {
   std::int64_t id = 0;

@@ -78,12 +78,10 @@ TEST(Restart, SigtermLetsRunningJobsFinishWithinGraceAndRequeuesTheRest) {
     long_job = api.submit(beam_scene(40, 400));
     queued = api.submit(beam_scene(10, 3));
     ASSERT_EQ(follow(api, long_job, std::nullopt, 5).events.size(), 5u);
+    ASSERT_TRUE(wait_open_streams(api, 0));  // the stream above is gone
     Stream open_stream;
     std::thread follower([&] { open_stream = follow(api, long_job); });
-    for (int tries = 0; tries < 2000; ++tries) {
-      if (api.get("/v1/metrics")->body.find("grip_open_streams 1\n") != std::string::npos) break;
-      std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    }
+    EXPECT_TRUE(wait_open_streams(api, 1));
     EXPECT_EQ(server.terminate(std::chrono::seconds(30)), 0);
     follower.join();  // SIGTERM closed the stream
     EXPECT_EQ(open_stream.status, 200);

@@ -77,10 +77,10 @@ struct Server {
 TEST(Service, PaperExamplesStreamEveryIterationAndGiveResultsInAllFormats) {
   Server server;
   const Api api = server.api();
+  // The paper's two examples (4.2 and 4.1), each as soon as its file exists.
   std::vector<fs::path> examples;
-  for (const auto& e : fs::directory_iterator(examples_dir()))
-    if (e.path().extension() == ".json") examples.push_back(e.path());
-  std::sort(examples.begin(), examples.end());
+  for (const char* name : {"beam-on-cylinder.json", "sheet-stretching.json"})
+    if (fs::exists(examples_dir() / name)) examples.push_back(examples_dir() / name);
   ASSERT_FALSE(examples.empty());
   for (const fs::path& example : examples) {
     SCOPED_TRACE(example.filename().string());
@@ -221,11 +221,18 @@ TEST(Service, TwentyConcurrentSubmissionsAndStreamsWhileHealthAnswers) {
   std::vector<Stream> streams(kJobs);
   std::vector<std::string> ids(kJobs);
   std::atomic<int> done{0};
+  std::mutex failures_mutex;
+  std::vector<std::string> failures;
   std::vector<std::thread> clients;
   for (int i = 0; i < kJobs; ++i)
     clients.emplace_back([&, i] {
-      ids[i] = api.submit(beam_scene(10 + i, 4 + i % 4));
-      streams[i] = follow(api, ids[i]);
+      try {
+        ids[i] = api.submit(beam_scene(10 + i, 4 + i % 4));
+        streams[i] = follow(api, ids[i]);
+      } catch (const std::exception& e) {
+        std::lock_guard lock(failures_mutex);
+        failures.push_back(e.what());
+      }
       ++done;
     });
   int health_checks = 0, healthy = 0;
@@ -239,6 +246,7 @@ TEST(Service, TwentyConcurrentSubmissionsAndStreamsWhileHealthAnswers) {
     std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
   for (auto& t : clients) t.join();
+  ASSERT_TRUE(failures.empty()) << failures.front() << "\n" << server.process->log();
   EXPECT_EQ(healthy, health_checks);
   std::printf("[ info ] %d health checks during 20 jobs + 20 streams, slowest %.1f ms\n", health_checks, slowest_ms);
   for (int i = 0; i < kJobs; ++i) {
@@ -300,19 +308,11 @@ TEST(Service, DismissStopsARunningJobAndFreesItsWorker) {
   expect_problem(r, 404, "result-not-ready");
 
   // Stream cap: two open streams, a third is refused (after the first stream is closed).
-  auto wait_open_streams = [&](int n) {
-    const std::string line = "grip_open_streams " + std::to_string(n) + "\n";
-    for (int tries = 0; tries < 2000; ++tries) {
-      if (api.get("/v1/metrics")->body.find(line) != std::string::npos) return;
-      std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    }
-    FAIL() << "open streams never became " << n;
-  };
-  wait_open_streams(0);
+  ASSERT_TRUE(wait_open_streams(api, 0));
   std::vector<std::thread> holders;
   std::vector<Stream> held(2);
   for (int i = 0; i < 2; ++i) holders.emplace_back([&, i] { held[i] = follow(api, running, seen.events.back().id); });
-  wait_open_streams(2);
+  ASSERT_TRUE(wait_open_streams(api, 2));
   r = api.get("/v1/jobs/" + running + "/events");
   expect_problem(r, 503, "too-many-streams");
   EXPECT_FALSE(r->get_header_value("Retry-After").empty());
