@@ -1,7 +1,8 @@
 #pragma once
 // A plane continuum body: isoparametric quadrilaterals (quad_element.hpp) in plane strain or
 // plane stress, with an elastic law (plane_material.hpp).
-//   linear: small strain, sigma = D eps; K is constant, assembled once and reused.
+//   linear: small strain, sigma = D eps; K is constant, assembled once and reused (traits()
+//   says so, and the equilibrium oracle then factorizes it once).
 //   finite: total Lagrangian, S(E) of the law, exact tangent.
 // Elements: q4 (2 x 2 Gauss), q4_bbar (q4 with the mean dilatation of B-bar: for nu -> 1/2
 // in plane strain, linear kinematics), q9 (3 x 3 Gauss).
@@ -67,8 +68,6 @@ class ContinuumBody final : public Body {
   const ContinuumOptions& options() const { return options_; }
   // The contact sides (boundary sides spanned by the contact set).
   const BoundaryPart& contact_surface() const { return contact_; }
-  // linear kinematics: K does not depend on q, so one factorization serves a whole step.
-  bool tangent_is_constant() const { return options_.kinematics == ContinuumKinematics::linear; }
   // Cauchy stress (sxx, syy, sxy, szz) at the centroid of element e.
   Eigen::Vector4d centroid_stress(const Vector& q, int e) const;
 
