@@ -7,6 +7,7 @@ packages=(
   libcpp-httplib-dev libvalijson-dev libsqlite3-dev
   python3 python3-matplotlib
   curl
+  clang libclang-rt-14-dev  # libFuzzer build of scripts/check-extended.sh
 )
 missing=()
 for p in "${packages[@]}"; do

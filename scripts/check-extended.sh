@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# Extended checks, slower than scripts/test.sh and each in a build directory of its own:
+#   1. build-asan: everything built with AddressSanitizer + UndefinedBehaviorSanitizer
+#      (GRIP_SANITIZE=ON, gcc); the unit and integration tests run under it (the integration
+#      tests start the sanitized `grip`).
+#   2. build-fuzz: clang + libFuzzer (GRIP_FUZZ=ON); the `fuzz` label fuzzes the scene reader
+#      for GRIP_FUZZ_SECONDS (default 60) and replays tests/fuzz/regressions.
+#   3. the `hard_slow` label (slow hard-case tests), in build-asan.
+# Usage: bash scripts/check-extended.sh [GRIP_FUZZ_SECONDS]. Exit status non-zero on any failure.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/setup.sh
+jobs=$(( $(nproc) < 2 ? $(nproc) : 2 ))
+fuzz_seconds=${1:-60}
+export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
+
+echo "== ASan + UBSan: unit and integration tests (build-asan)"
+cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DGRIP_SANITIZE=ON
+cmake --build build-asan -j "$jobs" --target grip grip_unit_tests grip_integration_tests
+ctest --test-dir build-asan -L 'unit|integration' --output-on-failure -j "$jobs" --timeout 900
+
+echo "== libFuzzer: scene reader (build-fuzz, ${fuzz_seconds} s)"
+cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DGRIP_FUZZ=ON \
+  -DCMAKE_CXX_COMPILER=clang++ -DGRIP_FUZZ_SECONDS="$fuzz_seconds"
+cmake --build build-fuzz -j "$jobs" --target grip_fuzz_scene
+ctest --test-dir build-fuzz -L fuzz --output-on-failure
+
+# ---- hard_slow: slow hard-case tests (label added separately), under the sanitizers too.
+# Builds the remaining targets of build-asan; a label that matches no test runs nothing.
+echo "== hard_slow tests (build-asan)"
+cmake --build build-asan -j "$jobs"
+ctest --test-dir build-asan -L hard_slow --output-on-failure --timeout 3600
