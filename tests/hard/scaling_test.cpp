@@ -1,0 +1,98 @@
+// Issue 9, units: the beam bent round the cylinder with Young's modulus and the load scaled
+// together by 1e6 up and down, and with every length in a unit a thousand times larger and a
+// thousand times smaller (E rescaled to match). A consistent change of units changes no
+// decision of the solver: displacements and forces scale exactly (to rounding, 1e-9
+// relative), and every step takes the same real solves and Newton iterations.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+
+#include "tests/hard/hard_scenes.hpp"
+#include "tests/support/result_checks.hpp"
+
+namespace grip {
+namespace {
+
+using namespace grip::testing;
+using nlohmann::json;
+
+json scaled_forces(double f) {  // E and the load times f: the same strains
+  json j = beam_on_cylinder(0.2);
+  j["body"]["material"]["young"] = j["body"]["material"]["young"].get<double>() * f;
+  j["body"]["loads"][0]["force"][1] = j["body"]["loads"][0]["force"][1].get<double>() * f;
+  return j;
+}
+
+json scaled_lengths(double l) {  // every length times l, E (force / length^2) over l^2, forces kept
+  json j = beam_on_cylinder(0.2);
+  json& b = j["body"];
+  b["material"]["young"] = b["material"]["young"].get<double>() / (l * l);
+  for (const char* k : {"width", "depth"}) b["section"][k] = b["section"][k].get<double>() * l;
+  b["mesh"]["length"] = b["mesh"]["length"].get<double>() * l;
+  json& c = j["obstacles"][0]["shape"];
+  c["radius"] = c["radius"].get<double>() * l;
+  for (int a = 0; a < 2; ++a) c["centre"][a] = c["centre"][a].get<double>() * l;
+  return j;
+}
+
+// Relative difference of a and b / scale, against b's size.
+double relative(const Vector& a, const Vector& b, double scale) {
+  return (a / scale - b).lpNorm<Eigen::Infinity>() / b.lpNorm<Eigen::Infinity>();
+}
+
+// The scaled run is sound and takes exactly the reference's work, step by step.
+void expect_same_work(const Solved& ref, const Solved& s, const std::string& what) {
+  print_work(what, s);
+  expect_hard_case_sound(s);
+  ASSERT_TRUE(s.run.completed) << what << ": " << s.run.reason;
+  ASSERT_EQ(s.run.steps.size(), ref.run.steps.size()) << what;
+  for (size_t k = 0; k < ref.run.steps.size(); ++k) {
+    const StepRecord &a = s.run.steps[k], &b = ref.run.steps[k];
+    EXPECT_EQ(a.solves, b.solves) << what << ", step " << k + 1;
+    EXPECT_EQ(a.newton_iterations, b.newton_iterations) << what << ", step " << k + 1;
+    EXPECT_EQ(a.passes, b.passes) << what << ", step " << k + 1;
+  }
+}
+
+TEST(Scaling, YoungsModulusAndLoadsTogether) {
+  const Solved ref = solve_scene(beam_on_cylinder(0.2));
+  print_work("reference", ref);
+  ASSERT_TRUE(ref.run.completed) << ref.run.reason;
+  for (const double f : {1e6, 1e-6}) {
+    const Solved s = solve_scene(scaled_forces(f));
+    expect_same_work(ref, s, "E and loads x " + std::to_string(f));
+    double worst = 0.0;
+    for (size_t k = 0; k < ref.run.steps.size(); ++k)
+      worst = std::max(worst, relative(s.run.steps[k].state.q, ref.run.steps[k].state.q, 1.0));
+    EXPECT_LT(worst, 1e-9) << "E and loads x " << f;
+    double worst_p = 0.0;
+    for (size_t k = 0; k < ref.run.steps.size(); ++k)
+      worst_p = std::max(worst_p, relative(s.run.steps[k].p, ref.run.steps[k].p, f));
+    std::printf("E and loads x %g: displacements differ by %.3g, forces by %.3g\n", f, worst, worst_p);
+    EXPECT_LT(worst_p, 1e-9) << "E and loads x " << f;
+  }
+}
+
+TEST(Scaling, LengthsInAnotherUnit) {
+  const Solved ref = solve_scene(beam_on_cylinder(0.2));
+  ASSERT_TRUE(ref.run.completed) << ref.run.reason;
+  for (const double l : {1e-3, 1e3}) {
+    const Solved s = solve_scene(scaled_lengths(l));
+    expect_same_work(ref, s, "lengths x " + std::to_string(l));
+    // u and w scale with l, theta does not; forces are unchanged.
+    double worst = 0.0, worst_p = 0.0;
+    for (size_t k = 0; k < ref.run.steps.size(); ++k) {
+      const Vector &a = s.run.steps[k].state.q, &b = ref.run.steps[k].state.q;
+      Vector unscaled = a;
+      for (Eigen::Index d = 0; d < a.size(); ++d) unscaled[d] = d % 3 == 2 ? a[d] : a[d] / l;
+      worst = std::max(worst, relative(unscaled, b, 1.0));
+      worst_p = std::max(worst_p, relative(s.run.steps[k].p, ref.run.steps[k].p, 1.0));
+    }
+    std::printf("lengths x %g: displacements differ by %.3g, forces by %.3g\n", l, worst, worst_p);
+    EXPECT_LT(worst, 1e-9) << "lengths x " << l;
+    EXPECT_LT(worst_p, 1e-9) << "lengths x " << l;
+  }
+}
+
+}  // namespace
+}  // namespace grip
