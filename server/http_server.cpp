@@ -10,6 +10,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include "server/tar.hpp"
@@ -51,7 +52,8 @@ void problem(Response& res, const Request& req, int status, const std::string& s
   const json body = {{"type", "urn:grip:problem:" + slug}, {"title", title},   {"status", status},
                      {"detail", detail},                   {"instance", req.path}, {"errors", errors}};
   res.status = status;
-  res.set_content(body.dump(), kProblemJson);
+  // A parse error's message quotes the bytes it stopped at, which may not be UTF-8.
+  res.set_content(body.dump(-1, ' ', false, json::error_handler_t::replace), kProblemJson);
 }
 
 void send_json(Response& res, int status, const json& body) {
@@ -93,8 +95,34 @@ std::string encode_cursor(std::int64_t before) {
 std::optional<std::int64_t> decode_cursor(const std::string& c) {
   if (c.size() < 3 || c.size() > 18 || c.compare(0, 2, "c1") != 0) return std::nullopt;
   if (!std::all_of(c.begin() + 2, c.end(), ::isxdigit)) return std::nullopt;
-  return static_cast<std::int64_t>(std::stoull(c.substr(2), nullptr, 16));
+  const unsigned long long v = std::stoull(c.substr(2), nullptr, 16);
+  if (v > static_cast<unsigned long long>(std::numeric_limits<std::int64_t>::max())) return std::nullopt;
+  return static_cast<std::int64_t>(v);
 }
+
+// Whether a JSON text nests arrays and objects deeper than `limit` (strings skipped). The
+// parser takes any depth, but copying, dumping and validating a value recurse once per
+// level: 100000 nested arrays overflowed an HTTP thread's stack.
+bool nested_deeper_than(const std::string& text, int limit) {
+  int depth = 0;
+  bool in_string = false, escaped = false;
+  for (const char c : text) {
+    if (in_string) {
+      if (escaped) escaped = false;
+      else if (c == '\\') escaped = true;
+      else if (c == '"') in_string = false;
+    } else if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth > limit) return true;
+    } else if ((c == ']' || c == '}') && depth > 0) {
+      --depth;
+    }
+  }
+  return false;
+}
+
+constexpr int kMaxJsonDepth = 64;  // a scene needs about 8
 
 std::string job_path(const std::string& id) { return "/v1/jobs/" + id; }
 
@@ -160,7 +188,7 @@ struct HttpServer::Impl {
   void hooks();
 
   // ---- handlers
-  void submit(const Request& req, Response& res, bool ogc);
+  void submit(const Request& req, Response& res, const httplib::ContentReader& reader, bool ogc);
   void list_jobs(const Request& req, Response& res);
   void get_job(const Request& req, Response& res);
   void dismiss(const Request& req, Response& res);
@@ -299,13 +327,15 @@ void HttpServer::Impl::routes() {
   });
   get({"/processes/contact2d", "/v1/processes/contact2d"},
       [this](const Request& req, Response& res) { process_description(req, res); });
-  svr.Post("/processes/contact2d/execution",
-           [this](const Request& req, Response& res) { submit(req, res, true); });
-  svr.Post("/v1/processes/contact2d/execution",
-           [this](const Request& req, Response& res) { submit(req, res, true); });
+  for (const char* p : {"/processes/contact2d/execution", "/v1/processes/contact2d/execution"})
+    svr.Post(p, [this](const Request& req, Response& res, const httplib::ContentReader& reader) {
+      submit(req, res, reader, true);
+    });
 
   // ---- jobs
-  svr.Post("/v1/jobs", [this](const Request& req, Response& res) { submit(req, res, false); });
+  svr.Post("/v1/jobs", [this](const Request& req, Response& res, const httplib::ContentReader& reader) {
+    submit(req, res, reader, false);
+  });
   get({"/v1/jobs", "/jobs"}, [this](const Request& req, Response& res) { list_jobs(req, res); });
   get({R"(/v1/jobs/([^/]+))", R"(/jobs/([^/]+))"},
       [this](const Request& req, Response& res) { get_job(req, res); });
@@ -334,7 +364,27 @@ void HttpServer::Impl::routes() {
   });
 }
 
-void HttpServer::Impl::submit(const Request& req, Response& res, bool ogc) {
+void HttpServer::Impl::submit(const Request& req, Response& res, const httplib::ContentReader& reader,
+                              bool ogc) {
+  // The body is read here: httplib 0.11.4 holds a body to the payload limit only when it has
+  // a Content-Length (a chunked one of 100 MB was buffered whole). Past the limit the rest is
+  // read and dropped, as httplib does with a long Content-Length, so the client gets its 413.
+  std::string text;
+  bool too_large = false;
+  const bool complete = reader([&](const char* data, size_t n) {
+    if (!too_large && text.size() + n > options.max_body_bytes) {
+      too_large = true;
+      std::string().swap(text);
+    }
+    if (!too_large) text.append(data, n);
+    return true;
+  });
+  if (too_large || res.status == 413)
+    return problem(res, req, 413, "payload-too-large", "Payload too large",
+                   "the request body is over this server's limit of " +
+                       std::to_string(options.max_body_bytes) + " bytes");
+  if (!complete)
+    return problem(res, req, 400, "unreadable-body", "Unreadable body", "the request body could not be read");
   const std::string type = lower(req.get_header_value("Content-Type"));
   const std::string media = type.substr(0, type.find(';'));
   auto trimmed = media;
@@ -346,13 +396,20 @@ void HttpServer::Impl::submit(const Request& req, Response& res, bool ogc) {
                    "a scene is submitted as application/json, not '" +
                        (media.empty() ? std::string("(none)") : media) + "'");
   }
+  if (nested_deeper_than(text, kMaxJsonDepth))
+    return problem(res, req, 400, "malformed-json", "Malformed JSON",
+                   "arrays and objects are nested deeper than " + std::to_string(kMaxJsonDepth) +
+                       " levels");
   json body;
   try {
-    body = json::parse(req.body);
+    body = json::parse(text);
   } catch (const json::parse_error& e) {
     return problem(res, req, 400, "malformed-json", "Malformed JSON",
                    "the body is not JSON: " + std::string(e.what()),
                    error_list("parse error at byte " + std::to_string(e.byte) + ": " + e.what()));
+  } catch (const json::exception& e) {  // a number out of range (1e400): out_of_range.406
+    return problem(res, req, 400, "malformed-json", "Malformed JSON",
+                   "the body is not JSON that this server can read: " + std::string(e.what()));
   }
   // OGC execute request: {"inputs": {"scene": {...}}} (or the scene's fields as inputs).
   std::string prefix;
@@ -380,12 +437,18 @@ void HttpServer::Impl::submit(const Request& req, Response& res, bool ogc) {
     if (r.replayed) res.set_header("Idempotent-Replayed", "true");
     send_json(res, 201, job_document(r.job));
   } catch (const SceneErrors& e) {
+    // Listed up to a bound: 8 MB of equal nodes made a million errors, a 99 MB answer and a
+    // peak of 1.9 GB.
+    constexpr size_t kMaxListed = 100;
+    const auto& issues = e.issues();
     json errors = json::array();
-    for (const auto& issue : e.issues())
-      errors.push_back({{"pointer", prefix + (issue.pointer == "/" ? "" : issue.pointer)},
-                        {"detail", issue.detail}});
+    for (size_t i = 0; i < std::min(issues.size(), kMaxListed); ++i)
+      errors.push_back({{"pointer", prefix + (issues[i].pointer == "/" ? "" : issues[i].pointer)},
+                        {"detail", issues[i].detail}});
     problem(res, req, 422, "invalid-scene", "Invalid scene",
-            std::to_string(e.issues().size()) + " problem(s) in the scene", errors);
+            std::to_string(issues.size()) + " problem(s) in the scene" +
+                (issues.size() > kMaxListed ? "; the first " + std::to_string(kMaxListed) + " are listed" : ""),
+            std::move(errors));
   } catch (const QueueFull& e) {
     res.set_header("Retry-After", std::to_string(e.retry_after_seconds));
     problem(res, req, 503, "queue-full", "Queue full",
