@@ -146,9 +146,16 @@ double Equilibrium::free_residual_norm(const Vector& q, const Vector& p) const {
   EquilibriumState paired;
   pair(q, paired);
   const Vector r = residual(q, paired, p, nullptr);
+  return scaled_free_norm(r);
+}
+
+// The norm of a residual over the free dofs in force units: a rotation's (moment) residual is
+// divided by its dof's length scale, so that backtracking does not depend on the unit of
+// length (the iteration counts of a scene stay the same when its lengths are rescaled).
+double Equilibrium::scaled_free_norm(const Vector& r) const {
   double norm = 0.0;
   for (int i = 0; i < r.size(); ++i)
-    if (free_index_[i] >= 0) norm += r[i] * r[i];
+    if (free_index_[i] >= 0) norm += (r[i] / length_scales_[i]) * (r[i] / length_scales_[i]);
   return std::sqrt(norm);
 }
 
@@ -210,7 +217,7 @@ EquilibriumState Equilibrium::solve(const Vector& q_guess, const Vector& p) {
     // Backtracking on the residual norm, inside the body's trust region: a strongly
     // nonlinear law (the regularized rigid-plastic membrane) makes full steps overshoot.
     double a = problem_.body->newton_step_fraction(state.q, dq);
-    const double r0 = r_free.norm();
+    const double r0 = scaled_free_norm(r);
     for (int k = 0; k < params_.max_backtracks; ++k) {
       if (free_residual_norm(state.q + a * dq, p) <= (1 - 1e-4 * a) * r0) break;
       a *= 0.5;
@@ -268,6 +275,18 @@ const Compliance& Equilibrium::compliance(const EquilibriumState& state,
   c_.block.noalias() = ts.transpose() * x_;
   c_.block = 0.5 * (c_.block + c_.block.transpose()).eval();
   return c_;
+}
+
+Vector Equilibrium::predicted_change(const Compliance& C, const Vector& dp) const {
+  Vector dp_block = Vector::Zero(C.block.rows());
+  for (size_t j = 0; j < C.position.size(); ++j)
+    if (C.position[j] >= 0) dp_block[C.position[j]] = dp[j];
+  Vector du = Vector::Zero(free_index_.size());
+  if (dp_block.size() == 0 || x_.cols() != dp_block.size()) return du;
+  const Vector du_free = x_ * dp_block;
+  for (size_t i = 0; i < free_index_.size(); ++i)
+    if (free_index_[i] >= 0) du[i] = du_free[free_index_[i]];
+  return du;
 }
 
 Vector Equilibrium::reactions(const EquilibriumState& state, const Vector& p) const {

@@ -89,6 +89,9 @@ class Equilibrium {
   // C = T^T K^-1 T over the given components, from the body's own tangent at state.q
   // (symmetric). The reference stays valid until the next call (the storage is reused).
   const Compliance& compliance(const EquilibriumState& state, const std::vector<int>& components);
+  // The linear model's displacement change K^-1 T dp for a force change dp, from the last
+  // compliance (its components only): where the next solve should start.
+  Vector predicted_change(const Compliance& C, const Vector& dp) const;
   // R = A(q) - lambda F - T(q) p on every dof, and (if asked) the triplets of dR/dq, with
   // the pairing evaluated at q.
   Vector residual(const Vector& q, const Vector& p, Triplets* tangent) const;
@@ -111,6 +114,7 @@ class Equilibrium {
   // p(q) of the penalty law at a paired state, and (if asked) its stiffness triplets.
   Vector penalty_forces(const EquilibriumState& paired, Triplets* tangent) const;
   double free_residual_norm(const Vector& q, const Vector& p) const;
+  double scaled_free_norm(const Vector& r) const;
   void fill_t_matrix(const EquilibriumState& state, const std::vector<int>& position);
 
   const Problem& problem_;
