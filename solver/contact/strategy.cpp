@@ -3,7 +3,6 @@
 #include <Eigen/Cholesky>
 #include <chrono>
 #include <cmath>
-#include <limits>
 
 #include "solver/contact/acceleration.hpp"
 #include "solver/contact/contact_error.hpp"
@@ -54,7 +53,6 @@ class StepSolver {
     solves_at_start_ = eq_.counters().solves;
     bool frictionless = true;
     for (const Candidate& c : problem_.candidates) frictionless &= c.xi < 0;
-    double relaxation = 1.0, last_change = std::numeric_limits<double>::infinity();
     for (int pass = 1; pass <= params_.max_tau_passes; ++pass) {
       pass_ = pass;
       out_.passes = pass;
@@ -78,14 +76,7 @@ class StepSolver {
         out_.converged = true;
         break;
       }
-      // Successive Tresca problems can cycle instead of settling: a large friction force can
-      // lift its own point off (a beam's surface offset turns it into a moment), and a point
-      // with no normal force carries no friction. When a pass changes p* no less than the one
-      // before, under-relax the update (halved each time): the fixed point lies in between.
-      if (change >= last_change) relaxation *= 0.5;
-      last_change = change;
-      for (const Candidate& c : problem_.candidates)
-        p_star[c.eta] += relaxation * (out_.p[c.eta] - p_star[c.eta]);
+      for (const Candidate& c : problem_.candidates) p_star[c.eta] = out_.p[c.eta];
       if (pass == params_.max_tau_passes)
         fail("the friction bound did not settle in " + std::to_string(pass) + " tau passes");
     }
