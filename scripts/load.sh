@@ -6,7 +6,10 @@
 # bench/results/load.md).
 #
 #   bash scripts/load.sh [--jobs 1000] [--clients 50] [--streams 100] [--build-dir build-load]
-#                        [--no-build] [--report FILE] [-- extra `grip serve` options]
+#                        [--no-build] [--report FILE] [--append] [-- extra `grip serve` options]
+#
+# --append adds the run to the report instead of replacing it; `-- --streams 32` gives the
+# server back its default stream cap (later options win).
 #
 # The server gets its default limits except --streams (32 by default, too few for the
 # streams asked for): it is given the streams asked for + 28 (so that the HTTP pool, streams
@@ -15,7 +18,7 @@
 set -euo pipefail
 
 cd "$(dirname "$0")/.."
-jobs=1000 clients=50 streams=100 build_dir=build-load build=1 report=bench/results/load.md
+jobs=1000 clients=50 streams=100 build_dir=build-load build=1 report=bench/results/load.md append=0
 serve_extra=()
 while [ $# -gt 0 ]; do
   case "$1" in
@@ -25,6 +28,7 @@ while [ $# -gt 0 ]; do
     --build-dir) build_dir=$2; shift 2 ;;
     --no-build) build=0; shift ;;
     --report) report=$2; shift 2 ;;
+    --append) append=1; shift ;;
     --) shift; serve_extra=("$@"); break ;;
     *) echo "load.sh: unknown argument $1" >&2; exit 2 ;;
   esac
@@ -67,17 +71,22 @@ cpu=$(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -n 1)
 mem=$(awk '/^MemTotal/ { printf "%.1f GiB", $2 / 1048576 }' /proc/meminfo)
 os=$(. /etc/os-release && echo "$PRETTY_NAME")
 mkdir -p "$(dirname "$report")"
+[ "$append" = 1 ] || : >"$report"
+limits=$(sed -n 's/.*grip serve: .*\(workers [0-9]* queue [0-9]* streams [0-9]* http-threads [0-9]*\).*/\1/p' \
+           "$tmp/server.log")
 {
-  echo "# Load run"
+  if [ "$append" = 0 ]; then echo "# Load runs (scripts/load.sh)"; fi
+  echo
+  echo "## $jobs jobs, $clients clients, $streams event streams; server: $limits"
   echo
   echo "$(date -u '+%Y-%m-%d %H:%M UTC'), commit $commit; $os, $(nproc) cores ($cpu), $mem;"
   echo "load average $(cut -d ' ' -f 1-3 /proc/loadavg) at the start (other work on the machine shows here)."
-  echo "Server: \`grip serve --streams $server_streams${serve_extra[*]:+ ${serve_extra[*]}}\`, the other limits at"
-  echo "their defaults ($(sed -n 's/.*grip serve: .*\(workers [0-9]* queue [0-9]*\).*/\1/p' "$tmp/server.log")), a fresh SQLite"
-  echo "data folder. Client on the same machine: \`grip_load --jobs $jobs --clients $clients --streams $streams\`,"
-  echo "each job \`$scene\`. Command: \`bash scripts/load.sh --jobs $jobs --clients $clients --streams $streams\`."
+  echo "\`bash scripts/load.sh --jobs $jobs --clients $clients --streams $streams${serve_extra[*]:+ -- ${serve_extra[*]}}\`:"
+  echo "\`grip serve --streams $server_streams${serve_extra[*]:+ ${serve_extra[*]}}\` (the last option wins; other limits"
+  echo "at their defaults) on a fresh SQLite data folder, \`grip_load\` on the same machine, each job"
+  echo "\`$scene\`."
   echo
-} >"$report"
+} >>"$report"
 
 set +e
 "$load" --port "$port" --scene "$scene" --jobs "$jobs" --clients "$clients" --streams "$streams" \
@@ -90,7 +99,7 @@ if ! kill -0 "$server_pid" 2>/dev/null; then
   status=1
 fi
 grep -E ' (error|critical) ' "$tmp/server.log" | head -n 20 >&2 || true
-cat >>"$report" <<'NOTE'
+[ "$append" = 1 ] || cat >>"$report" <<'NOTE'
 
 Submit latency: from sending the POST to its 201, for the attempt that was accepted (503
 answers are counted, not timed). Iteration -> event delay: events carry no wall-clock time,
