@@ -57,9 +57,17 @@ class StepSolver {
       pass_ = pass;
       out_.passes = pass;
       out_.tau = friction_bounds(problem_, p_star);
-      // Each pass restarts from one solve with p clipped to the new bounds (section 9).
+      // Each pass restarts from one solve with p clipped to the new bounds (section 9); when
+      // the clip changes nothing, the last accepted state is that solve already.
+      const Vector unclipped = out_.p;
       clip_to_bounds(problem_, out_.tau, out_.p);
-      if (!fresh_solve(pass == 1 ? q_guess : out_.state.q)) break;
+      if (pass > 1 && out_.p == unclipped) {
+        accept(std::move(out_.state), unclipped);
+        m_ = 0;
+        emit(0, 0, 0, 0, 0.0);
+      } else if (!fresh_solve(pass == 1 ? q_guess : out_.state.q)) {
+        break;
+      }
       const bool ok = params_.loop == ContactLoop::paper || params_.method == ContactMethod::uzawa
                           ? paper_pass()
                           : inner_pass();
@@ -432,7 +440,7 @@ class StepSolver {
         case ContactState::slip: ++ev.slip; break;
       }
     }
-    ev.newton_iterations = out_.state.newton_iterations;
+    ev.newton_iterations = trials > 0 ? out_.state.newton_iterations : 0;
     ev.elapsed_ms = std::chrono::duration<double, std::milli>(Clock::now() - start_).count();
     out_.history.push_back(ev);
     if (observer_) observer_(ev);
