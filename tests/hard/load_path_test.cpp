@@ -28,13 +28,13 @@ std::vector<size_t> stage_ends(const Solved& s) {
   return ends;
 }
 
-// The beam bent round the cylinder to 500 kgf, then unloaded to 150 kgf: where it slid outward
+// The beam bent round the cylinder to 500 kgf, then unloaded to 350 kgf: where it slid outward
 // on the cylinder while loading it slides back while unloading, so some point that presses at
 // both ends carries a friction force of the opposite sign (each at least a tenth of its bound).
 TEST(LoadPath, UnloadingReversesTheFrictionOnTheCylinder) {
   const Solved s = solve_scene(with_stages(beam_on_cylinder(0.2), json::array({
                                                {{"steps", 10}, {"factors", {{"main", 1.0}}}},
-                                               {{"steps", 7}, {"factors", {{"main", 0.3}}}}})));
+                                               {{"steps", 6}, {"factors", {{"main", 0.7}}}}})));
   print_work("beam on cylinder, load then unload", s);
   expect_hard_case_sound(s);
   ASSERT_TRUE(s.run.completed) << s.run.reason;
@@ -45,9 +45,6 @@ TEST(LoadPath, UnloadingReversesTheFrictionOnTheCylinder) {
   for (size_t i = 0; i < s.scene.problem.candidates.size(); ++i) {
     const Candidate& c = s.scene.problem.candidates[i];
     const double a = loaded.p[c.xi], b = unloaded.p[c.xi];
-    if (loaded.p[c.eta] < 0 || unloaded.p[c.eta] < 0)
-      std::printf("node %d: p_n %.4g -> %.4g, p_t %.4g -> %.4g (tau %.4g -> %.4g)\n", c.site, loaded.p[c.eta],
-                  unloaded.p[c.eta], a, b, loaded.tau[i], unloaded.tau[i]);
     if (loaded.p[c.eta] < 0 && unloaded.p[c.eta] < 0 && a * b < 0 && std::abs(a) > 0.1 * loaded.tau[i] &&
         std::abs(b) > 0.1 * unloaded.tau[i])
       ++reversed;
