@@ -4,6 +4,10 @@
 // request the server must answer /v1/health; at the end the jobs solved before the table are
 // still there, successful, with the same stored result, and no malformed request made a job.
 #include <gtest/gtest.h>
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
 
 #include <chrono>
 #include <cstdio>
@@ -296,6 +300,58 @@ TEST(MalformedRequests, TableOfBadRequestsGetTheirProblemAndHarmNothing) {
     EXPECT_TRUE(res->body == results[id]) << "the stored result of " << id << " changed";
   }
   EXPECT_EQ(server.terminate(std::chrono::seconds(30)), 0) << server.log();
+}
+
+// Reads everything the server sends on a raw connection until it closes it (or `patience`
+// passes); the text and the seconds it took.
+std::pair<std::string, double> read_until_closed(int fd, std::chrono::seconds patience) {
+  const auto t0 = Clock::now();
+  timeval tv{1, 0};
+  setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof tv);
+  std::string text;
+  char buf[4096];
+  while (Clock::now() - t0 < patience) {
+    const ssize_t n = ::recv(fd, buf, sizeof buf, 0);
+    if (n == 0) break;
+    if (n > 0) text.append(buf, static_cast<size_t>(n));
+  }
+  return {text, std::chrono::duration<double>(Clock::now() - t0).count()};
+}
+
+int connect_raw(int port, const std::string& sent) {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_port = htons(static_cast<uint16_t>(port));
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  if (fd < 0 || ::connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) != 0) return -1;
+  ::send(fd, sent.data(), sent.size(), 0);
+  return fd;
+}
+
+// A client that stops in the middle of its request holds one HTTP thread until the server's
+// read timeout (10 s), never the server: /v1/health answers meanwhile, and the stalled
+// request is answered with a 400 and closed.
+TEST(MalformedRequests, StalledRequestsTimeOutAndBlockNothing) {
+  TempDir dir;
+  ServerProcess server(dir.path() / "grip.sqlite", {}, dir.path() / "server.log");
+  const Api api(server.port());
+  const int body = connect_raw(server.port(),
+                               "POST /v1/jobs HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\n"
+                               "Content-Length: 100\r\n\r\n{\"body\":");
+  const int head = connect_raw(server.port(), "GET /v1/health HTTP/1.1\r\nHost: x\r\n");
+  ASSERT_GE(body, 0);
+  ASSERT_GE(head, 0);
+  const auto health = api.client(5).Get("/v1/health");
+  ASSERT_TRUE(health && health->status == 200);
+  for (const int fd : {body, head}) {
+    const auto [text, seconds] = read_until_closed(fd, std::chrono::seconds(40));
+    ::close(fd);
+    EXPECT_LT(seconds, 30.0);
+    EXPECT_EQ(text.rfind("HTTP/1.1 400", 0), 0u) << text;
+    EXPECT_NE(text.find("application/problem+json"), std::string::npos) << text;
+  }
+  EXPECT_EQ(api.get("/v1/health")->status, 200);
 }
 
 }  // namespace
