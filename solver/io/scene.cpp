@@ -16,6 +16,7 @@ namespace {
 using nlohmann::json;
 using scene_io::Reader;
 using scene_io::show;
+using scene_io::token;
 
 std::string join(const std::vector<SceneIssue>& issues) {
   std::ostringstream os;
@@ -299,7 +300,7 @@ std::vector<LoadStep> read_load_path(Reader& r, json& scene, std::vector<Obstacl
         size_t k = 0;
         while (k < cases && r.cases[k] != name) ++k;
         if (k == cases) {
-          r.error(sp + "/factors/" + name, "names no load case (cases: " + Reader::list(r.cases) + ")");
+          r.error(sp + "/factors/" + token(name), "names no load case (cases: " + Reader::list(r.cases) + ")");
           continue;
         }
         target[k] = r.number(*f, sp + "/factors", name.c_str());
@@ -310,11 +311,11 @@ std::vector<LoadStep> read_load_path(Reader& r, json& scene, std::vector<Obstacl
         size_t o = 0;
         while (o < obstacles.size() && obstacles[o].name != name) ++o;
         if (o == obstacles.size()) {
-          r.error(sp + "/friction/" + name, "names no obstacle");
+          r.error(sp + "/friction/" + token(name), "names no obstacle");
           continue;
         }
         friction[o] = r.number(*fr, sp + "/friction", name.c_str());
-        if (friction[o] < 0) r.error(sp + "/friction/" + name, "is negative");
+        if (friction[o] < 0) r.error(sp + "/friction/" + token(name), "is negative");
         if (friction[o] > 0) obstacles[o].frictional = true;
       }
     total += n;

@@ -24,7 +24,7 @@ namespace {
 // [a, b] of integers in [lo, hi].
 std::optional<std::pair<int, int>> integer_pair(Reader& r, json& obj, const std::string& ptr, const char* key,
                                                 int lo, int hi) {
-  const std::string p = ptr + "/" + key;
+  const std::string p = ptr + "/" + token(key);
   if (!obj.contains(key)) {
     r.error(p, "is required ([n1, n2])");
     return std::nullopt;
@@ -78,7 +78,7 @@ std::optional<PlaneMesh> read_explicit_mesh(Reader& r, json& mesh, const std::st
     }
   if (json* sets = r.object(mesh, ptr, "sets", false))
     for (auto& [name, v] : sets->items()) {
-      const std::string sp = ptr + "/sets/" + name;
+      const std::string sp = ptr + "/sets/" + token(name);
       std::vector<int> ids;
       if (!v.is_array()) r.error(sp, show(v) + " is not an array of node ids");
       else
@@ -173,7 +173,7 @@ void for_each_object(Reader& r, json& body, const std::string& ptr, const char* 
   json* entries = r.array(body, ptr, key, false);
   if (!entries) return;
   for (size_t i = 0; i < entries->size(); ++i) {
-    const std::string p = ptr + "/" + key + "/" + std::to_string(i);
+    const std::string p = ptr + "/" + token(key) + "/" + std::to_string(i);
     if ((*entries)[i].is_object()) read((*entries)[i], p);
     else r.error(p, "is not an object");
   }
@@ -217,7 +217,7 @@ void read_continuum_supports(Reader& r, json& body, const std::string& ptr, cons
       for (const auto& [name, v] : values->items()) {
         bool listed = false;
         for (const auto& comp : *fix) listed |= comp == name;
-        if (!listed) r.error(sp + "/values/" + name, "is given but \"" + name + "\" is not in fix");
+        if (!listed) r.error(sp + "/values/" + token(name), "is given but \"" + name + "\" is not in fix");
       }
   });
 }

@@ -42,7 +42,7 @@ void read_supports(Reader& r, json& body, const std::string& ptr, int nodes,
         for (const auto& [name, v] : values->items()) {
           bool fixed = false;
           for (const auto& comp : *fix) fixed |= comp == name;
-          if (!fixed) r.error(sp + "/values/" + name, "is given but \"" + name + "\" is not in fix");
+          if (!fixed) r.error(sp + "/values/" + token(name), "is given but \"" + name + "\" is not in fix");
         }
     }
 

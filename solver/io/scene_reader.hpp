@@ -14,6 +14,14 @@ namespace grip::scene_io {
 
 using nlohmann::json;
 
+// A key as one JSON pointer token (RFC 6901): '~' -> "~0", '/' -> "~1". Keys that the scene
+// names itself (load cases, obstacles, node sets) may hold either.
+inline std::string token(const std::string& key) {
+  std::string t;
+  for (char c : key) t += c == '~' ? "~0" : c == '/' ? "~1" : std::string(1, c);
+  return t;
+}
+
 inline std::string show(const json& j) {
   std::string s = j.dump();
   return s.size() > 40 ? s.substr(0, 37) + "..." : s;
@@ -31,7 +39,7 @@ class Reader {
 
   // obj[key] as an object (created empty when absent and optional).
   json* object(json& obj, const std::string& ptr, const char* key, bool required) {
-    const std::string p = ptr + "/" + key;
+    const std::string p = ptr + "/" + token(key);
     if (!obj.is_object()) return nullptr;
     if (!obj.contains(key)) {
       if (required) {
@@ -48,7 +56,7 @@ class Reader {
   }
 
   json* array(json& obj, const std::string& ptr, const char* key, bool required) {
-    const std::string p = ptr + "/" + key;
+    const std::string p = ptr + "/" + token(key);
     if (!obj.is_object()) return nullptr;
     if (!obj.contains(key)) {
       if (required) {
@@ -67,7 +75,7 @@ class Reader {
   // A finite number; `fallback` fills it in when absent (required when no fallback).
   double number(json& obj, const std::string& ptr, const char* key,
                 std::optional<double> fallback = std::nullopt) {
-    const std::string p = ptr + "/" + key;
+    const std::string p = ptr + "/" + token(key);
     if (!obj.is_object()) return fallback.value_or(0.0);
     if (!obj.contains(key)) {
       if (!fallback) {
@@ -94,13 +102,13 @@ class Reader {
                   std::optional<double> fallback = std::nullopt) {
     const double d = number(obj, ptr, key, fallback);
     if (obj.is_object() && obj.contains(key) && obj[key].is_number() && !(d > 0))
-      error(ptr + "/" + key, show(obj[key]) + " is not positive");
+      error(ptr + "/" + token(key), show(obj[key]) + " is not positive");
     return d;
   }
 
   int integer(json& obj, const std::string& ptr, const char* key, int lo, int hi,
               std::optional<int> fallback = std::nullopt) {
-    const std::string p = ptr + "/" + key;
+    const std::string p = ptr + "/" + token(key);
     if (!obj.is_object()) return fallback.value_or(lo);
     if (!obj.contains(key)) {
       if (!fallback) {
@@ -128,7 +136,7 @@ class Reader {
 
   std::string choice(json& obj, const std::string& ptr, const char* key,
                      const std::vector<std::string>& options, std::optional<std::string> fallback) {
-    const std::string p = ptr + "/" + key;
+    const std::string p = ptr + "/" + token(key);
     if (!obj.is_object()) return fallback.value_or(options.front());
     if (!obj.contains(key)) {
       if (!fallback) {
@@ -148,7 +156,7 @@ class Reader {
 
   Vec2 vec2(json& obj, const std::string& ptr, const char* key,
             std::optional<Vec2> fallback = std::nullopt) {
-    const std::string p = ptr + "/" + key;
+    const std::string p = ptr + "/" + token(key);
     if (!obj.is_object()) return Vec2::Zero();
     if (!obj.contains(key)) {
       if (!fallback) {
