@@ -21,7 +21,7 @@ ctest --test-dir build-asan -L 'unit|integration' --output-on-failure -j "$jobs"
 
 echo "== libFuzzer: scene reader (build-fuzz, ${fuzz_seconds} s)"
 # -O1 with assertions on (no NDEBUG): Eigen's index checks count as findings too.
-cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" \
+cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" \
   -DGRIP_FUZZ=ON -DCMAKE_CXX_COMPILER=clang++ -DGRIP_FUZZ_SECONDS="$fuzz_seconds"
 cmake --build build-fuzz -j "$jobs" --target grip_fuzz_scene
 ctest --test-dir build-fuzz -L fuzz --output-on-failure

@@ -17,6 +17,7 @@
 #include "server/util.hpp"
 #include "solver/io/export_csv.hpp"
 #include "solver/io/export_vtk.hpp"
+#include "solver/io/json_depth.hpp"
 #include "solver/io/scene.hpp"
 
 // After Eigen (through the solver's headers): httplib.h brings <resolv.h>, whose `_res`
@@ -99,30 +100,6 @@ std::optional<std::int64_t> decode_cursor(const std::string& c) {
   if (v > static_cast<unsigned long long>(std::numeric_limits<std::int64_t>::max())) return std::nullopt;
   return static_cast<std::int64_t>(v);
 }
-
-// Whether a JSON text nests arrays and objects deeper than `limit` (strings skipped). The
-// parser takes any depth, but copying, dumping and validating a value recurse once per
-// level: 100000 nested arrays overflowed an HTTP thread's stack.
-bool nested_deeper_than(const std::string& text, int limit) {
-  int depth = 0;
-  bool in_string = false, escaped = false;
-  for (const char c : text) {
-    if (in_string) {
-      if (escaped) escaped = false;
-      else if (c == '\\') escaped = true;
-      else if (c == '"') in_string = false;
-    } else if (c == '"') {
-      in_string = true;
-    } else if (c == '[' || c == '{') {
-      if (++depth > limit) return true;
-    } else if ((c == ']' || c == '}') && depth > 0) {
-      --depth;
-    }
-  }
-  return false;
-}
-
-constexpr int kMaxJsonDepth = 64;  // a scene needs about 8
 
 std::string job_path(const std::string& id) { return "/v1/jobs/" + id; }
 

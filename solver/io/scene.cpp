@@ -7,6 +7,7 @@
 #include <optional>
 #include <sstream>
 
+#include "solver/io/json_depth.hpp"
 #include "solver/io/scene_reader.hpp"
 #include "solver/io/schema_validation.hpp"
 
@@ -427,10 +428,15 @@ Scene read_checked_scene(const nlohmann::json& input) {
 Scene read_scene_file(const std::string& path) {
   std::ifstream in(path);
   if (!in) throw SceneErrors(std::vector<SceneIssue>{{"/", "cannot open " + path}});
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (nested_deeper_than(text.str(), kMaxJsonDepth))
+    throw SceneErrors(std::vector<SceneIssue>{
+        {"/", "malformed JSON: arrays and objects are nested deeper than " + std::to_string(kMaxJsonDepth) + " levels"}});
   json j;
   try {
-    in >> j;
-  } catch (const json::parse_error& e) {
+    j = json::parse(text.str());
+  } catch (const json::exception& e) {  // parse_error, or out_of_range.406 for a number like 1e400
     throw SceneErrors(std::vector<SceneIssue>{{"/", std::string("malformed JSON: ") + e.what()}});
   }
   return read_scene(j);

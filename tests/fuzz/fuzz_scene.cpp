@@ -1,6 +1,6 @@
 // libFuzzer target: the input bytes are a scene document, read the way `POST /v1/jobs`
-// (server/http_server.cpp, server/job_service.cpp) and `grip solve` read one: json::parse
-// (a parse_error is the service's 400), then read_scene (schema stage, then the checked
+// (server/http_server.cpp, server/job_service.cpp) and `grip solve` read one: a bound on
+// nesting, then json::parse (either failing is the service's 400), then read_scene (schema stage, then the checked
 // reader and problem building; SceneErrors is the 422). Nothing is solved.
 // Any other exception, a crash, a leak or a UBSan report is a finding.
 #include <cstddef>
@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "solver/io/json_depth.hpp"
 #include "solver/io/scene.hpp"
 
 namespace {
@@ -42,11 +43,12 @@ void check_issues(const grip::SceneErrors& e) {
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string_view text(reinterpret_cast<const char*>(data), size);
+  if (grip::nested_deeper_than(text, grip::kMaxJsonDepth)) return 0;  // 400 malformed-json
   nlohmann::json scene;
   try {
     scene = nlohmann::json::parse(text);
-  } catch (const nlohmann::json::parse_error&) {
-    return 0;  // the service answers 400 malformed-json
+  } catch (const nlohmann::json::exception&) {
+    return 0;  // 400 malformed-json (parse_error, or out_of_range.406 for 1e400)
   }
   (void)scene.dump();  // JobService::submit keys idempotency on the canonical dump
   try {

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "solver/io/json_depth.hpp"
 #include "solver/io/scene.hpp"
 
 namespace grip {
@@ -54,6 +55,28 @@ TEST(FuzzRegressions, EveryInputIsReadOrRejectedWithPointers) {
     }
   }
   EXPECT_GT(inputs, 0);
+}
+
+// A few MB of '[' parse, but dumping or copying them overflowed the stack of `grip solve`
+// (and of an HTTP thread): the file is refused before parsing.
+TEST(FuzzRegressions, DeepNestingIsRefusedBeforeParsing) {
+  const int levels = 1000000;
+  const fs::path path = fs::temp_directory_path() / "grip_deep_nesting_test.json";
+  {
+    std::ofstream out(path, std::ios::binary);
+    out << "{\"units\": " << std::string(levels, '[') << std::string(levels, ']') << "}";
+  }
+  try {
+    read_scene_file(path.string());
+    ADD_FAILURE() << "a scene nested a million levels deep was read";
+  } catch (const SceneErrors& e) {
+    ASSERT_EQ(e.issues().size(), 1u);
+    EXPECT_EQ(e.issues()[0].pointer, "/");
+    EXPECT_NE(e.issues()[0].detail.find("nested deeper than"), std::string::npos);
+  }
+  fs::remove(path);
+  EXPECT_FALSE(nested_deeper_than("{\"a\": [[1], {\"b\": \"[[[[\"}]}", 3));
+  EXPECT_TRUE(nested_deeper_than("[[[[]]]]", 3));
 }
 
 }  // namespace
