@@ -75,6 +75,13 @@ TEST(FuzzRegressions, DeepNestingIsRefusedBeforeParsing) {
     EXPECT_NE(e.issues()[0].detail.find("nested deeper than"), std::string::npos);
   }
   fs::remove(path);
+  // A number beyond double: nlohmann throws out_of_range.406, not a parse_error.
+  {
+    std::ofstream out(path, std::ios::binary);
+    out << "{\"steps\": 1e400}";
+  }
+  EXPECT_THROW(read_scene_file(path.string()), SceneErrors);
+  fs::remove(path);
   EXPECT_FALSE(nested_deeper_than("{\"a\": [[1], {\"b\": \"[[[[\"}]}", 3));
   EXPECT_TRUE(nested_deeper_than("[[[[]]]]", 3));
 }
