@@ -15,7 +15,7 @@ using namespace grip::testing;
 using nlohmann::json;
 
 // A cantilever (20 elements, length 10, depth 0.5) whose lower surface touches a cylinder of
-// radius 50 at x = 5 (node 10) and nowhere else, loaded at its tip by `tip`.
+// radius 50 at x = 5 (node 10) and nowhere else, loaded at its tip by (fx, fy).
 json grazing_beam(double fx, double fy) {
   json j = beam_on_flat(20, 0.3, "von_karman");
   j["body"]["loads"] = json::array({{{"node", 20}, {"force", {fx, fy}}}});
@@ -25,8 +25,8 @@ json grazing_beam(double fx, double fy) {
 }
 
 // Pulled along its axis the beam stays straight: node 10 slides off the top of the cylinder by
-// its axial displacement u, so its gap opens by u^2 / 2R (2.5e-7 here, about twice the
-// tolerance) with no force; lifted, it leaves; pushed down, node 10 presses.
+// its axial displacement u, so its gap opens by u^2 / 2R (2.5e-7 here, 2.5 times the
+// contact tolerance) with no force; lifted, it leaves; pushed down, node 10 presses.
 TEST(GeometryEdges, GrazingContactAtACandidatePoint) {
   const struct {
     double fx, fy;
