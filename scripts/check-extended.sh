@@ -26,8 +26,9 @@ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_
 cmake --build build-fuzz -j "$jobs" --target grip_fuzz_scene
 ctest --test-dir build-fuzz -L fuzz --output-on-failure
 
-# ---- hard_slow: slow hard-case tests (label added separately), under the sanitizers too.
+# ---- hard_slow: slow hard-case tests (tests/hard, registered for configuration "slow" only),
+# under the sanitizers too.
 # Builds the remaining targets of build-asan; a label that matches no test runs nothing.
 echo "== hard_slow tests (build-asan)"
 cmake --build build-asan -j "$jobs"
-ctest --test-dir build-asan -L hard_slow --output-on-failure --timeout 3600
+ctest --test-dir build-asan -C slow -L hard_slow --output-on-failure --timeout 3600
