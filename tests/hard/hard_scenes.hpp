@@ -39,14 +39,4 @@ inline nlohmann::json beam_on_cylinder(double mu) {
   return j;
 }
 
-// The paper's sheet (schemas/examples/sheet-stretching.json) with `elements` elements.
-inline nlohmann::json sheet(int elements, double mu) {
-  nlohmann::json j = example_scene("sheet-stretching");
-  j["body"]["mesh"]["elements"] = elements;
-  j["body"]["supports"][1]["node"] = elements;
-  j["obstacles"][0]["friction"] = mu;
-  j["obstacles"][1]["friction"] = mu;
-  return j;
-}
-
 }  // namespace grip::testing

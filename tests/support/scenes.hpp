@@ -20,6 +20,16 @@ struct Solved {
   RunResult run;
 };
 
+// The paper's sheet (schemas/examples/sheet-stretching.json) with `elements` elements.
+inline nlohmann::json sheet(int elements, double mu) {
+  nlohmann::json j = example_scene("sheet-stretching");
+  j["body"]["mesh"]["elements"] = elements;
+  j["body"]["supports"][1]["node"] = elements;
+  j["obstacles"][0]["friction"] = mu;
+  j["obstacles"][1]["friction"] = mu;
+  return j;
+}
+
 inline Solved solve_scene(const nlohmann::json& j) {
   Solved s{read_scene(j), {}};
   s.run = run_load_steps(s.scene.problem, s.scene.steps, s.scene.params);

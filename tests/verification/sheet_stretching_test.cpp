@@ -14,14 +14,7 @@ using testing::example_scene;
 using testing::solve_scene;
 using testing::Solved;
 
-nlohmann::json sheet(int elements, double mu) {
-  nlohmann::json j = example_scene("sheet-stretching");
-  j["body"]["mesh"]["elements"] = elements;
-  j["body"]["supports"][1]["node"] = elements;
-  j["obstacles"][0]["friction"] = mu;
-  j["obstacles"][1]["friction"] = mu;
-  return j;
-}
+using testing::sheet;
 
 // Solved once per (mesh, friction) and shared by the tests that read it.
 const Solved& solved(int elements, double mu) {
