@@ -67,7 +67,8 @@ int solve(int argc, char** argv) {
     std::printf("%5d %12.6g %6d %6d %6d %12.3e %7d %6d %6d %9.2f  %s\n", rec.index,
                 rec.load_factor, rec.solves, rec.passes, rec.newton_iterations, last.v2,
                 last.stick + last.slip, last.stick, last.slip, rec.seconds * 1e3,
-                rec.converged ? "converged" : rec.reason.c_str());
+                rec.converged ? (rec.warning.empty() ? "converged" : ("converged; warning: " + rec.warning).c_str())
+                              : rec.reason.c_str());
     std::fflush(stdout);
   };
   const grip::RunResult run =

@@ -45,7 +45,8 @@ class StepSolver {
   }
 
   StepOutcome run(const Vector& q_guess, const Vector& p_start, const Vector& p_star_in) {
-    eq_.params().displacement_tolerance = params_.newton_fraction * tol_;
+    couple_newton(eq_.params(), params_.tolerance, params_.newton_fraction,
+                  problem_.body->characteristic_length());
     if (params_.method == ContactMethod::penalty) return run_penalty(q_guess, p_start);
     const long solves0 = eq_.counters().solves, newton0 = eq_.counters().newton_iterations;
     out_.p = p_start;

@@ -95,6 +95,9 @@ class Body {
   virtual double newton_step_fraction(const Vector& /*q*/, const Vector& /*dq*/) const { return 1.0; }
   // Why a converged state is not physical (empty if it is): e.g. a membrane in compression.
   virtual std::string inadmissible(const Vector& /*q*/) const { return {}; }
+  // Where a converged state lies beyond the range the model is accurate for (empty if it
+  // does not): the answer stands, with this warning (e.g. a von Karman beam rotated far).
+  virtual std::string validity_warning(const Vector& /*q*/) const { return {}; }
 
   // Bodies with history (plasticity) keep old/new state; commit after a converged step.
   virtual void commit(const Vector& /*q*/) {}

@@ -1,8 +1,10 @@
 #include "solver/elements/timoshenko_beam.hpp"
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 namespace grip {
@@ -149,6 +151,20 @@ Vector TimoshenkoBeam::rigid_rotation() const {
 Body::Traits TimoshenkoBeam::traits() const {
   const bool linear = kinematics_ == Kinematics::linear;
   return {!linear, false, linear};
+}
+
+std::string TimoshenkoBeam::validity_warning(const Vector& q) const {
+  double largest = 0.0;
+  for (int k = 0; k < node_count(); ++k) largest = std::max(largest, std::abs(q[node_dof(k, 2)]));
+  if (largest <= kModerateRotation) return {};
+  char text[320];
+  std::snprintf(text, sizeof text,
+                "rotation reaches %.3f rad (%.1f deg), beyond the %.2f rad up to which the %s beam is within "
+                "about 1 %% of an exact-rotation model (its error grows like 0.45 theta^2): for large rotations "
+                "use the continuum with finite kinematics",
+                largest, largest * 180 / std::acos(-1.0), kModerateRotation,
+                kinematics_ == Kinematics::linear ? "linear" : "von Karman");
+  return text;
 }
 
 std::vector<std::vector<int>> TimoshenkoBeam::cells() const {

@@ -27,6 +27,7 @@ json step_finished_event(const StepRecord& rec) {
             {"contact_iterations", rec.solves}, {"newton_iterations", rec.newton_iterations},
             {"seconds", rec.seconds}, {"stage", rec.stage}, {"factors", rec.factors}};
   if (!rec.converged) j["reason"] = rec.reason;
+  if (!rec.warning.empty()) j["warning"] = rec.warning;
   return j;
 }
 
@@ -50,6 +51,9 @@ json step_json(const Problem& problem, const StepRecord& rec, const OutputOption
   j.erase("type");
   j["inner_iterations"] = rec.inner_iterations;
   j["cuts"] = rec.cuts;
+  if (rec.converged)
+    j["equilibrium"] = {{"relative_residual", rec.state.relative_residual},
+                        {"at_round_off_floor", rec.state.at_floor}};
   if (!rec.epsilon_used.empty()) j["epsilon"] = rec.epsilon_used;
   if (output.wants("history")) {
     json history = json::array();

@@ -1,7 +1,9 @@
 #include "solver/solve/equilibrium.hpp"
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace grip {
 
@@ -113,17 +115,18 @@ double Equilibrium::stiffness_scale(const Vector& q) const {
 }
 
 Vector Equilibrium::residual(const Vector& q, const EquilibriumState& paired, const Vector& p_given,
-                             Triplets* tangent) const {
+                             Triplets* tangent, double* force_scale) const {
   const Vector p = penalty_ ? penalty_forces(paired, tangent) : p_given;
   Vector r = Vector::Zero(q.size());
   problem_.body->internal_force(q, r, tangent);
-  r -= problem_.load(factors_);
+  const Vector external = problem_.load(factors_);
+  Vector contact = Vector::Zero(q.size());
   for (size_t i = 0; i < problem_.candidates.size(); ++i) {
     const Candidate& c = problem_.candidates[i];
     const PairedPoint& pp = paired.points[i];
     const double p_eta = p[c.eta], p_xi = c.xi >= 0 ? p[c.xi] : 0.0;
     const Vec2 f = p_eta * pp.eta + p_xi * pp.xi;
-    for (const auto& j : pp.point.jacobian) r[j.dof] -= j.dx.dot(f);
+    for (const auto& j : pp.point.jacobian) contact[j.dof] += j.dx.dot(f);
     if (!tangent) continue;
     // f = -p_eta n + p_xi rot90(n): df/dx = (-p_eta I + p_xi R) dn/dx. Emitted even when zero,
     // so that the tangent's pattern stays the same from one iterate to the next.
@@ -134,6 +137,11 @@ Vector Equilibrium::residual(const Vector& q, const EquilibriumState& paired, co
       for (const auto& b : pp.point.jacobian)
         tangent->emplace_back(a.dof, b.dof, -a.dx.dot(df_dx * b.dx));
   }
+  if (force_scale) {
+    auto largest = [&](const Vector& v) { return (v.array() / length_scales_.array()).abs().maxCoeff(); };
+    *force_scale = r.size() ? std::max({largest(r), largest(external), largest(contact)}) : 0.0;
+  }
+  r -= external + contact;
   return r;
 }
 
@@ -152,12 +160,34 @@ double Equilibrium::free_residual_norm(const Vector& q, const Vector& p) const {
 // The norm of a residual over the free dofs in force units: a rotation's (moment) residual is
 // divided by its dof's length scale, so that backtracking does not depend on the unit of
 // length (the iteration counts of a scene stay the same when its lengths are rescaled).
+double Equilibrium::scaled_free_max(const Vector& r) const {
+  double largest = 0.0;
+  for (int i = 0; i < r.size(); ++i)
+    if (free_index_[i] >= 0) largest = std::max(largest, std::abs(r[i] / length_scales_[i]));
+  return largest;
+}
+
 double Equilibrium::scaled_free_norm(const Vector& r) const {
   double norm = 0.0;
   for (int i = 0; i < r.size(); ++i)
     if (free_index_[i] >= 0) norm += (r[i] / length_scales_[i]) * (r[i] / length_scales_[i]);
   return std::sqrt(norm);
 }
+
+namespace {
+
+// |K|_inf over the free block in force / length units (moments over the length scale of
+// their dof, rotations times it), from the tangent's triplets.
+double free_row_sum_norm(const Triplets& triplets, const std::vector<int>& free_index, int free_count,
+                         const Vector& length_scales) {
+  Vector rows = Vector::Zero(free_count);
+  for (const auto& t : triplets)
+    if (free_index[t.row()] >= 0 && free_index[t.col()] >= 0)
+      rows[free_index[t.row()]] += std::abs(t.value()) / (length_scales[t.row()] * length_scales[t.col()]);
+  return free_count ? rows.maxCoeff() : 0.0;
+}
+
+}  // namespace
 
 EquilibriumState Equilibrium::solve(const Vector& q_guess, const Vector& p) {
   ++counters_.solves;
@@ -167,16 +197,35 @@ EquilibriumState Equilibrium::solve(const Vector& q_guess, const Vector& p) {
     state.q[c.dof] = c.load_case < static_cast<int>(factors_.size()) ? factors_[c.load_case] * c.value : 0.0;
   for (const Constraint& c : extra_) state.q[c.dof] = c.value;
   const double body_length = problem_.body->characteristic_length();
+  constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
   // The penalty law adds stiffness that changes with the contact state: no reuse then.
   const bool reuse = constant_tangent_ && !penalty_;
   Triplets triplets;
-  for (int it = 1; it <= params_.max_iterations; ++it) {
+  double previous_residual = std::numeric_limits<double>::infinity(), last_step = 0.0;
+  for (int it = 1; it <= params_.max_iterations + 1; ++it) {
     pair(state.q, state);
     triplets.clear();
-    const Vector r = residual(state.q, state, p, reuse ? nullptr : &triplets);
-    Vector r_free(free_count_);
-    for (int i = 0; i < r.size(); ++i)
-      if (free_index_[i] >= 0) r_free[free_index_[i]] = r[i];
+    double force_scale = 0.0;
+    const Vector r = residual(state.q, state, p, reuse ? nullptr : &triplets, &force_scale);
+    const double r_max = scaled_free_max(r);
+    state.relative_residual = force_scale > 0 ? r_max / force_scale : 0.0;
+    if (!std::isfinite(r_max)) {
+      state.reason = "Newton produced a non-finite residual";
+      return state;
+    }
+    double k_norm = body_tangent_norm_;
+    if (!reuse) k_norm = free_row_sum_norm(triplets, free_index_, free_count_, length_scales_);
+    const double q_size = (state.q.array() * length_scales_.array()).abs().maxCoeff();
+    const double round_off = params_.floor_factor * kEpsilon * (k_norm * q_size + force_scale);
+    const bool residual_met = r_max <= params_.residual_tolerance * force_scale;
+    const bool at_floor = it > 1 && r_max > params_.floor_stall * previous_residual && r_max <= round_off;
+    if (residual_met || at_floor) {
+      state.at_floor = at_floor && !residual_met;
+      state.noise = state.at_floor ? last_step : 0.0;
+      return finish(state, p);
+    }
+    if (it > params_.max_iterations) break;
+    previous_residual = r_max;
     if (reuse) {
       if (!factorize_body_tangent(state.q)) {
         state.reason = "singular stiffness: the supports do not hold the body";
@@ -189,15 +238,16 @@ EquilibriumState Equilibrium::solve(const Vector& q_guess, const Vector& p) {
         return state;
       }
     }
-    const Vector rhs = -r_free;
-    const Vector dq_free = reuse ? body_lu_.solve(rhs) : lu_.solve(rhs);
+    Vector r_free(free_count_);
+    for (int i = 0; i < r.size(); ++i)
+      if (free_index_[i] >= 0) r_free[free_index_[i]] = r[i];
+    const Vector dq_free = reuse ? body_lu_.solve(Vector(-r_free)) : lu_.solve(Vector(-r_free));
     state.newton_iterations = it;
     ++counters_.newton_iterations;
     Vector dq = Vector::Zero(state.q.size());
     for (int i = 0; i < state.q.size(); ++i)
       if (free_index_[i] >= 0) dq[i] = dq_free[free_index_[i]];
-    double step = 0.0;
-    for (int i = 0; i < state.q.size(); ++i) step = std::max(step, std::abs(dq[i]) * length_scales_[i]);
+    const double step = (dq.array() * length_scales_.array()).abs().maxCoeff();
     if (!std::isfinite(step)) {
       state.reason = "Newton produced a non-finite displacement";
       return state;
@@ -206,27 +256,73 @@ EquilibriumState Equilibrium::solve(const Vector& q_guess, const Vector& p) {
       state.reason = "Newton diverged (correction of " + std::to_string(step) + " length units)";
       return state;
     }
+    last_step = step;
     if (step <= params_.displacement_tolerance) {
       state.q += dq;
       pair(state.q, state);
-      state.reason = problem_.body->inadmissible(state.q);
-      state.converged = state.reason.empty();
-      state.p = penalty_ ? penalty_forces(state, nullptr) : p;
-      return state;
+      return finish(state, p);
     }
-    // Backtracking on the residual norm, inside the body's trust region: a strongly
-    // nonlinear law (the regularized rigid-plastic membrane) makes full steps overshoot.
-    double a = problem_.body->newton_step_fraction(state.q, dq);
-    const double r0 = scaled_free_norm(r);
-    for (int k = 0; k < params_.max_backtracks; ++k) {
-      if (free_residual_norm(state.q + a * dq, p) <= (1 - 1e-4 * a) * r0) break;
-      a *= 0.5;
-    }
-    state.q += a * dq;
+    state.q += line_search(state.q, dq, r, p) * dq;
   }
   pair(state.q, state);
-  state.reason = "Newton did not converge in " + std::to_string(params_.max_iterations) + " iterations";
+  state.reason = "Newton did not converge in " + std::to_string(params_.max_iterations) +
+                 " iterations (free residual " + std::to_string(state.relative_residual) +
+                 " of the force scale)";
   return state;
+}
+
+EquilibriumState& Equilibrium::finish(EquilibriumState& state, const Vector& p) const {
+  state.reason = problem_.body->inadmissible(state.q);
+  state.converged = state.reason.empty();
+  state.p = penalty_ ? penalty_forces(state, nullptr) : p;
+  return state;
+}
+
+double Equilibrium::free_dot(const Vector& a, const Vector& b) const {
+  double sum = 0.0;
+  for (int i = 0; i < a.size(); ++i)
+    if (free_index_[i] >= 0) sum += a[i] * b[i];
+  return sum;
+}
+
+double Equilibrium::line_search(const Vector& q, const Vector& dq, const Vector& r, const Vector& p) const {
+  const double a_max = problem_.body->newton_step_fraction(q, dq);
+  const double g0 = free_dot(dq, r);
+  if (!(g0 < 0)) {  // not an energy descent direction (unsymmetric contact terms): backtrack
+    double a = a_max;
+    const double r0 = scaled_free_norm(r);
+    for (int k = 0; k < params_.max_backtracks; ++k, a *= 0.5)
+      if (free_residual_norm(q + a * dq, p) <= (1 - 1e-4 * a) * r0) break;
+    return a;
+  }
+  // g(a) = dq . R(q + a dq): accept a once |g(a)| <= 0.8 |g(0)|; else regula falsi between
+  // the last point where g < 0 (or 0) and the first where g > 0.
+  auto slope = [&](double a) {
+    EquilibriumState paired;
+    const Vector qa = q + a * dq;
+    pair(qa, paired);
+    return free_dot(dq, residual(qa, paired, p, nullptr));
+  };
+  double lo = 0.0, g_lo = g0, hi = a_max, g_hi = slope(a_max);
+  if (!std::isfinite(g_hi) || g_hi > 0) {
+    double a = a_max, g = g_hi;
+    for (int k = 0; k < params_.max_backtracks; ++k) {
+      if (std::isfinite(g) && std::abs(g) <= 0.8 * std::abs(g0)) return a;
+      if (!std::isfinite(g) || g > 0) {
+        hi = a;
+        g_hi = g;
+      } else {
+        lo = a;
+        g_lo = g;
+      }
+      // A non-finite slope gives no information to interpolate with: halve.
+      a = std::isfinite(g_hi) ? lo + (hi - lo) * g_lo / (g_lo - g_hi) : 0.5 * (lo + hi);
+      a = std::clamp(a, lo + 0.1 * (hi - lo), hi - 0.1 * (hi - lo));
+      g = slope(a);
+    }
+    return std::isfinite(g) ? a : lo > 0 ? lo : 0.5 * a;
+  }
+  return a_max;
 }
 
 Matrix Compliance::sub(const std::vector<int>& components) const {
@@ -259,6 +355,7 @@ bool Equilibrium::factorize_body_tangent(const Vector& q) {
   problem_.body->internal_force(q, force, &triplets);
   ++counters_.factorizations;
   body_factorized_ = true;
+  body_tangent_norm_ = free_row_sum_norm(triplets, free_index_, free_count_, length_scales_);
   return body_lu_.factorize(triplets, free_index_, free_count_);
 }
 

@@ -13,16 +13,36 @@
 
 namespace grip {
 
+// Newton's stopping tests, each always reachable in floating point (ALGORITHM.md 9). An
+// iterate is converged when one of them holds:
+// - correction: the largest correction, in length units (rotations times their dof's length
+//   scale), is below `displacement_tolerance` (the contact loop's precision);
+// - residual: the largest free residual, in force units (moments over the length scale), is
+//   below `residual_tolerance` times the force scale (the largest of the applied loads, the
+//   internal forces, which hold the reactions, and the contact forces);
+// - round-off floor: the residual no longer falls (above `floor_stall` of the one before)
+//   and is within `floor_factor` x machine precision of the scale of the sums that form it
+//   (|K| |q| + force scale). Recorded in the state: its corrections are noise.
+// couple_newton() sets the first two from the contact tolerance.
 struct NewtonParams {
   int max_iterations = 40;
-  // Converged when the largest correction, in length units (rotations times the body's
-  // length), is below this. Set by the contact strategy from its tolerance.
-  double displacement_tolerance = 1e-10;
+  double displacement_tolerance = 1e-10;  // length
+  double residual_tolerance = 1e-11;      // relative to the force scale
+  double floor_factor = 1e3;
+  double floor_stall = 0.5;
   // Diverged when a correction exceeds this many body lengths.
   double divergence_lengths = 10.0;
-  // Halvings of a Newton correction that does not lower the residual norm.
+  // Steps of the line search along a Newton correction.
   int max_backtracks = 8;
 };
+
+// Newton's tests as a fraction of the contact tolerance (relative to `length`, the body's
+// characteristic length): the contact error has a floor of about ||K^-1|| x the Newton
+// residual, so Newton must be that much tighter (ALGORITHM.md 9).
+inline void couple_newton(NewtonParams& newton, double contact_tolerance, double fraction, double length) {
+  newton.displacement_tolerance = fraction * contact_tolerance * length;
+  newton.residual_tolerance = fraction * contact_tolerance;
+}
 
 // The kinematics of one candidate at a state.
 struct PairedPoint {
@@ -39,7 +59,12 @@ struct EquilibriumState {
   std::vector<char> enabled;  // component has a non-zero column of T on the free dofs
   int newton_iterations = 0;
   bool converged = false;
-  std::string reason;         // why Newton failed
+  // Converged at the round-off floor (not by the correction or residual test); then the
+  // last correction (length units) is the noise of the displacements.
+  bool at_floor = false;
+  double noise = 0.0;
+  double relative_residual = 0.0;  // final free residual over the force scale
+  std::string reason;              // why Newton failed
 };
 
 struct EquilibriumCounters {
@@ -108,13 +133,24 @@ class Equilibrium {
 
  private:
   void pair(const Vector& q, EquilibriumState& state) const;
+  // A converged iterate: admissibility and the forces in equilibrium (penalty law).
+  EquilibriumState& finish(EquilibriumState& state, const Vector& p) const;
   // R = A(q) - lambda F - T p on all dofs; tangent of R (with the contact load stiffness).
+  // force_scale (if asked): the largest of |A(q)|, |lambda F| and |T p| over all dofs, in
+  // force units (the scale Newton's residual test is relative to).
   Vector residual(const Vector& q, const EquilibriumState& paired, const Vector& p,
-                  Triplets* tangent) const;
+                  Triplets* tangent, double* force_scale = nullptr) const;
   // p(q) of the penalty law at a paired state, and (if asked) its stiffness triplets.
   Vector penalty_forces(const EquilibriumState& paired, Triplets* tangent) const;
+  // Step length along the Newton correction dq at q (with residual r there): the energy
+  // slope g(a) = dq . R(q + a dq) driven toward zero (Crisfield's line search), which a rigid
+  // rotation does not penalize; residual-norm backtracking where dq is not a descent
+  // direction of the energy. At most the body's trust-region fraction.
+  double line_search(const Vector& q, const Vector& dq, const Vector& r, const Vector& p) const;
+  double free_dot(const Vector& a, const Vector& b) const;
   double free_residual_norm(const Vector& q, const Vector& p) const;
   double scaled_free_norm(const Vector& r) const;
+  double scaled_free_max(const Vector& r) const;
   void fill_t_matrix(const EquilibriumState& state, const std::vector<int>& position);
 
   const Problem& problem_;
@@ -134,6 +170,7 @@ class Equilibrium {
   bool body_factorized_ = false;
   FreeBlockSolver body_lu_;  // the body's own tangent (compliance, constant tangents)
   FreeBlockSolver lu_;       // Newton's tangent, with the contact terms
+  double body_tangent_norm_ = 0.0;  // |K|_inf of the constant body tangent (round-off scale)
   Matrix t_, x_;  // compliance work storage, reused
   Compliance c_;
 };

@@ -20,8 +20,8 @@ std::optional<Vector> start_up(const Problem& problem, const SteppingParams& par
                                Vector& p, std::string& reason) {
   const StartUp& st = *problem.start;
   Equilibrium pre(problem, params.newton, {{st.dof, st.value, 0}});
-  pre.params().displacement_tolerance = params.contact.newton_fraction * params.contact.tolerance *
-                                        problem.body->characteristic_length();
+  couple_newton(pre.params(), params.contact.tolerance, params.contact.newton_fraction,
+                problem.body->characteristic_length());
   pre.set_step(factors, zeta);
   const int ndof = problem.body->dof_count();
   Vector prescribed = Vector::Zero(ndof);
@@ -129,6 +129,7 @@ RunResult run_load_steps(Problem& problem, const std::vector<LoadStep>& steps,
         rec.p = out.p;
         rec.tau = out.tau;
         rec.reactions = eq.reactions(out.state, out.p);
+        rec.warning = problem.body->validity_warning(out.state.q);
         if (params.record_fields.empty() || params.record_fields[k]) {
           rec.site_fields = problem.body->site_fields(out.state.q);
           rec.element_fields = problem.body->element_fields(out.state.q);

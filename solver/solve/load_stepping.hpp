@@ -28,6 +28,7 @@ struct StepRecord {
   LoadFactors factors;         // every load case's factor
   bool converged = false;
   std::string reason;
+  std::string warning;         // the converged state lies beyond the model's accurate range
   int cuts = 0;                // sub-increments this step needed beyond one
   int passes = 0, solves = 0, newton_iterations = 0, inner_iterations = 0;
   double seconds = 0.0;

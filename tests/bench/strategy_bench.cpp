@@ -421,8 +421,8 @@ std::pair<double, double> overhead(const json& scene_json, const RunStats& st, i
     Scene scene = read_scene(scene_json);
     Problem& problem = scene.problem;
     Equilibrium eq(problem, scene.params.newton);
-    eq.params().displacement_tolerance = scene.params.contact.newton_fraction * scene.params.contact.tolerance *
-                                         problem.body->characteristic_length();
+    couple_newton(eq.params(), scene.params.contact.tolerance, scene.params.contact.newton_fraction,
+                  problem.body->characteristic_length());
     const int ndof = problem.body->dof_count();
     const size_t cases = scene.steps.empty() ? 1 : scene.steps.front().factors.size();
     Vector q = Vector::Zero(ndof), q_before = q;
