@@ -1,0 +1,133 @@
+// Strategy `cev`: the contact error vector scheme with the default loop of ALGORITHM.md
+// section 5 (inner iterations on the linear model, one real solve per update) or the paper's
+// literal loop (`loop: paper`), inside the tau passes of eq. 14.
+#include "solver/contact/acceleration.hpp"
+#include "solver/contact/step.hpp"
+
+namespace grip {
+namespace {
+
+class CevStep : public StepSolver {
+ public:
+  using StepSolver::StepSolver;
+
+ private:
+  void solve(const Vector& q_guess, const Vector& p_start, const Vector& p_star) override {
+    tau_passes(q_guess, p_start, p_star, [this] {
+      if (needs_warmup() && !warmup()) return false;
+      return params_.loop == ContactLoop::paper ? literal_pass(params_.acceleration, 0.0)
+                                                : inner_pass();
+    });
+  }
+
+  // Inner iterations on the linear model, then one real solve and its line search.
+  bool inner_pass() {
+    while (error_.norm2 > tol_) {
+      if (!budget_left()) return false;
+      const Compliance& C = eq_.compliance(out_.state, relevant_components());
+      int inner = 0, halvings = 0, n_used = 0;
+      double alpha_used = 1.0;
+      const Vector pl = predict(C, inner, halvings, n_used, alpha_used);
+      out_.inner_iterations += inner;
+      // Newton starts from the model's own displacement, saving about one iteration a solve.
+      const Vector du = eq_.predicted_change(C, pl - out_.p);
+      int trials = 0;
+      if (!line_search(pl, du, trials)) return false;
+      ++m_;
+      emit(trials, inner, halvings, n_used, alpha_used);
+    }
+    return true;
+  }
+
+  // q(p + dp) - q(p) = (s + C dp / 2) . dp < 0, over the non-zeros of dp only.
+  static bool decreases_q(const Compliance& C, const Vector& s, const Vector& dp) {
+    std::vector<int> nz;
+    for (int j = 0; j < dp.size(); ++j)
+      if (dp[j] != 0.0) nz.push_back(j);
+    double change = 0.0;
+    for (int a : nz) {
+      double cdp = 0.0;
+      for (int b : nz) cdp += C(a, b) * dp[b];
+      change += (s[a] + 0.5 * cdp) * dp[a];
+    }
+    return change < 0;
+  }
+
+  // eq. 13 iterated on s(p) = s + C (p - p0), accepted by the decrease of
+  // q(p) = p.C.p/2 + (s - C p0).p; returns the predicted force.
+  Vector predict(const Compliance& C, int& inner, int& halvings, int& n_used, double& alpha_used) {
+    Vector pl = out_.p, sl = out_.state.s;
+    const double target = std::min(0.1 * tol_, 1e-6 * error_.norm2);
+    for (inner = 0; inner < params_.max_inner_iterations; ++inner) {
+      const ContactError e = error_at(pl, sl, out_.state.enabled);
+      if (e.norm2 <= target) break;
+      Vector dp;
+      bool descended = false;
+      // The accelerated direction first; the plain gradient (n = 1, always a descent
+      // direction for a small enough step) if the projection spoiled it.
+      for (int attempt = 0; attempt < 2 && !descended; ++attempt) {
+        const Direction dir = attempt == 0 ? direction(C, e, params_.acceleration, 0.0)
+                                           : direction(C, e, 1, 1.0);
+        if (!dir.ok) continue;
+        double a = 1.0;
+        for (int k = 0; k <= params_.max_halvings; ++k, a *= 0.5) {
+          dp = project_forces(problem_, pl, pl - a * dir.d, e, out_.tau) - pl;
+          if (decreases_q(C, sl, dp)) {
+            descended = true;
+            n_used = dir.n;
+            alpha_used = dir.alpha * a;
+            break;
+          }
+          ++halvings;
+        }
+      }
+      if (!descended) break;  // stationary on the model: the real solve decides
+      pl += dp;
+      for (int j = 0; j < dp.size(); ++j)  // dp is zero off the active set
+        if (dp[j] != 0.0)
+          for (size_t a = 0; a < C.position.size(); ++a)
+            if (C.position[a] >= 0 && C.position[j] >= 0) sl[a] += C.block(C.position[a], C.position[j]) * dp[j];
+    }
+    return pl;
+  }
+
+  // The eq. 30 estimate is made once per step, in its first pass, and reused by later passes.
+  bool needs_warmup() const {
+    return params_.epsilon == EpsilonSource::warmup && params_.acceleration != kAccelerationInfinity &&
+           params_.acceleration != 1 && pass_ == 1;
+  }
+
+  // eq. 30: J iterations of n = 1, alpha = 1.99, each one real solve, to estimate epsbar_1.
+  bool warmup() {
+    std::vector<double> norms{error_.norm2};
+    for (int m = 1; m <= params_.warmup_last && error_.norm2 > tol_; ++m) {
+      if (!budget_left()) return false;
+      const Compliance& C = eq_.compliance(out_.state, relevant_components());
+      const Direction dir = direction(C, error_, 1, params_.warmup_alpha);
+      if (!dir.ok) break;
+      const Vector pt = project_forces(problem_, out_.p, out_.p - dir.d, error_, out_.tau);
+      EquilibriumState trial = eq_.solve(out_.state.q, pt);
+      if (!trial.converged) break;
+      accept(std::move(trial), pt);
+      norms.push_back(error_.norm2);
+      ++m_;
+      emit(1, 0, 0, 1, params_.warmup_alpha);
+    }
+    // Too short a history (the error vanished, or a trial failed) leaves the exact
+    // eigenvalue in charge.
+    const int last = static_cast<int>(norms.size()) - 1;
+    if (last >= params_.warmup_first)
+      warmup_eps_ = warmup_epsilon(norms, params_.warmup_alpha, params_.warmup_first, last);
+    return true;
+  }
+};
+
+}  // namespace
+
+StepOutcome solve_cev_step(Equilibrium& eq, const Vector& q_guess, const Vector& p_start,
+                           const Vector& p_star, const ContactParams& params, int step,
+                           const IterationObserver& observer, const StopRequest& stop) {
+  return CevStep(eq, params, step, observer, stop).run(q_guess, p_start, p_star);
+}
+
+}  // namespace grip

@@ -1,0 +1,301 @@
+#include "solver/contact/step.hpp"
+
+#include <Eigen/Cholesky>
+#include <cmath>
+
+#include "solver/contact/acceleration.hpp"
+
+namespace grip {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double inf_norm(const Matrix& A) {
+  return A.size() ? A.cwiseAbs().rowwise().sum().maxCoeff() : 0.0;
+}
+
+}  // namespace
+
+std::vector<int> active_indices(const ContactError& e) {
+  std::vector<int> idx;
+  for (int i = 0; i < static_cast<int>(e.active.size()); ++i)
+    if (e.active[i]) idx.push_back(i);
+  return idx;
+}
+
+StepSolver::StepSolver(Equilibrium& eq, const ContactParams& params, int step,
+                       const IterationObserver& obs, const StopRequest& stop)
+    : eq_(eq), problem_(eq.problem()), params_(params), step_(step), observer_(obs), stop_(stop),
+      start_(Clock::now()) {
+  tol_ = params.tolerance * problem_.body->characteristic_length();
+  is_normal_.assign(problem_.component_count, 0);
+  for (const Candidate& c : problem_.candidates) is_normal_[c.eta] = 1;
+}
+
+StepOutcome StepSolver::run(const Vector& q_guess, const Vector& p_start, const Vector& p_star) {
+  couple_newton(eq_.params(), params_.tolerance, params_.newton_fraction,
+                problem_.body->characteristic_length());
+  const long solves0 = eq_.counters().solves, newton0 = eq_.counters().newton_iterations;
+  solves_at_start_ = solves0;
+  solve(q_guess, p_start, p_star);
+  out_.solves = static_cast<int>(eq_.counters().solves - solves0);
+  out_.newton_iterations = static_cast<int>(eq_.counters().newton_iterations - newton0);
+  out_.v2 = error_.norm2;
+  return std::move(out_);
+}
+
+bool StepSolver::frictionless() const {
+  for (const Candidate& c : problem_.candidates)
+    if (c.xi >= 0) return false;
+  return true;
+}
+
+void StepSolver::tau_passes(const Vector& q_guess, const Vector& p_start, const Vector& p_star_in,
+                            const std::function<bool()>& pass) {
+  out_.p = p_start;
+  Vector p_star = p_star_in;
+  const bool no_friction = frictionless();
+  for (int pass_index = 1; pass_index <= params_.max_tau_passes; ++pass_index) {
+    pass_ = pass_index;
+    out_.passes = pass_index;
+    out_.tau = friction_bounds(problem_, p_star);
+    // Each pass restarts from one solve with p clipped to the new bounds (section 9); when
+    // the clip changes nothing, the last accepted state is that solve already.
+    const Vector unclipped = out_.p;
+    clip_to_bounds(problem_, out_.tau, out_.p);
+    if (pass_index > 1 && out_.p == unclipped) {
+      accept(std::move(out_.state), unclipped);
+      m_ = 0;
+      emit(0, 0, 0, 0, 0.0);
+    } else if (!fresh_solve(pass_index == 1 ? q_guess : out_.state.q)) {
+      break;
+    }
+    if (!pass()) break;
+    if (no_friction) break;
+    double change = 0.0, scale = 0.0;
+    for (const Candidate& c : problem_.candidates) {
+      change = std::max(change, std::abs(out_.p[c.eta] - p_star[c.eta]));
+      scale = std::max(scale, std::abs(out_.p[c.eta]));
+    }
+    // ||v|| <= tol pins p only to about C_EE^-1 v_E: a change of p* below that is noise
+    // (section 9: a tighter test makes p* cycle).
+    if (change <= params_.tau_tolerance * scale || change <= force_precision()) {
+      out_.converged = true;
+      break;
+    }
+    for (const Candidate& c : problem_.candidates) p_star[c.eta] = out_.p[c.eta];
+    if (pass_index == params_.max_tau_passes)
+      fail("the friction bound did not settle in " + std::to_string(pass_index) + " tau passes");
+  }
+  if (no_friction && out_.reason.empty()) out_.converged = true;
+  if (out_.converged) final_check();
+}
+
+bool StepSolver::fresh_solve(const Vector& q) {
+  if (!budget_left()) return false;
+  EquilibriumState s = eq_.solve(q, out_.p);
+  if (!s.converged) return fail("equilibrium solve failed: " + s.reason);
+  accept(std::move(s), out_.p);
+  m_ = 0;
+  emit(1, 0, 0, 0, 0.0);
+  return true;
+}
+
+void StepSolver::accept(EquilibriumState s, const Vector& p) {
+  out_.state = std::move(s);
+  out_.p = p;
+  error_ = error_at(out_.p, out_.state.s, out_.state.enabled);
+}
+
+bool StepSolver::fail(std::string reason) {
+  out_.converged = false;
+  if (out_.reason.empty()) out_.reason = std::move(reason);
+  return false;
+}
+
+bool StepSolver::budget_left() {
+  if (stop_ && stop_()) {
+    out_.stopped = true;
+    return fail("stopped on request");
+  }
+  if (eq_.counters().solves < solves_at_start_ + params_.max_iterations) return true;
+  return fail("contact error " + std::to_string(error_.norm2) + " above tolerance " +
+              std::to_string(tol_) + " after " + std::to_string(params_.max_iterations) +
+              " contact iterations");
+}
+
+bool StepSolver::line_search(const Vector& pl, const Vector& du, int& trials) {
+  const Vector p0 = out_.p;
+  const double v0 = error_.norm2;
+  for (int h = 0; h <= params_.line_search_steps; ++h) {
+    if (!budget_left()) return false;
+    const double f = std::ldexp(1.0, -h);
+    const Vector pt = h == 0 ? pl : Vector(p0 + f * (pl - p0));
+    ++trials;
+    EquilibriumState trial = eq_.solve(out_.state.q + f * du, pt);
+    if (!trial.converged) continue;  // a diverging trial is a failed trial: halve
+    const ContactError e = error_at(pt, trial.s, trial.enabled);
+    if (e.norm2 < v0) {
+      accept(std::move(trial), pt);
+      return true;
+    }
+  }
+  return fail("no decrease of the contact error along the predicted force change (||v|| = " +
+              std::to_string(v0) + ")");
+}
+
+Direction StepSolver::direction(const Compliance& C, const ContactError& err, int level,
+                                double alpha_fixed) {
+  Direction dir;
+  const std::vector<int> idx = active_indices(err);
+  dir.d = Vector::Zero(err.v.size());
+  if (idx.empty()) return dir;
+  const Matrix Cee = C.sub(idx);
+  Vector v_e(idx.size());
+  for (size_t a = 0; a < idx.size(); ++a) v_e[a] = err.v[idx[a]];
+  const double norm = inf_norm(Cee);
+  if (!(norm > 0)) return dir;
+  Vector d_e;
+  if (level == kAccelerationInfinity) {
+    Eigen::LLT<Matrix> llt(Cee);
+    if (llt.info() != Eigen::Success) return dir;
+    d_e = llt.solve(v_e);
+    dir.alpha = 1.0;
+    dir.n = 0;
+  } else {
+    const Matrix C1 = Cee / norm;
+    if (alpha_fixed > 0) {  // uzawa, or the eq. 30 warm-up
+      d_e = alpha_fixed * v_e / norm;
+      dir.alpha = alpha_fixed;
+      dir.n = 1;
+    } else {
+      double eps1;
+      if (params_.epsilon == EpsilonSource::warmup && warmup_eps_ > 0) {
+        out_.epsilon_used = "warmup";
+        eps1 = std::min(1.0, warmup_eps_);
+      } else {
+        out_.epsilon_used = "exact";
+        eps1 = smallest_eigenvalue(C1);
+      }
+      const int n = level == kAccelerationAuto ? auto_level(eps1) : level;
+      const AcceleratedStep step = accelerate(C1, eps1, n);
+      d_e = step.step_matrix * v_e / norm;
+      dir.alpha = step.alpha;
+      dir.n = n;
+    }
+  }
+  for (size_t a = 0; a < idx.size(); ++a) dir.d[idx[a]] = d_e[a];
+  dir.ok = d_e.allFinite();
+  return dir;
+}
+
+bool StepSolver::literal_pass(int first_level, double alpha_fixed) {
+  while (error_.norm2 > tol_) {
+    if (!budget_left()) return false;
+    int level = first_level;  // each update starts at the chosen n
+    const Compliance& C = eq_.compliance(out_.state, relevant_components());
+    const double v0 = error_.norm2;
+    const ContactError e = error_;
+    int trials = 0, halvings = 0;
+    double a = 1.0;
+    while (true) {
+      const Direction dir = direction(C, e, level, alpha_fixed);
+      if (!dir.ok) return fail("the active block of the compliance is not positive definite");
+      if (!budget_left()) return false;
+      const Vector pt = project_forces(problem_, out_.p, out_.p - a * dir.d, e, out_.tau);
+      ++trials;
+      EquilibriumState trial = eq_.solve(out_.state.q, pt);
+      if (trial.converged) {
+        const ContactError et = error_at(pt, trial.s, trial.enabled);
+        if (et.norm2 < v0) {
+          accept(std::move(trial), pt);
+          ++m_;
+          emit(trials, 0, halvings, dir.n, dir.alpha * a);
+          break;
+        }
+      }
+      a *= 0.5;
+      ++halvings;
+      if (halvings % params_.halvings_before_fallback == 0 && level > 1) {
+        --level;  // fall back to a smaller n, with a fresh alpha
+        a = 1.0;
+      }
+      if (halvings > params_.max_halvings)
+        return fail("alpha halved " + std::to_string(params_.max_halvings) +
+                    " times without a decrease of the contact error");
+    }
+  }
+  return true;
+}
+
+// Every component with a force or a friction bound, and those of candidates penetrating or
+// within a few per cent of the body's length of their obstacle. The others are frozen (a far
+// point that the real solve brings into contact joins at the next iteration).
+std::vector<int> StepSolver::relevant_components() const {
+  const double window = 0.05 * problem_.body->characteristic_length();
+  std::vector<int> out;
+  for (size_t i = 0; i < problem_.candidates.size(); ++i) {
+    const Candidate& c = problem_.candidates[i];
+    if (!out_.state.enabled[c.eta]) continue;
+    const bool near = out_.p[c.eta] < 0 || out_.tau[i] > 0 || out_.state.s[c.eta] > -window;
+    if (!near) continue;
+    out.push_back(c.eta);
+    if (c.xi >= 0 && out_.state.enabled[c.xi]) out.push_back(c.xi);
+  }
+  return out;
+}
+
+double StepSolver::force_precision() {
+  if (error_.norm2 == 0.0) return 0.0;
+  const std::vector<int> idx = active_indices(error_);
+  const Compliance& C = eq_.compliance(out_.state, idx);
+  Vector v_e(idx.size());
+  for (size_t a = 0; a < idx.size(); ++a) v_e[a] = error_.v[idx[a]];
+  Eigen::LLT<Matrix> llt(C.sub(idx));
+  if (llt.info() != Eigen::Success) return 0.0;
+  const Vector dp = llt.solve(v_e);
+  double largest = 0.0;
+  for (size_t a = 0; a < idx.size(); ++a)
+    if (is_normal_[idx[a]]) largest = std::max(largest, std::abs(dp[a]));
+  return largest;
+}
+
+void StepSolver::final_check() {
+  if (error_.norm2 > tol_) {
+    fail("contact error above tolerance at the end of the step");
+    return;
+  }
+  for (size_t i = 0; i < problem_.candidates.size(); ++i) {
+    const Candidate& c = problem_.candidates[i];
+    if (out_.p[c.eta] > 0) fail("a normal contact force pulls");
+    if (c.xi >= 0 && std::abs(out_.p[c.xi]) > out_.tau[i] * (1 + 1e-9) + 1e-300)
+      fail("a friction force exceeds its Coulomb bound");
+  }
+}
+
+void StepSolver::emit(int trials, int inner, int halvings, int n, double alpha) {
+  IterationEvent ev;
+  ev.step = step_;
+  ev.pass = pass_;
+  ev.m = m_;
+  ev.trials = trials;
+  ev.inner_iterations = inner;
+  ev.halvings = halvings;
+  ev.n = n;
+  ev.alpha = alpha;
+  ev.v2 = error_.norm2;
+  ev.v_inf = error_.norm_inf;
+  for (size_t i = 0; i < problem_.candidates.size(); ++i) {
+    switch (contact_state(problem_, i, out_.p, out_.tau)) {
+      case ContactState::open: ++ev.open; break;
+      case ContactState::stick: ++ev.stick; break;
+      case ContactState::slip: ++ev.slip; break;
+    }
+  }
+  ev.newton_iterations = trials > 0 ? out_.state.newton_iterations : 0;
+  ev.elapsed_ms = std::chrono::duration<double, std::milli>(Clock::now() - start_).count();
+  out_.history.push_back(ev);
+  if (observer_) observer_(ev);
+}
+
+}  // namespace grip

@@ -1,0 +1,109 @@
+#pragma once
+// What every contact strategy shares (internal to solver/contact): one load step's state, the
+// oracle calls (real equilibrium solves), the budgets (iterations, stop requests), the events,
+// the tau passes of eq. 14, the direction of eq. 13, the line search of real solves along a
+// predicted force change, the paper's literal loop (cev's `loop: paper`, and uzawa) and the
+// final check of eq. 12. Each strategy derives from StepSolver in its own file (cev.cpp,
+// uzawa.cpp, penalty.cpp, ssn.cpp); strategy.cpp picks one. Layering: the equilibrium oracle
+// below, load stepping above.
+#include <chrono>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "solver/contact/contact_error.hpp"
+#include "solver/contact/strategy.hpp"
+
+namespace grip {
+
+// The direction d of eq. 13 (pbar = p - d) on the active block, scattered to all components.
+struct Direction {
+  Vector d;
+  int n = 0;
+  double alpha = 1.0;
+  bool ok = false;
+};
+
+std::vector<int> active_indices(const ContactError& e);
+
+class StepSolver {
+ public:
+  StepSolver(Equilibrium& eq, const ContactParams& params, int step, const IterationObserver& obs,
+             const StopRequest& stop);
+  virtual ~StepSolver() = default;
+
+  // Couples Newton to the contact tolerance, runs the strategy, counts solves and iterations.
+  StepOutcome run(const Vector& q_guess, const Vector& p_start, const Vector& p_star);
+
+ protected:
+  // The strategy itself: fills out_ (converged, reason, p, tau, state).
+  virtual void solve(const Vector& q_guess, const Vector& p_start, const Vector& p_star) = 0;
+
+  // The tau passes of eq. 14 (ALGORITHM.md sections 4, 5): each pass holds tau = mu |p*| and
+  // runs `pass` (a Tresca problem); passes end when p* settles.
+  void tau_passes(const Vector& q_guess, const Vector& p_start, const Vector& p_star_in,
+                  const std::function<bool()>& pass);
+
+  // One real solve at out_.p from q, accepted as the new state (an event with m = 0).
+  bool fresh_solve(const Vector& q);
+  void accept(EquilibriumState s, const Vector& p);
+  bool fail(std::string reason);
+  // False (with the reason) once the step's real-solve budget is spent or a stop is asked.
+  bool budget_left();
+
+  // Real solves along p -> pl: the first trial is pl itself, then p + 2^-h (pl - p); the first
+  // with a smaller ||v|| is accepted. du is the linear model's displacement change for pl - p
+  // (Newton starts from it). `trials` counts the real solves.
+  bool line_search(const Vector& pl, const Vector& du, int& trials);
+
+  // Direction of eq. 13 for the active block of v: n = infinity solves with C'_EE; a finite n
+  // uses the polynomial accelerator (normalized, section 8); level 1 with alpha_fixed > 0 is
+  // the multiplier update.
+  Direction direction(const Compliance& C, const ContactError& err, int level, double alpha_fixed);
+
+  // The paper's literal loop: one real solve per eq. 13 update at acceleration `level` (cev's
+  // `loop: paper`), or the multiplier update with a fixed alpha (uzawa).
+  bool literal_pass(int level, double alpha_fixed);
+
+  // The components that can take part in this iteration (see step.cpp).
+  std::vector<int> relevant_components() const;
+  // The largest normal-force correction that the remaining contact error asks for.
+  double force_precision();
+  // eq. 12 with the current tau.
+  void final_check();
+  void emit(int trials, int inner, int halvings, int n, double alpha);
+
+  bool frictionless() const;
+  // The contact error at (p, s) with the current bounds out_.tau.
+  ContactError error_at(const Vector& p, const Vector& s, const std::vector<char>& enabled) const {
+    return contact_error(problem_, p, s, out_.tau, enabled);
+  }
+
+  Equilibrium& eq_;
+  const Problem& problem_;
+  const ContactParams& params_;
+  int step_;
+  const IterationObserver& observer_;
+  const StopRequest& stop_;
+  std::chrono::steady_clock::time_point start_;
+  double tol_ = 0.0;
+  int pass_ = 0, m_ = 0;
+  long solves_at_start_ = 0;
+  double warmup_eps_ = 0.0;
+  std::vector<char> is_normal_;
+  ContactError error_;
+  StepOutcome out_;
+};
+
+// One entry per strategy file.
+StepOutcome solve_cev_step(Equilibrium& eq, const Vector& q_guess, const Vector& p_start,
+                           const Vector& p_star, const ContactParams& params, int step,
+                           const IterationObserver& observer, const StopRequest& stop);
+StepOutcome solve_uzawa_step(Equilibrium& eq, const Vector& q_guess, const Vector& p_start,
+                             const Vector& p_star, const ContactParams& params, int step,
+                             const IterationObserver& observer, const StopRequest& stop);
+StepOutcome solve_penalty_step(Equilibrium& eq, const Vector& q_guess, const Vector& p_start,
+                               const Vector& p_star, const ContactParams& params, int step,
+                               const IterationObserver& observer, const StopRequest& stop);
+
+}  // namespace grip
