@@ -6,9 +6,13 @@ packages=(
   libeigen3-dev nlohmann-json3-dev libspdlog-dev libgtest-dev
   libcpp-httplib-dev libvalijson-dev libsqlite3-dev
   python3 python3-matplotlib
+  python3-venv python3-setuptools python3-wheel  # pip install ./clients/python, no index
   curl
+  chromium  # headless, for the browser test (tests/browser)
   clang libclang-rt-14-dev  # libFuzzer build of scripts/check-extended.sh
 )
+# Node.js and npm run the browser test's driver; an installed Node.js with its own npm will do.
+command -v npm > /dev/null || packages+=(nodejs npm)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -17,4 +21,13 @@ if [ ${#missing[@]} -gt 0 ]; then
   SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
   $SUDO apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+# The browser test's driver, puppeteer-core, at the versions pinned in its package-lock.json;
+# no browser is downloaded (the test uses Debian's chromium).
+browser_tests="$(cd "$(dirname "$0")/.." && pwd)/tests/browser"
+if [ -f "$browser_tests/package-lock.json" ] &&
+   { [ ! -f "$browser_tests/node_modules/.package-lock.json" ] ||
+     [ "$browser_tests/package-lock.json" -nt "$browser_tests/node_modules/.package-lock.json" ]; }; then
+  (cd "$browser_tests" && npm ci --no-audit --no-fund --ignore-scripts --loglevel=error)
 fi

@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "server/tar.hpp"
+#include "server/ui.hpp"
 #include "server/util.hpp"
 #include "solver/io/export_csv.hpp"
 #include "solver/io/export_vtk.hpp"
@@ -204,7 +205,8 @@ void HttpServer::Impl::hooks() {
   svr.set_pre_routing_handler([this](const Request& req, Response& res) {
     request_start = std::chrono::steady_clock::now();
     ++requests;
-    if (!options.token || req.path == "/v1/health") return httplib::Server::HandlerResponse::Unhandled;
+    if (!options.token || req.path == "/v1/health" || is_page_request(req))
+      return httplib::Server::HandlerResponse::Unhandled;
     const std::string auth = req.get_header_value("Authorization");
     const std::string prefix = "Bearer ";
     if (auth.size() > prefix.size() && lower(auth.substr(0, prefix.size())) == "bearer " &&
@@ -275,7 +277,9 @@ void HttpServer::Impl::routes() {
   svr.Get("/v1/metrics", [this](const Request& req, Response& res) { metrics(req, res); });
 
   // ---- landing page and OGC API - Processes
-  svr.Get("/", [](const Request&, Response& res) {
+  svr.Get("/", [](const Request& req, Response& res) {
+    res.set_header("Vary", "Accept");
+    if (wants_page(req) && serve_page_file(req, res, "index.html")) return;
     send_json(res, 200,
               {{"title", "grip"},
                {"description", "2D frictional contact solver service (contact error vector scheme)"},
@@ -283,6 +287,12 @@ void HttpServer::Impl::routes() {
                                       {{"href", "/conformance"}, {"rel", "http://www.opengis.net/def/rel/ogc/1.0/conformance"}},
                                       {{"href", "/processes"}, {"rel", "http://www.opengis.net/def/rel/ogc/1.0/processes"}},
                                       {{"href", "/jobs"}, {"rel", "http://www.opengis.net/def/rel/ogc/1.0/job-list"}}})}});
+  });
+  // ---- the browser page (server/ui.hpp)
+  svr.Get("/ui", [](const Request& req, Response& res) { serve_page_file(req, res, "index.html"); });
+  svr.Get(R"(/ui/([^/]+))", [](const Request& req, Response& res) {
+    if (!serve_page_file(req, res, req.matches[1]))
+      problem(res, req, 404, "not-found", "Not found", "the page has no file '" + req.matches[1].str() + "'");
   });
   svr.Get("/conformance", [](const Request&, Response& res) {
     send_json(res, 200,

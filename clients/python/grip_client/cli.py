@@ -352,8 +352,10 @@ def cmd_plot(client: Client, args, out: TextIO) -> int:
         plots.pyplot()
     except ImportError as e:
         out.flush()
-        sys.stderr.write(f"plot needs matplotlib ({e}); on Debian: apt-get install "
-                         "python3-matplotlib and run /usr/bin/python3\n")
+        sys.stderr.write(f"plot needs matplotlib ({e}). On Debian: apt-get install "
+                         "python3-matplotlib, then run /usr/bin/python3, or a venv made with "
+                         "--system-site-packages; elsewhere: pip install 'grip-client[plot]'. "
+                         "Every other command works without it.\n")
         return EXIT_USAGE
     if args.paper:
         return plot_paper(client, args, out, plots)
@@ -471,7 +473,9 @@ def build_parser() -> argparse.ArgumentParser:
                         help="service URL (default: $GRIP_URL, else http://127.0.0.1:8080)")
     common.add_argument("--token", default=argparse.SUPPRESS,
                         help="bearer token (default: $GRIP_TOKEN)")
-    p = argparse.ArgumentParser(prog="python3 -m grip_client", parents=[common],
+    # `grip-client` when installed (console script), else the module.
+    prog = "grip-client" if os.path.basename(sys.argv[0]) == "grip-client" else "python3 -m grip_client"
+    p = argparse.ArgumentParser(prog=prog, parents=[common],
                                 description="Submit, follow, fetch and plot grip jobs.",
                                 epilog="Exit codes: 0 success, 1 a job failed, 2 usage or HTTP "
                                        "error (with the problem's pointers).")

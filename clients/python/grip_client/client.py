@@ -71,7 +71,14 @@ class GripError(Exception):
 
 
 class Event:
-    """One event of a job: `id` (the per-job sequence, SSE id), `type`, `data` (dict)."""
+    """One event of a job: `id` (the per-job sequence, SSE id), `type`, `data` (dict).
+
+    Types (schemas/event.schema.json): step_started {step, load_factor}; iteration {step,
+    pass, m, n, alpha, v2 and v_inf (||v||_2 and ||v||_inf of the contact error vector, in the
+    scene's length unit), open, stick, slip (contact point counts), newton_iterations,
+    elapsed_ms (milliseconds since the step began)}; step_finished {step, load_factor,
+    converged, contact_iterations, newton_iterations, seconds, ...}; job_finished; job_failed
+    {reason}."""
 
     __slots__ = ("id", "type", "data")
 
@@ -80,13 +87,13 @@ class Event:
         self.type = type
         self.data = data
 
-    def __getitem__(self, key):
+    def __getitem__(self, key: str) -> Any:
         return self.data[key]
 
-    def get(self, key, default=None):
+    def get(self, key: str, default: Any = None) -> Any:
         return self.data.get(key, default)
 
-    def __repr__(self):
+    def __repr__(self) -> str:
         return f"Event(id={self.id!r}, type={self.type!r}, data={self.data!r})"
 
 
@@ -144,8 +151,10 @@ class Client:
         return h
 
     def open(self, method: str, path: str, body: Optional[bytes] = None,
-             headers: Optional[dict] = None, timeout: Optional[float] = None):
-        """Sends a request and returns the open response; raises GripError on >= 400."""
+             headers: Optional[Dict[str, str]] = None,
+             timeout: Optional[float] = None) -> http.client.HTTPResponse:
+        """Sends a request and returns the open response; raises GripError on >= 400.
+        `timeout` in seconds (default: the client's)."""
         url = self.absolute(path)
         req = urllib.request.Request(url, data=body, method=method, headers=self._headers(headers))
         try:
@@ -157,7 +166,7 @@ class Client:
             raise GripError(0, message=f"cannot reach {url}: {reason}", url=url) from None
 
     def request(self, method: str, path: str, body: Optional[bytes] = None,
-                headers: Optional[dict] = None, raw: bool = False):
+                headers: Optional[Dict[str, str]] = None, raw: bool = False) -> Any:
         """Sends a request; returns parsed JSON, or bytes when `raw` or not JSON."""
         with self.open(method, path, body, headers) as resp:
             data = resp.read()
@@ -168,12 +177,14 @@ class Client:
             return json.loads(data.decode("utf-8")) if data else None
         return data
 
-    def get(self, path: str, **kw):
+    def get(self, path: str, **kw: Any) -> Any:
+        """GET `path`: parsed JSON, or bytes (see request)."""
         return self.request("GET", path, **kw)
 
     # ---- service
 
     def health(self) -> dict:
+        """{"status": "ok"} while the server runs."""
         return self.get("/v1/health")
 
     def examples(self) -> List[str]:
@@ -181,9 +192,11 @@ class Client:
         return [item["name"] for item in self.get("/v1/examples").get("items", [])]
 
     def example(self, name: str) -> dict:
+        """A built-in example scene (units in its `units`, e.g. kgf and cm)."""
         return self.get("/v1/examples/" + urllib.parse.quote(name))
 
     def schema(self, name: str) -> dict:
+        """A JSON Schema by name: scene, result, event or job."""
         return self.get("/v1/schemas/" + urllib.parse.quote(name))
 
     # ---- jobs
@@ -258,7 +271,7 @@ class Job:
         self.last_event_id: Optional[int] = None
         self.reconnects = 0
 
-    def __repr__(self):
+    def __repr__(self) -> str:
         return f"Job({self.id!r}, status={self.doc.get('status')!r})"
 
     @property
@@ -357,7 +370,14 @@ class Job:
                step: Optional[int] = None) -> Union[dict, str, bytes]:
         """The result: a dict (json), CSV text (csv; `table` = steps | nodes | elements |
         contact_points | history) or VTK bytes (vtk: a tar of per-step files + .pvd, or one
-        step's legacy file with `step`)."""
+        step's legacy file with `step`, from 1).
+
+        The dict (schemas/result.schema.json) has `scene` (effective, defaults filled),
+        `effects`, `mesh.cells`, `summary` and `steps[]`; per step `nodes[]` (deformed x, y and
+        displacements in the scene's length unit, beam rotation theta in radians),
+        `elements[]`, and `contact_points[]` with p_n, p_t (force; p_n <= 0 presses),
+        sigma_n, sigma_t (force per length squared), gap and slip (length), state (open |
+        stick | slip)."""
         query: Dict[str, str] = {}
         if format != "json":
             query["format"] = format
@@ -374,7 +394,9 @@ class Job:
         return data
 
     def convergence(self, format: str = "json") -> Union[dict, str]:
-        """The whole contact error history: {"iterations": [...]} or CSV text."""
+        """The whole contact error history: {"jobID", "status", "iterations": [row, ...]}, one
+        row per contact iteration (the iteration event without its type: v2 and v_inf in the
+        scene's length unit, elapsed_ms in milliseconds), or the same as CSV text."""
         data = self.client.get(self.path + "/convergence?format=" + format, raw=True)
         return json.loads(data.decode("utf-8")) if format == "json" else data.decode("utf-8")
 

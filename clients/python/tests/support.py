@@ -23,10 +23,18 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 PACKAGE_DIR = os.path.dirname(HERE)  # clients/python
 REPO = os.path.dirname(os.path.dirname(PACKAGE_DIR))
 EXAMPLES = os.path.join(REPO, "schemas", "examples")
-if PACKAGE_DIR not in sys.path:
+# GRIP_CLIENT_INSTALLED=1 (tests/installed.sh): the package as pip installed it into a venv,
+# and the command line as its `grip-client` script; otherwise this source tree.
+INSTALLED = os.environ.get("GRIP_CLIENT_INSTALLED") == "1"
+if not INSTALLED and PACKAGE_DIR not in sys.path:
     sys.path.insert(0, PACKAGE_DIR)
 
+import grip_client  # noqa: E402
 from grip_client import Client  # noqa: E402
+
+if INSTALLED and os.path.abspath(grip_client.__file__).startswith(PACKAGE_DIR + os.sep):
+    raise RuntimeError(f"GRIP_CLIENT_INSTALLED=1 but grip_client comes from the source tree: "
+                       f"{grip_client.__file__}")
 
 
 def grip_binary() -> str:
@@ -132,15 +140,20 @@ def long_sheet(steps: int = 600) -> dict:
 
 
 def cli(*args, env_extra=None, timeout=120):
-    """Runs `python3 -m grip_client ARGS` (this interpreter) against the run's server."""
+    """Runs `python3 -m grip_client ARGS` (this interpreter; installed: the venv's `grip-client`
+    command) against the run's server."""
     env = dict(os.environ)
-    env["PYTHONPATH"] = PACKAGE_DIR + os.pathsep + env.get("PYTHONPATH", "")
     env["GRIP_URL"] = server().url
     env.pop("GRIP_TOKEN", None)
+    if INSTALLED:
+        command = [os.path.join(os.path.dirname(sys.executable), "grip-client")]
+    else:
+        env["PYTHONPATH"] = PACKAGE_DIR + os.pathsep + env.get("PYTHONPATH", "")
+        command = [sys.executable, "-m", "grip_client"]
     if env_extra:
         env.update(env_extra)
-    return subprocess.run([sys.executable, "-m", "grip_client", *args], capture_output=True,
-                          text=True, env=env, timeout=timeout, cwd=REPO)
+    return subprocess.run([*command, *args], capture_output=True, text=True, env=env,
+                          timeout=timeout, cwd=REPO)
 
 
 class CuttingProxy:

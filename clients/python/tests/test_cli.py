@@ -83,6 +83,25 @@ class Cli(unittest.TestCase):
         self.assertEqual(p.returncode, 2)
         self.assertIn("cannot reach", p.stderr)
 
+    def test_plot_without_matplotlib_says_how_to_get_it(self):
+        # A matplotlib that cannot be imported, first on the path: as on a python without it.
+        hidden = os.path.join(self.tmp.name, "no-matplotlib", "matplotlib")
+        os.makedirs(hidden, exist_ok=True)
+        with open(os.path.join(hidden, "__init__.py"), "w", encoding="utf-8") as f:
+            f.write("raise ImportError('No module named matplotlib')\n")
+        path = os.path.dirname(hidden) + os.pathsep + os.environ.get("PYTHONPATH", "")
+        if not support.INSTALLED:
+            path = os.path.dirname(hidden) + os.pathsep + support.PACKAGE_DIR
+        p = support.cli("plot", "any-job", "-o", self.tmp.name, env_extra={"PYTHONPATH": path})
+        self.assertEqual(p.returncode, 2, p.stderr)
+        self.assertIn("plot needs matplotlib", p.stderr)
+        self.assertIn("python3-matplotlib", p.stderr)
+        self.assertIn("grip-client[plot]", p.stderr)
+        self.assertNotIn("Traceback", p.stderr)
+        # Everything else works without it.
+        p = support.cli("list", "--limit", "1", env_extra={"PYTHONPATH": path})
+        self.assertEqual(p.returncode, 0, p.stderr)
+
     def test_status_list_result_dismiss(self):
         job = self.client.submit(support.small_beam(steps=2))
         job.wait()

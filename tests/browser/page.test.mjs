@@ -1,0 +1,324 @@
+// The page of `grip serve` in a real browser: Debian's headless Chromium driven by
+// puppeteer-core (tests/browser/package-lock.json, installed by scripts/setup.sh with npm ci).
+// Against a live `grip serve` on a free loopback port: a running job watched live and across a
+// server restart, the beam example submitted and shown, a bad scene's pointer errors.
+// Screenshots go to $GRIP_ARTIFACTS (default build/browser-artifacts), never committed.
+//   GRIP_BINARY=build/apps/grip node --test tests/browser/page.test.mjs
+import { test, before, after } from "node:test";
+import assert from "node:assert/strict";
+import { spawn } from "node:child_process";
+import { mkdtempSync, mkdirSync, readFileSync, rmSync, openSync } from "node:fs";
+import { tmpdir } from "node:os";
+import { dirname, join, resolve } from "node:path";
+import { fileURLToPath } from "node:url";
+import puppeteer from "puppeteer-core";
+
+const REPO = resolve(dirname(fileURLToPath(import.meta.url)), "../..");
+const GRIP = process.env.GRIP_BINARY || join(REPO, "build/apps/grip");
+const CHROMIUM = process.env.CHROMIUM || "/usr/bin/chromium";
+const ARTIFACTS = process.env.GRIP_ARTIFACTS || join(REPO, "build/browser-artifacts");
+const example = (name) => JSON.parse(readFileSync(join(REPO, "schemas/examples", name + ".json"), "utf8"));
+const sleep = (ms) => new Promise((r) => setTimeout(r, ms));
+
+// ---- a throwaway `grip serve`: temp folder, loopback, the port read from its log.
+class Server {
+  constructor(extraArgs = []) {
+    this.dir = mkdtempSync(join(tmpdir(), "grip-browser-"));
+    this.port = 0;
+    this.extraArgs = extraArgs;
+  }
+  async start() {
+    const log = join(this.dir, `server-${Date.now()}.log`);
+    const fd = openSync(log, "w");
+    this.proc = spawn(GRIP, ["serve", "--host", "127.0.0.1", "--port", String(this.port),
+                             "--db", join(this.dir, "jobs.sqlite"), "--workers", "2", "--grace", "0",
+                             "--heartbeat", "1", "--schemas", join(REPO, "schemas"), ...this.extraArgs],
+                      { stdio: ["ignore", fd, fd], cwd: this.dir });
+    const deadline = Date.now() + 30000;
+    while (Date.now() < deadline) {
+      const m = readFileSync(log, "utf8").match(/listening on http:\/\/[0-9.]+:(\d+)/);
+      if (m) {
+        this.port = Number(m[1]);
+        this.url = `http://127.0.0.1:${this.port}`;
+        return;
+      }
+      if (this.proc.exitCode !== null) break;
+      await sleep(50);
+    }
+    throw new Error("grip serve did not start:\n" + readFileSync(log, "utf8"));
+  }
+  async stop() {
+    if (!this.proc || this.proc.exitCode !== null) return;
+    const exited = new Promise((r) => this.proc.once("exit", r));
+    this.proc.kill("SIGTERM");
+    await Promise.race([exited, sleep(20000)]);
+    if (this.proc.exitCode === null) this.proc.kill("SIGKILL");
+  }
+  async api(path, init = {}) {
+    if (this.token) init = { ...init, headers: { ...init.headers, Authorization: "Bearer " + this.token } };
+    const res = await fetch(this.url + path, init);
+    const text = await res.text();
+    return { status: res.status, headers: res.headers, body: text.startsWith("{") ? JSON.parse(text) : text };
+  }
+  submit(scene) {
+    return this.api("/v1/jobs", { method: "POST", headers: { "Content-Type": "application/json" }, body: JSON.stringify(scene) });
+  }
+  // Every event of a finished job from its SSE replay: [{seq, type, data}].
+  async events(id) {
+    const text = (await this.api(`/v1/jobs/${id}/events`)).body;
+    return text.split("\n\n").filter((b) => b.includes("data:")).map((b) => {
+      const f = Object.fromEntries(b.split("\n").map((l) => [l.slice(0, l.indexOf(":")), l.slice(l.indexOf(":") + 2)]));
+      return { seq: Number(f.id), type: f.event, data: JSON.parse(f.data) };
+    });
+  }
+}
+
+// A beam of many elements: about ten contact iterations a second, for minutes.
+function slowBeam() {
+  const s = example("beam-on-cylinder");
+  s.body.mesh.elements = 1500;
+  s.body.loads[0].node = 1500;
+  s.steps = 400;
+  return s;
+}
+
+const server = new Server();
+let browser, page;
+const problems = [];  // console errors, page errors, CSP violations
+
+before(async () => {
+  mkdirSync(ARTIFACTS, { recursive: true });
+  await server.start();
+  browser = await puppeteer.launch({
+    executablePath: CHROMIUM,
+    headless: true,
+    // Chromium's sandbox refuses to run as root (containers, CI); as any other user it stays on.
+    args: process.getuid?.() === 0 ? ["--no-sandbox"] : [],
+  });
+  page = await browser.newPage();
+  await page.setViewport({ width: 1280, height: 800 });
+  page.on("console", (m) => { if (m.type() === "error") problems.push("console: " + m.text()); });
+  page.on("pageerror", (e) => problems.push("page error: " + e.message));
+  await page.evaluateOnNewDocument(() => {
+    document.addEventListener("securitypolicyviolation", (e) => console.error(`CSP violation: ${e.violatedDirective} ${e.blockedURI}`));
+  });
+});
+
+after(async () => {
+  await browser?.close();
+  await server.stop();
+  rmSync(server.dir, { recursive: true, force: true });
+});
+
+const count = (selector) => page.$$eval(selector, (els) => els.length);
+const text = (selector) => page.$eval(selector, (el) => el.textContent);
+
+test("the page is served with ETag, caching and CSP; JSON clients still get the landing document", async () => {
+  const html = await server.api("/", { headers: { Accept: "text/html,application/xhtml+xml,*/*;q=0.8" } });
+  assert.equal(html.status, 200);
+  assert.match(html.headers.get("content-type"), /^text\/html/);
+  assert.match(html.headers.get("content-security-policy"), /default-src 'none'; script-src 'self'/);
+  assert.equal(html.headers.get("cache-control"), "no-cache");
+  const etag = html.headers.get("etag");
+  assert.match(etag, /^"[0-9a-f]{20}"$/);
+  assert.equal((await server.api("/ui", { headers: { "If-None-Match": etag } })).status, 304);
+  const js = await server.api("/ui/app.js");
+  assert.match(js.headers.get("content-type"), /^text\/javascript/);
+  assert.notEqual(js.headers.get("etag"), etag);
+  const landing = await server.api("/", { headers: { Accept: "application/json" } });
+  assert.equal(landing.body.title, "grip");
+  assert.equal((await server.api("/ui/missing.js")).status, 404);
+});
+
+test("a running job: the plot grows live, and resumes across a server restart without gaps", async () => {
+  const started = Date.now();
+  const job = (await server.submit(slowBeam())).body;
+  await page.goto(`${server.url}/#job=${job.jobID}`);
+  await page.waitForFunction(() => document.querySelectorAll("#conv-plot circle.pt").length >= 8, { timeout: 30000 });
+  assert.equal(await text("#job-id"), job.jobID);
+  assert.match(await text("#job-status"), /running: step \d+/);
+  const rows = await count("#step-table tbody tr");
+  assert.ok(rows >= 1, "steps finished so far are in the table");
+  await page.screenshot({ path: join(ARTIFACTS, "running.png"), fullPage: true });
+
+  // Restart the server mid-stream: the page loses its stream, retries, and resumes with
+  // Last-Event-ID; the interrupted run's events are discarded by the server and the job runs
+  // again, so the page starts the plot over with the new run.
+  const seqBefore = await page.$$eval("#conv-plot circle.pt", (els) => Math.max(...els.map((e) => Number(e.dataset.seq))));
+  await server.stop();
+  await page.waitForFunction(() => /connection lost/.test(document.getElementById("stream-status").textContent), { timeout: 15000 });
+  await server.start();  // same port, same database
+  await page.waitForFunction(() => /restarted the job/.test(document.getElementById("stream-status").textContent), { timeout: 30000 });
+  // The new run's points: numbered after the old run's (event ids are never reused).
+  await page.waitForFunction((before) => {
+    const pts = [...document.querySelectorAll("#conv-plot circle.pt")];
+    return pts.length >= 4 && Number(pts[0].dataset.seq) > before;
+  }, { timeout: 30000 }, seqBefore);
+  await page.screenshot({ path: join(ARTIFACTS, "running-after-restart.png"), fullPage: true });
+
+  // Dismiss from the list; the page ends with job_failed (dismissed), holding exactly the
+  // server's iteration events of the run.
+  await page.waitForSelector(`#jobs-table tr[data-job="${job.jobID}"] button[aria-label^="dismiss"]`);
+  await page.click(`#jobs-table tr[data-job="${job.jobID}"] button[aria-label^="dismiss"]`);
+  await page.waitForFunction(() => document.getElementById("job-panel").dataset.state !== "watching", { timeout: 30000 });
+  assert.match(await text("#job-status"), /failed: dismissed/);
+  assert.equal((await server.api(`/v1/jobs/${job.jobID}`)).body.status, "dismissed");
+  await sleep(400);  // the plot redraws at most every 250 ms
+  const serverSeqs = (await server.events(job.jobID)).filter((e) => e.type === "iteration").map((e) => e.seq);
+  const pageSeqs = await page.$$eval("#conv-plot circle.pt", (els) => els.map((e) => Number(e.dataset.seq)));
+  assert.deepEqual(pageSeqs, serverSeqs);
+  console.log(`# running job, restart and dismissal: ${((Date.now() - started) / 1000).toFixed(1)} s, ${pageSeqs.length} points after the restart`);
+});
+
+test("the beam example: submitted from the page, watched to the end, its result drawn", async () => {
+  await page.goto(server.url + "/ui");
+  await page.waitForFunction(() => document.querySelectorAll("#example option").length > 1);
+  await page.select("#example", "/v1/examples/beam-on-cylinder");
+  await page.waitForFunction(() => document.getElementById("scene").value.includes("beam-on-cylinder"));
+  await page.click("#submit");
+  await page.waitForFunction(() => document.getElementById("job-panel").dataset.state === "result", { timeout: 60000 });
+  await sleep(400);
+  const id = await text("#job-id");
+  const result = (await server.api(`/v1/jobs/${id}/result`)).body;
+  const events = await server.events(id);
+
+  // One point per iteration event, in order, each in its step's colour.
+  const iterations = events.filter((e) => e.type === "iteration");
+  assert.ok(iterations.length > 20);
+  const points = await page.$$eval("#conv-plot circle.pt", (els) => els.map((e) => ({ seq: Number(e.dataset.seq), step: Number(e.dataset.step) })));
+  assert.deepEqual(points, iterations.map((e) => ({ seq: e.seq, step: e.data.step })));
+  assert.equal(await page.$eval("#count-iterations", (e) => Number(e.textContent)), iterations.length);
+  // The tolerance line: 1e-8 x the beam's 30 cm.
+  const tol = await page.$eval("#tolerance-line", (e) => Number(e.dataset.value));
+  assert.ok(Math.abs(tol - 30e-8) < 1e-15, `tolerance ${tol}`);
+
+  // The step table equals the result's steps.
+  const table = await page.$$eval("#step-table tbody tr", (rows) => rows.map((r) => [...r.cells].map((c) => c.textContent)));
+  assert.equal(table.length, result.steps.length);
+  table.forEach((row, k) => {
+    const s = result.steps[k];
+    assert.equal(Number(row[0]), s.step);
+    assert.equal(Number(row[1]), s.load_factor);
+    assert.equal(row[2], s.converged ? "yes" : `no: ${s.reason}`);
+    assert.equal(Number(row[3]), s.contact_iterations);
+    assert.equal(Number(row[4]), s.newton_iterations);
+  });
+
+  // Contact points: one per candidate of the step shown, coloured as the legend says for its state.
+  const legend = await page.evaluate(() => Object.fromEntries(["open", "stick", "slip"].map((s) =>
+    [s, getComputedStyle(document.querySelector(`#result-view .key.${s}`), "::before").backgroundColor])));
+  const rgb = (hex) => `rgb(${[1, 3, 5].map((i) => parseInt(hex.slice(i, i + 2), 16)).join(", ")})`;
+  async function checkStep(k) {
+    assert.equal(await page.$eval("#body-view", (e) => Number(e.dataset.step)), k);
+    const drawn = await page.$$eval("#body-view circle.cp", (els) => els.map((e) =>
+      ({ node: Number(e.dataset.node), state: e.dataset.state, fill: e.getAttribute("fill") })));
+    const expected = result.steps[k - 1].contact_points;
+    assert.equal(drawn.length, expected.length);
+    drawn.forEach((d, i) => {
+      assert.equal(d.node, expected[i].node);
+      assert.equal(d.state, expected[i].state);
+      assert.equal(rgb(d.fill), legend[d.state], `node ${d.node} (${d.state}) drawn ${d.fill}`);
+    });
+    return new Set(drawn.map((d) => d.state));
+  }
+  const last = result.steps.length;
+  const statesLast = await checkStep(last);
+  assert.ok(statesLast.size >= 2, `the last step shows several states: ${[...statesLast]}`);
+  assert.equal(await count("#stress-plot circle.sigma_n-pt"), result.steps[last - 1].contact_points.length);
+  await page.screenshot({ path: join(ARTIFACTS, "finished.png"), fullPage: true });
+
+  // The step slider by keyboard: Home goes to step 1.
+  await page.focus("#step-slider");
+  await page.keyboard.press("Home");
+  await checkStep(1);
+
+  // Downloads: JSON, CSV and VTK links that answer.
+  const links = await page.$$eval("#downloads a", (as) => as.map((a) => a.getAttribute("href")));
+  for (const want of ["/result", "format=csv&table=nodes", "format=csv&table=contact_points", "/convergence?format=csv", "format=vtk"])
+    assert.ok(links.some((h) => h.includes(want)), `a download link with ${want}`);
+  for (const href of links) assert.equal((await server.api(href)).status, 200, href);
+
+  // Phone width: everything fits across.
+  await page.setViewport({ width: 390, height: 844 });
+  await sleep(200);
+  assert.ok(await page.evaluate(() => document.documentElement.scrollWidth <= window.innerWidth + 1), "no sideways scrolling at 390 px");
+  await page.screenshot({ path: join(ARTIFACTS, "finished-phone.png"), fullPage: true });
+  await page.setViewport({ width: 1280, height: 800 });
+});
+
+test("a bad scene: errors next to the pointers the server names, nothing queued", async () => {
+  await page.goto(server.url + "/ui");
+  const before = (await server.api("/v1/jobs?limit=1000")).body.jobs.length;
+  const bad = example("beam-on-cylinder");
+  bad.body.material.young = -1;
+  bad.obstacles[0].friction = "high";
+  const expected = (await server.submit(bad)).body;  // the API's own answer, for comparison
+  assert.equal(expected.status, 422);
+
+  await page.$eval("#scene", (e, t) => { e.value = t; }, JSON.stringify(bad, null, 2));
+  await page.click("#submit");
+  await page.waitForSelector("#submit-errors li");
+  const shown = await page.$$eval("#submit-errors li", (lis) => lis.map((li) =>
+    ({ pointer: li.dataset.pointer, code: li.querySelector("code.pointer").textContent, text: li.textContent })));
+  assert.deepEqual(shown.map((s) => s.pointer), expected.errors.map((e) => e.pointer));
+  assert.ok(shown.some((s) => s.code === "/body/material/young"));
+  assert.ok(shown.some((s) => s.code === "/obstacles/0/friction"));
+  shown.forEach((s, i) => assert.ok(s.text.includes(expected.errors[i].detail)));
+  await page.screenshot({ path: join(ARTIFACTS, "bad-scene.png"), fullPage: true });
+
+  // Not JSON at all: found by the page, never sent.
+  await page.$eval("#scene", (e) => { e.value = "{\"body\": "; });
+  await page.click("#submit");
+  await page.waitForFunction(() => /not JSON/.test(document.getElementById("submit-errors").textContent));
+  assert.equal((await server.api("/v1/jobs?limit=1000")).body.jobs.length, before);
+});
+
+test("the job list: newest first, ten to a page, Older and Newer", async () => {
+  const tiny = example("beam-on-cylinder");
+  Object.assign(tiny, { steps: 2 });
+  Object.assign(tiny.body.mesh, { elements: 4 });
+  tiny.body.loads[0].node = 4;
+  for (let i = 0; i < 11; i++) assert.equal((await server.submit(tiny)).status, 201);
+  const all = (await server.api("/v1/jobs?limit=1000")).body.jobs.map((j) => j.jobID);
+  assert.ok(all.length > 10);
+  await page.goto(server.url + "/ui");
+  const rows = () => page.$$eval("#jobs-table tbody tr", (trs) => trs.map((tr) => tr.dataset.job));
+  await page.waitForFunction(() => document.querySelectorAll("#jobs-table tbody tr").length === 10);
+  assert.deepEqual(await rows(), all.slice(0, 10));
+  await page.click("#jobs-older");
+  await page.waitForFunction(() => document.getElementById("jobs-page").textContent === "page 2");
+  assert.deepEqual(await rows(), all.slice(10, 20));
+  await page.click("#jobs-newer");
+  await page.waitForFunction(() => document.getElementById("jobs-page").textContent === "page 1");
+  assert.deepEqual(await rows(), all.slice(0, 10));
+});
+
+test("with a bearer token: the page asks for it, keeps it in sessionStorage, and works", async () => {
+  const secured = new Server(["--token", "page-test-token"]);
+  await secured.start();
+  try {
+    const tab = await browser.newPage();
+    await tab.goto(secured.url + "/");  // the page itself needs no token
+    await tab.waitForFunction(() => /wants a bearer token/.test(document.getElementById("connection").textContent));
+    await tab.type("#token", "page-test-token");
+    await tab.click("#token-form button");
+    await tab.waitForFunction(() => document.querySelectorAll("#example option").length > 1);
+    assert.equal(await tab.evaluate(() => sessionStorage.getItem("grip.token")), "page-test-token");
+    await tab.select("#example", "/v1/examples/beam-on-cylinder");
+    await tab.waitForFunction(() => document.getElementById("scene").value.includes("beam-on-cylinder"));
+    await tab.click("#submit");
+    await tab.waitForFunction(() => document.getElementById("job-panel").dataset.state === "result", { timeout: 60000 });
+    assert.ok(await tab.$$eval("#conv-plot circle.pt", (els) => els.length) > 20);
+    // A reload keeps the token (same tab).
+    await tab.reload();
+    await tab.waitForFunction(() => document.querySelectorAll("#jobs-table tbody tr").length === 1);
+    await tab.close();
+  } finally {
+    await secured.stop();
+    rmSync(secured.dir, { recursive: true, force: true });
+  }
+});
+
+test("no console errors, page errors or CSP violations", () => {
+  assert.deepEqual(problems.filter((p) => !/Failed to load resource|ERR_CONNECTION_REFUSED|net::ERR/.test(p)), []);
+});
