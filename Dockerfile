@@ -2,11 +2,17 @@
 # non-root user with the job database on a volume.
 #   docker build -t grip .
 #   docker run -d -p 8080:8080 -v grip-data:/var/lib/grip --name grip grip
-#   docker stop grip     # SIGTERM: running jobs get --grace seconds (default 8) to finish
+#   docker stop grip     # SIGTERM: running jobs get GRIP_GRACE seconds (5 here) to finish
+# Grace and stop timeout fit together: `docker stop` waits 10 s by default before SIGKILL; the
+# service takes GRIP_GRACE (5 s) for running jobs, then requeues what is left and exits, well
+# inside those 10 s. A longer GRIP_GRACE needs `docker stop -t` / `--stop-timeout` (compose:
+# stop_grace_period) at least GRIP_GRACE + 5 s.
+# A bind-mounted data folder (-v /srv/grip:/var/lib/grip) must be writable by uid 10001.
+# Several replicas on one PostgreSQL: GRIP_DB=postgresql://... (deploy/compose.yaml).
 FROM debian:12-slim AS build
 WORKDIR /src
 COPY scripts/setup.sh scripts/setup.sh
-RUN bash scripts/setup.sh && rm -rf /var/lib/apt/lists/*
+RUN bash scripts/setup.sh --service && rm -rf /var/lib/apt/lists/*
 COPY . .
 RUN cmake -S . -B /build -G Ninja -DCMAKE_BUILD_TYPE=Release \
  && cmake --build /build --target grip \
@@ -15,7 +21,7 @@ RUN cmake -S . -B /build -G Ninja -DCMAKE_BUILD_TYPE=Release \
 FROM debian:12-slim
 RUN apt-get update -qq \
  && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
-      libcpp-httplib0.11 libspdlog1.10 libfmt9 libsqlite3-0 \
+      libcpp-httplib0.11 libspdlog1.10 libfmt9 libsqlite3-0 libpq5 \
  && rm -rf /var/lib/apt/lists/* \
  && useradd --system --uid 10001 --user-group --home-dir /var/lib/grip --create-home grip
 COPY --from=build /build/apps/grip /usr/local/bin/grip
@@ -23,6 +29,7 @@ COPY --from=build /src/schemas /usr/local/share/grip/schemas
 ENV GRIP_HOST=0.0.0.0 \
     GRIP_PORT=8080 \
     GRIP_DB=/var/lib/grip/grip.sqlite \
+    GRIP_GRACE=5 \
     GRIP_SCHEMAS=/usr/local/share/grip/schemas
 USER grip
 WORKDIR /var/lib/grip

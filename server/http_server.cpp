@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <regex>
 #include <sstream>
 
 #include "server/tar.hpp"
@@ -104,12 +105,29 @@ std::optional<std::int64_t> decode_cursor(const std::string& c) {
 
 std::string job_path(const std::string& id) { return "/v1/jobs/" + id; }
 
+// The methods a known route takes (empty: no such route), for 405 + Allow.
+std::string allowed_methods(const std::string& path) {
+  static const std::vector<std::pair<std::regex, std::string>> routes = {
+      {std::regex(R"(/v1/jobs)"), "GET, POST"},
+      {std::regex(R"(/jobs)"), "GET"},
+      {std::regex(R"(/(v1/)?jobs/[^/]+)"), "GET, DELETE"},
+      {std::regex(R"(/(v1/)?jobs/[^/]+/(events|convergence|result|results))"), "GET"},
+      {std::regex(R"(/(v1/)?processes/contact2d/execution)"), "POST"},
+      {std::regex(R"(/|/conformance|/(v1/)?processes(/contact2d)?|/v1/(health|ready|metrics))"), "GET"},
+      {std::regex(R"(/v1/(schemas|examples)(/[^/]+)?)"), "GET"},
+  };
+  for (const auto& [pattern, methods] : routes)
+    if (std::regex_match(path, pattern)) return methods;
+  return "";
+}
+
 json job_document(const JobView& v) {
   const JobRecord& r = v.record;
   json doc = {{"jobID", r.id},          {"processID", kProcessId}, {"type", "process"},
               {"status", to_string(r.status)}, {"message", r.message}, {"created", r.created},
               {"updated", r.updated},   {"nodes", r.nodes},        {"steps", r.steps},
               {"attempts", r.attempts}};
+  if (!r.owner.empty()) doc["replica"] = r.owner;  // the process that runs (or last ran) it
   if (!r.started.empty()) doc["started"] = r.started;
   if (!r.finished.empty()) doc["finished"] = r.finished;
   int percent = r.status == JobStatus::successful ? 100 : 0;
@@ -224,9 +242,18 @@ void HttpServer::Impl::hooks() {
   svr.set_error_handler(httplib::Server::HandlerWithResponse([](const Request& req, Response& res) {
     if (!res.body.empty()) return httplib::Server::HandlerResponse::Unhandled;
     switch (res.status) {
-      case 404:
+      case 404: {
+        // A known route asked with another method: 405 and the methods it takes.
+        const std::string allow = allowed_methods(req.path);
+        if (!allow.empty()) {
+          res.set_header("Allow", allow);
+          problem(res, req, 405, "method-not-allowed", "Method not allowed",
+                  req.method + " is not allowed on " + req.path + "; allowed: " + allow);
+          break;
+        }
         problem(res, req, 404, "not-found", "Not found", "no route " + req.method + " " + req.path);
         break;
+      }
       case 413:
         problem(res, req, 413, "payload-too-large", "Payload too large",
                 "the request body is over this server's limit");
@@ -243,6 +270,12 @@ void HttpServer::Impl::hooks() {
     std::string what = "unknown exception";
     try {
       std::rethrow_exception(ep);
+    } catch (const StoreUnavailable& e) {
+      spdlog::warn("{} {}: {}", req.method, req.path, e.what());
+      res.headers.clear();
+      res.set_header("Retry-After", "5");
+      return problem(res, req, 503, "database-unavailable", "Database unavailable",
+                     "the job database does not answer; nothing was changed; retry later");
     } catch (const std::exception& e) {
       what = e.what();
     } catch (...) {
@@ -269,10 +302,10 @@ void HttpServer::Impl::routes() {
     if (!service.ready()) {
       res.set_header("Retry-After", "5");
       return problem(res, req, 503, "not-ready", "Not ready",
-                     service.draining() ? "the server is shutting down" : "the server is starting");
+                     service.draining() ? "the server is shutting down"
+                                        : "the server is starting or its database does not answer");
     }
-    service.stats();  // the store answers
-    send_json(res, 200, {{"status", "ready"}});
+    send_json(res, 200, {{"status", "ready"}, {"replica", service.replica()}});
   });
   svr.Get("/v1/metrics", [this](const Request& req, Response& res) { metrics(req, res); });
 
@@ -698,6 +731,15 @@ void HttpServer::Impl::metrics(const Request&, Response& res) {
      << "# HELP grip_events_stored_total Events stored by this process.\n"
      << "# TYPE grip_events_stored_total counter\n"
      << "grip_events_stored_total " << s.events << "\n"
+     << "# HELP grip_events_waiting Events not yet stored (the database unreachable or slow).\n"
+     << "# TYPE grip_events_waiting gauge\n"
+     << "grip_events_waiting " << s.events_waiting << "\n"
+     << "# HELP grip_db_round_trips_total Queries sent to the database by this process.\n"
+     << "# TYPE grip_db_round_trips_total counter\n"
+     << "grip_db_round_trips_total " << s.db_round_trips << "\n"
+     << "# HELP grip_db_bytes_total Bytes sent to and received from the database by this process.\n"
+     << "# TYPE grip_db_bytes_total counter\n"
+     << "grip_db_bytes_total " << s.db_bytes << "\n"
      << "# HELP grip_http_requests_total HTTP requests received by this process.\n"
      << "# TYPE grip_http_requests_total counter\n"
      << "grip_http_requests_total " << requests.load() << "\n";

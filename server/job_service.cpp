@@ -18,11 +18,14 @@ bool is_terminal_event(const std::string& type) {
 }
 
 struct JobService::ActiveJob {
-  explicit ActiveJob(std::string job_id) : id(std::move(job_id)) {}
-  const std::string id;
-  bool taken = false;  // by a worker (guarded by the service mutex)
+  explicit ActiveJob(Lease l) : lease(std::move(l)), id(lease.job_id) {}
+  const Lease lease;
+  const std::string& id;
+  const Clock::time_point started = Clock::now();
   std::atomic<bool> dismissed{false};
+  std::atomic<bool> lost{false};          // the lease went to another run: write nothing more
   std::atomic<std::int64_t> last_seq{0};  // the last event sequence number given out
+  std::int64_t stored_seq = 0;            // the last one stored (guarded by events_mutex_)
   std::mutex progress_mutex;
   std::optional<Progress> progress;  // while running
 };
@@ -63,30 +66,58 @@ JobService::JobService(Store& store, ServiceOptions options)
   if (options_.workers <= 0)
     options_.workers = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
   options_.queue_capacity = std::max(1, options_.queue_capacity);
+  options_.event_buffer = std::max<std::size_t>(16, options_.event_buffer);
+  if (!(options_.lease_seconds > 0)) options_.lease_seconds = 10;
+  if (options_.replica.empty()) options_.replica = default_replica_name();
 }
 
 JobService::~JobService() {
   if (started_) shutdown(std::chrono::milliseconds(0));
+  store_.set_listener(nullptr);
 }
 
 void JobService::start() {
-  const std::vector<std::string> accepted = store_.recover(now_iso8601(), failed_event("dismissed").dump());
+  store_.set_listener([this](const StoreChange& c) { on_change(c); });
+  store_.release_leases(options_.replica);
+  const int requeued = store_.requeue_expired(now_iso8601());
+  if (requeued > 0) spdlog::info("requeued {} interrupted job(s)", requeued);
   {
     std::lock_guard lock(mutex_);
-    for (const auto& id : accepted) {
-      const auto rec = store_.job(id);
-      {
-        std::lock_guard ev(events_mutex_);
-        committed_[id] = rec ? rec->last_seq : 0;
-      }
-      active_[id] = std::make_shared<ActiveJob>(id);
-      queue_.push_back(id);
-    }
+    work_hints_ = options_.workers;  // look for accepted jobs at once
   }
-  if (!accepted.empty()) spdlog::info("recovered {} accepted job(s), queued in creation order", accepted.size());
   writer_ = std::thread([this] { writer_loop(); });
+  lease_thread_ = std::thread([this] { lease_loop(); });
   for (int i = 0; i < options_.workers; ++i) workers_.emplace_back([this] { worker_loop(); });
   started_ = true;
+  spdlog::info("replica {}: lease {} s", options_.replica, options_.lease_seconds);
+}
+
+void JobService::on_change(const StoreChange& change) {
+  if (change.kind == StoreChange::job) {
+    {
+      std::lock_guard lock(mutex_);
+      ++work_hints_;
+    }
+    work_cv_.notify_one();
+  }
+  if (change.kind == StoreChange::dismissed) {
+    std::lock_guard lock(mutex_);
+    const auto it = active_.find(change.job_id);
+    if (it != active_.end()) it->second->dismissed = true;
+  }
+  {
+    std::lock_guard lock(events_mutex_);
+    if (changes_.size() > 100000) changes_.clear();  // waiters then wake once, harmlessly
+    ++changes_[change.job_id];
+    if (change.job_id.empty())
+      for (auto& [id, n] : changes_) ++n;
+  }
+  stored_cv_.notify_all();
+}
+
+bool JobService::ready() {
+  if (!started_ || draining_) return false;
+  return store_.ping();
 }
 
 std::optional<SubmitResult> JobService::replay(const std::optional<std::string>& key,
@@ -110,59 +141,57 @@ SubmitResult JobService::submit(const json& scene_json,
     throw SceneErrors(std::vector<SceneIssue>{
         {"/body/mesh", "the body has at least " + std::to_string(*least) +
                            " nodes; this service takes at most " + std::to_string(lim.max_nodes)}});
-  const Scene scene = read_scene(scene_json);  // throws SceneErrors
-  const int nodes = scene.problem.body->site_count();
-  const int steps = static_cast<int>(scene.steps.size());
+  struct {
+    int nodes, steps;
+  } size;
+  {
+    const Scene scene = read_scene(scene_json);  // throws SceneErrors
+    size = {scene.problem.body->site_count(), static_cast<int>(scene.steps.size())};
+  }
   std::vector<SceneIssue> issues;
-  if (nodes > lim.max_nodes)
-    issues.push_back({"/body/mesh", "the body has " + std::to_string(nodes) +
+  if (size.nodes > lim.max_nodes)
+    issues.push_back({"/body/mesh", "the body has " + std::to_string(size.nodes) +
                                         " nodes; this service takes at most " +
                                         std::to_string(lim.max_nodes)});
-  if (steps > lim.max_steps)
-    issues.push_back({scene.effective.contains("stages") ? "/stages" : "/steps",
-                      "the scene has " + std::to_string(steps) +
+  if (size.steps > lim.max_steps)
+    issues.push_back({scene_json.contains("stages") ? "/stages" : "/steps",
+                      "the scene has " + std::to_string(size.steps) +
                           " load steps; this service takes at most " +
                           std::to_string(lim.max_steps)});
   if (!issues.empty()) throw SceneErrors(std::move(issues));
 
+  const std::int64_t waiting = store_.count_accepted();
   {
     std::lock_guard lock(mutex_);
-    if (queue_.size() + reserved_ >= static_cast<size_t>(options_.queue_capacity))
-      throw QueueFull(retry_after_seconds());
+    if (waiting + reserved_ >= options_.queue_capacity) throw QueueFull(retry_after_seconds());
     ++reserved_;
   }
+  struct Unreserve {
+    JobService& s;
+    ~Unreserve() {
+      std::lock_guard lock(s.mutex_);
+      --s.reserved_;
+    }
+  } unreserve{*this};
   JobRecord rec;
   rec.id = new_job_id();
   rec.status = JobStatus::accepted;
   rec.scene = canonical;
   rec.created = rec.updated = now_iso8601();
   rec.message = "accepted";
-  rec.steps = steps;
-  rec.nodes = nodes;
+  rec.steps = size.steps;
+  rec.nodes = size.nodes;
   rec.idempotency_key = idempotency_key;
   try {
     store_.insert_job(rec);
+  } catch (const StoreUnavailable&) {
+    throw;
   } catch (...) {
-    {
-      std::lock_guard lock(mutex_);
-      --reserved_;
-    }
     // A concurrent submission with the same key won the race: answer as a replay.
     if (auto earlier = replay(idempotency_key, canonical)) return *earlier;
     throw;
   }
-  {
-    std::lock_guard lock(mutex_);
-    --reserved_;
-    {
-      std::lock_guard ev(events_mutex_);
-      committed_[rec.id] = 0;
-    }
-    active_[rec.id] = std::make_shared<ActiveJob>(rec.id);
-    queue_.push_back(rec.id);
-  }
-  queue_cv_.notify_one();
-  spdlog::info("job {} accepted: {} nodes, {} steps", rec.id, nodes, steps);
+  spdlog::info("job {} accepted: {} nodes, {} steps", rec.id, size.nodes, size.steps);
   rec.scene.clear();
   return {JobView{rec, std::nullopt}, false};
 }
@@ -201,84 +230,42 @@ JobPage JobService::list(std::optional<JobStatus> status, int limit,
 }
 
 std::pair<DismissOutcome, std::optional<JobView>> JobService::dismiss(const std::string& id) {
-  std::shared_ptr<ActiveJob> active;
-  bool queued = false;
-  {
-    std::lock_guard lock(mutex_);
-    auto it = active_.find(id);
-    if (it != active_.end()) {
-      active = it->second;
-      active->dismissed = true;
-      if (!active->taken) {
-        queued = true;
-        queue_.erase(std::remove(queue_.begin(), queue_.end(), id), queue_.end());
-      }
-    }
-  }
-  if (active) {
-    store_.mark_dismissed(id, now_iso8601());
-    if (queued) {
-      // Never started: finish it here. Its worker (none) cannot.
-      // Never started, so no events are on their way: the stored last_seq is the last.
-      JobOutcome o;
-      o.status = JobStatus::dismissed;
-      o.message = "dismissed before it started";
-      o.finished = now_iso8601();
-      const auto rec = store_.job(id);
-      finish(active, std::move(o), rec ? rec->last_seq : 0);
-    }
-    spdlog::info("job {} dismissed ({})", id, queued ? "queued" : "running");
-    auto view = job(id);
-    if (view) {
-      view->record.status = JobStatus::dismissed;
-      view->progress.reset();
-    }
-    return {DismissOutcome::dismissed, view};
-  }
-  auto rec = store_.job(id);
-  if (!rec) return {DismissOutcome::not_found, std::nullopt};
-  if (!is_finished(rec->status)) {
-    // Accepted or running in the store but unknown here: another process's job (a shared
-    // store) or a race with its worker finishing. Mark it; its owner finishes it.
-    store_.mark_dismissed(id, now_iso8601());
-    rec->status = JobStatus::dismissed;
-    return {DismissOutcome::dismissed, JobView{*rec, std::nullopt}};
-  }
-  store_.delete_job(id);
-  spdlog::info("job {} removed", id);
-  return {DismissOutcome::removed, JobView{*rec, std::nullopt}};
+  // The store decides atomically (a job that has just finished is removed, not "dismissed");
+  // the run, on whichever process, hears of it through the listener.
+  auto [outcome, rec] = store_.dismiss_job(id, now_iso8601());
+  if (outcome == DismissOutcome::not_found || !rec) return {DismissOutcome::not_found, std::nullopt};
+  spdlog::info("job {} {}", id, outcome == DismissOutcome::removed ? "removed" : "dismissed");
+  return {outcome, JobView{std::move(*rec), std::nullopt}};
 }
 
 EventBatch JobService::wait_events(const std::string& id, std::int64_t after,
                                    std::chrono::milliseconds wait, int limit) {
   const auto deadline = Clock::now() + wait;
   while (true) {
-    std::uint64_t generation = 0;
+    std::uint64_t seen = 0;
     {
-      std::unique_lock lock(events_mutex_);
-      generation = generation_;
-      auto it = committed_.find(id);
-      if (it != committed_.end() && it->second <= after) {
-        // An active job with nothing new stored yet.
-        const bool woke = committed_cv_.wait_until(
-            lock, deadline, [&] { return generation_ != generation || draining_.load(); });
-        if (!woke || draining_) return {};
-        continue;
+      std::lock_guard lock(events_mutex_);
+      seen = changes_[id];
+    }
+    try {
+      EventBatch batch;
+      batch.events = store_.events_after(id, after, limit);
+      if (!batch.events.empty()) {
+        batch.ended = is_terminal_event(batch.events.back().type);
+        return batch;
       }
+      const auto rec = store_.job(id);
+      if (!rec) return {false, {}, false};
+      if (is_finished(rec->status) && !rec->finished.empty()) return {true, {}, true};
+    } catch (const StoreUnavailable&) {
+      // Nothing to read now; the stream waits (and pings) until the store is back.
+      std::unique_lock lock(events_mutex_);
+      stored_cv_.wait_until(lock, deadline, [&] { return draining_.load(); });
+      return {};
     }
-    EventBatch batch;
-    batch.events = store_.events_after(id, after, limit);
-    if (!batch.events.empty()) {
-      batch.ended = is_terminal_event(batch.events.back().type);
-      return batch;
-    }
-    const auto rec = store_.job(id);
-    if (!rec) return {false, {}, false};
-    if (is_finished(rec->status) && !rec->finished.empty()) return {true, {}, true};
-    // Accepted but not known here yet (between store and queue), or another process's job.
     std::unique_lock lock(events_mutex_);
-    const bool woke = committed_cv_.wait_until(
-        lock, deadline, [&] { return generation_ != generation || draining_.load(); });
+    const bool woke = stored_cv_.wait_until(
+        lock, deadline, [&] { return changes_[id] != seen || draining_.load(); });
     if (!woke || draining_) return {};
   }
 }
@@ -294,7 +281,6 @@ ServiceStats JobService::stats() {
   ServiceStats s;
   {
     std::lock_guard lock(mutex_);
-    s.queue_depth = queue_.size();
     s.running = running_;
     s.workers = options_.workers;
     s.solve_seconds = solve_seconds_;
@@ -303,22 +289,31 @@ ServiceStats JobService::stats() {
   {
     std::lock_guard lock(events_mutex_);
     s.events = events_stored_;
+    s.events_waiting = pending_.size();
   }
+  std::tie(s.db_round_trips, s.db_bytes) = store_.traffic();
   s.jobs = store_.count_by_status();
+  const auto it = s.jobs.find(JobStatus::accepted);
+  s.queue_depth = it == s.jobs.end() ? 0 : static_cast<std::size_t>(it->second);
   return s;
 }
 
 int JobService::retry_after_seconds() const {
-  // Expected wait for one queue slot: the queue ahead shared by the workers (mutex_ held).
+  // Time until a worker frees (mutex_ held): the mean run less the longest-running job's time
+  // so far; without a run here, one mean run.
   const double mean = finished_runs_ ? solve_seconds_ / static_cast<double>(finished_runs_) : 1.0;
-  const double wait = mean * static_cast<double>(queue_.size()) / options_.workers;
+  double wait = mean;
+  for (const auto& [id, job] : active_) {
+    const double elapsed = std::chrono::duration<double>(Clock::now() - job->started).count();
+    wait = std::min(wait, std::max(0.0, mean - elapsed));
+  }
   return std::clamp(static_cast<int>(std::ceil(wait)), 1, 300);
 }
 
 void JobService::begin_drain() {
   draining_ = true;
   std::lock_guard lock(events_mutex_);
-  committed_cv_.notify_all();
+  stored_cv_.notify_all();
 }
 
 void JobService::shutdown(std::chrono::milliseconds grace) {
@@ -327,14 +322,18 @@ void JobService::shutdown(std::chrono::milliseconds grace) {
   {
     std::unique_lock lock(mutex_);
     stop_workers_ = true;
-    queue_cv_.notify_all();
+    work_cv_.notify_all();
     if (running_ > 0)
       spdlog::info("waiting up to {:.1f} s for {} running job(s)", grace.count() / 1000.0, running_);
     if (!idle_cv_.wait_for(lock, grace, [&] { return running_ == 0; })) {
-      spdlog::warn("grace period over: stopping {} running job(s); they run again at the next start",
-                   running_);
+      spdlog::warn("grace period over: stopping {} running job(s); they run again later", running_);
       abort_runs_ = true;
     }
+  }
+  {
+    std::lock_guard lock(events_mutex_);
+    room_cv_.notify_all();
+    stored_cv_.notify_all();
   }
   for (auto& w : workers_) w.join();
   workers_.clear();
@@ -344,27 +343,39 @@ void JobService::shutdown(std::chrono::milliseconds grace) {
   }
   writer_cv_.notify_all();
   if (writer_.joinable()) writer_.join();
+  lease_cv_.notify_all();
+  if (lease_thread_.joinable()) lease_thread_.join();
 }
 
 void JobService::worker_loop() {
   while (true) {
-    std::shared_ptr<ActiveJob> job;
     {
       std::unique_lock lock(mutex_);
-      queue_cv_.wait(lock, [&] { return stop_workers_ || !queue_.empty(); });
+      // Announcements wake a worker; the timeout covers any that were missed (the store was
+      // unreachable when they were sent).
+      work_cv_.wait_for(lock, std::chrono::seconds(5), [&] { return stop_workers_ || work_hints_ > 0; });
       if (stop_workers_) return;
-      const std::string id = queue_.front();
-      queue_.pop_front();
-      auto it = active_.find(id);
-      if (it == active_.end()) continue;
-      job = it->second;
-      job->taken = true;
-      ++running_;
+      work_hints_ = 0;
     }
+    std::optional<JobRecord> claimed;
     try {
-      run_job(job);
+      claimed = store_.claim_job(options_.replica, now_iso8601(), options_.lease_seconds);
     } catch (const std::exception& e) {
-      // Most likely the store failed; try to leave the job failed rather than running.
+      spdlog::warn("cannot claim a job: {}", e.what());
+      continue;
+    }
+    if (!claimed) continue;
+    auto job = std::make_shared<ActiveJob>(Lease{claimed->id, claimed->generation});
+    {
+      std::lock_guard lock(mutex_);
+      active_[job->id] = job;
+      ++running_;
+      ++work_hints_;  // there may be more: let another idle worker look
+    }
+    work_cv_.notify_one();
+    try {
+      run_job(job, *claimed);
+    } catch (const std::exception& e) {
       spdlog::error("job {}: {}", job->id, e.what());
       try {
         JobOutcome o;
@@ -373,12 +384,12 @@ void JobService::worker_loop() {
         o.finished = now_iso8601();
         finish(job, std::move(o), job->last_seq);
       } catch (const std::exception& again) {
-        spdlog::error("job {} stays unfinished until the next start: {}", job->id, again.what());
-        forget(job->id);
+        spdlog::error("job {} stays unfinished until its lease expires: {}", job->id, again.what());
       }
     }
     {
       std::lock_guard lock(mutex_);
+      active_.erase(job->id);
       --running_;
     }
     idle_cv_.notify_all();
@@ -390,18 +401,17 @@ void JobService::emit(const std::shared_ptr<ActiveJob>& job, std::int64_t seq, c
   job->last_seq = seq;
   if (options_.event_tap) options_.event_tap(id, seq, event);
   {
-    std::lock_guard lock(events_mutex_);
-    pending_.push_back({id, stored(seq, event)});
+    std::unique_lock lock(events_mutex_);
+    // A full buffer (the store unreachable for long) pauses the run instead of growing.
+    room_cv_.wait(lock, [&] { return pending_.size() < options_.event_buffer || abort_runs_ || job->lost; });
+    pending_.push_back({job->lease, stored(seq, event)});
   }
   writer_cv_.notify_one();
 }
 
-void JobService::flush(const std::string& id, std::int64_t seq) {
+void JobService::flush(const std::shared_ptr<ActiveJob>& job, std::int64_t seq) {
   std::unique_lock lock(events_mutex_);
-  committed_cv_.wait(lock, [&] {
-    auto it = committed_.find(id);
-    return it == committed_.end() || it->second >= seq;
-  });
+  stored_cv_.wait(lock, [&] { return job->stored_seq >= seq || job->lost || stop_writer_; });
 }
 
 void JobService::writer_loop() {
@@ -416,94 +426,136 @@ void JobService::writer_loop() {
                    std::make_move_iterator(pending_.end()));
       pending_.clear();
     }
+    room_cv_.notify_all();
+    std::vector<Lease> refused;
     try {
-      store_.append_events(batch);
+      refused = store_.append_events(batch);
+      if (failures > 0) spdlog::info("events stored again after {} failed attempt(s)", failures);
       failures = 0;
     } catch (const std::exception& e) {
-      if (++failures < 5) {
+      // Kept and retried: an acknowledged job's events are not dropped while this process runs.
+      if (failures++ % 20 == 0)
         spdlog::error("storing {} event(s) failed, retrying: {}", batch.size(), e.what());
-        std::this_thread::sleep_for(std::chrono::milliseconds(100 * failures));
-        continue;
+      std::unique_lock lock(events_mutex_);
+      if (stop_writer_) {
+        spdlog::warn("stopping with {} event(s) unstored; their runs are taken over", batch.size());
+        return;
       }
-      spdlog::critical("dropping {} event(s) that could not be stored: {}", batch.size(), e.what());
-      failures = 0;
+      writer_cv_.wait_for(lock, std::chrono::milliseconds(std::min(2000, 50 * failures)),
+                          [&] { return stop_writer_; });
+      continue;
+    }
+    std::vector<std::shared_ptr<ActiveJob>> jobs;
+    {
+      std::lock_guard lock(mutex_);
+      for (const NewEvent& e : batch) {
+        const auto it = active_.find(e.lease.job_id);
+        if (it != active_.end() && it->second->lease.generation == e.lease.generation)
+          jobs.push_back(it->second);
+      }
     }
     {
       std::lock_guard lock(events_mutex_);
-      for (const NewEvent& e : batch) {
-        auto it = committed_.find(e.job_id);
-        if (it != committed_.end()) it->second = std::max(it->second, e.event.seq);
-      }
+      for (const NewEvent& e : batch)
+        for (const auto& j : jobs)
+          if (j->id == e.lease.job_id) j->stored_seq = std::max(j->stored_seq, e.event.seq);
+      for (const Lease& l : refused)
+        for (const auto& j : jobs)
+          if (j->id == l.job_id && !j->lost.exchange(true))
+            spdlog::warn("job {}: its lease went to another run; this run stops", j->id);
       events_stored_ += static_cast<std::int64_t>(batch.size());
-      ++generation_;
     }
     batch.clear();
-    committed_cv_.notify_all();
+    stored_cv_.notify_all();
   }
 }
 
-void JobService::forget(const std::string& id) {
-  {
-    std::lock_guard lock(events_mutex_);
-    committed_.erase(id);
-    ++generation_;
+void JobService::lease_loop() {
+  const auto period = std::chrono::milliseconds(static_cast<long long>(options_.lease_seconds * 1000 / 3));
+  std::unique_lock lock(mutex_);
+  while (!lease_cv_.wait_for(lock, period, [&] { return stop_workers_ && running_ == 0; })) {
+    lock.unlock();
+    try {
+      const LeaseRenewal r = store_.renew_leases(options_.replica, options_.lease_seconds);
+      std::unique_lock relock(mutex_);
+      for (auto& [id, job] : active_) {
+        const bool held = std::any_of(r.held.begin(), r.held.end(), [&](const Lease& l) {
+          return l.job_id == id && l.generation == job->lease.generation;
+        });
+        if (!held && !job->lost.exchange(true))
+          spdlog::warn("job {}: lease lost; this run stops", id);
+        if (std::find(r.dismissed.begin(), r.dismissed.end(), id) != r.dismissed.end())
+          job->dismissed = true;
+      }
+      relock.unlock();
+      store_.requeue_expired(now_iso8601());
+    } catch (const std::exception& e) {
+      spdlog::warn("cannot renew leases: {}", e.what());
+    }
+    {
+      std::lock_guard ev(events_mutex_);
+      room_cv_.notify_all();
+      stored_cv_.notify_all();
+    }
+    lock.lock();
   }
-  committed_cv_.notify_all();
-  std::lock_guard lock(mutex_);
-  active_.erase(id);
+}
+
+bool JobService::retry_store(const std::shared_ptr<ActiveJob>& job, const std::function<void()>& call) {
+  for (int failures = 0;; ++failures) {
+    try {
+      call();
+      return true;
+    } catch (const StoreUnavailable& e) {
+      if (abort_runs_ || job->lost) return false;
+      if (failures % 20 == 0) spdlog::warn("job {}: store unavailable, retrying: {}", job->id, e.what());
+      std::this_thread::sleep_for(std::chrono::milliseconds(std::min(2000, 50 * (failures + 1))));
+    }
+  }
 }
 
 void JobService::finish(const std::shared_ptr<ActiveJob>& job, JobOutcome outcome,
                         std::int64_t last) {
-  flush(job->id, last);  // the job's events come first
-  if (!outcome.terminal) {
+  flush(job, last);  // the job's events come first
+  if (job->lost) {
+    spdlog::warn("job {}: run not recorded (its lease went to another run)", job->id);
+    return;
+  }
+  if (outcome.terminal.type.empty()) {
     const json ev = outcome.status == JobStatus::successful
                         ? json{{"type", "job_finished"}}
                         : failed_event(outcome.status == JobStatus::dismissed ? "dismissed"
                                                                               : outcome.message);
     outcome.terminal = stored(last + 1, ev);
   }
-  store_.finish_job(job->id, outcome);
-  {
-    std::lock_guard lock(mutex_);
-    if (outcome.status != JobStatus::dismissed || outcome.solve_seconds > 0) {
-      solve_seconds_ += outcome.solve_seconds;
-      iterations_ += outcome.iterations;
-      ++finished_runs_;
-    }
-  }
-  forget(job->id);
-}
-
-void JobService::run_job(const std::shared_ptr<ActiveJob>& job) {
-  const std::string& id = job->id;
-  const std::string started = now_iso8601();
-  if (job->dismissed || !store_.start_job(id, started)) {
-    const auto rec = store_.job(id);
-    if (rec && rec->status == JobStatus::dismissed && rec->finished.empty()) {
-      JobOutcome o;
-      o.status = JobStatus::dismissed;
-      o.message = "dismissed before it started";
-      o.finished = now_iso8601();
-      finish(job, std::move(o), rec->last_seq);
-    } else {
-      forget(id);
-    }
+  std::optional<JobStatus> stored_status;
+  if (!retry_store(job, [&] { stored_status = store_.finish_job(job->lease, outcome); })) return;
+  if (!stored_status) {
+    spdlog::warn("job {}: run not recorded (fenced: another run holds it)", job->id);
     return;
   }
-  const auto rec = store_.job(id, true);
-  std::int64_t seq = rec ? rec->last_seq : 0;
+  std::lock_guard lock(mutex_);
+  if (*stored_status != JobStatus::dismissed || outcome.solve_seconds > 0) {
+    solve_seconds_ += outcome.solve_seconds;
+    iterations_ += outcome.iterations;
+    ++finished_runs_;
+  }
+}
+
+void JobService::run_job(const std::shared_ptr<ActiveJob>& job, const JobRecord& rec) {
+  const std::string& id = job->id;
+  std::int64_t seq = rec.last_seq;
   job->last_seq = seq;
   {
     std::lock_guard lock(events_mutex_);
-    committed_[id] = std::max(committed_[id], seq);
+    job->stored_seq = seq;
   }
-  spdlog::info("job {} started (attempt {})", id, rec ? rec->attempts : 1);
+  spdlog::info("job {} started (attempt {}, generation {})", id, rec.attempts, rec.generation);
 
   JobOutcome outcome;
   std::optional<Scene> scene;
   try {
-    scene.emplace(read_scene(json::parse(rec->scene)));
+    scene.emplace(read_scene(json::parse(rec.scene)));
   } catch (const SceneErrors& e) {
     outcome.status = JobStatus::failed;
     outcome.message = std::string("invalid scene: ") + e.what();
@@ -533,7 +585,7 @@ void JobService::run_job(const std::shared_ptr<ActiveJob>& job) {
 
   const auto t0 = Clock::now();
   std::int64_t iterations = 0;
-  enum class Stop { none, dismissed, shutdown, iterations, seconds } stop = Stop::none;
+  enum class Stop { none, dismissed, shutdown, lost, iterations, seconds } stop = Stop::none;
   SteppingObserver observer;
   observer.step_started = [&](int step, double load_factor) {
     emit(job, ++seq, step_started_event(step, load_factor));
@@ -554,6 +606,7 @@ void JobService::run_job(const std::shared_ptr<ActiveJob>& job) {
   };
   observer.stop_requested = [&] {
     if (job->dismissed) stop = Stop::dismissed;
+    else if (job->lost) stop = Stop::lost;
     else if (abort_runs_) stop = Stop::shutdown;
     else if (iterations >= lim.max_iterations) stop = Stop::iterations;
     else if (std::chrono::duration<double>(Clock::now() - t0).count() > lim.max_seconds)
@@ -570,10 +623,17 @@ void JobService::run_job(const std::shared_ptr<ActiveJob>& job) {
   }
   const double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
 
+  if (job->lost) {
+    spdlog::warn("job {}: run abandoned after {:.3f} s (its lease went to another run)", id, seconds);
+    return;
+  }
   if (stop == Stop::shutdown && !job->dismissed) {
-    flush(id, seq);
-    store_.requeue_job(id, now_iso8601());
-    forget(id);
+    flush(job, seq);
+    try {
+      store_.requeue_job(job->lease, now_iso8601());
+    } catch (const std::exception& e) {
+      spdlog::warn("job {}: not requeued ({}); another process takes it when its lease expires", id, e.what());
+    }
     spdlog::info("job {} interrupted by shutdown after {:.3f} s; accepted again", id, seconds);
     return;
   }

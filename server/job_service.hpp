@@ -3,18 +3,23 @@
 // Plain C++, testable without sockets.
 //
 // Design:
-// - A bounded queue of accepted jobs and a pool of worker threads of its own; a worker runs
-//   one job at a time with run_load_steps. HTTP threads never solve.
+// - The store holds the queue: a worker claims the oldest accepted job from it (a lease with
+//   a generation, renewed by a lease thread) and runs it with run_load_steps. HTTP threads
+//   never solve. Several processes may share one store (PostgreSQL): any of them accepts,
+//   answers and dismisses any job, and their workers share the queue.
 // - Events are numbered per job (seq = the SSE id) on the worker and handed to one writer
-//   thread that stores whatever has accumulated in one transaction (group commit) and then
-//   wakes the event readers. Readers only ever see stored events, so an id a client saw is
-//   never given to another event, whatever happens to the process.
+//   thread that stores whatever has accumulated in one transaction (group commit), only while
+//   the run's lease is current. Readers only ever see stored events, so an id a client saw is
+//   never given to another event, whatever happens to the process. While the store cannot be
+//   reached, events wait in a bounded buffer (a full buffer pauses the run).
 // - A job's final status, result and terminal event are stored in one transaction after all
-//   its other events; only then is it reported finished.
-// - Dismissal sets a flag that the run's stop request reads before every contact iteration.
-// - After a crash (start()): interrupted runs go back to accepted with their events discarded
-//   and their sequence continuing above the discarded ids; every accepted job is queued in
-//   creation order.
+//   its other events, at most once (fenced by the lease generation).
+// - The store announces changes (its listener): new events wake the readers, new or requeued
+//   jobs wake a worker, a dismissal sets the run's flag that its stop request reads before
+//   every contact iteration.
+// - A run whose lease expired (its process died or lost the store for longer than the lease)
+//   goes back to accepted with its events discarded and its sequence continuing above the
+//   discarded ids; any process then claims it.
 #include <nlohmann/json.hpp>
 
 #include <atomic>
@@ -47,7 +52,10 @@ struct JobLimits {
 
 struct ServiceOptions {
   int workers = 0;           // 0: one per core
-  int queue_capacity = 256;  // accepted jobs waiting for a worker
+  int queue_capacity = 256;  // accepted jobs waiting for a worker (all processes together)
+  std::string replica;       // this process's name in leases; empty: host-pid-random
+  double lease_seconds = 10;  // a run unrenewed this long is taken over by another process
+  std::size_t event_buffer = 100000;  // events waiting for the store before runs pause
   JobLimits limits;
   // Test and benchmark hook, called on the worker thread as each event is produced (before
   // it is stored).
@@ -99,8 +107,6 @@ struct EventBatch {
   bool ended = false;  // the job's terminal event has been delivered (or was before `after`)
 };
 
-enum class DismissOutcome { not_found, dismissed, removed };
-
 struct ServiceStats {
   std::size_t queue_depth = 0;
   int running = 0;
@@ -108,6 +114,9 @@ struct ServiceStats {
   double solve_seconds = 0.0;     // finished runs, this process
   std::int64_t iterations = 0;    // contact iterations of finished runs, this process
   std::int64_t events = 0;        // events stored, this process
+  std::size_t events_waiting = 0;  // events not yet stored
+  std::int64_t db_round_trips = 0;  // with the database, this process
+  std::int64_t db_bytes = 0;
   std::map<JobStatus, std::int64_t> jobs;  // by status, from the store
 };
 
@@ -143,28 +152,34 @@ class JobService {
   std::optional<std::string> result(const std::string& id);
 
   ServiceStats stats();
-  bool ready() const { return started_ && !draining_; }
+  // Started, not draining, and the store answers.
+  bool ready();
+  const std::string& replica() const { return options_.replica; }
   const ServiceOptions& options() const { return options_; }
 
   // Refuses new submissions and releases every event reader at once.
   void begin_drain();
   bool draining() const { return draining_; }
   // Takes no more jobs from the queue, lets running jobs finish for up to `grace`, then stops
-  // them and puts them back to accepted (the next start runs them again).
+  // them and puts them back to accepted (the next start, or another process, runs them again).
   void shutdown(std::chrono::milliseconds grace);
 
  private:
   struct ActiveJob;
   // The earlier submission with this idempotency key, if any (same scene, else it throws).
   std::optional<SubmitResult> replay(const std::optional<std::string>& key, const std::string& scene);
+  void on_change(const StoreChange& change);
   void worker_loop();
   void writer_loop();
-  void run_job(const std::shared_ptr<ActiveJob>& job);
+  void lease_loop();
+  void run_job(const std::shared_ptr<ActiveJob>& job, const JobRecord& record);
   void emit(const std::shared_ptr<ActiveJob>& job, std::int64_t seq, const nlohmann::json& event);
-  void flush(const std::string& id, std::int64_t seq);
-  // Stores the outcome after all events up to `last_seq`, then forgets the active job.
+  // Waits until the job's events up to `seq` are stored (or its lease is lost).
+  void flush(const std::shared_ptr<ActiveJob>& job, std::int64_t seq);
+  // Stores the outcome after all events up to `last_seq`.
   void finish(const std::shared_ptr<ActiveJob>& job, JobOutcome outcome, std::int64_t last_seq);
-  void forget(const std::string& id);
+  // Runs a store call until it succeeds or the runs are aborted (false then).
+  bool retry_store(const std::shared_ptr<ActiveJob>& job, const std::function<void()>& call);
   int retry_after_seconds() const;
 
   Store& store_;
@@ -172,13 +187,13 @@ class JobService {
   std::atomic<bool> started_{false};
   std::atomic<bool> draining_{false};
 
-  // Queue and active jobs.
+  // Workers and active (claimed) jobs.
   mutable std::mutex mutex_;
-  std::condition_variable queue_cv_;
+  std::condition_variable work_cv_;  // a job may be waiting: workers try a claim
   std::condition_variable idle_cv_;
-  std::deque<std::string> queue_;
+  int work_hints_ = 0;
   std::unordered_map<std::string, std::shared_ptr<ActiveJob>> active_;
-  int reserved_ = 0;  // submissions past the capacity check, not yet queued
+  int reserved_ = 0;  // submissions past the capacity check, not yet stored
   int running_ = 0;
   bool stop_workers_ = false;
   std::atomic<bool> abort_runs_{false};
@@ -186,14 +201,16 @@ class JobService {
   double solve_seconds_ = 0.0;
   std::int64_t iterations_ = 0;
   std::int64_t finished_runs_ = 0;
+  std::thread lease_thread_;
+  std::condition_variable lease_cv_;
 
-  // Events: pending batch, committed sequence per active job, readers' wake-up.
+  // Events: pending batch, stored sequence per active run, readers' wake-up.
   std::mutex events_mutex_;
   std::condition_variable writer_cv_;
-  std::condition_variable committed_cv_;
+  std::condition_variable stored_cv_;   // events stored (this writer) or announced (any)
+  std::condition_variable room_cv_;     // the pending buffer has room again
   std::vector<NewEvent> pending_;
-  std::unordered_map<std::string, std::int64_t> committed_;
-  std::uint64_t generation_ = 0;
+  std::unordered_map<std::string, std::uint64_t> changes_;  // per job: announcements seen
   std::int64_t events_stored_ = 0;
   bool stop_writer_ = false;
   std::thread writer_;

@@ -12,6 +12,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "server/postgres_store.hpp"
 #include "server/sqlite_store.hpp"
 
 namespace grip::server {
@@ -60,7 +61,7 @@ const std::vector<Flag>& flags() {
        [](ServeConfig& c, const std::string& v) { c.http.host = v; }},
       {"port", "GRIP_PORT", "PORT", "port (default 8080; 0: any free port)",
        [](ServeConfig& c, const std::string& v) { c.http.port = static_cast<int>(integer(v, "--port", 0, 65535)); }},
-      {"db", "GRIP_DB", "PATH", "SQLite file (default data/grip.sqlite)",
+      {"db", "GRIP_DB", "PATH|URL", "SQLite file (default data/grip.sqlite) or postgresql:// URL",
        [](ServeConfig& c, const std::string& v) { c.db = v; }},
       {"workers", "GRIP_WORKERS", "N", "solver threads (default: one per core)",
        [](ServeConfig& c, const std::string& v) { c.service.workers = static_cast<int>(integer(v, "--workers", 1, 1024)); }},
@@ -80,6 +81,10 @@ const std::vector<Flag>& flags() {
        [](ServeConfig& c, const std::string& v) { c.service.limits.max_iterations = integer(v, "--max-iterations", 1, 1LL << 50); }},
       {"max-seconds", "GRIP_MAX_SECONDS", "S", "wall seconds per job run (default 3600)",
        [](ServeConfig& c, const std::string& v) { c.service.limits.max_seconds = real(v, "--max-seconds", 0.001); }},
+      {"replica", "GRIP_REPLICA", "NAME", "this process's name in job leases (default host-pid-random)",
+       [](ServeConfig& c, const std::string& v) { c.service.replica = v; }},
+      {"lease", "GRIP_LEASE", "S", "a run unrenewed this long is taken over by another replica (default 10)",
+       [](ServeConfig& c, const std::string& v) { c.service.lease_seconds = real(v, "--lease", 0.3); }},
       {"token", "GRIP_TOKEN", "TOKEN", "bearer token required on every route but /v1/health",
        [](ServeConfig& c, const std::string& v) { if (!v.empty()) c.http.token = v; }},
       {"grace", "GRIP_GRACE", "S", "SIGTERM: seconds running jobs may still finish (default 8)",
@@ -171,7 +176,7 @@ int serve(const ServeConfig& config) {
   const ServeConfig& c = config;
   const int threads = c.http.threads > 0 ? c.http.threads : c.http.max_streams + 32;
   spdlog::info("grip serve: host {} port {} db {} workers {} queue {} streams {} http-threads {}",
-               c.http.host, c.http.port, c.db,
+               c.http.host, c.http.port, is_postgresql_url(c.db) ? redacted_url(c.db) : c.db,
                c.service.workers > 0 ? c.service.workers : static_cast<int>(std::thread::hardware_concurrency()),
                c.service.queue_capacity, c.http.max_streams, threads);
   spdlog::info("limits: body {} bytes, {} nodes, {} steps, {} contact iterations, {} s per job",
@@ -181,9 +186,10 @@ int serve(const ServeConfig& config) {
                c.http.token ? "required" : "not required", c.grace_seconds,
                c.http.heartbeat.count() / 1000.0, c.http.schemas_dir, c.log_level);
 
-  std::unique_ptr<SqliteStore> store;
+  std::unique_ptr<Store> store;
   try {
-    store = std::make_unique<SqliteStore>(c.db);
+    if (is_postgresql_url(c.db)) store = std::make_unique<PostgresStore>(c.db);
+    else store = std::make_unique<SqliteStore>(c.db);
   } catch (const std::exception& e) {
     spdlog::critical("cannot open the job store: {}", e.what());
     return 1;
@@ -207,7 +213,8 @@ int serve(const ServeConfig& config) {
     sigwait(&signals, &sig);
     signalled = true;
     spdlog::info("{}: stopping: no new jobs, closing streams", sig == SIGTERM ? "SIGTERM" : "SIGINT");
-    service.begin_drain();
+    // Jobs stay readable while the running ones use their grace period; HTTP stops after.
+    service.shutdown(std::chrono::milliseconds(static_cast<long long>(c.grace_seconds * 1000)));
     http.stop();
   });
   http.listen();
@@ -216,7 +223,6 @@ int serve(const ServeConfig& config) {
     pthread_kill(signal_thread.native_handle(), SIGTERM);
   }
   signal_thread.join();
-  service.shutdown(std::chrono::milliseconds(static_cast<long long>(c.grace_seconds * 1000)));
   spdlog::info("stopped");
   return signalled ? 0 : 1;
 }

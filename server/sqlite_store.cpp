@@ -1,7 +1,8 @@
 #include "server/sqlite_store.hpp"
 
-#include <array>
+#include <chrono>
 #include <filesystem>
+#include <set>
 
 namespace grip::server {
 
@@ -24,7 +25,10 @@ CREATE TABLE IF NOT EXISTS jobs (
   last_seq INTEGER NOT NULL DEFAULT 0,
   attempts INTEGER NOT NULL DEFAULT 0,
   solve_seconds REAL NOT NULL DEFAULT 0,
-  iterations INTEGER NOT NULL DEFAULT 0
+  iterations INTEGER NOT NULL DEFAULT 0,
+  owner TEXT NOT NULL DEFAULT '',
+  generation INTEGER NOT NULL DEFAULT 0,
+  lease_expires REAL NOT NULL DEFAULT 0
 );
 CREATE INDEX IF NOT EXISTS jobs_by_status ON jobs (status, ord);
 CREATE TABLE IF NOT EXISTS events (
@@ -38,13 +42,19 @@ CREATE TABLE IF NOT EXISTS results (
   job_id TEXT PRIMARY KEY,
   data TEXT NOT NULL
 );
-PRAGMA user_version = 1;
+)sql";
+
+// Schema 1 (before leases) to 2.
+constexpr const char* kUpgrade1to2 = R"sql(
+ALTER TABLE jobs ADD COLUMN owner TEXT NOT NULL DEFAULT '';
+ALTER TABLE jobs ADD COLUMN generation INTEGER NOT NULL DEFAULT 0;
+ALTER TABLE jobs ADD COLUMN lease_expires REAL NOT NULL DEFAULT 0;
 )sql";
 
 // Columns read by read_job, in this order.
 constexpr const char* kJobColumns =
     "id, ord, status, created, started, finished, updated, message, steps, nodes, "
-    "idempotency_key, last_seq, attempts, solve_seconds, iterations";
+    "idempotency_key, last_seq, attempts, solve_seconds, iterations, owner, generation";
 
 JobRecord read_job(const Statement& st, bool with_scene) {
   JobRecord j;
@@ -63,7 +73,9 @@ JobRecord read_job(const Statement& st, bool with_scene) {
   j.attempts = static_cast<int>(st.int64(12));
   j.solve_seconds = st.real(13);
   j.iterations = st.int64(14);
-  if (with_scene) j.scene = st.text(15);
+  j.owner = st.text(15);
+  j.generation = st.int64(16);
+  if (with_scene) j.scene = st.text(17);
   return j;
 }
 
@@ -72,34 +84,79 @@ std::string select_job(bool with_scene, const char* where) {
          " FROM jobs WHERE " + where;
 }
 
+// Unix time in seconds: lease expiry (one process, one clock).
+double unix_now() {
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+}
+
+void insert_event(Database& db, const std::string& id, const StoredEvent& e) {
+  db.prepare("INSERT INTO events (job_id, seq, type, data) VALUES (?, ?, ?, ?)")
+      .bind(1, id).bind(2, e.seq).bind(3, e.type).bind(4, e.data).run();
+}
+
 }  // namespace
 
 SqliteStore::SqliteStore(const std::string& path, int busy_timeout_ms) {
   const auto parent = std::filesystem::path(path).parent_path();
   if (!parent.empty()) std::filesystem::create_directories(parent);
   writer_ = std::make_unique<Database>(path, busy_timeout_ms);
+  {
+    auto v = writer_->prepare("PRAGMA user_version");
+    v.step();
+    const bool has_jobs = [&] {
+      auto t = writer_->prepare("SELECT count(*) FROM sqlite_master WHERE name = 'jobs'");
+      t.step();
+      return t.int64(0) > 0;
+    }();
+    if (has_jobs && v.int64(0) < 2) writer_->exec(kUpgrade1to2);
+  }
   writer_->exec(kSchema);
+  writer_->exec("PRAGMA user_version = 2");
+  // The file is this process's alone: whatever a previous process held is free now.
+  writer_->exec("UPDATE jobs SET lease_expires = 0 WHERE finished IS NULL");
   reader_ = std::make_unique<Database>(path, busy_timeout_ms);
 }
 
+void SqliteStore::set_listener(std::function<void(const StoreChange&)> listener) {
+  std::lock_guard lock(listener_mutex_);
+  listener_ = std::move(listener);
+}
+
+void SqliteStore::announce(StoreChange::Kind kind, const std::string& job_id) {
+  std::function<void(const StoreChange&)> l;
+  {
+    std::lock_guard lock(listener_mutex_);
+    l = listener_;
+  }
+  if (l) l(StoreChange{kind, job_id});
+}
+
 void SqliteStore::insert_job(JobRecord& job) {
-  std::lock_guard lock(write_mutex_);
-  auto st = writer_->prepare(
-      "INSERT INTO jobs (id, status, scene, created, updated, message, steps, nodes, "
-      "idempotency_key) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)");
-  st.bind(1, job.id).bind(2, to_string(job.status)).bind(3, job.scene).bind(4, job.created);
-  st.bind(5, job.updated).bind(6, job.message).bind(7, job.steps).bind(8, job.nodes);
-  st.bind(9, job.idempotency_key);
-  st.run();
-  job.ord = sqlite3_last_insert_rowid(writer_->handle());
+  {
+    std::lock_guard lock(write_mutex_);
+    auto st = writer_->prepare(
+        "INSERT INTO jobs (id, status, scene, created, updated, message, steps, nodes, "
+        "idempotency_key) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)");
+    st.bind(1, job.id).bind(2, to_string(job.status)).bind(3, job.scene).bind(4, job.created);
+    st.bind(5, job.updated).bind(6, job.message).bind(7, job.steps).bind(8, job.nodes);
+    st.bind(9, job.idempotency_key);
+    st.run();
+    job.ord = sqlite3_last_insert_rowid(writer_->handle());
+  }
+  announce(StoreChange::job, job.id);
+}
+
+std::optional<JobRecord> SqliteStore::job_locked(Database& db, const std::string& id,
+                                                 bool with_scene) {
+  auto st = db.prepare(select_job(with_scene, "id = ?"));
+  st.bind(1, id);
+  if (!st.step()) return std::nullopt;
+  return read_job(st, with_scene);
 }
 
 std::optional<JobRecord> SqliteStore::job(const std::string& id, bool with_scene) {
   std::lock_guard lock(read_mutex_);
-  auto st = reader_->prepare(select_job(with_scene, "id = ?"));
-  st.bind(1, id);
-  if (!st.step()) return std::nullopt;
-  return read_job(st, with_scene);
+  return job_locked(*reader_, id, with_scene);
 }
 
 std::optional<JobRecord> SqliteStore::job_by_idempotency_key(const std::string& key) {
@@ -137,101 +194,233 @@ std::map<JobStatus, std::int64_t> SqliteStore::count_by_status() {
   return counts;
 }
 
-bool SqliteStore::start_job(const std::string& id, const std::string& started) {
-  std::lock_guard lock(write_mutex_);
-  auto st = writer_->prepare(
-      "UPDATE jobs SET status = 'running', started = ?1, updated = ?1, message = 'running', "
-      "attempts = attempts + 1 WHERE id = ?2 AND status = 'accepted'");
-  st.bind(1, started).bind(2, id).run();
-  return writer_->changes() == 1;
+std::int64_t SqliteStore::count_accepted() {
+  std::lock_guard lock(read_mutex_);
+  auto st = reader_->prepare("SELECT count(*) FROM jobs WHERE status = 'accepted'");
+  st.step();
+  return st.int64(0);
 }
 
-bool SqliteStore::mark_dismissed(const std::string& id, const std::string& updated) {
-  std::lock_guard lock(write_mutex_);
-  auto st = writer_->prepare(
-      "UPDATE jobs SET status = 'dismissed', updated = ?1, message = 'dismissed' "
-      "WHERE id = ?2 AND status IN ('accepted', 'running')");
-  st.bind(1, updated).bind(2, id).run();
-  return writer_->changes() == 1;
+std::optional<JobRecord> SqliteStore::claim_job(const std::string& owner, const std::string& now,
+                                                double lease_seconds) {
+  std::optional<JobRecord> claimed;
+  {
+    std::lock_guard lock(write_mutex_);
+    Transaction tx(*writer_);
+    std::string id;
+    {
+      auto st = writer_->prepare("SELECT id FROM jobs WHERE status = 'accepted' ORDER BY ord LIMIT 1");
+      if (!st.step()) return std::nullopt;
+      id = st.text(0);
+    }
+    writer_->prepare(
+               "UPDATE jobs SET status = 'running', started = ?1, updated = ?1, message = 'running', "
+               "attempts = attempts + 1, generation = generation + 1, owner = ?2, lease_expires = ?3 "
+               "WHERE id = ?4")
+        .bind(1, now).bind(2, owner).bind(3, unix_now() + lease_seconds).bind(4, id).run();
+    claimed = job_locked(*writer_, id, true);
+    tx.commit();
+  }
+  announce(StoreChange::job, claimed->id);
+  return claimed;
 }
 
-void SqliteStore::append_events(const std::vector<NewEvent>& events) {
-  if (events.empty()) return;
+LeaseRenewal SqliteStore::renew_leases(const std::string& owner, double lease_seconds) {
   std::lock_guard lock(write_mutex_);
-  // Events commit without fsync: kill -9 cannot lose them (the WAL is in the OS's cache), and
-  // the next synchronous=FULL commit of the same WAL (a job's finish) makes them durable on
-  // disk before that job is reported finished. A running job's events are discarded at
-  // recovery anyway.
-  writer_->exec("PRAGMA synchronous=NORMAL");
-  struct Restore {
-    Database& db;
-    ~Restore() {
-      try {
-        db.exec("PRAGMA synchronous=FULL");
-      } catch (...) {
+  Transaction tx(*writer_);
+  writer_->prepare(
+             "UPDATE jobs SET lease_expires = ?1 WHERE owner = ?2 AND finished IS NULL "
+             "AND status IN ('running', 'dismissed')")
+      .bind(1, unix_now() + lease_seconds).bind(2, owner).run();
+  LeaseRenewal r;
+  auto st = writer_->prepare(
+      "SELECT id, generation, status FROM jobs WHERE owner = ? AND finished IS NULL "
+      "AND status IN ('running', 'dismissed')");
+  st.bind(1, owner);
+  while (st.step()) {
+    r.held.push_back({st.text(0), st.int64(1)});
+    if (st.text(2) == "dismissed") r.dismissed.push_back(st.text(0));
+  }
+  tx.commit();
+  return r;
+}
+
+void SqliteStore::release_leases(const std::string& owner) {
+  std::lock_guard lock(write_mutex_);
+  writer_->prepare("UPDATE jobs SET lease_expires = 0 WHERE owner = ? AND finished IS NULL")
+      .bind(1, owner).run();
+}
+
+int SqliteStore::requeue_expired(const std::string& now) {
+  int changed = 0;
+  {
+    std::lock_guard lock(write_mutex_);
+    Transaction tx(*writer_);
+    const double t = unix_now();
+    writer_->prepare(
+               "DELETE FROM events WHERE job_id IN (SELECT id FROM jobs WHERE status = 'running' "
+               "AND lease_expires < ?)")
+        .bind(1, t).run();
+    writer_->prepare(
+               "UPDATE jobs SET status = 'accepted', started = NULL, updated = ?1, "
+               "message = 'requeued after an interrupted run' WHERE status = 'running' "
+               "AND lease_expires < ?2")
+        .bind(1, now).bind(2, t).run();
+    changed += static_cast<int>(writer_->changes());
+    // Dismissed while running, then its runner went away before finishing it.
+    std::vector<std::pair<std::string, std::int64_t>> unfinished;
+    {
+      auto st = writer_->prepare(
+          "SELECT id, last_seq FROM jobs WHERE status = 'dismissed' AND finished IS NULL "
+          "AND lease_expires < ?");
+      st.bind(1, t);
+      while (st.step()) unfinished.emplace_back(st.text(0), st.int64(1));
+    }
+    for (const auto& [id, last_seq] : unfinished) {
+      insert_event(*writer_, id, {last_seq + 1, "job_failed", std::string(kDismissedEvent)});
+      writer_->prepare("UPDATE jobs SET finished = ?1, updated = ?1, last_seq = ?2 WHERE id = ?3")
+          .bind(1, now).bind(2, last_seq + 1).bind(3, id).run();
+    }
+    changed += static_cast<int>(unfinished.size());
+    tx.commit();
+  }
+  if (changed > 0) announce(StoreChange::job, "");
+  return changed;
+}
+
+std::vector<Lease> SqliteStore::append_events(const std::vector<NewEvent>& events) {
+  if (events.empty()) return {};
+  // The highest seq per run in this batch.
+  std::map<std::pair<std::string, std::int64_t>, std::int64_t> runs;
+  for (const NewEvent& e : events) {
+    auto& top = runs[{e.lease.job_id, e.lease.generation}];
+    top = std::max(top, e.event.seq);
+  }
+  std::vector<Lease> refused;
+  {
+    std::lock_guard lock(write_mutex_);
+    // Events commit without fsync: kill -9 cannot lose them (the WAL is in the OS's cache),
+    // and the next synchronous=FULL commit of the same WAL (a job's finish) makes them
+    // durable on disk before that job is reported finished. A running job's events are
+    // discarded when it is requeued anyway.
+    writer_->exec("PRAGMA synchronous=NORMAL");
+    struct Restore {
+      Database& db;
+      ~Restore() {
+        try {
+          db.exec("PRAGMA synchronous=FULL");
+        } catch (...) {
+        }
+      }
+    } restore{*writer_};
+    Transaction tx(*writer_);
+    std::set<std::pair<std::string, std::int64_t>> stale;
+    auto seq = writer_->prepare(
+        "UPDATE jobs SET last_seq = max(last_seq, ?) WHERE id = ? AND generation = ? "
+        "AND finished IS NULL AND status IN ('running', 'dismissed')");
+    for (const auto& [run, top] : runs) {
+      seq.reset();
+      seq.bind(1, top).bind(2, run.first).bind(3, run.second).run();
+      if (writer_->changes() != 1) {
+        stale.insert(run);
+        refused.push_back({run.first, run.second});
       }
     }
-  } restore{*writer_};
-  Transaction tx(*writer_);
-  auto ins = writer_->prepare("INSERT INTO events (job_id, seq, type, data) VALUES (?, ?, ?, ?)");
-  auto seq = writer_->prepare("UPDATE jobs SET last_seq = max(last_seq, ?) WHERE id = ?");
-  for (size_t i = 0; i < events.size(); ++i) {
-    const NewEvent& e = events[i];
-    ins.reset();
-    ins.bind(1, e.job_id).bind(2, e.event.seq).bind(3, e.event.type).bind(4, e.event.data).run();
-    // last_seq once per job and batch: at the job's last event in the batch.
-    bool last_of_job = true;
-    for (size_t k = i + 1; k < events.size() && last_of_job; ++k)
-      if (events[k].job_id == e.job_id) last_of_job = false;
-    if (last_of_job) {
-      seq.reset();
-      seq.bind(1, e.event.seq).bind(2, e.job_id).run();
+    auto ins = writer_->prepare("INSERT INTO events (job_id, seq, type, data) VALUES (?, ?, ?, ?)");
+    for (const NewEvent& e : events) {
+      if (stale.count({e.lease.job_id, e.lease.generation})) continue;
+      ins.reset();
+      ins.bind(1, e.lease.job_id).bind(2, e.event.seq).bind(3, e.event.type).bind(4, e.event.data).run();
     }
+    tx.commit();
   }
-  tx.commit();
+  for (const auto& [run, top] : runs) announce(StoreChange::events, run.first);
+  return refused;
 }
 
-void SqliteStore::finish_job(const std::string& id, const JobOutcome& o) {
-  std::lock_guard lock(write_mutex_);
-  Transaction tx(*writer_);
-  auto st = writer_->prepare(
-      "UPDATE jobs SET status = ?1, message = ?2, finished = ?3, updated = ?3, "
-      "solve_seconds = ?4, iterations = ?5, last_seq = max(last_seq, ?6) WHERE id = ?7");
-  st.bind(1, to_string(o.status)).bind(2, o.message).bind(3, o.finished);
-  st.bind(4, o.solve_seconds).bind(5, o.iterations);
-  st.bind(6, o.terminal ? o.terminal->seq : std::int64_t{0}).bind(7, id).run();
-  if (o.result) {
-    auto r = writer_->prepare("INSERT OR REPLACE INTO results (job_id, data) VALUES (?, ?)");
-    r.bind(1, id).bind(2, *o.result).run();
+std::optional<JobStatus> SqliteStore::finish_job(const Lease& lease, const JobOutcome& o) {
+  JobStatus final_status = o.status;
+  {
+    std::lock_guard lock(write_mutex_);
+    Transaction tx(*writer_);
+    std::string status;
+    {
+      auto st = writer_->prepare(
+          "SELECT status FROM jobs WHERE id = ? AND generation = ? AND finished IS NULL");
+      st.bind(1, lease.job_id).bind(2, lease.generation);
+      if (!st.step()) return std::nullopt;
+      status = st.text(0);
+    }
+    if (status != "running" && status != "dismissed") return std::nullopt;
+    const bool dismissed = status == "dismissed" || o.status == JobStatus::dismissed;
+    if (dismissed) final_status = JobStatus::dismissed;
+    StoredEvent terminal = o.terminal;
+    if (dismissed) terminal = {o.terminal.seq, "job_failed", std::string(kDismissedEvent)};
+    writer_->prepare(
+               "UPDATE jobs SET status = ?1, message = ?2, finished = ?3, updated = ?3, "
+               "solve_seconds = ?4, iterations = ?5, last_seq = max(last_seq, ?6) WHERE id = ?7")
+        .bind(1, to_string(final_status)).bind(2, dismissed ? std::string("dismissed") : o.message)
+        .bind(3, o.finished).bind(4, o.solve_seconds).bind(5, o.iterations)
+        .bind(6, terminal.seq).bind(7, lease.job_id).run();
+    if (o.result && !dismissed)
+      writer_->prepare("INSERT OR REPLACE INTO results (job_id, data) VALUES (?, ?)")
+          .bind(1, lease.job_id).bind(2, *o.result).run();
+    insert_event(*writer_, lease.job_id, terminal);
+    tx.commit();
   }
-  if (o.terminal) {
-    auto e = writer_->prepare("INSERT INTO events (job_id, seq, type, data) VALUES (?, ?, ?, ?)");
-    e.bind(1, id).bind(2, o.terminal->seq).bind(3, o.terminal->type).bind(4, o.terminal->data);
-    e.run();
-  }
-  tx.commit();
+  announce(StoreChange::events, lease.job_id);
+  return final_status;
 }
 
-void SqliteStore::requeue_job(const std::string& id, const std::string& updated) {
-  std::lock_guard lock(write_mutex_);
-  Transaction tx(*writer_);
-  writer_->prepare("DELETE FROM events WHERE job_id = ?").bind(1, id).run();
-  auto st = writer_->prepare(
-      "UPDATE jobs SET status = 'accepted', started = NULL, updated = ?1, "
-      "message = 'requeued after an interrupted run' WHERE id = ?2 AND status = 'running'");
-  st.bind(1, updated).bind(2, id).run();
-  tx.commit();
+bool SqliteStore::requeue_job(const Lease& lease, const std::string& updated) {
+  bool done = false;
+  {
+    std::lock_guard lock(write_mutex_);
+    Transaction tx(*writer_);
+    writer_->prepare(
+               "UPDATE jobs SET status = 'accepted', started = NULL, updated = ?1, "
+               "message = 'requeued after an interrupted run' WHERE id = ?2 AND generation = ?3 "
+               "AND status = 'running'")
+        .bind(1, updated).bind(2, lease.job_id).bind(3, lease.generation).run();
+    done = writer_->changes() == 1;
+    if (done) writer_->prepare("DELETE FROM events WHERE job_id = ?").bind(1, lease.job_id).run();
+    tx.commit();
+  }
+  if (done) announce(StoreChange::job, lease.job_id);
+  return done;
 }
 
-bool SqliteStore::delete_job(const std::string& id) {
-  std::lock_guard lock(write_mutex_);
-  Transaction tx(*writer_);
-  writer_->prepare("DELETE FROM events WHERE job_id = ?").bind(1, id).run();
-  writer_->prepare("DELETE FROM results WHERE job_id = ?").bind(1, id).run();
-  writer_->prepare("DELETE FROM jobs WHERE id = ?").bind(1, id).run();
-  const bool removed = writer_->changes() == 1;
-  tx.commit();
-  return removed;
+std::pair<DismissOutcome, std::optional<JobRecord>> SqliteStore::dismiss_job(
+    const std::string& id, const std::string& now) {
+  std::pair<DismissOutcome, std::optional<JobRecord>> out{DismissOutcome::not_found, std::nullopt};
+  {
+    std::lock_guard lock(write_mutex_);
+    Transaction tx(*writer_);
+    auto rec = job_locked(*writer_, id, false);
+    if (!rec) return out;
+    if (rec->status == JobStatus::accepted) {
+      const std::int64_t seq = rec->last_seq + 1;
+      writer_->prepare(
+                 "UPDATE jobs SET status = 'dismissed', message = 'dismissed before it started', "
+                 "finished = ?1, updated = ?1, last_seq = ?2 WHERE id = ?3")
+          .bind(1, now).bind(2, seq).bind(3, id).run();
+      insert_event(*writer_, id, {seq, "job_failed", std::string(kDismissedEvent)});
+      out = {DismissOutcome::dismissed, job_locked(*writer_, id, false)};
+    } else if (!is_finished(rec->status) || rec->finished.empty()) {
+      writer_->prepare(
+                 "UPDATE jobs SET status = 'dismissed', message = 'dismissed', updated = ? WHERE id = ?")
+          .bind(1, now).bind(2, id).run();
+      out = {DismissOutcome::dismissed, job_locked(*writer_, id, false)};
+    } else {
+      writer_->prepare("DELETE FROM events WHERE job_id = ?").bind(1, id).run();
+      writer_->prepare("DELETE FROM results WHERE job_id = ?").bind(1, id).run();
+      writer_->prepare("DELETE FROM jobs WHERE id = ?").bind(1, id).run();
+      out = {DismissOutcome::removed, rec};
+    }
+    tx.commit();
+  }
+  announce(out.first == DismissOutcome::dismissed ? StoreChange::dismissed : StoreChange::job, id);
+  return out;
 }
 
 std::vector<StoredEvent> SqliteStore::events_after(const std::string& id, std::int64_t after,
@@ -257,45 +446,6 @@ std::optional<std::string> SqliteStore::result(const std::string& id) {
   st.bind(1, id);
   if (!st.step()) return std::nullopt;
   return st.text(0);
-}
-
-std::vector<std::string> SqliteStore::recover(const std::string& now,
-                                              const std::string& terminal_for_dismissed) {
-  std::lock_guard lock(write_mutex_);
-  Transaction tx(*writer_);
-  writer_->exec(
-      "DELETE FROM events WHERE job_id IN (SELECT id FROM jobs WHERE status = 'running')");
-  writer_->prepare(
-             "UPDATE jobs SET status = 'accepted', started = NULL, updated = ?, "
-             "message = 'requeued after an interrupted run' WHERE status = 'running'")
-      .bind(1, now)
-      .run();
-  // Dismissed while running, then interrupted before the worker finished it.
-  std::vector<std::pair<std::string, std::int64_t>> unfinished;
-  {
-    auto st = writer_->prepare(
-        "SELECT id, last_seq FROM jobs WHERE status = 'dismissed' AND finished IS NULL");
-    while (st.step()) unfinished.emplace_back(st.text(0), st.int64(1));
-  }
-  for (const auto& [id, last_seq] : unfinished) {
-    writer_->prepare("INSERT INTO events (job_id, seq, type, data) VALUES (?, ?, 'job_failed', ?)")
-        .bind(1, id)
-        .bind(2, last_seq + 1)
-        .bind(3, terminal_for_dismissed)
-        .run();
-    writer_->prepare("UPDATE jobs SET finished = ?1, updated = ?1, last_seq = ?2 WHERE id = ?3")
-        .bind(1, now)
-        .bind(2, last_seq + 1)
-        .bind(3, id)
-        .run();
-  }
-  std::vector<std::string> accepted;
-  {
-    auto st = writer_->prepare("SELECT id FROM jobs WHERE status = 'accepted' ORDER BY ord");
-    while (st.step()) accepted.push_back(st.text(0));
-  }
-  tx.commit();
-  return accepted;
 }
 
 }  // namespace grip::server

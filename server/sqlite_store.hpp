@@ -1,9 +1,12 @@
 #pragma once
-// The embedded job store: one SQLite file in WAL mode. Job changes commit with
-// synchronous=FULL (they survive kill -9 and power loss); event batches with NORMAL (they
-// survive kill -9, and the job's FULL finish makes them durable before it is reported). One
-// connection writes and one reads (WAL lets reads run beside a write), each under its own
-// mutex.
+// The embedded job store: one SQLite file in WAL mode, used by one process. Job changes
+// commit with synchronous=FULL (they survive kill -9 and power loss); event batches with
+// NORMAL (they survive kill -9, and the job's FULL finish makes them durable before it is
+// reported). One connection writes and one reads (WAL lets reads run beside a write), each
+// under its own mutex. Since no other process shares the file, opening it releases every
+// lease: the runs of the previous process are requeued at once by requeue_expired. Changes
+// are announced to the listener right after they commit.
+#include <functional>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -15,7 +18,7 @@ namespace grip::server {
 
 class SqliteStore final : public Store {
  public:
-  // Creates the file (and its folder) and the schema when missing.
+  // Creates the file (and its folder) and the schema when missing; upgrades an older schema.
   explicit SqliteStore(const std::string& path, int busy_timeout_ms = 5000);
 
   void insert_job(JobRecord& job) override;
@@ -24,23 +27,33 @@ class SqliteStore final : public Store {
   JobPage list_jobs(std::optional<JobStatus> status, int limit,
                     std::optional<std::int64_t> before) override;
   std::map<JobStatus, std::int64_t> count_by_status() override;
-  bool start_job(const std::string& id, const std::string& started) override;
-  bool mark_dismissed(const std::string& id, const std::string& updated) override;
-  void append_events(const std::vector<NewEvent>& events) override;
-  void finish_job(const std::string& id, const JobOutcome& outcome) override;
-  void requeue_job(const std::string& id, const std::string& updated) override;
-  bool delete_job(const std::string& id) override;
+  std::int64_t count_accepted() override;
+  std::optional<JobRecord> claim_job(const std::string& owner, const std::string& now,
+                                     double lease_seconds) override;
+  LeaseRenewal renew_leases(const std::string& owner, double lease_seconds) override;
+  void release_leases(const std::string& owner) override;
+  int requeue_expired(const std::string& now) override;
+  std::vector<Lease> append_events(const std::vector<NewEvent>& events) override;
+  std::optional<JobStatus> finish_job(const Lease& lease, const JobOutcome& outcome) override;
+  bool requeue_job(const Lease& lease, const std::string& updated) override;
+  std::pair<DismissOutcome, std::optional<JobRecord>> dismiss_job(const std::string& id,
+                                                                  const std::string& now) override;
   std::vector<StoredEvent> events_after(const std::string& id, std::int64_t after, int limit,
                                         std::string_view type) override;
   std::optional<std::string> result(const std::string& id) override;
-  std::vector<std::string> recover(const std::string& now,
-                                   const std::string& terminal_for_dismissed) override;
+  bool ping() override { return true; }
+  void set_listener(std::function<void(const StoreChange&)> listener) override;
 
  private:
+  void announce(StoreChange::Kind kind, const std::string& job_id);
+  std::optional<JobRecord> job_locked(Database& db, const std::string& id, bool with_scene);
+
   std::mutex write_mutex_;
   std::unique_ptr<Database> writer_;
   std::mutex read_mutex_;
   std::unique_ptr<Database> reader_;
+  std::mutex listener_mutex_;
+  std::function<void(const StoreChange&)> listener_;
 };
 
 }  // namespace grip::server

@@ -1,15 +1,24 @@
 #pragma once
-// The job store: jobs (scene, status, timings), their events and their results, behind one
-// small interface so that a shared store (PostgreSQL) can replace the embedded SQLite one.
-//
-// Contract every implementation keeps:
+// The job store: jobs (scene, status, timings, leases), their events and their results,
+// behind one interface with two implementations: SQLite (embedded, one process, the default)
+// and PostgreSQL (shared by several replicas). tests/integration/store_contract_test.cpp
+// holds every implementation to this contract:
 // - a call returns only once its writes are durable (a 201 is never lost, even to kill -9);
+// - claims are atomic: one job goes to one claimant, the oldest accepted job first;
+// - a claim is a lease (owner, expiry, generation). Only the current generation may store
+//   events, requeue or finish the job (fencing): a run whose lease expired and was taken over
+//   can no longer write anything;
 // - event sequence numbers of a job are never reused: `last_seq` only grows, also when an
-//   interrupted run's events are discarded (see requeue_job and recover);
-// - finish_job writes the final status, the result and the terminal event in one transaction.
+//   interrupted run's events are discarded;
+// - finish_job writes the final status, the result and the terminal event in one transaction,
+//   at most once per job;
+// - every change is announced to the listener (set_listener) of every store instance on the
+//   same database, this one included.
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -24,6 +33,15 @@ std::optional<JobStatus> parse_job_status(std::string_view text);
 inline bool is_finished(JobStatus s) {
   return s == JobStatus::successful || s == JobStatus::failed || s == JobStatus::dismissed;
 }
+
+// The database cannot be reached (now); nothing was written. Retry later.
+class StoreUnavailable : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// The terminal event of a dismissed job, as the store writes it.
+inline constexpr std::string_view kDismissedEvent = R"({"reason":"dismissed","type":"job_failed"})";
 
 struct JobRecord {
   std::string id;
@@ -42,6 +60,14 @@ struct JobRecord {
   int attempts = 0;           // runs started; above 1 after an interrupted run
   double solve_seconds = 0.0;
   std::int64_t iterations = 0;  // contact iterations of the final run
+  std::string owner;            // replica holding (or that last held) the lease
+  std::int64_t generation = 0;  // lease generation: grows with every claim
+};
+
+// A run's hold on a job (fencing token).
+struct Lease {
+  std::string job_id;
+  std::int64_t generation = 0;
 };
 
 struct StoredEvent {
@@ -51,7 +77,7 @@ struct StoredEvent {
 };
 
 struct NewEvent {
-  std::string job_id;
+  Lease lease;
   StoredEvent event;
 };
 
@@ -61,13 +87,27 @@ struct JobOutcome {
   std::string finished;  // timestamp
   double solve_seconds = 0.0;
   std::int64_t iterations = 0;
-  std::optional<std::string> result;   // result JSON, when the run produced one
-  std::optional<StoredEvent> terminal;  // job_finished | job_failed
+  std::optional<std::string> result;  // result JSON, when the run produced one
+  StoredEvent terminal;                // job_finished | job_failed
 };
 
 struct JobPage {
   std::vector<JobRecord> jobs;
   std::optional<std::int64_t> next_before;  // ord to continue below; none: last page
+};
+
+enum class DismissOutcome { not_found, dismissed, removed };
+
+// What renew_leases found about the owner's jobs.
+struct LeaseRenewal {
+  std::vector<Lease> held;                // leases still this owner's (renewed)
+  std::vector<std::string> dismissed;     // among them: jobs dismissed meanwhile
+};
+
+// A change announced to listeners.
+struct StoreChange {
+  enum Kind { events, job, dismissed } kind = job;  // events stored; status changed; dismissed
+  std::string job_id;                               // empty: some job (a claim, a requeue)
 };
 
 class Store {
@@ -83,31 +123,47 @@ class Store {
   virtual JobPage list_jobs(std::optional<JobStatus> status, int limit,
                             std::optional<std::int64_t> before) = 0;
   virtual std::map<JobStatus, std::int64_t> count_by_status() = 0;
+  virtual std::int64_t count_accepted() = 0;
 
-  // accepted -> running (attempts + 1). False when the job is no longer accepted.
-  virtual bool start_job(const std::string& id, const std::string& started) = 0;
-  // accepted | running -> dismissed, without finishing it (a running job's worker does).
-  // False when the job was not accepted or running.
-  virtual bool mark_dismissed(const std::string& id, const std::string& updated) = 0;
-  // Appends events of any jobs in one transaction and raises each job's last_seq.
-  virtual void append_events(const std::vector<NewEvent>& events) = 0;
-  // Final status, timings, result and terminal event in one transaction.
-  virtual void finish_job(const std::string& id, const JobOutcome& outcome) = 0;
-  // Back to accepted, the interrupted run's events discarded (last_seq kept).
-  virtual void requeue_job(const std::string& id, const std::string& updated) = 0;
-  // Removes a job with its events and result. False when there was none.
-  virtual bool delete_job(const std::string& id) = 0;
+  // The oldest accepted job becomes running for `owner` (attempts + 1, a new generation, a
+  // lease of `lease_seconds`); returned with its scene. None when no job is accepted.
+  virtual std::optional<JobRecord> claim_job(const std::string& owner, const std::string& now,
+                                             double lease_seconds) = 0;
+  // Extends every lease `owner` holds on an unfinished job.
+  virtual LeaseRenewal renew_leases(const std::string& owner, double lease_seconds) = 0;
+  // Ends every lease `owner` holds at once: a process starting under a fixed name knows that
+  // its previous incarnation is gone.
+  virtual void release_leases(const std::string& owner) = 0;
+  // Jobs whose lease expired: running ones go back to accepted (events discarded, last_seq
+  // kept), dismissed ones are finished. Returns how many changed.
+  virtual int requeue_expired(const std::string& now) = 0;
+
+  // Appends events and raises each job's last_seq, in one transaction, each only while its
+  // lease is current. Returns the leases that were not (their events are dropped).
+  virtual std::vector<Lease> append_events(const std::vector<NewEvent>& events) = 0;
+  // Final status, timings, result and terminal event in one transaction, if `lease` is current
+  // and the job unfinished. A job dismissed meanwhile ends dismissed (no result, the dismissed
+  // event). Returns the status stored, or none when fenced out.
+  virtual std::optional<JobStatus> finish_job(const Lease& lease, const JobOutcome& outcome) = 0;
+  // Back to accepted, the run's events discarded (last_seq kept), if `lease` is current.
+  virtual bool requeue_job(const Lease& lease, const std::string& updated) = 0;
+  // Atomically: an accepted job is finished as dismissed (with the dismissed event), a running
+  // one marked dismissed (its runner finishes it), a finished one removed with its events and
+  // result. Returns the job as it is afterwards (removed: as it was).
+  virtual std::pair<DismissOutcome, std::optional<JobRecord>> dismiss_job(
+      const std::string& id, const std::string& now) = 0;
 
   // Events with seq > after, in order, at most `limit`; only of `type` when given.
   virtual std::vector<StoredEvent> events_after(const std::string& id, std::int64_t after,
                                                 int limit, std::string_view type = {}) = 0;
   virtual std::optional<std::string> result(const std::string& id) = 0;
 
-  // After a crash: running jobs go back to accepted (their events discarded), dismissed jobs
-  // that were never finished get finished with `terminal_for_dismissed`; returns the ids of
-  // all accepted jobs in creation order.
-  virtual std::vector<std::string> recover(const std::string& now,
-                                           const std::string& terminal_for_dismissed) = 0;
+  // True when the database answers now.
+  virtual bool ping() = 0;
+  // Called (on a store thread) for every change on the database, from any store instance.
+  virtual void set_listener(std::function<void(const StoreChange&)> listener) = 0;
+  // Round trips and bytes exchanged with the database so far (benchmarks; 0 when embedded).
+  virtual std::pair<std::int64_t, std::int64_t> traffic() const { return {0, 0}; }
 };
 
 }  // namespace grip::server

@@ -5,6 +5,8 @@
 #include <ctime>
 #include <random>
 
+#include <unistd.h>
+
 namespace grip::server {
 
 std::string now_iso8601() {
@@ -46,6 +48,16 @@ bool equal_constant_time(const std::string& a, const std::string& b) {
   const std::string& c = a.size() == b.size() ? b : a;
   for (size_t i = 0; i < a.size(); ++i) diff |= static_cast<unsigned char>(a[i] ^ c[i]);
   return diff == 0;
+}
+
+}  // namespace grip::server
+
+namespace grip::server {
+
+std::string default_replica_name() {
+  char host[256] = {};
+  if (gethostname(host, sizeof host - 1) != 0) std::snprintf(host, sizeof host, "grip");
+  return std::string(host) + "-" + std::to_string(getpid()) + "-" + new_job_id().substr(0, 8);
 }
 
 }  // namespace grip::server

@@ -10,6 +10,10 @@ std::string now_iso8601();
 // A random UUID v4: job ids are opaque and unguessable.
 std::string new_job_id();
 
+// This process's name in job leases: host, pid and a random part (a restarted process is a
+// new replica: its predecessor's leases expire rather than being silently inherited).
+std::string default_replica_name();
+
 // Constant-time comparison (bearer tokens).
 bool equal_constant_time(const std::string& a, const std::string& b);
 

@@ -1,6 +1,7 @@
 // The job API without sockets: JobService over a SQLite store in a temporary folder.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <condition_variable>
 #include <mutex>
 
@@ -96,11 +97,14 @@ TEST(JobService, RecoveryRunsInterruptedJobsAgainAboveTheirOldEventIds) {
       rec.nodes = 11;
       store.insert_job(rec);
     }
-    ASSERT_TRUE(store.start_job("a-running", "2025-01-01T00:00:01.000Z"));
+    const auto claimed = store.claim_job("crashed", "2025-01-01T00:00:01.000Z", 60);
+    ASSERT_TRUE(claimed);
+    ASSERT_EQ(claimed->id, "a-running");
     std::vector<server::NewEvent> events;
     for (int k = 1; k <= 3; ++k)
-      events.push_back({"a-running", {k, "step_started", R"({"type":"step_started","step":1,"load_factor":0.1})"}});
-    store.append_events(events);
+      events.push_back({{"a-running", claimed->generation},
+                        {k, "step_started", R"({"type":"step_started","step":1,"load_factor":0.1})"}});
+    EXPECT_TRUE(store.append_events(events).empty());
   }
   SqliteStore store(path);
   JobService service(store, ServiceOptions{});
@@ -133,6 +137,35 @@ TEST(JobService, InvalidScenesAndLimitsThrowWithPointers) {
   bad["body"]["material"]["young"] = -1;
   EXPECT_THROW(service.submit(bad), SceneErrors);
   EXPECT_TRUE(service.list(std::nullopt, 10, std::nullopt).jobs.empty());  // nothing stored
+}
+
+// Retry-After of a full queue is the time until a worker frees (a queue slot then frees too),
+// not the time to drain the whole queue.
+TEST(JobService, RetryAfterIsTheTimeUntilAWorkerFreesNotTheTimeToDrainTheQueue) {
+  TempDir dir;
+  SqliteStore store((dir.path() / "grip.sqlite").string());
+  ServiceOptions options;
+  options.workers = 1;
+  options.queue_capacity = 4;
+  JobService service(store, options);
+  service.start();
+  const nlohmann::json scene = beam_scene(40, 60);
+  const std::string first = service.submit(scene).job.record.id;
+  events_to_end(service, first);
+  const double mean = service.job(first)->record.solve_seconds;  // the only finished run
+  std::vector<std::string> ids;
+  for (int i = 0; i < 5; ++i) ids.push_back(service.submit(scene).job.record.id);  // 1 runs, 4 wait
+  try {
+    service.submit(scene);
+    FAIL() << "the queue should be full";
+  } catch (const server::QueueFull& e) {
+    // Draining the queue would take 4 runs; a worker frees within one.
+    EXPECT_LE(e.retry_after_seconds, static_cast<int>(std::ceil(mean)));
+    EXPECT_GE(e.retry_after_seconds, 1);
+    std::printf("[ info ] mean run %.2f s, Retry-After %d s (draining the queue: %.1f s)\n", mean,
+                e.retry_after_seconds, 4 * mean);
+  }
+  for (const auto& id : ids) service.dismiss(id);
 }
 
 }  // namespace

@@ -244,7 +244,7 @@ TEST(MalformedRequests, TableOfBadRequestsGetTheirProblemAndHarmNothing) {
       {"GET /v1/jobs/nope/events", 404, "", "GET", "/v1/jobs/nope/events"},
       {"GET /v1/jobs/nope/convergence", 404, "", "GET", "/v1/jobs/nope/convergence"},
       {"DELETE /v1/jobs/nope", 404, "", "DELETE", "/v1/jobs/nope"},
-      {"PUT /v1/jobs (no such route)", 404, "", "PUT", "/v1/jobs", "{}"},
+      {"PUT /v1/jobs (405, Allow: GET, POST)", 405, "", "PUT", "/v1/jobs", "{}"},
       {"GET /v1/nothing-here", 404, "", "GET", "/v1/nothing-here"},
       // events and result of a real job
       {"events with Last-Event-ID: abc", 400, "", "GET", job + "/events", "", "", {{"Last-Event-ID", "abc"}}},
