@@ -6,6 +6,7 @@
 #   2. build-fuzz: clang + libFuzzer (GRIP_FUZZ=ON); the `fuzz` label fuzzes the scene reader
 #      for GRIP_FUZZ_SECONDS (default 60) and replays tests/fuzz/regressions.
 #   3. the `hard_slow` label (slow hard-case tests), in build-asan.
+#   4. deploy/compose.yaml in Docker (scripts/check-compose.sh).
 # Usage: bash scripts/check-extended.sh [GRIP_FUZZ_SECONDS]. Exit status non-zero on any failure.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -32,3 +33,8 @@ ctest --test-dir build-fuzz -L fuzz --output-on-failure
 echo "== hard_slow tests (build-asan)"
 cmake --build build-asan -j "$jobs"
 ctest --test-dir build-asan -C slow -L hard_slow --output-on-failure --timeout 3600
+
+# ---- deploy/compose.yaml: PostgreSQL, three replicas and HAProxy in Docker (images built
+# FROM a local debian:12-slim made with debootstrap when Docker Hub does not answer).
+echo "== compose (deploy/compose.yaml)"
+bash scripts/check-compose.sh

@@ -476,7 +476,12 @@ void JobService::lease_loop() {
   while (!lease_cv_.wait_for(lock, period, [&] { return stop_workers_ && running_ == 0; })) {
     lock.unlock();
     try {
-      const LeaseRenewal r = store_.renew_leases(options_.replica, options_.lease_seconds);
+      std::vector<Lease> held;
+      {
+        std::lock_guard relock(mutex_);
+        for (const auto& [id, job] : active_) held.push_back(job->lease);
+      }
+      const LeaseRenewal r = store_.renew_leases(options_.replica, held, options_.lease_seconds);
       std::unique_lock relock(mutex_);
       for (auto& [id, job] : active_) {
         const bool held = std::any_of(r.held.begin(), r.held.end(), [&](const Lease& l) {

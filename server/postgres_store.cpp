@@ -441,12 +441,18 @@ std::optional<JobRecord> PostgresStore::claim_job(const std::string& owner, cons
   return read_job(r, 0, true);
 }
 
-LeaseRenewal PostgresStore::renew_leases(const std::string& owner, double lease_seconds) {
+LeaseRenewal PostgresStore::renew_leases(const std::string& owner, const std::vector<Lease>& leases,
+                                         double lease_seconds) {
+  if (leases.empty()) return {};
+  nlohmann::json list = nlohmann::json::array();
+  for (const Lease& l : leases) list.push_back({{"id", l.job_id}, {"g", l.generation}});
   Session s(*pool_);
   const Result r = s.query(
-      "UPDATE grip_jobs SET lease_expires = now() + make_interval(secs => $2) WHERE owner = $1 "
-      "AND finished IS NULL AND status IN ('running', 'dismissed') RETURNING id, generation, status",
-      {owner, num(lease_seconds)});
+      "UPDATE grip_jobs j SET lease_expires = now() + make_interval(secs => $2) "
+      "FROM jsonb_array_elements($3::jsonb) x WHERE j.id = x->>'id' AND j.generation = (x->>'g')::bigint "
+      "AND j.owner = $1 AND j.finished IS NULL AND j.status IN ('running', 'dismissed') "
+      "RETURNING j.id, j.generation, j.status",
+      {owner, num(lease_seconds), list.dump()});
   LeaseRenewal out;
   for (int i = 0; i < r.rows(); ++i) {
     out.held.push_back({r.text(i, 0), r.int64(i, 1)});

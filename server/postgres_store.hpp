@@ -26,7 +26,7 @@ class PostgresStore final : public Store {
  public:
   // Connects and creates the tables when missing. Throws StoreUnavailable when the database
   // cannot be reached.
-  explicit PostgresStore(const std::string& url, int pool_size = 8);
+  explicit PostgresStore(const std::string& url, int pool_size = 16);
   ~PostgresStore() override;
 
   void insert_job(JobRecord& job) override;
@@ -38,7 +38,8 @@ class PostgresStore final : public Store {
   std::int64_t count_accepted() override;
   std::optional<JobRecord> claim_job(const std::string& owner, const std::string& now,
                                      double lease_seconds) override;
-  LeaseRenewal renew_leases(const std::string& owner, double lease_seconds) override;
+  LeaseRenewal renew_leases(const std::string& owner, const std::vector<Lease>& leases,
+                            double lease_seconds) override;
   void release_leases(const std::string& owner) override;
   int requeue_expired(const std::string& now) override;
   std::vector<Lease> append_events(const std::vector<NewEvent>& events) override;

@@ -225,21 +225,22 @@ std::optional<JobRecord> SqliteStore::claim_job(const std::string& owner, const 
   return claimed;
 }
 
-LeaseRenewal SqliteStore::renew_leases(const std::string& owner, double lease_seconds) {
+LeaseRenewal SqliteStore::renew_leases(const std::string& owner, const std::vector<Lease>& leases,
+                                       double lease_seconds) {
+  LeaseRenewal r;
+  if (leases.empty()) return r;
   std::lock_guard lock(write_mutex_);
   Transaction tx(*writer_);
-  writer_->prepare(
-             "UPDATE jobs SET lease_expires = ?1 WHERE owner = ?2 AND finished IS NULL "
-             "AND status IN ('running', 'dismissed')")
-      .bind(1, unix_now() + lease_seconds).bind(2, owner).run();
-  LeaseRenewal r;
-  auto st = writer_->prepare(
-      "SELECT id, generation, status FROM jobs WHERE owner = ? AND finished IS NULL "
-      "AND status IN ('running', 'dismissed')");
-  st.bind(1, owner);
-  while (st.step()) {
-    r.held.push_back({st.text(0), st.int64(1)});
-    if (st.text(2) == "dismissed") r.dismissed.push_back(st.text(0));
+  for (const Lease& l : leases) {
+    writer_->prepare(
+               "UPDATE jobs SET lease_expires = ?1 WHERE id = ?2 AND generation = ?3 AND owner = ?4 "
+               "AND finished IS NULL AND status IN ('running', 'dismissed')")
+        .bind(1, unix_now() + lease_seconds).bind(2, l.job_id).bind(3, l.generation).bind(4, owner).run();
+    if (writer_->changes() != 1) continue;
+    r.held.push_back(l);
+    auto st = writer_->prepare("SELECT status FROM jobs WHERE id = ?");
+    st.bind(1, l.job_id);
+    if (st.step() && st.text(0) == "dismissed") r.dismissed.push_back(l.job_id);
   }
   tx.commit();
   return r;

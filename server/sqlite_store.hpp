@@ -30,7 +30,8 @@ class SqliteStore final : public Store {
   std::int64_t count_accepted() override;
   std::optional<JobRecord> claim_job(const std::string& owner, const std::string& now,
                                      double lease_seconds) override;
-  LeaseRenewal renew_leases(const std::string& owner, double lease_seconds) override;
+  LeaseRenewal renew_leases(const std::string& owner, const std::vector<Lease>& leases,
+                            double lease_seconds) override;
   void release_leases(const std::string& owner) override;
   int requeue_expired(const std::string& now) override;
   std::vector<Lease> append_events(const std::vector<NewEvent>& events) override;

@@ -129,8 +129,10 @@ class Store {
   // lease of `lease_seconds`); returned with its scene. None when no job is accepted.
   virtual std::optional<JobRecord> claim_job(const std::string& owner, const std::string& now,
                                              double lease_seconds) = 0;
-  // Extends every lease `owner` holds on an unfinished job.
-  virtual LeaseRenewal renew_leases(const std::string& owner, double lease_seconds) = 0;
+  // Extends the given leases of `owner` that are still current (unfinished, same generation);
+  // a lease its process no longer runs is left to expire.
+  virtual LeaseRenewal renew_leases(const std::string& owner, const std::vector<Lease>& leases,
+                                    double lease_seconds) = 0;
   // Ends every lease `owner` holds at once: a process starting under a fixed name knows that
   // its previous incarnation is gone.
   virtual void release_leases(const std::string& owner) = 0;

@@ -215,12 +215,14 @@ TEST_P(StoreContract, RenewedLeasesHoldAndReportDismissals) {
   store->insert_job(r);
   const auto run = store->claim_job("me", "2025-01-01T00:00:01.000Z", 0.3);
   ASSERT_TRUE(run);
-  LeaseRenewal renewal = store->renew_leases("me", 60);
+  const std::vector<Lease> mine = {{"job-b", run->generation}};
+  LeaseRenewal renewal = store->renew_leases("me", mine, 60);
   ASSERT_EQ(renewal.held.size(), 1u);
   EXPECT_EQ(renewal.held[0].job_id, "job-b");
   EXPECT_EQ(renewal.held[0].generation, run->generation);
   EXPECT_TRUE(renewal.dismissed.empty());
-  EXPECT_TRUE(store->renew_leases("someone-else", 60).held.empty());
+  EXPECT_TRUE(store->renew_leases("someone-else", mine, 60).held.empty());
+  EXPECT_TRUE(store->renew_leases("me", {{"job-b", run->generation + 1}}, 60).held.empty());
   std::this_thread::sleep_for(500ms);
   EXPECT_EQ(store->requeue_expired("2025-01-01T00:00:02.000Z"), 0);
 
@@ -228,7 +230,7 @@ TEST_P(StoreContract, RenewedLeasesHoldAndReportDismissals) {
   EXPECT_EQ(outcome, DismissOutcome::dismissed);
   EXPECT_EQ(doc->status, JobStatus::dismissed);
   EXPECT_TRUE(doc->finished.empty());  // its runner finishes it
-  renewal = store->renew_leases("me", 60);
+  renewal = store->renew_leases("me", mine, 60);
   ASSERT_EQ(renewal.dismissed.size(), 1u);
   // The run ends as it was about to succeed: dismissed wins, no result.
   EXPECT_EQ(store->finish_job({"job-b", run->generation}, success(1)), JobStatus::dismissed);

@@ -1,0 +1,57 @@
+#!/usr/bin/env bash
+# Checks deploy/compose.yaml for real (part of scripts/check-extended.sh): Debian's Docker
+# engine and compose, a local debian:12-slim base made with debootstrap when none is there
+# (Docker Hub does not answer on these machines), the grip image from the Dockerfile, then
+# PostgreSQL + three replicas + HAProxy up; a job through HAProxy; one replica killed; the
+# job still served and a new job solved; everything removed again.
+#   bash scripts/check-compose.sh      (as root: starts and stops its own dockerd)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+scratch=${SCRATCH:-$(mktemp -d "${TMPDIR:-/tmp}/grip-compose-XXXXXX")}
+DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
+  docker.io docker-compose debootstrap iptables >/dev/null
+dockerd_pid=
+if ! docker info >/dev/null 2>&1; then
+  nohup dockerd --data-root "$scratch/docker-data" >"$scratch/dockerd.log" 2>&1 &
+  dockerd_pid=$!
+  for _ in $(seq 1 60); do docker info >/dev/null 2>&1 && break; sleep 1; done
+fi
+compose=(docker-compose -f deploy/compose.yaml -p grip-check)
+cleanup() {
+  "${compose[@]}" down -v >/dev/null 2>&1 || true
+  [ -n "$dockerd_pid" ] && kill "$dockerd_pid" && wait "$dockerd_pid" 2>/dev/null || true
+}
+trap cleanup EXIT
+
+if ! docker image inspect debian:12-slim >/dev/null 2>&1; then
+  mirror=$(sed -n 's/^URIs: *//p' /etc/apt/sources.list.d/*.sources | head -n 1)
+  debootstrap --variant=minbase bookworm "$scratch/rootfs" "$mirror" >/dev/null
+  rm -f "$scratch/rootfs/etc/apt/sources.list"
+  cp /etc/apt/sources.list.d/*.sources "$scratch/rootfs/etc/apt/sources.list.d/"
+  rm -rf "$scratch/rootfs/var/lib/apt/lists/"*
+  tar -C "$scratch/rootfs" -c . | docker import \
+    --change 'ENV PATH=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin' \
+    --change 'CMD ["bash"]' - debian:12-slim
+fi
+DOCKER_BUILDKIT=1 docker build -q -t grip .
+"${compose[@]}" up -d --build
+
+api=http://127.0.0.1:8080
+for _ in $(seq 1 120); do curl -sf "$api/v1/ready" >/dev/null && break; sleep 1; done
+curl -sf "$api/v1/ready"; echo
+job=$(curl -sf -H 'Content-Type: application/json' --data @tests/load/small-job.json "$api/v1/jobs" |
+      sed -n 's/.*"jobID":"\([^"]*\)".*/\1/p')
+for _ in $(seq 1 60); do
+  curl -sf "$api/v1/jobs/$job" | grep -q '"status":"successful"' && break; sleep 1
+done
+curl -sf "$api/v1/jobs/$job" | grep -q '"status":"successful"'
+"${compose[@]}" kill -s KILL grip2
+sleep 3
+for _ in 1 2 3 4 5 6; do curl -sf "$api/v1/jobs/$job/result" >/dev/null; done  # every replica left answers
+job2=$(curl -sf -H 'Content-Type: application/json' --data @tests/load/small-job.json "$api/v1/jobs" |
+       sed -n 's/.*"jobID":"\([^"]*\)".*/\1/p')
+for _ in $(seq 1 60); do
+  curl -sf "$api/v1/jobs/$job2" | grep -q '"status":"successful"' && break; sleep 1
+done
+curl -sf "$api/v1/jobs/$job2" | grep -q '"status":"successful"'
+echo "compose check: 3 replicas on PostgreSQL behind HAProxy; jobs solved and served with one replica killed"
