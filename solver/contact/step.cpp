@@ -26,7 +26,7 @@ std::vector<int> active_indices(const ContactError& e) {
 StepSolver::StepSolver(Equilibrium& eq, const ContactParams& params, int step,
                        const IterationObserver& obs, const StopRequest& stop)
     : eq_(eq), problem_(eq.problem()), params_(params), step_(step), observer_(obs), stop_(stop),
-      start_(Clock::now()) {
+      start_(Clock::now()), newton_emitted_(eq.counters().newton_iterations) {
   tol_ = params.tolerance * problem_.body->characteristic_length();
   is_normal_.assign(problem_.component_count, 0);
   for (const Candidate& c : problem_.candidates) is_normal_[c.eta] = 1;
@@ -292,7 +292,10 @@ void StepSolver::emit(int trials, int inner, int halvings, int n, double alpha) 
       case ContactState::slip: ++ev.slip; break;
     }
   }
-  ev.newton_iterations = trials > 0 ? out_.state.newton_iterations : 0;
+  // Every Newton iteration since the last event, rejected line-search trials' included, so
+  // that the events of a step add up to its count.
+  ev.newton_iterations = static_cast<int>(eq_.counters().newton_iterations - newton_emitted_);
+  newton_emitted_ = eq_.counters().newton_iterations;
   ev.elapsed_ms = std::chrono::duration<double, std::milli>(Clock::now() - start_).count();
   out_.history.push_back(ev);
   if (observer_) observer_(ev);

@@ -89,6 +89,7 @@ class StepSolver {
   double tol_ = 0.0;
   int pass_ = 0, m_ = 0;
   long solves_at_start_ = 0;
+  long newton_emitted_ = 0;  // the Newton counter at the last event
   double warmup_eps_ = 0.0;
   std::vector<char> is_normal_;
   ContactError error_;

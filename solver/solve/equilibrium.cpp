@@ -150,15 +150,8 @@ Vector Equilibrium::residual(const Vector& q, const Vector& p, Triplets* tangent
 }
 
 
-double Equilibrium::free_residual_norm(const Vector& q, const Vector& p) const {
-  EquilibriumState paired;
-  pair(q, paired);
-  const Vector r = residual(q, paired, p, nullptr);
-  return scaled_free_norm(r);
-}
-
-// The norm of a residual over the free dofs in force units: a rotation's (moment) residual is
-// divided by its dof's length scale, so that backtracking does not depend on the unit of
+// The largest residual over the free dofs in force units: a rotation's (moment) residual is
+// divided by its dof's length scale, so that the stopping test does not depend on the unit of
 // length (the iteration counts of a scene stay the same when its lengths are rescaled).
 double Equilibrium::scaled_free_max(const Vector& r) const {
   double largest = 0.0;
@@ -167,10 +160,12 @@ double Equilibrium::scaled_free_max(const Vector& r) const {
   return largest;
 }
 
-double Equilibrium::scaled_free_norm(const Vector& r) const {
+// The Euclidean norm of a displacement change over the free dofs in length units (rotations
+// times their dof's length scale): the line search's measure, independent of the length unit.
+double Equilibrium::free_length_norm(const Vector& dq) const {
   double norm = 0.0;
-  for (int i = 0; i < r.size(); ++i)
-    if (free_index_[i] >= 0) norm += (r[i] / length_scales_[i]) * (r[i] / length_scales_[i]);
+  for (int i = 0; i < dq.size(); ++i)
+    if (free_index_[i] >= 0) norm += (dq[i] * length_scales_[i]) * (dq[i] * length_scales_[i]);
   return std::sqrt(norm);
 }
 
@@ -201,7 +196,7 @@ EquilibriumState Equilibrium::solve(const Vector& q_guess, const Vector& p) {
   // The penalty law adds stiffness that changes with the contact state: no reuse then.
   const bool reuse = constant_tangent_ && !penalty_;
   Triplets triplets;
-  double previous_residual = std::numeric_limits<double>::infinity(), last_step = 0.0;
+  double last_step = 0.0;
   for (int it = 1; it <= params_.max_iterations + 1; ++it) {
     pair(state.q, state);
     triplets.clear();
@@ -218,14 +213,13 @@ EquilibriumState Equilibrium::solve(const Vector& q_guess, const Vector& p) {
     const double q_size = (state.q.array() * length_scales_.array()).abs().maxCoeff();
     const double round_off = params_.floor_factor * kEpsilon * (k_norm * q_size + force_scale);
     const bool residual_met = r_max <= params_.residual_tolerance * force_scale;
-    const bool at_floor = it > 1 && r_max > params_.floor_stall * previous_residual && r_max <= round_off;
+    const bool at_floor = it > 1 && r_max <= round_off;
     if (residual_met || at_floor) {
       state.at_floor = at_floor && !residual_met;
       state.noise = state.at_floor ? last_step : 0.0;
       return finish(state, p);
     }
     if (it > params_.max_iterations) break;
-    previous_residual = r_max;
     if (reuse) {
       if (!factorize_body_tangent(state.q)) {
         state.reason = "singular stiffness: the supports do not hold the body";
@@ -262,7 +256,7 @@ EquilibriumState Equilibrium::solve(const Vector& q_guess, const Vector& p) {
       pair(state.q, state);
       return finish(state, p);
     }
-    state.q += line_search(state.q, dq, r, p) * dq;
+    state.q += line_search(state.q, dq, p, reuse ? body_lu_ : lu_) * dq;
   }
   pair(state.q, state);
   state.reason = "Newton did not converge in " + std::to_string(params_.max_iterations) +
@@ -278,51 +272,30 @@ EquilibriumState& Equilibrium::finish(EquilibriumState& state, const Vector& p) 
   return state;
 }
 
-double Equilibrium::free_dot(const Vector& a, const Vector& b) const {
-  double sum = 0.0;
-  for (int i = 0; i < a.size(); ++i)
-    if (free_index_[i] >= 0) sum += a[i] * b[i];
-  return sum;
-}
-
-double Equilibrium::line_search(const Vector& q, const Vector& dq, const Vector& r, const Vector& p) const {
-  const double a_max = problem_.body->newton_step_fraction(q, dq);
-  const double g0 = free_dot(dq, r);
-  if (!(g0 < 0)) {  // not an energy descent direction (unsymmetric contact terms): backtrack
-    double a = a_max;
-    const double r0 = scaled_free_norm(r);
-    for (int k = 0; k < params_.max_backtracks; ++k, a *= 0.5)
-      if (free_residual_norm(q + a * dq, p) <= (1 - 1e-4 * a) * r0) break;
-    return a;
-  }
-  // g(a) = dq . R(q + a dq): accept a once |g(a)| <= 0.8 |g(0)|; else regula falsi between
-  // the last point where g < 0 (or 0) and the first where g > 0.
-  auto slope = [&](double a) {
-    EquilibriumState paired;
+double Equilibrium::line_search(const Vector& q, const Vector& dq, const Vector& p,
+                                const FreeBlockSolver& solver) const {
+  // Deuflhard's natural monotonicity test: the simplified correction K^-1 R(q + a dq), with
+  // the factorization already at hand, must be shorter than (1 - a/4) |dq|. It measures the
+  // distance to the solution in the tangent's metric, so a large rigid rotation with small
+  // strains is a full step, where the residual norm would grow and refuse it.
+  const double dq_norm = free_length_norm(dq);
+  double a = problem_.body->newton_step_fraction(q, dq);
+  for (int k = 0; k < params_.max_backtracks; ++k, a *= 0.5) {
     const Vector qa = q + a * dq;
+    EquilibriumState paired;
     pair(qa, paired);
-    return free_dot(dq, residual(qa, paired, p, nullptr));
-  };
-  double lo = 0.0, g_lo = g0, hi = a_max, g_hi = slope(a_max);
-  if (!std::isfinite(g_hi) || g_hi > 0) {
-    double a = a_max, g = g_hi;
-    for (int k = 0; k < params_.max_backtracks; ++k) {
-      if (std::isfinite(g) && std::abs(g) <= 0.8 * std::abs(g0)) return a;
-      if (!std::isfinite(g) || g > 0) {
-        hi = a;
-        g_hi = g;
-      } else {
-        lo = a;
-        g_lo = g;
-      }
-      // A non-finite slope gives no information to interpolate with: halve.
-      a = std::isfinite(g_hi) ? lo + (hi - lo) * g_lo / (g_lo - g_hi) : 0.5 * (lo + hi);
-      a = std::clamp(a, lo + 0.1 * (hi - lo), hi - 0.1 * (hi - lo));
-      g = slope(a);
-    }
-    return std::isfinite(g) ? a : lo > 0 ? lo : 0.5 * a;
+    const Vector r = residual(qa, paired, p, nullptr);
+    Vector r_free(free_count_);
+    for (int i = 0; i < r.size(); ++i)
+      if (free_index_[i] >= 0) r_free[free_index_[i]] = r[i];
+    const Vector simplified = solver.solve(r_free);
+    Vector full = Vector::Zero(q.size());
+    for (int i = 0; i < q.size(); ++i)
+      if (free_index_[i] >= 0) full[i] = simplified[free_index_[i]];
+    const double norm = free_length_norm(full);
+    if (std::isfinite(norm) && norm <= (1.0 - 0.25 * a) * dq_norm) return a;
   }
-  return a_max;
+  return a;
 }
 
 Matrix Compliance::sub(const std::vector<int>& components) const {

@@ -20,16 +20,15 @@ namespace grip {
 // - residual: the largest free residual, in force units (moments over the length scale), is
 //   below `residual_tolerance` times the force scale (the largest of the applied loads, the
 //   internal forces, which hold the reactions, and the contact forces);
-// - round-off floor: the residual no longer falls (above `floor_stall` of the one before)
-//   and is within `floor_factor` x machine precision of the scale of the sums that form it
-//   (|K| |q| + force scale). Recorded in the state: its corrections are noise.
+// - round-off floor: after a first correction, the residual is within `floor_factor` x
+//   machine precision of the scale of the sums that form it (|K| |q| + force scale), where
+//   a further correction is noise. Recorded in the state.
 // couple_newton() sets the first two from the contact tolerance.
 struct NewtonParams {
   int max_iterations = 40;
   double displacement_tolerance = 1e-10;  // length
   double residual_tolerance = 1e-11;      // relative to the force scale
-  double floor_factor = 1e3;
-  double floor_stall = 0.5;
+  double floor_factor = 1e2;
   // Diverged when a correction exceeds this many body lengths.
   double divergence_lengths = 10.0;
   // Steps of the line search along a Newton correction.
@@ -142,14 +141,10 @@ class Equilibrium {
                   Triplets* tangent, double* force_scale = nullptr) const;
   // p(q) of the penalty law at a paired state, and (if asked) its stiffness triplets.
   Vector penalty_forces(const EquilibriumState& paired, Triplets* tangent) const;
-  // Step length along the Newton correction dq at q (with residual r there): the energy
-  // slope g(a) = dq . R(q + a dq) driven toward zero (Crisfield's line search), which a rigid
-  // rotation does not penalize; residual-norm backtracking where dq is not a descent
-  // direction of the energy. At most the body's trust-region fraction.
-  double line_search(const Vector& q, const Vector& dq, const Vector& r, const Vector& p) const;
-  double free_dot(const Vector& a, const Vector& b) const;
-  double free_residual_norm(const Vector& q, const Vector& p) const;
-  double scaled_free_norm(const Vector& r) const;
+  // Step length along the Newton correction dq at q: the natural monotonicity test with the
+  // factorization `solver` of the step's tangent; at most the body's trust-region fraction.
+  double line_search(const Vector& q, const Vector& dq, const Vector& p, const FreeBlockSolver& solver) const;
+  double free_length_norm(const Vector& dq) const;
   double scaled_free_max(const Vector& r) const;
   void fill_t_matrix(const EquilibriumState& state, const std::vector<int>& position);
 

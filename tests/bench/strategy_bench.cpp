@@ -36,6 +36,7 @@
 
 #include "solver/io/scene.hpp"
 #include "tests/support/contact_profile.hpp"
+#include "tests/support/elastica.hpp"
 #include "solver/solve/equilibrium.hpp"
 #include "solver/solve/load_stepping.hpp"
 
@@ -227,6 +228,51 @@ SceneCase half_disc_case(bool sheared, std::array<double, 3> sizes) {
   return s;
 }
 
+// The slender strip of issue 13 (L/t = 50, q9, finite strain, F L^2/EI = 10): free, where the
+// tip deflection has the elastica's closed form, or wrapped onto a cylinder with friction.
+SceneCase strip_case(const std::string& name, const std::string& file) {
+  SceneCase s;
+  s.name = name;
+  s.file = file;
+  s.with_mesh = [](json j, int level) {
+    j["body"]["mesh"]["rectangle"]["divisions"][0] = 25 << level;
+    return j;
+  };
+  s.mesh_label = [](const json& j) {
+    const json& d = j["body"]["mesh"]["rectangle"]["divisions"];
+    return std::to_string(d[0].get<int>()) + "x" + std::to_string(d[1].get<int>());
+  };
+  // The free end's mid-surface node (largest reference x, reference y nearest t/2 = 0.01).
+  auto tip = [](const StepRecord& last, const std::string& component) {
+    const auto x = column(last.site_fields, "x"), ux = column(last.site_fields, "ux");
+    const auto y = column(last.site_fields, "y"), uy = column(last.site_fields, "uy");
+    const auto c = column(last.site_fields, component);
+    size_t end = 0;
+    auto distance = [&](size_t n) { return std::hypot(x[n] - ux[n] - 1.0, y[n] - uy[n] - 0.01); };
+    for (size_t n = 0; n < x.size(); ++n)
+      if (distance(n) < distance(end)) end = n;
+    return c[end];
+  };
+  s.measure = [tip](const Scene& sc, const RunResult& run) {
+    const StepRecord& last = run.steps.back();
+    Quantities q;
+    q.force = contact_resultant(sc.problem, last).norm();
+    q.peak = peak_normal_stress(sc.problem, last);
+    q.point = -tip(last, "uy");
+    return q;
+  };
+  if (name == "cantilever")
+    s.closed_form = [](const Scene&, const RunResult&) {
+      Quantities q;
+      q.point = testing::elastica_tip(10.0).deflection;  // L = 1
+      return q;
+    };
+  s.quantities = "force: total contact force; peak: peak normal contact stress; point: tip deflection (mid-surface)";
+  s.closed_form_note = name == "cantilever" ? "closed form for point (the elastica's tip deflection, Mattiasson 1981)"
+                                            : "every quantity against the finest mesh";
+  return s;
+}
+
 std::vector<SceneCase> scene_cases() {
   std::vector<SceneCase> out;
   {
@@ -279,6 +325,8 @@ std::vector<SceneCase> scene_cases() {
   out.push_back(half_disc_case(false, {0.1, 0.05, 0.025}));  // 0.05 as shipped
   // 0.028 as shipped; below 0.02 the generator makes inverted elements at this grading.
   out.push_back(half_disc_case(true, {0.056, 0.028, 0.02}));
+  out.push_back(strip_case("cantilever", "strip-cantilever"));
+  out.push_back(strip_case("strip-cylinder", "strip-on-cylinder"));
   return out;
 }
 
@@ -876,7 +924,7 @@ int main(int argc, char** argv) {
       } else {
         std::fprintf(stderr,
                      "usage: grip_bench [--quick] [--out DIR] [--runs N] [--jobs N] [--budget MINUTES] "
-                     "[--run-seconds S] [--scenes beam,sheet,hertz,cattaneo-mindlin] [--levels 0,1,2] "
+                     "[--run-seconds S] [--scenes beam,sheet,hertz,cattaneo-mindlin,cantilever,strip-cylinder] [--levels 0,1,2] "
                      "[--source DIR] [--label TEXT]\n");
         return a == "--help" ? 0 : 2;
       }

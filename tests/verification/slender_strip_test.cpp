@@ -1,0 +1,169 @@
+// Slender bodies and large rotations (issue 13): a strip modelled as a continuum bent far
+// beyond small rotations, against the elastica; the same strip linear against beam theory;
+// the strip wrapped onto a cylinder; the von Karman beam's warning where it stops being
+// accurate.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "solver/elements/timoshenko_beam.hpp"
+#include "tests/support/elastica.hpp"
+#include "tests/support/strips.hpp"
+
+namespace grip {
+namespace {
+
+using testing::elastica_tip;
+using testing::ElasticaTip;
+using testing::expect_every_step_sound;
+using testing::solve_scene;
+using testing::StripSpec;
+using testing::strip_scene;
+using testing::strip_tip;
+
+// The shooting solution reproduces Mattiasson's (1981) table of the elastica.
+TEST(Elastica, ReproducesMattiassonsTable) {
+  struct Row { double alpha, v, u, theta; };
+  for (const Row& row : {Row{1, 0.30172, 0.05643, 0.46135}, Row{2, 0.49346, 0.16064, 0.78175},
+                         Row{5, 0.71379, 0.38763, 1.21537}, Row{10, 0.81061, 0.55500, 1.43029}}) {
+    const ElasticaTip tip = elastica_tip(row.alpha);
+    EXPECT_NEAR(tip.deflection, row.v, 1e-5) << row.alpha;
+    EXPECT_NEAR(tip.shortening, row.u, 1e-5) << row.alpha;
+    EXPECT_NEAR(tip.rotation, row.theta, 1e-5) << row.alpha;
+  }
+}
+
+// A strip of L/t = 50 (q9, 50 x 2, finite strain) bent by a dead end load to F L^2/EI = 10
+// (tip rotation 82 deg) in 20 steps: at every step its tip is the elastica's within 0.3 %
+// of L (the continuum's own extension and shear, about (t/L)^2 and the load's spread over
+// the end section), and Newton needs no cut of the increment.
+TEST(SlenderStrip, CantileverFollowsTheElastica) {
+  const StripSpec spec;
+  const auto s = solve_scene(strip_scene(spec));
+  expect_every_step_sound(s);
+  ASSERT_EQ(s.run.steps.size(), 20u);
+  for (size_t k = 0; k < s.run.steps.size(); ++k) {
+    const StepRecord& rec = s.run.steps[k];
+    EXPECT_EQ(rec.cuts, 0) << "step " << k + 1;
+    const ElasticaTip exact = elastica_tip(spec.alpha * rec.load_factor);
+    const ElasticaTip tip = strip_tip(s, spec, k);
+    EXPECT_NEAR(tip.deflection, exact.deflection, 3e-3) << "step " << k + 1;
+    EXPECT_NEAR(tip.shortening, exact.shortening, 3e-3) << "step " << k + 1;
+    EXPECT_NEAR(tip.rotation, exact.rotation, 3e-3 * exact.rotation) << "step " << k + 1;
+  }
+  // Steps after the first start from the last converged state: a few Newton iterations each.
+  for (size_t k = 1; k < s.run.steps.size(); ++k) EXPECT_LE(s.run.steps[k].newton_iterations, 12) << k + 1;
+}
+
+// Doubling the mesh along the strip changes the tip by far less than the distance to the
+// elastica: the 0.3 % above is the model's, not the mesh's.
+TEST(SlenderStrip, CantileverIsMeshConverged) {
+  StripSpec coarse, fine;
+  coarse.steps = fine.steps = 10;
+  fine.along = 100;
+  const auto a = solve_scene(strip_scene(coarse)), b = solve_scene(strip_scene(fine));
+  ASSERT_TRUE(a.run.completed && b.run.completed) << a.run.reason << b.run.reason;
+  const ElasticaTip ta = strip_tip(a, coarse, 9), tb = strip_tip(b, fine, 9);
+  EXPECT_NEAR(ta.deflection, tb.deflection, 5e-4);
+  EXPECT_NEAR(ta.rotation, tb.rotation, 5e-4 * tb.rotation);
+}
+
+// The same strip at L/t = 1000 with linear kinematics: a constant tangent, so one
+// factorization for the run and at most one correction per step; the tip deflection is
+// beam theory's F L^3 / (3 EI) + F L / (kappa G A) to the mesh's accuracy.
+TEST(SlenderStrip, LinearStripIsOneSolvePerStep) {
+  StripSpec spec;
+  spec.kinematics = "linear";
+  spec.thickness = 1e-3;
+  spec.young = 12.0 / 1e-9;  // EI = 1 again
+  spec.along = 250;
+  spec.alpha = 0.01;
+  spec.steps = 5;
+  const auto s = solve_scene(strip_scene(spec));
+  expect_every_step_sound(s);
+  EXPECT_EQ(s.run.counters.factorizations, 1);
+  for (const StepRecord& rec : s.run.steps) EXPECT_LE(rec.newton_iterations, 2) << rec.index;
+  const double F = spec.alpha, G = spec.young / 2, A = spec.thickness;
+  const double beam = F / 3.0 + F / (5.0 / 6.0 * G * A);
+  EXPECT_NEAR(strip_tip(s, spec, 4).deflection, beam, 5e-3 * beam);
+}
+
+// The strip wrapped onto a cylinder of radius 0.4 without friction (25 x 2 elements, 8
+// steps): cev and Uzawa find the same contact forces (they solve the same problem by
+// different iterations), and a mesh twice as fine moves the tip by less than 0.5 % of L.
+TEST(SlenderStrip, WrapsOntoACylinder) {
+  StripSpec spec;
+  spec.radius = 0.4;
+  spec.along = 25;
+  spec.steps = 8;
+  const auto cev = solve_scene(strip_scene(spec));
+  expect_every_step_sound(cev);
+  nlohmann::json uzawa_scene = strip_scene(spec);
+  uzawa_scene["solver"]["contact"]["method"] = "uzawa";
+  const auto uzawa = solve_scene(uzawa_scene);
+  ASSERT_TRUE(uzawa.run.completed) << uzawa.run.reason;
+  const StepRecord &a = cev.run.steps.back(), &b = uzawa.run.steps.back();
+  const double scale = a.p.cwiseAbs().maxCoeff();
+  ASSERT_GT(scale, 0.0);
+  EXPECT_LT((a.p - b.p).cwiseAbs().maxCoeff(), 1e-4 * scale);
+  int touching = 0;
+  for (const Candidate& c : cev.scene.problem.candidates) touching += a.p[c.eta] < 0;
+  EXPECT_GE(touching, 5);  // the strip lies on an arc of the cylinder, not on one point
+
+  StripSpec fine = spec;
+  fine.along = 50;
+  const auto refined = solve_scene(strip_scene(fine));
+  ASSERT_TRUE(refined.run.completed) << refined.run.reason;
+  EXPECT_NEAR(strip_tip(cev, spec, 7).deflection, strip_tip(refined, fine, 7).deflection, 5e-3);
+}
+
+// With friction 0.3 (the shipped strip-on-cylinder scene): every step converges, Coulomb
+// holds at every point, and the contact error falls monotonically.
+TEST(SlenderStrip, WrapsOntoACylinderWithFriction) {
+  const auto s = solve_scene(testing::example_scene("strip-on-cylinder"));
+  expect_every_step_sound(s);
+  ASSERT_EQ(s.run.steps.size(), 20u);
+  int slipping = 0;
+  for (const auto& p : s.scene.problem.candidates) slipping += std::abs(s.run.steps.back().p[p.xi]) > 0;
+  EXPECT_GE(slipping, 1);
+  // The counters are honest: a step's iteration events add up to its real solves and its
+  // Newton iterations (rejected line-search trials included).
+  for (const StepRecord& rec : s.run.steps) {
+    if (rec.cuts > 0) continue;
+    int trials = 0, newton = 0;
+    for (const IterationEvent& ev : rec.history) {
+      trials += ev.trials;
+      newton += ev.newton_iterations;
+    }
+    EXPECT_EQ(trials, rec.solves) << "step " << rec.index;
+    EXPECT_EQ(newton, rec.newton_iterations) << "step " << rec.index;
+  }
+}
+
+// The von Karman beam as a cantilever: its tip deflection departs from the elastica like
+// 0.45 theta^2 (1 % at 0.15 rad), and the step record warns exactly where the largest
+// rotation passes 0.15 rad.
+TEST(VonKarmanBeam, WarnsWhereItLeavesTheElastica) {
+  nlohmann::json j = testing::example_scene("beam-on-cylinder");
+  const double EI = 210000.0 * 2 * 8 / 12.0, L = 30.0, alpha = 1.0;
+  j["body"]["loads"] = {{{"node", 40}, {"force", {0.0, -alpha * EI / (L * L)}}}};
+  j["obstacles"][0]["shape"]["centre"] = {0, -500};
+  j["steps"] = 10;
+  const auto s = solve_scene(j);
+  ASSERT_TRUE(s.run.completed) << s.run.reason;
+  int warned = 0;
+  for (const StepRecord& rec : s.run.steps) {
+    const double theta = std::abs(rec.state.q[TimoshenkoBeam::node_dof(40, 2)]);
+    const ElasticaTip exact = elastica_tip(alpha * rec.load_factor);
+    const double error = std::abs(-rec.state.q[TimoshenkoBeam::node_dof(40, 1)] / L - exact.deflection) / exact.deflection;
+    EXPECT_LE(error, 0.5 * theta * theta + 2e-3) << "step " << rec.index;
+    EXPECT_EQ(!rec.warning.empty(), theta > 0.15) << "step " << rec.index << ": " << rec.warning;
+    warned += !rec.warning.empty();
+  }
+  EXPECT_GE(warned, 1);
+  EXPECT_LE(warned, 9);
+}
+
+}  // namespace
+}  // namespace grip
