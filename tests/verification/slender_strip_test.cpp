@@ -49,6 +49,9 @@ TEST(SlenderStrip, CantileverFollowsTheElastica) {
     EXPECT_EQ(rec.cuts, 0) << "step " << k + 1;
     const ElasticaTip exact = elastica_tip(spec.alpha * rec.load_factor);
     const ElasticaTip tip = strip_tip(s, spec, k);
+    std::printf("F L^2/EI = %4.1f: %2d Newton; tip deflection %+.2e, shortening %+.2e (of L), rotation %+.2e (relative)\n",
+                spec.alpha * rec.load_factor, rec.newton_iterations, tip.deflection - exact.deflection,
+                tip.shortening - exact.shortening, tip.rotation / exact.rotation - 1);
     EXPECT_NEAR(tip.deflection, exact.deflection, 3e-3) << "step " << k + 1;
     EXPECT_NEAR(tip.shortening, exact.shortening, 3e-3) << "step " << k + 1;
     EXPECT_NEAR(tip.rotation, exact.rotation, 3e-3 * exact.rotation) << "step " << k + 1;
