@@ -7,6 +7,7 @@
 import { test, before, after } from "node:test";
 import assert from "node:assert/strict";
 import { spawn } from "node:child_process";
+import { createServer, connect } from "node:net";
 import { mkdtempSync, mkdirSync, readFileSync, rmSync, openSync } from "node:fs";
 import { tmpdir } from "node:os";
 import { dirname, join, resolve } from "node:path";
@@ -51,7 +52,9 @@ class Server {
     if (!this.proc || this.proc.exitCode !== null) return;
     const exited = new Promise((r) => this.proc.once("exit", r));
     this.proc.kill("SIGTERM");
-    await Promise.race([exited, sleep(20000)]);
+    let timer;
+    await Promise.race([exited, new Promise((r) => { timer = setTimeout(r, 20000); })]);
+    clearTimeout(timer);  // a pending timer would keep node running
     if (this.proc.exitCode === null) this.proc.kill("SIGKILL");
   }
   async api(path, init = {}) {
@@ -71,6 +74,44 @@ class Server {
       return { seq: Number(f.id), type: f.event, data: JSON.parse(f.data) };
     });
   }
+}
+
+// A loopback TCP proxy to the server that cuts the first event stream after `cutAfter` bytes
+// of its response: those bytes are passed on, the rest is held back, and half a second later
+// (time for the page to read them) both sockets are destroyed. Records every request head.
+async function cuttingProxy(target, cutAfter) {
+  const proxy = { heads: [], cut: false };
+  proxy.server = createServer((client) => {
+    const upstream = connect(target, "127.0.0.1");
+    let limit = null;
+    let sent = 0;
+    // The browser keeps connections alive: every request head on one, each a GET without body.
+    client.on("data", (d) => {
+      for (const head of d.toString("latin1").split("\r\n\r\n").filter((h) => /^[A-Z]+ \S+ HTTP/.test(h))) {
+        proxy.heads.push(head);
+        if (/^GET [^ ]*\/events/.test(head) && !proxy.cut) { proxy.cut = true; limit = cutAfter; sent = 0; }
+      }
+      upstream.write(d);
+    });
+    upstream.on("data", (d) => {
+      if (limit !== null && sent >= limit) return;  // cut: held back
+      if (limit !== null && sent + d.length >= limit) {
+        client.write(d.subarray(0, limit - sent));
+        sent = limit;
+        setTimeout(() => { client.destroy(); upstream.destroy(); }, 500);
+        return;
+      }
+      sent += d.length;
+      client.write(d);
+    });
+    for (const [a, b] of [[client, upstream], [upstream, client]]) {
+      a.on("end", () => b.end());
+      a.on("error", () => b.destroy());
+    }
+  });
+  await new Promise((r) => proxy.server.listen(0, "127.0.0.1", r));
+  proxy.url = `http://127.0.0.1:${proxy.server.address().port}`;
+  return proxy;
 }
 
 // A beam of many elements: about ten contact iterations a second, for minutes.
@@ -111,6 +152,9 @@ after(async () => {
 });
 
 const count = (selector) => page.$$eval(selector, (els) => els.length);
+// The plot redraws at most every 250 ms: wait until it holds every iteration counted so far.
+const plotCaughtUp = (tab) => tab.waitForFunction(() =>
+  document.getElementById("conv-plot").dataset.points === document.getElementById("count-iterations").textContent);
 const text = (selector) => page.$eval(selector, (el) => el.textContent);
 
 test("the page is served with ETag, caching and CSP; JSON clients still get the landing document", async () => {
@@ -163,7 +207,7 @@ test("a running job: the plot grows live, and resumes across a server restart wi
   await page.waitForFunction(() => document.getElementById("job-panel").dataset.state !== "watching", { timeout: 30000 });
   assert.match(await text("#job-status"), /failed: dismissed/);
   assert.equal((await server.api(`/v1/jobs/${job.jobID}`)).body.status, "dismissed");
-  await sleep(400);  // the plot redraws at most every 250 ms
+  await plotCaughtUp(page);
   const serverSeqs = (await server.events(job.jobID)).filter((e) => e.type === "iteration").map((e) => e.seq);
   const pageSeqs = await page.$$eval("#conv-plot circle.pt", (els) => els.map((e) => Number(e.dataset.seq)));
   assert.deepEqual(pageSeqs, serverSeqs);
@@ -171,13 +215,14 @@ test("a running job: the plot grows live, and resumes across a server restart wi
 });
 
 test("the beam example: submitted from the page, watched to the end, its result drawn", async () => {
+  await page.bringToFront();
   await page.goto(server.url + "/ui");
   await page.waitForFunction(() => document.querySelectorAll("#example option").length > 1);
   await page.select("#example", "/v1/examples/beam-on-cylinder");
   await page.waitForFunction(() => document.getElementById("scene").value.includes("beam-on-cylinder"));
   await page.click("#submit");
   await page.waitForFunction(() => document.getElementById("job-panel").dataset.state === "result", { timeout: 60000 });
-  await sleep(400);
+  await plotCaughtUp(page);
   const id = await text("#job-id");
   const result = (await server.api(`/v1/jobs/${id}/result`)).body;
   const events = await server.events(id);
@@ -247,6 +292,7 @@ test("the beam example: submitted from the page, watched to the end, its result 
 });
 
 test("a bad scene: errors next to the pointers the server names, nothing queued", async () => {
+  await page.bringToFront();
   await page.goto(server.url + "/ui");
   const before = (await server.api("/v1/jobs?limit=1000")).body.jobs.length;
   const bad = example("beam-on-cylinder");
@@ -266,11 +312,41 @@ test("a bad scene: errors next to the pointers the server names, nothing queued"
   shown.forEach((s, i) => assert.ok(s.text.includes(expected.errors[i].detail)));
   await page.screenshot({ path: join(ARTIFACTS, "bad-scene.png"), fullPage: true });
 
+  // Upload: the file's text lands in the editor.
+  const input = await page.$("#scene-file");
+  await input.uploadFile(join(REPO, "schemas/examples/sliding-block.json"));
+  await page.waitForFunction(() => document.getElementById("scene").value.includes("sliding"));
+  assert.equal(await page.$eval("#scene", (e) => e.value), readFileSync(join(REPO, "schemas/examples/sliding-block.json"), "utf8"));
+
   // Not JSON at all: found by the page, never sent.
   await page.$eval("#scene", (e) => { e.value = "{\"body\": "; });
   await page.click("#submit");
   await page.waitForFunction(() => /not JSON/.test(document.getElementById("submit-errors").textContent));
   assert.equal((await server.api("/v1/jobs?limit=1000")).body.jobs.length, before);
+});
+
+test("a stream dropped mid-way resumes with Last-Event-ID: every event once, none missing", async () => {
+  const job = (await server.submit(example("beam-on-cylinder"))).body;
+  const proxy = await cuttingProxy(server.port, 6000);
+  const tab = await browser.newPage();
+  try {
+    await tab.goto(`${proxy.url}/#job=${job.jobID}`);
+    await tab.waitForFunction(() => document.getElementById("job-panel").dataset.state === "result", { timeout: 60000 });
+    await plotCaughtUp(tab);
+    const streams = proxy.heads.filter((h) => /^GET [^ ]*\/events/.test(h));
+    assert.ok(streams.length >= 2, `the page reconnected: ${streams.length} stream requests`);
+    const resumedAt = Number(streams[1].match(/last-event-id: (\d+)/i)?.[1]);
+    assert.ok(resumedAt > 0, `the second request carries Last-Event-ID:\n${streams[1]}`);
+    const serverSeqs = (await server.events(job.jobID)).filter((e) => e.type === "iteration").map((e) => e.seq);
+    const pageSeqs = await tab.$$eval("#conv-plot circle.pt", (els) => els.map((e) => Number(e.dataset.seq)));
+    assert.ok(pageSeqs.some((q) => q < resumedAt) && pageSeqs.some((q) => q > resumedAt), "points on both sides of the cut");
+    assert.deepEqual(pageSeqs, serverSeqs);
+    const steps = await tab.$$eval("#step-table tbody tr", (rows) => rows.map((r) => Number(r.dataset.step)));
+    assert.deepEqual(steps, Array.from({ length: 20 }, (_, k) => k + 1));
+  } finally {
+    await tab.close();
+    proxy.server.close();
+  }
 });
 
 test("the job list: newest first, ten to a page, Older and Newer", async () => {
@@ -281,6 +357,7 @@ test("the job list: newest first, ten to a page, Older and Newer", async () => {
   for (let i = 0; i < 11; i++) assert.equal((await server.submit(tiny)).status, 201);
   const all = (await server.api("/v1/jobs?limit=1000")).body.jobs.map((j) => j.jobID);
   assert.ok(all.length > 10);
+  await page.bringToFront();
   await page.goto(server.url + "/ui");
   const rows = () => page.$$eval("#jobs-table tbody tr", (trs) => trs.map((tr) => tr.dataset.job));
   await page.waitForFunction(() => document.querySelectorAll("#jobs-table tbody tr").length === 10);
@@ -296,8 +373,8 @@ test("the job list: newest first, ten to a page, Older and Newer", async () => {
 test("with a bearer token: the page asks for it, keeps it in sessionStorage, and works", async () => {
   const secured = new Server(["--token", "page-test-token"]);
   await secured.start();
+  const tab = await browser.newPage();
   try {
-    const tab = await browser.newPage();
     await tab.goto(secured.url + "/");  // the page itself needs no token
     await tab.waitForFunction(() => /wants a bearer token/.test(document.getElementById("connection").textContent));
     await tab.type("#token", "page-test-token");
@@ -312,8 +389,8 @@ test("with a bearer token: the page asks for it, keeps it in sessionStorage, and
     // A reload keeps the token (same tab).
     await tab.reload();
     await tab.waitForFunction(() => document.querySelectorAll("#jobs-table tbody tr").length === 1);
-    await tab.close();
   } finally {
+    await tab.close();
     await secured.stop();
     rmSync(secured.dir, { recursive: true, force: true });
   }
