@@ -32,7 +32,17 @@ class CevStep : public StepSolver {
       // Newton starts from the model's own displacement, saving about one iteration a solve.
       const Vector du = eq_.predicted_change(C, pl - out_.p);
       int trials = 0;
-      if (!line_search(pl, du, trials)) return false;
+      // A compliance from an earlier state (reuse_compliance, a changing tangent) that
+      // mispredicts is renewed: retried afresh when no trial was accepted, formed afresh for
+      // the next update when only a shortened step was.
+      const bool stale = eq_.compliance_reused();
+      if (!line_search(pl, du, trials)) {
+        if (!stale || !budget_left()) return false;
+        out_.reason.clear();
+        eq_.refresh_compliance();
+        continue;
+      }
+      if (stale && trials > 1) eq_.refresh_compliance();
       ++m_;
       emit(trials, inner, halvings, n_used, alpha_used);
     }

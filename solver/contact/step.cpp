@@ -35,6 +35,7 @@ StepSolver::StepSolver(Equilibrium& eq, const ContactParams& params, int step,
 StepOutcome StepSolver::run(const Vector& q_guess, const Vector& p_start, const Vector& p_star) {
   couple_newton(eq_.params(), params_.tolerance, params_.newton_fraction,
                 problem_.body->characteristic_length());
+  eq_.set_compliance_reuse(params_.reuse_compliance);
   const long solves0 = eq_.counters().solves, newton0 = eq_.counters().newton_iterations;
   solves_at_start_ = solves0;
   solve(q_guess, p_start, p_star);

@@ -23,6 +23,7 @@ Equilibrium::Equilibrium(const Problem& problem, NewtonParams params, std::vecto
 void Equilibrium::set_step(LoadFactors factors, std::vector<double> zeta_previous) {
   factors_ = std::move(factors);
   zeta_previous_ = std::move(zeta_previous);
+  refresh_compliance();  // a changing tangent's G serves one step at most
 }
 
 void Equilibrium::pair(const Vector& q, EquilibriumState& state) const {
@@ -305,22 +306,6 @@ Matrix Compliance::sub(const std::vector<int>& components) const {
   return B;
 }
 
-void Equilibrium::fill_t_matrix(const EquilibriumState& state, const std::vector<int>& position) {
-  t_.setZero(free_count_, c_.block.rows());
-  for (size_t i = 0; i < problem_.candidates.size(); ++i) {
-    const Candidate& c = problem_.candidates[i];
-    const PairedPoint& pp = state.points[i];
-    const int eta = position[c.eta], xi = c.xi >= 0 ? position[c.xi] : -1;
-    if (eta < 0 && xi < 0) continue;
-    for (const auto& j : pp.point.jacobian) {
-      const int f = free_index_[j.dof];
-      if (f < 0) continue;
-      if (eta >= 0) t_(f, eta) += j.dx.dot(pp.eta);
-      if (xi >= 0) t_(f, xi) += j.dx.dot(pp.xi);
-    }
-  }
-}
-
 bool Equilibrium::factorize_body_tangent(const Vector& q) {
   if (constant_tangent_ && body_factorized_) return body_lu_.ok();
   Triplets triplets;
@@ -332,28 +317,97 @@ bool Equilibrium::factorize_body_tangent(const Vector& q) {
   return body_lu_.factorize(triplets, free_index_, free_count_);
 }
 
+void Equilibrium::extend_surface_compliance(const std::vector<int>& added) {
+  const int m0 = static_cast<int>(surface_free_.size());
+  for (int f : added) {
+    surface_row_[f] = static_cast<int>(surface_free_.size());
+    surface_free_.push_back(f);
+  }
+  const int m = static_cast<int>(surface_free_.size());
+  g_.conservativeResize(m, m);
+  // Unit right-hand sides in blocks: the work storage stays (free dofs) x kBlock.
+  constexpr int kBlock = 64;
+  Matrix rhs;
+  for (int start = m0; start < m; start += kBlock) {
+    const int cols = std::min(kBlock, m - start);
+    rhs.setZero(free_count_, cols);
+    for (int c = 0; c < cols; ++c) rhs(surface_free_[start + c], c) = 1.0;
+    const Matrix x = body_lu_.solve(rhs);
+    for (int c = 0; c < cols; ++c)
+      for (int r = 0; r < m; ++r) {
+        g_(r, start + c) = x(surface_free_[r], c);
+        if (r < m0) g_(start + c, r) = g_(r, start + c);
+      }
+  }
+  const Matrix added_block = g_.bottomRightCorner(m - m0, m - m0);
+  g_.bottomRightCorner(m - m0, m - m0) = 0.5 * (added_block + added_block.transpose());
+  counters_.compliance_columns += m - m0;
+}
+
 const Compliance& Equilibrium::compliance(const EquilibriumState& state,
                                           const std::vector<int>& components) {
+  const int k = static_cast<int>(components.size());
   c_.position.assign(problem_.component_count, -1);
-  for (size_t k = 0; k < components.size(); ++k) c_.position[components[k]] = static_cast<int>(k);
-  c_.block.setZero(components.size(), components.size());
-  if (components.empty() || !factorize_body_tangent(state.q)) return c_;
-  fill_t_matrix(state, c_.position);
-  x_ = body_lu_.solve(t_);
-  // T has two or three non-zeros per column: its sparse transpose makes T^T X cheap.
-  const Eigen::SparseMatrix<double> ts = t_.sparseView();
-  c_.block.noalias() = ts.transpose() * x_;
-  c_.block = 0.5 * (c_.block + c_.block.transpose()).eval();
+  for (int a = 0; a < k; ++a) c_.position[components[a]] = a;
+  c_.block.setZero(k, k);
+  t_surface_.resize(0, k);
+  if (components.empty()) return c_;
+  if (!constant_tangent_ && !compliance_reuse_) g_valid_ = false;
+  compliance_reused_ = g_valid_ && !constant_tangent_;
+  if (!g_valid_) {  // a new G: from the tangent at this state
+    surface_free_.clear();
+    surface_row_.assign(free_count_, -1);
+    g_.resize(0, 0);
+    if (!factorize_body_tangent(state.q)) return c_;
+    ++counters_.compliance_forms;
+    g_valid_ = true;
+  }
+  // The surface dofs of these components that G does not cover yet join it.
+  std::vector<int> added;
+  std::vector<char> adding(free_count_, 0);
+  for (size_t i = 0; i < problem_.candidates.size(); ++i) {
+    const Candidate& c = problem_.candidates[i];
+    if (c_.position[c.eta] < 0 && (c.xi < 0 || c_.position[c.xi] < 0)) continue;
+    for (const auto& j : state.points[i].point.jacobian) {
+      const int f = free_index_[j.dof];
+      if (f >= 0 && surface_row_[f] < 0 && !adding[f]) {
+        adding[f] = 1;
+        added.push_back(f);
+      }
+    }
+  }
+  if (!added.empty()) extend_surface_compliance(added);
+  Triplets ts;
+  for (size_t i = 0; i < problem_.candidates.size(); ++i) {
+    const Candidate& c = problem_.candidates[i];
+    const PairedPoint& pp = state.points[i];
+    const int eta = c_.position[c.eta], xi = c.xi >= 0 ? c_.position[c.xi] : -1;
+    if (eta < 0 && xi < 0) continue;
+    for (const auto& j : pp.point.jacobian) {
+      const int f = free_index_[j.dof];
+      if (f < 0) continue;
+      if (eta >= 0) ts.emplace_back(surface_row_[f], eta, j.dx.dot(pp.eta));
+      if (xi >= 0) ts.emplace_back(surface_row_[f], xi, j.dx.dot(pp.xi));
+    }
+  }
+  t_surface_.resize(g_.rows(), k);
+  t_surface_.setFromTriplets(ts.begin(), ts.end());
+  const Matrix gt = g_ * t_surface_;  // (surface dofs) x nnz(T_s) multiply-adds
+  c_.block.noalias() = t_surface_.transpose() * gt;
+  c_.block = (0.5 * (c_.block + c_.block.transpose())).eval();
   return c_;
 }
 
 Vector Equilibrium::predicted_change(const Compliance& C, const Vector& dp) const {
+  Vector du = Vector::Zero(free_index_.size());
+  if (C.block.rows() == 0 || t_surface_.cols() != C.block.rows() || !body_lu_.ok()) return du;
   Vector dp_block = Vector::Zero(C.block.rows());
   for (size_t j = 0; j < C.position.size(); ++j)
     if (C.position[j] >= 0) dp_block[C.position[j]] = dp[j];
-  Vector du = Vector::Zero(free_index_.size());
-  if (dp_block.size() == 0 || x_.cols() != dp_block.size()) return du;
-  const Vector du_free = x_ * dp_block;
+  const Vector force_surface = t_surface_ * dp_block;
+  Vector force = Vector::Zero(free_count_);
+  for (size_t r = 0; r < surface_free_.size(); ++r) force[surface_free_[r]] = force_surface[r];
+  const Vector du_free = body_lu_.solve(force);
   for (size_t i = 0; i < free_index_.size(); ++i)
     if (free_index_[i] >= 0) du[i] = du_free[free_index_[i]];
   return du;

@@ -70,6 +70,8 @@ struct EquilibriumCounters {
   long solves = 0;            // calls of solve(): real equilibrium solves
   long newton_iterations = 0;
   long factorizations = 0;
+  long compliance_forms = 0;    // G formed afresh (each on a factorization of its own)
+  long compliance_columns = 0;  // columns of G solved for, all forms together
 };
 
 // The penalty baseline (strategy `penalty`): p_eta = -k_n <s_eta>, and a tangential spring
@@ -110,11 +112,24 @@ class Equilibrium {
   double stiffness_scale(const Vector& q) const;
   // The pairing and s at q, without solving (e.g. the reference configuration).
   EquilibriumState evaluate(const Vector& q) const;
-  // C = T^T K^-1 T over the given components, from the body's own tangent at state.q
-  // (symmetric). The reference stays valid until the next call (the storage is reused).
+  // C = T^T K^-1 T over the given components, from the body's own tangent (symmetric), as
+  // C = T_s^T G T_s: G = K^-1 restricted to the surface dofs of the candidates asked for so
+  // far, one solve per surface dof with one factorization of K, and T_s the rows of T at
+  // those dofs (two or three non-zeros per column), so each call costs O(components^2),
+  // nothing per free dof. A constant tangent gives one G per run. A changing one gives G at state.q,
+  // or, with reuse on, the G of an earlier state of the same load step (set_step and
+  // refresh_compliance() renew it): the inner loop's linear model is then approximate, the
+  // real solves still decide. The reference stays valid until the next call.
   const Compliance& compliance(const EquilibriumState& state, const std::vector<int>& components);
+  // Reuse G across a load step's real solves for a changing tangent (default off).
+  void set_compliance_reuse(bool on) { compliance_reuse_ = on; }
+  // The next compliance() forms G afresh at its state.
+  void refresh_compliance() { g_valid_ = constant_tangent_ && g_valid_; }
+  // The last compliance() used a G formed at an earlier state (a changing tangent only).
+  bool compliance_reused() const { return compliance_reused_; }
   // The linear model's displacement change K^-1 T dp for a force change dp, from the last
-  // compliance (its components only): where the next solve should start.
+  // compliance (its components only, with the tangent its G came from): where the next
+  // solve should start. One sparse solve.
   Vector predicted_change(const Compliance& C, const Vector& dp) const;
   // R = A(q) - lambda F - T(q) p on every dof, and (if asked) the triplets of dR/dq, with
   // the pairing evaluated at q.
@@ -146,7 +161,8 @@ class Equilibrium {
   double line_search(const Vector& q, const Vector& dq, const Vector& p, const FreeBlockSolver& solver) const;
   double free_length_norm(const Vector& dq) const;
   double scaled_free_max(const Vector& r) const;
-  void fill_t_matrix(const EquilibriumState& state, const std::vector<int>& position);
+  // Adds free dofs to G's surface: one solve with the body's factorization per dof.
+  void extend_surface_compliance(const std::vector<int>& added);
 
   const Problem& problem_;
   NewtonParams params_;
@@ -166,7 +182,12 @@ class Equilibrium {
   FreeBlockSolver body_lu_;  // the body's own tangent (compliance, constant tangents)
   FreeBlockSolver lu_;       // Newton's tangent, with the contact terms
   double body_tangent_norm_ = 0.0;  // |K|_inf of the constant body tangent (round-off scale)
-  Matrix t_, x_;  // compliance work storage, reused
+  std::vector<int> surface_free_;  // surface row of G -> free index
+  std::vector<int> surface_row_;   // free index -> surface row of G, -1 off the surface
+  Matrix g_;                       // G = K^-1 on the surface dofs
+  bool g_valid_ = false;
+  bool compliance_reuse_ = false, compliance_reused_ = false;
+  Eigen::SparseMatrix<double> t_surface_;  // the last compliance's T_s (surface rows x block)
   Compliance c_;
 };
 

@@ -36,7 +36,7 @@ bool FreeBlockSolver::factorize(const Triplets& triplets, const std::vector<int>
         const double* t = &matrix_.coeffRef(it.col(), it.row());
         mirror_[&it.valueRef() - matrix_.valuePtr()] = static_cast<int>(t - matrix_.valuePtr());
       }
-    lu_analysed_ = ldlt_analysed_ = false;
+    lu_analysed_ = llt_analysed_ = false;
   }
   std::fill(matrix_.valuePtr(), matrix_.valuePtr() + matrix_.nonZeros(), 0.0);
   for (size_t k = 0; k < triplets.size(); ++k)
@@ -54,15 +54,12 @@ bool FreeBlockSolver::factorize(const Triplets& triplets, const std::vector<int>
       if (mirror_[k] > k) w[k] = w[mirror_[k]] = 0.5 * (w[k] + w[mirror_[k]]);
   }
   if (symmetric_) {
-    if (!ldlt_analysed_) ldlt_.analyzePattern(matrix_);
-    ldlt_analysed_ = true;
-    ldlt_.factorize(matrix_);
-    ok_ = ldlt_.info() == Eigen::Success;
-    if (ok_) {  // a zero pivot is not reported as failure: look at D
-      const Vector d = ldlt_.vectorD();
-      const double big = d.cwiseAbs().maxCoeff();
-      ok_ = big > 0 && d.cwiseAbs().minCoeff() > 1e-14 * big;
-    }
+    if (!llt_analysed_) llt_.analyzePattern(matrix_);  // the ordering: once per pattern
+    llt_analysed_ = true;
+    llt_.factorize(matrix_);
+    // Not positive definite, or a pivot at round-off (the supports do not hold the body):
+    // (min/max diag L)^2 is the min/max of LDL^T's D.
+    ok_ = llt_.info() == Eigen::Success && llt_.rcond() > 1e-14;
     if (ok_) return true;
     symmetric_ = false;  // fall back to LU
   }

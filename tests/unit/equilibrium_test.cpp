@@ -2,11 +2,14 @@
 // load d(T(u) p)/du, so it must equal a finite difference of the residual.
 #include <gtest/gtest.h>
 
+#include <Eigen/Dense>
 #include <Eigen/SparseCore>
 #include <random>
 
 #include "solver/elements/timoshenko_beam.hpp"
+#include "solver/io/scene.hpp"
 #include "solver/solve/equilibrium.hpp"
+#include "tests/support/scenes.hpp"
 
 namespace grip {
 namespace {
@@ -64,6 +67,111 @@ TEST(EquilibriumTangent, IncludesTheFollowerContactLoadStiffness) {
     const Matrix K0 = dense_tangent(eq, q, Vector::Zero(p.size()));
     EXPECT_GT((K - K0).norm(), 1e-4 * K.norm());
   }
+}
+
+// C = T^T K^-1 T formed densely over every free dof: the reference for the compliance from G.
+Matrix dense_compliance(const Problem& problem, const Equilibrium& eq, const EquilibriumState& state,
+                        const std::vector<int>& components) {
+  const int n = problem.body->dof_count();
+  std::vector<int> free_index(n, -1);
+  int free_count = 0;
+  for (int i = 0; i < n; ++i)
+    if (eq.is_free(i)) free_index[i] = free_count++;
+  Triplets t;
+  Vector force = Vector::Zero(n);
+  problem.body->internal_force(state.q, force, &t);
+  Matrix K = Matrix::Zero(free_count, free_count);
+  for (const auto& e : t)
+    if (free_index[e.row()] >= 0 && free_index[e.col()] >= 0) K(free_index[e.row()], free_index[e.col()]) += e.value();
+  Matrix T = Matrix::Zero(free_count, components.size());
+  for (size_t k = 0; k < components.size(); ++k)
+    for (size_t i = 0; i < problem.candidates.size(); ++i) {
+      const Candidate& c = problem.candidates[i];
+      if (c.eta != components[k] && c.xi != components[k]) continue;
+      const PairedPoint& pp = state.points[i];
+      const Vec2 direction = c.eta == components[k] ? pp.eta : pp.xi;
+      for (const auto& j : pp.point.jacobian)
+        if (free_index[j.dof] >= 0) T(free_index[j.dof], k) += j.dx.dot(direction);
+    }
+  return T.transpose() * K.partialPivLu().solve(T);
+}
+
+// The compliance from G on the components asked for, first on every other enabled component
+// (G covers their surface dofs), then on all (G grows by the rest, with reuse on): both equal
+// the dense one, from one factorization.
+void expect_compliance_from_g_is_dense(const Problem& problem, const Vector& q, const std::string& what) {
+  Equilibrium eq(problem, NewtonParams{});
+  eq.set_compliance_reuse(true);  // a changing tangent too keeps its G while it grows
+  eq.set_step({0.7}, std::vector<double>(problem.candidates.size(), 0.0));
+  const EquilibriumState state = eq.evaluate(q);
+  std::vector<int> all, half;
+  for (int a = 0; a < problem.component_count; ++a)
+    if (state.enabled[a]) all.push_back(a);
+  for (size_t k = 0; k < all.size(); k += 2) half.push_back(all[k]);
+  ASSERT_GT(all.size(), 6u) << what;
+  for (const auto* components : {&half, &all}) {
+    const Matrix reference = dense_compliance(problem, eq, state, *components);
+    const Matrix C = eq.compliance(state, *components).block;
+    const double error = (C - reference).norm() / reference.norm();
+    std::printf("%s, %zu components: |C_G - C_dense| / |C_dense| = %.3g\n", what.c_str(), components->size(), error);
+    EXPECT_LT(error, 1e-12) << what << ", " << components->size() << " components";
+  }
+  EXPECT_EQ(eq.counters().compliance_forms, 1) << what;
+  EXPECT_EQ(eq.counters().factorizations, 1) << what;
+}
+
+Vector small_random_displacement(const Problem& problem, double size) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-size, size);
+  Vector q(problem.body->dof_count());
+  for (int i = 0; i < q.size(); ++i) q[i] = u(rng);
+  return q;
+}
+
+TEST(Compliance, FromGEqualsTheDenseOneOnABeam) {
+  // von Karman kinematics: the tangent depends on q; candidates carry rotation dofs too.
+  Problem problem = beam_over(make_circle({3, -10.3}, 10), 0.4);
+  for (int d : {1, 2}) problem.constraints.push_back({TimoshenkoBeam::node_dof(0, d), 0.0});  // clamped
+  expect_compliance_from_g_is_dense(problem, small_random_displacement(problem, 0.02), "von Karman beam");
+}
+
+// The shipped Hertz half-disc, coarse (8 x 4 elements), all of its arc a contact set.
+Scene coarse_half_disc(const char* kinematics) {
+  nlohmann::json j = testing::example_scene("hertz");
+  nlohmann::json& disc = j["body"]["mesh"]["half_disc"];
+  disc.erase("refine");
+  disc["divisions"] = {8, 4};
+  j["body"]["contact_set"] = "arc";
+  j["body"]["kinematics"] = kinematics;
+  j["obstacles"][0]["friction"] = 0.3;
+  return read_scene(j);
+}
+
+TEST(Compliance, FromGEqualsTheDenseOneOnAContinuum) {
+  for (const char* kinematics : {"linear", "finite"}) {
+    const Scene scene = coarse_half_disc(kinematics);
+    expect_compliance_from_g_is_dense(scene.problem, small_random_displacement(scene.problem, 0.05),
+                                      std::string("half-disc, ") + kinematics);
+  }
+}
+
+// A constant tangent: one factorization and one G serve every call, whatever the state.
+TEST(Compliance, ConstantTangentFormsGOnce) {
+  const Scene scene = coarse_half_disc("linear");
+  Equilibrium eq(scene.problem, NewtonParams{});
+  std::vector<int> all;
+  for (int a = 0; a < scene.problem.component_count; ++a) all.push_back(a);
+  for (const double size : {0.0, 0.01, 0.02}) {
+    eq.set_step({1.0}, std::vector<double>(scene.problem.candidates.size(), 0.0));
+    const EquilibriumState state = eq.evaluate(small_random_displacement(scene.problem, size));
+    std::vector<int> enabled;
+    for (int a : all)
+      if (state.enabled[a]) enabled.push_back(a);
+    const Matrix reference = dense_compliance(scene.problem, eq, state, enabled);
+    EXPECT_LT((eq.compliance(state, enabled).block - reference).norm(), 1e-12 * reference.norm());
+  }
+  EXPECT_EQ(eq.counters().compliance_forms, 1);
+  EXPECT_EQ(eq.counters().factorizations, 1);
 }
 
 }  // namespace

@@ -131,5 +131,40 @@ TEST(Hertz, LinearAndFiniteAgreeForSmallLoads) {
   EXPECT_LT((pa - pb).lpNorm<Eigen::Infinity>(), 5e-3 * pa.lpNorm<Eigen::Infinity>());
 }
 
+// A tangent that changes (finite kinematics) with friction: the compliance's G reused across
+// a step's real solves changes the path, not the answer (to what the contact tolerance pins
+// it), and forms G fewer times.
+TEST(Hertz, ComplianceReuseKeepsTheAnswer) {
+  json j = with_pole_elements(example_scene("hertz"), 0.1, 8);
+  j["body"]["kinematics"] = "finite";
+  j["obstacles"][0]["friction"] = 0.3;
+  j["body"]["supports"] = json::parse(
+      R"([{"set": "diameter", "fix": ["y"], "values": {"y": -0.05}}, {"set": "centre", "fix": ["x"]}])");
+  j["steps"] = 4;
+  Solved reused{read_scene(j), {}}, fresh{read_scene(j), {}};
+  reused.scene.params.contact.reuse_compliance = true;
+  for (Solved* s : {&reused, &fresh}) {
+    s->run = run_load_steps(s->scene.problem, s->scene.steps, s->scene.params);
+    expect_every_step_sound(*s);
+    ASSERT_TRUE(s->run.completed) << s->run.reason;
+  }
+  const double tol = tolerances_of(reused.scene).length;
+  double dq = 0.0, dp = 0.0, p_scale = 0.0;
+  for (size_t k = 0; k < reused.run.steps.size(); ++k) {
+    const StepRecord &a = reused.run.steps[k], &b = fresh.run.steps[k];
+    dq = std::max(dq, (a.state.q - b.state.q).lpNorm<Eigen::Infinity>());
+    dp = std::max(dp, (a.p - b.p).lpNorm<Eigen::Infinity>());
+    p_scale = std::max(p_scale, b.p.lpNorm<Eigen::Infinity>());
+  }
+  const EquilibriumCounters &cr = reused.run.counters, &cf = fresh.run.counters;
+  std::printf("reused: %ld G formed, %ld real solves, %ld factorizations; fresh: %ld, %ld, %ld; "
+              "|dq| %.3g (tolerance %.3g), |dp| %.3g of %.3g\n",
+              cr.compliance_forms, cr.solves, cr.factorizations, cf.compliance_forms, cf.solves,
+              cf.factorizations, dq, tol, dp, p_scale);
+  EXPECT_LT(dq, tol);
+  EXPECT_LT(dp, 1e-4 * p_scale);
+  EXPECT_LT(cr.compliance_forms, cf.compliance_forms);
+}
+
 }  // namespace
 }  // namespace grip
