@@ -1,0 +1,105 @@
+#!/usr/bin/python3
+"""grip against GetFEM on the same Hertz geometry (run by bench/peers/run.sh).
+
+Both codes: the half-disc of schemas/examples/hertz.json, its diameter lowered 0.05 mm in
+10 equal steps (held in x at the centre node), a rigid flat with friction 0 or 0.3, the
+same graded mesh (elements of `size` within 0.8 mm of the pole, 12 graded divisions
+beyond). Accuracy: a and p0 of a semi-ellipse fitted to the nodal contact pressures,
+against the closed form at each code's own load P. Time: the whole process (start-up,
+meshing, solving, reading the answer), one run each. Writes bench/results/peers.md.
+"""
+import json
+import math
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "bench"))
+from scaling import hertz_scene  # noqa: E402  the scenes of the scaling benchmark
+
+E, NU, R = 200000.0, 0.3, 10.0
+ES = E / (1 - NU * NU)
+SIZES = {10: 0.05, 20: 0.0265}
+
+
+def fit(xs, sigma):
+    X = [x * x for x, s in zip(xs, sigma) if s > 0]
+    Y = [s * s for s in sigma if s > 0]
+    n = len(X)
+    sx, sy = sum(X), sum(Y)
+    slope = (n * sum(a * b for a, b in zip(X, Y)) - sx * sy) / (n * sum(a * a for a in X) - sx * sx)
+    intercept = (sy - slope * sx) / n
+    return math.sqrt(-intercept / slope), math.sqrt(intercept)
+
+
+def grip_run(grip, a_over_h, mu):
+    with tempfile.TemporaryDirectory() as tmp:
+        scene = Path(tmp) / "scene.json"
+        scene.write_text(json.dumps(hertz_scene(a_over_h, mu)))
+        start = time.monotonic()
+        subprocess.run([grip, "solve", str(scene), "--out", str(Path(tmp) / "out.json")], check=True,
+                       capture_output=True)
+        seconds = time.monotonic() - start
+        step = json.loads((Path(tmp) / "out.json").read_text())["steps"][-1]
+    points = step["contact_points"]
+    P = -sum(c["p_n"] for c in points)
+    xc = sum(c["p_n"] * c["x"] for c in points) / sum(c["p_n"] for c in points)
+    a_fit, p0_fit = fit([c["x"] - xc for c in points], [-c["sigma_n"] for c in points])
+    a = math.sqrt(4 * P * R / (math.pi * ES))
+    p0 = 2 * P / (math.pi * a)
+    return {"P": P, "a_error": a_fit / a - 1, "p0_error": p0_fit / p0 - 1, "seconds": seconds}
+
+
+def getfem_run(a_over_h, mu):
+    start = time.monotonic()
+    out = subprocess.run(["/usr/bin/python3", str(Path(__file__).parent / "getfem_hertz.py"), str(mu),
+                          str(SIZES[a_over_h]), "1"], check=True, capture_output=True, text=True).stdout
+    seconds = time.monotonic() - start
+    r = json.loads(out.strip().splitlines()[-1])
+    r["seconds"] = seconds
+    return r
+
+
+def main():
+    grip = sys.argv[1] if len(sys.argv) > 1 else str(ROOT / "build/apps/grip")
+    load = os.getloadavg()
+    rows = []
+    for a_over_h in (10, 20):
+        for mu in (0.0, 0.3):
+            g = grip_run(grip, a_over_h, mu)
+            f = getfem_run(a_over_h, mu)
+            rows.append((a_over_h, mu, g, f))
+            print(a_over_h, mu, json.dumps(g), json.dumps(f), flush=True)
+    commit = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"], capture_output=True,
+                            text=True).stdout.strip()
+    pct = lambda v: f"{100 * v:+.2f} %"
+    lines = [
+        "# grip and GetFEM on the same Hertz geometry (bench/peers/run.sh)",
+        "",
+        f"Measured at commit {commit}, {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}, on 2 hardware threads "
+        f"shared with other sessions (load average {load[0]:.1f} at the start, {os.getloadavg()[0]:.1f} at the "
+        "end). Half-disc R 10 mm, E 200 GPa, nu 0.3, plane strain, small strain; diameter lowered 0.05 mm in "
+        "10 steps; the same graded quadrilateral mesh (q4 / GetFEM Q1). grip: `cev` (tolerance 1e-8). GetFEM "
+        "5.4 (Debian python3-getfem): integral contact brick with a rigid obstacle, Alart-Curnier augmented "
+        "Lagrangian, Newton (residual 1e-9). a and p0: a semi-ellipse fitted to the nodal contact pressures, "
+        "error against the closed form at each code's own load P. Time: the whole process, one run each.",
+        "",
+        "| a/h | friction | grip P N/mm | grip a err | grip p0 err | grip s | GetFEM P N/mm | GetFEM a err | "
+        "GetFEM p0 err | GetFEM s | time ratio |",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for a_over_h, mu, g, f in rows:
+        lines.append(f"| {a_over_h} | {mu} | {g['P']:.0f} | {pct(g['a_error'])} | {pct(g['p0_error'])} | "
+                     f"{g['seconds']:.2f} | {f['P']:.0f} | {pct(f['a_error'])} | {pct(f['p0_error'])} | "
+                     f"{f['seconds']:.2f} | {f['seconds'] / g['seconds']:.0f}x |")
+    lines.append("")
+    (ROOT / "bench/results/peers.md").write_text("\n".join(lines))
+    print("\n".join(lines))
+
+
+if __name__ == "__main__":
+    main()
