@@ -202,7 +202,7 @@ function onEvent(seq, type, data) {
     cell(row, data.seconds.toFixed(3));
     // Keep the newest step in sight unless the reader scrolled up.
     const box = $("step-table").parentElement;
-    const atEnd = box.scrollTop + box.clientHeight >= box.scrollHeight - 4;
+    const atEnd = box.scrollHeight - box.scrollTop - box.clientHeight < 40;  // within a row of the end
     $("step-table").tBodies[0].append(row);
     if (atEnd) box.scrollTop = box.scrollHeight;
   } else if (type === "job_finished" || type === "job_failed") {

@@ -249,6 +249,12 @@ test("the beam example: submitted from the page, watched to the end, its result 
     assert.equal(Number(row[4]), s.newton_iterations);
   });
 
+  // The table followed the steps: its last row is in sight.
+  assert.ok(await page.$eval("#step-table", (t) => {
+    const box = t.parentElement;
+    return box.scrollHeight - box.scrollTop - box.clientHeight < 2;
+  }), "the step table is scrolled to its last row");
+
   // Contact points: one per candidate of the step shown, coloured as the legend says for its state.
   const legend = await page.evaluate(() => Object.fromEntries(["open", "stick", "slip"].map((s) =>
     [s, getComputedStyle(document.querySelector(`#result-view .key.${s}`), "::before").backgroundColor])));
