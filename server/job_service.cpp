@@ -101,9 +101,13 @@ void JobService::on_change(const StoreChange& change) {
     work_cv_.notify_one();
   }
   if (change.kind == StoreChange::dismissed) {
-    std::lock_guard lock(mutex_);
-    const auto it = active_.find(change.job_id);
-    if (it != active_.end()) it->second->dismissed = true;
+    std::shared_ptr<ActiveJob> job;
+    {
+      std::lock_guard lock(mutex_);
+      const auto it = active_.find(change.job_id);
+      if (it != active_.end()) job = it->second;
+    }
+    if (job) hear_dismissal(*job, "notification");
   }
   {
     std::lock_guard lock(events_mutex_);
@@ -113,6 +117,17 @@ void JobService::on_change(const StoreChange& change) {
       for (auto& [id, n] : changes_) ++n;
   }
   stored_cv_.notify_all();
+}
+
+void JobService::hear_dismissal(ActiveJob& job, const char* how) {
+  if (job.dismissed.exchange(true)) return;
+  std::int64_t at = 0;
+  {
+    std::lock_guard lock(job.progress_mutex);
+    if (job.progress) at = job.progress->iterations;
+  }
+  // The run stops before its next contact iteration (its stop request reads the flag).
+  spdlog::info("job {}: dismissal heard at contact iteration {} ({})", job.id, at, how);
 }
 
 bool JobService::ready() {
@@ -490,7 +505,7 @@ void JobService::lease_loop() {
         if (!held && !job->lost.exchange(true))
           spdlog::warn("job {}: lease lost; this run stops", id);
         if (std::find(r.dismissed.begin(), r.dismissed.end(), id) != r.dismissed.end())
-          job->dismissed = true;
+          hear_dismissal(*job, "lease renewal");
       }
       relock.unlock();
       store_.requeue_expired(now_iso8601());

@@ -169,6 +169,7 @@ class JobService {
   // The earlier submission with this idempotency key, if any (same scene, else it throws).
   std::optional<SubmitResult> replay(const std::optional<std::string>& key, const std::string& scene);
   void on_change(const StoreChange& change);
+  void hear_dismissal(ActiveJob& job, const char* how);
   void worker_loop();
   void writer_loop();
   void lease_loop();

@@ -101,6 +101,21 @@ struct PostgresStore::Pool {
     return c;
   }
 
+  // A connection now, or StoreUnavailable (and fail fast for a second).
+  PGconn* reconnect() {
+    {
+      std::lock_guard lock(mutex);
+      if (Clock::now() < retry_at) throw StoreUnavailable("the database does not answer");
+    }
+    try {
+      return connect();
+    } catch (...) {
+      std::lock_guard lock(mutex);
+      retry_at = Clock::now() + std::chrono::seconds(1);
+      throw;
+    }
+  }
+
   std::unique_ptr<Connection> take() {
     std::unique_lock lock(mutex);
     freed.wait(lock, [&] { return !idle.empty() || created < size; });
@@ -189,6 +204,19 @@ class Session {
     }
     PGresult* raw = PQexecParams(c_->conn, sql, static_cast<int>(values.size()), nullptr,
                                  values.data(), nullptr, nullptr, 0);
+    // A pooled connection that the database dropped while idle (it restarted) fails its first
+    // statement: connect again and send that statement once more. Statements whose reply
+    // could have been lost with a commit are safe to repeat (events: ON CONFLICT DO NOTHING;
+    // a job: its unique id; a finish: fenced).
+    if (first_ && !in_transaction_ && PQstatus(c_->conn) != CONNECTION_OK) {
+      PQclear(raw);
+      PQfinish(c_->conn);
+      c_->conn = nullptr;
+      c_->conn = pool_.reconnect();
+      raw = PQexecParams(c_->conn, sql, static_cast<int>(values.size()), nullptr, values.data(),
+                         nullptr, nullptr, 0);
+    }
+    first_ = false;
     Result r(raw);
     ++pool_.round_trips;
     std::int64_t received = 0;
@@ -230,6 +258,7 @@ class Session {
   PostgresStore::Pool& pool_;
   std::unique_ptr<PostgresStore::Connection> c_;
   bool in_transaction_ = false;
+  bool first_ = true;  // no statement sent yet
 };
 
 JobRecord read_job(const Result& r, int row, bool with_scene) {
@@ -505,7 +534,7 @@ std::vector<Lease> PostgresStore::append_events(const std::vector<NewEvent>& eve
         "WITH ok AS (UPDATE grip_jobs SET last_seq = greatest(last_seq, $3) WHERE id = $1 AND "
         "generation = $2 AND finished IS NULL AND status IN ('running', 'dismissed') RETURNING id), "
         "ins AS (INSERT INTO grip_events (job_id, seq, type, data) SELECT ok.id, (e->>'s')::bigint, "
-        "e->>'t', e->>'d' FROM ok, jsonb_array_elements($4::jsonb) e) "
+        "e->>'t', e->>'d' FROM ok, jsonb_array_elements($4::jsonb) e ON CONFLICT (job_id, seq) DO NOTHING) "
         "SELECT id, pg_notify('grip', 'e' || id) FROM ok",
         {run.first, num(run.second), num(batch.first), batch.second.dump()});
     if (r.rows() == 0) refused.push_back({run.first, run.second});

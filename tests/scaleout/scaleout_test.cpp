@@ -257,28 +257,6 @@ TEST(Scaleout, ThreeReplicasOnePostgresNothingLostNothingRunTwice) {
   note(std::to_string(acks.load()) + " acknowledged");
   ASSERT_EQ(acknowledged.size(), static_cast<size_t>(kJobs));
 
-  note("dismissals");
-  // Dismissal across replicas: a long job, dismissed through a replica that does not run it.
-  const json long_job = beam_scene(40, 400);
-  for (int d = 0; d < 2; ++d) {
-    const std::string id = Api(ports[d]).submit(long_job);
-    const json running = Api(ports[d]).wait_status(id, {"running"}, 120s);
-    const std::string runner = running.at("replica");
-    const int other = runner == "r0" ? 1 : 0;
-    auto del = Api(ports[other]).del("/v1/jobs/" + id);
-    ASSERT_TRUE(del);
-    EXPECT_EQ(del->status, 200);
-    EXPECT_EQ(json::parse(del->body)["status"], "dismissed");
-    const json done = Api(ports[2]).wait_status(id, {"dismissed"}, 60s);
-    const Stream s = follow(Api(ports[2]), id);
-    ASSERT_TRUE(s.ended);
-    EXPECT_EQ(s.events.back().object()["reason"], "dismissed");
-    EXPECT_EQ(Api(ports[2]).get("/v1/jobs/" + id + "/result")->status, 404);
-    int iterations = 0;
-    for (const auto& e : s.events) iterations += e.type == "iteration";
-    std::printf("[ info ] dismissed on %s through r%d after %d iterations\n", runner.c_str(), other, iterations);
-  }
-
   // Every acknowledged job: successful, exactly once, its result equal to grip solve's, one
   // complete stream (read through any replica).
   int retried = 0;
@@ -301,6 +279,49 @@ TEST(Scaleout, ThreeReplicasOnePostgresNothingLostNothingRunTwice) {
   load_done = true;
   for (auto& t : streamers) t.join();
   note("all checked");
+  note("dismissals");
+  // Dismissal across replicas: a long job, dismissed through a replica that does not run it.
+  const json long_job = beam_scene(40, 400);
+  for (int d = 0; d < 2; ++d) {
+    const std::string id = Api(ports[d]).submit(long_job);  // the queue is empty by now
+    const json running = Api(ports[d]).wait_status(id, {"running"}, 120s);
+    const std::string runner = running.at("replica");
+    const int other = runner == "r0" ? 1 : 0;
+    std::this_thread::sleep_for(300ms);  // well into its run
+    const auto before = Api(ports[other]).get("/v1/jobs/" + id + "/convergence");
+    ASSERT_TRUE(before);
+    const size_t stored_before = json::parse(before->body)["iterations"].size();
+    auto del = Api(ports[other]).del("/v1/jobs/" + id);
+    ASSERT_TRUE(del);
+    EXPECT_EQ(del->status, 200);
+    EXPECT_EQ(json::parse(del->body)["status"], "dismissed");
+    EXPECT_EQ(Api(ports[2]).wait_status(id, {"dismissed"}, 60s)["status"], "dismissed");
+    const Stream s = follow(Api(ports[2]), id);
+    ASSERT_TRUE(s.ended);
+    EXPECT_EQ(s.events.back().object()["reason"], "dismissed");
+    EXPECT_EQ(Api(ports[2]).get("/v1/jobs/" + id + "/result")->status, 404);
+    int iterations = 0, steps = 0;
+    for (const auto& e : s.events) {
+      iterations += e.type == "iteration";
+      steps += e.type == "step_finished";
+    }
+    EXPECT_LT(steps, 400);  // stopped early
+    // Iterations stored after the snapshot taken just before the DELETE: the ones in flight to
+    // the database then, plus those run before the dismissal reached the runner.
+    // The runner's own account: the contact iteration at which it heard of the dismissal and
+    // the iterations it ran in all.
+    const std::string log = read_text(dir.path() / ("replica" + runner.substr(1) + ".log"));
+    std::smatch heard, ran;
+    ASSERT_TRUE(std::regex_search(log, heard, std::regex("job " + id + ": dismissal heard at contact iteration (\\d+)")));
+    ASSERT_TRUE(std::regex_search(log, ran, std::regex("job " + id + " dismissed in [0-9.]+ s: (\\d+) contact iterations")));
+    EXPECT_LE(std::stoi(ran[1]) - std::stoi(heard[1]), 1);
+    EXPECT_EQ(std::stoi(ran[1]), iterations);
+    std::printf("[ info ] dismissed on %s through r%d: heard at iteration %s, stopped after %s; %zu iterations "
+                "stored after a snapshot taken just before the DELETE\n",
+                runner.c_str(), other, heard[1].str().c_str(), ran[1].str().c_str(),
+                static_cast<size_t>(iterations) - stored_before);
+  }
+
   // No job twice: the store holds exactly the acknowledged jobs and the two dismissed ones.
   int listed = 0;
   std::string next_link = "/v1/jobs?limit=1000";
