@@ -4,6 +4,7 @@
 #include <cmath>
 #include <condition_variable>
 #include <mutex>
+#include <thread>
 
 // Eigen (through the solver) before httplib.h, whose <resolv.h> defines `_res`.
 #include "server/job_service.hpp"
@@ -153,8 +154,10 @@ TEST(JobService, RetryAfterIsTheTimeUntilAWorkerFreesNotTheTimeToDrainTheQueue) 
   const std::string first = service.submit(scene).job.record.id;
   events_to_end(service, first);
   const double mean = service.job(first)->record.solve_seconds;  // the only finished run
-  std::vector<std::string> ids;
-  for (int i = 0; i < 5; ++i) ids.push_back(service.submit(scene).job.record.id);  // 1 runs, 4 wait
+  std::vector<std::string> ids = {service.submit(scene).job.record.id};
+  while (service.job(ids[0])->record.status == JobStatus::accepted)  // claimed by the worker
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  for (int i = 0; i < 4; ++i) ids.push_back(service.submit(scene).job.record.id);  // they wait
   try {
     service.submit(scene);
     FAIL() << "the queue should be full";
