@@ -271,7 +271,13 @@ EventBatch JobService::wait_events(const std::string& id, std::int64_t after,
       }
       const auto rec = store_.job(id);
       if (!rec) return {false, {}, false};
-      if (is_finished(rec->status) && !rec->finished.empty()) return {true, {}, true};
+      if (is_finished(rec->status) && !rec->finished.empty()) {
+        // Finished between the two reads: its terminal event (stored with the status) may be
+        // new. Read once more; nothing new means the stream had everything already.
+        batch.events = store_.events_after(id, after, limit);
+        batch.ended = batch.events.empty() || is_terminal_event(batch.events.back().type);
+        return batch;
+      }
     } catch (const StoreUnavailable&) {
       // Nothing to read now; the stream waits (and pings) until the store is back.
       std::unique_lock lock(events_mutex_);
