@@ -1,7 +1,11 @@
-// Strategy `cev`: the contact error vector scheme with the default loop of ALGORITHM.md
-// section 5 (inner iterations on the linear model, one real solve per update) or the paper's
-// literal loop (`loop: paper`), inside the tau passes of eq. 14.
+// Strategy `cev`: the contact error vector scheme. Default: each iteration solves the
+// contact conditions with Coulomb's cone on the linear model s(p) = s + C (p - p0)
+// (coulomb_model.hpp), then makes one real solve at the prediction with its line search; the
+// friction bound moves with p_eta, so there are no tau passes. Options: the tau passes of
+// eq. 14 around the same inner loop with eq. 13 on the model (`friction_loop: passes`,
+// ALGORITHM.md section 5), or around the paper's literal loop (`loop: paper`).
 #include "solver/contact/acceleration.hpp"
+#include "solver/contact/coulomb_model.hpp"
 #include "solver/contact/step.hpp"
 
 namespace grip {
@@ -13,11 +17,82 @@ class CevStep : public StepSolver {
 
  private:
   void solve(const Vector& q_guess, const Vector& p_start, const Vector& p_star) override {
+    if (params_.loop == ContactLoop::inner && params_.friction_loop == FrictionLoop::inner)
+      return coulomb_loop(q_guess, p_start);
     tau_passes(q_guess, p_start, p_star, [this] {
       if (needs_warmup() && !warmup()) return false;
       return params_.loop == ContactLoop::paper ? literal_pass(params_.acceleration, 0.0)
                                                 : inner_pass();
     });
+  }
+
+  // The default: Coulomb's law on the linear model, one real solve per iteration.
+  void coulomb_loop(const Vector& q_guess, const Vector& p_start) {
+    coulomb_ = true;
+    pass_ = out_.passes = 1;
+    out_.p = p_start;
+    project_to_cone(problem_, out_.p);
+    if (!fresh_solve(q_guess)) return;
+    while (error_.norm2 > tol_) {
+      if (!budget_left()) return;
+      const Compliance& C = eq_.compliance(out_.state, relevant_components());
+      int inner = 0, halvings = 0;
+      const Vector pl = predict_coulomb(C, inner, halvings);
+      out_.inner_iterations += inner;
+      const Vector du = eq_.predicted_change(C, pl - out_.p);
+      int trials = 0;
+      if (!line_search(pl, du, trials)) return;
+      ++m_;
+      emit(trials, inner, halvings, 0, 1.0);
+    }
+    out_.converged = true;
+    final_check();
+  }
+
+  // The semismooth Newton on the model; where it stalls, tau passes on the model (Tresca
+  // problems solved by eq. 13 on the model, the bound updated from the model's p_eta).
+  Vector predict_coulomb(const Compliance& C, int& inner, int& halvings) {
+    CoulombModelParams mp;
+    mp.target = model_target();
+    mp.augmentation = params_.augmentation;
+    mp.max_iterations = params_.max_inner_iterations;
+    mp.max_halvings = params_.max_halvings;
+    const CoulombModelSolution sol =
+        solve_coulomb_model(problem_, C, out_.p, out_.state.s, out_.state.enabled, mp);
+    inner = sol.iterations;
+    halvings = sol.halvings;
+    if (sol.converged) return sol.p;
+    Vector pl = sol.p, sl = sol.s;
+    for (int pass = 0; pass < params_.max_tau_passes; ++pass) {
+      const Vector tau = friction_bounds(problem_, pl);
+      int n_used = 0, k = 0, h = 0;
+      double alpha_used = 1.0;
+      const Vector next = predict(C, pl, sl, tau, k, h, n_used, alpha_used);
+      inner += k;
+      halvings += h;
+      double change = 0.0;
+      for (const Candidate& c : problem_.candidates) change = std::max(change, std::abs(next[c.eta] - pl[c.eta]));
+      sl += model_change(C, next - pl);
+      pl = next;
+      project_to_cone(problem_, pl);
+      if (contact_error(problem_, pl, sl, friction_bounds(problem_, pl), out_.state.enabled).norm2 <= mp.target ||
+          change == 0.0)
+        break;
+    }
+    return pl;
+  }
+
+  // The inner loop's target on the model: well below the step's tolerance and the error now.
+  double model_target() const { return std::min(0.1 * tol_, 1e-6 * error_.norm2); }
+
+  // C dp over the compliance's components.
+  static Vector model_change(const Compliance& C, const Vector& dp) {
+    Vector ds = Vector::Zero(dp.size());
+    for (int j = 0; j < dp.size(); ++j)
+      if (dp[j] != 0.0)
+        for (size_t a = 0; a < C.position.size(); ++a)
+          if (C.position[a] >= 0 && C.position[j] >= 0) ds[a] += C.block(C.position[a], C.position[j]) * dp[j];
+    return ds;
   }
 
   // Inner iterations on the linear model, then one real solve and its line search.
@@ -27,7 +102,7 @@ class CevStep : public StepSolver {
       const Compliance& C = eq_.compliance(out_.state, relevant_components());
       int inner = 0, halvings = 0, n_used = 0;
       double alpha_used = 1.0;
-      const Vector pl = predict(C, inner, halvings, n_used, alpha_used);
+      const Vector pl = predict(C, out_.p, out_.state.s, out_.tau, inner, halvings, n_used, alpha_used);
       out_.inner_iterations += inner;
       // Newton starts from the model's own displacement, saving about one iteration a solve.
       const Vector du = eq_.predicted_change(C, pl - out_.p);
@@ -63,13 +138,14 @@ class CevStep : public StepSolver {
     return change < 0;
   }
 
-  // eq. 13 iterated on s(p) = s + C (p - p0), accepted by the decrease of
-  // q(p) = p.C.p/2 + (s - C p0).p; returns the predicted force.
-  Vector predict(const Compliance& C, int& inner, int& halvings, int& n_used, double& alpha_used) {
-    Vector pl = out_.p, sl = out_.state.s;
-    const double target = std::min(0.1 * tol_, 1e-6 * error_.norm2);
+  // eq. 13 with the bounds tau iterated on s(p) = s0 + C (p - p0), accepted by the decrease
+  // of q(p) = p.C.p/2 + (s0 - C p0).p; returns the predicted force.
+  Vector predict(const Compliance& C, const Vector& p0, const Vector& s0, const Vector& tau, int& inner,
+                 int& halvings, int& n_used, double& alpha_used) {
+    Vector pl = p0, sl = s0;
+    const double target = model_target();
     for (inner = 0; inner < params_.max_inner_iterations; ++inner) {
-      const ContactError e = error_at(pl, sl, out_.state.enabled);
+      const ContactError e = contact_error(problem_, pl, sl, tau, out_.state.enabled);
       if (e.norm2 <= target) break;
       Vector dp;
       bool descended = false;
@@ -81,7 +157,7 @@ class CevStep : public StepSolver {
         if (!dir.ok) continue;
         double a = 1.0;
         for (int k = 0; k <= params_.max_halvings; ++k, a *= 0.5) {
-          dp = project_forces(problem_, pl, pl - a * dir.d, e, out_.tau) - pl;
+          dp = project_forces(problem_, pl, pl - a * dir.d, e, tau) - pl;
           if (decreases_q(C, sl, dp)) {
             descended = true;
             n_used = dir.n;
@@ -93,10 +169,7 @@ class CevStep : public StepSolver {
       }
       if (!descended) break;  // stationary on the model: the real solve decides
       pl += dp;
-      for (int j = 0; j < dp.size(); ++j)  // dp is zero off the active set
-        if (dp[j] != 0.0)
-          for (size_t a = 0; a < C.position.size(); ++a)
-            if (C.position[a] >= 0 && C.position[j] >= 0) sl[a] += C.block(C.position[a], C.position[j]) * dp[j];
+      sl += model_change(C, dp);  // dp is zero off the active set
     }
     return pl;
   }

@@ -40,7 +40,8 @@ StepOutcome StepSolver::run(const Vector& q_guess, const Vector& p_start, const 
   solves_at_start_ = solves0;
   solve(q_guess, p_start, p_star);
   out_.solves = static_cast<int>(eq_.counters().solves - solves0);
-  out_.newton_iterations = static_cast<int>(eq_.counters().newton_iterations - newton0);
+  out_.newton_iterations =
+      static_cast<int>(eq_.counters().newton_iterations - newton0 + own_newton_iterations_);
   out_.v2 = error_.norm2;
   return std::move(out_);
 }
@@ -105,6 +106,7 @@ bool StepSolver::fresh_solve(const Vector& q) {
 void StepSolver::accept(EquilibriumState s, const Vector& p) {
   out_.state = std::move(s);
   out_.p = p;
+  if (coulomb_) out_.tau = friction_bounds(problem_, p);
   error_ = error_at(out_.p, out_.state.s, out_.state.enabled);
 }
 
@@ -274,7 +276,7 @@ void StepSolver::final_check() {
   }
 }
 
-void StepSolver::emit(int trials, int inner, int halvings, int n, double alpha) {
+void StepSolver::emit(int trials, int inner, int halvings, int n, double alpha, int own_newton) {
   IterationEvent ev;
   ev.step = step_;
   ev.pass = pass_;
@@ -294,8 +296,9 @@ void StepSolver::emit(int trials, int inner, int halvings, int n, double alpha) 
     }
   }
   // Every Newton iteration since the last event, rejected line-search trials' included, so
-  // that the events of a step add up to its count.
-  ev.newton_iterations = static_cast<int>(eq_.counters().newton_iterations - newton_emitted_);
+  // that the events of a step add up to its count (plus those made outside the oracle: ssn).
+  ev.newton_iterations = static_cast<int>(eq_.counters().newton_iterations - newton_emitted_) +
+                         own_newton;
   newton_emitted_ = eq_.counters().newton_iterations;
   ev.elapsed_ms = std::chrono::duration<double, std::milli>(Clock::now() - start_).count();
   out_.history.push_back(ev);

@@ -71,12 +71,14 @@ class StepSolver {
   double force_precision();
   // eq. 12 with the current tau.
   void final_check();
-  void emit(int trials, int inner, int halvings, int n, double alpha);
+  // own_newton: Newton iterations made outside the oracle since the last event (ssn).
+  void emit(int trials, int inner, int halvings, int n, double alpha, int own_newton = 0);
 
   bool frictionless() const;
-  // The contact error at (p, s) with the current bounds out_.tau.
+  // The contact error at (p, s): with the bounds out_.tau of the pass, or with Coulomb's
+  // bounds mu |p_eta| of p itself.
   ContactError error_at(const Vector& p, const Vector& s, const std::vector<char>& enabled) const {
-    return contact_error(problem_, p, s, out_.tau, enabled);
+    return contact_error(problem_, p, s, coulomb_ ? friction_bounds(problem_, p) : out_.tau, enabled);
   }
 
   Equilibrium& eq_;
@@ -91,6 +93,8 @@ class StepSolver {
   long solves_at_start_ = 0;
   long newton_emitted_ = 0;  // the Newton counter at the last event
   double warmup_eps_ = 0.0;
+  bool coulomb_ = false;  // the friction bound moves with p (no tau passes)
+  long own_newton_iterations_ = 0;  // Newton iterations made outside the oracle (ssn)
   std::vector<char> is_normal_;
   ContactError error_;
   StepOutcome out_;
@@ -103,6 +107,9 @@ StepOutcome solve_cev_step(Equilibrium& eq, const Vector& q_guess, const Vector&
 StepOutcome solve_uzawa_step(Equilibrium& eq, const Vector& q_guess, const Vector& p_start,
                              const Vector& p_star, const ContactParams& params, int step,
                              const IterationObserver& observer, const StopRequest& stop);
+StepOutcome solve_ssn_step(Equilibrium& eq, const Vector& q_guess, const Vector& p_start,
+                           const Vector& p_star, const ContactParams& params, int step,
+                           const IterationObserver& observer, const StopRequest& stop);
 StepOutcome solve_penalty_step(Equilibrium& eq, const Vector& q_guess, const Vector& p_start,
                                const Vector& p_star, const ContactParams& params, int step,
                                const IterationObserver& observer, const StopRequest& stop);

@@ -11,6 +11,8 @@ StepOutcome solve_contact_step(Equilibrium& equilibrium, const Vector& q_guess,
   switch (params.method) {
     case ContactMethod::uzawa:
       return solve_uzawa_step(equilibrium, q_guess, p_start, p_star, params, step, observer, stop);
+    case ContactMethod::ssn:
+      return solve_ssn_step(equilibrium, q_guess, p_start, p_star, params, step, observer, stop);
     case ContactMethod::penalty:
       return solve_penalty_step(equilibrium, q_guess, p_start, p_star, params, step, observer, stop);
     case ContactMethod::cev:

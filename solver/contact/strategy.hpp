@@ -13,8 +13,11 @@
 
 namespace grip {
 
-enum class ContactMethod { cev, uzawa, penalty };
+enum class ContactMethod { cev, uzawa, penalty, ssn };
 enum class ContactLoop { inner, paper };  // inner: section 5's default; paper: the literal loop
+// inner: Coulomb's bound mu |p_eta| moves with p_eta inside the inner loop (cev's default);
+// passes: the tau passes of eq. 14, each a Tresca problem (the paper's loop always uses them).
+enum class FrictionLoop { inner, passes };
 enum class EpsilonSource { exact, warmup };
 
 // Acceleration level n: kInfinity = a Cholesky solve with the active block (default);
@@ -25,6 +28,7 @@ inline constexpr int kAccelerationAuto = -1;
 struct ContactParams {
   ContactMethod method = ContactMethod::cev;
   ContactLoop loop = ContactLoop::inner;
+  FrictionLoop friction_loop = FrictionLoop::inner;
   // ||v||_2 <= tolerance * (body's characteristic length) ends a step.
   double tolerance = 1e-8;
   int acceleration = kAccelerationInfinity;
@@ -34,6 +38,10 @@ struct ContactParams {
   double uzawa_alpha = 1.0;  // fixed alpha of the multiplier update
   int max_iterations = 500;  // real solves per load step, all tau passes together
   int max_inner_iterations = 2000;
+  // The Alart-Curnier augmentation r of the semismooth Newton iterations: cev's model uses
+  // r_i = augmentation / C_ii (each component's own contact stiffness), ssn r = augmentation x
+  // the largest diagonal entry of the body's stiffness. It changes the path, not the answer.
+  double augmentation = 1.0;
   int max_halvings = 40;  // halvings of the step inside the inner loop, or of alpha (paper)
   int halvings_before_fallback = 4;  // paper loop: then n -> n - 1
   int line_search_steps = 10;  // H of the line search along p -> prediction

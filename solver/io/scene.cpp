@@ -161,8 +161,11 @@ void read_solver(Reader& r, json& scene, SteppingParams& params) {
   ContactParams& c = params.contact;
   if (contact) {
     const std::string cp = sp + "/contact";
-    const std::string method = r.choice(*contact, cp, "method", {"cev", "uzawa", "penalty"}, "cev");
-    c.method = method == "uzawa" ? ContactMethod::uzawa : method == "penalty" ? ContactMethod::penalty : ContactMethod::cev;
+    const std::string method = r.choice(*contact, cp, "method", {"cev", "uzawa", "penalty", "ssn"}, "cev");
+    c.method = method == "uzawa"     ? ContactMethod::uzawa
+               : method == "penalty" ? ContactMethod::penalty
+               : method == "ssn"     ? ContactMethod::ssn
+                                     : ContactMethod::cev;
     if (json* pen = r.object(*contact, cp, "penalty", false)) {
       const std::string pp = cp + "/penalty";
       c.penalty_normal = r.number(*pen, pp, "normal", 0.0);
@@ -175,6 +178,9 @@ void read_solver(Reader& r, json& scene, SteppingParams& params) {
     if (c.tolerance >= 1) r.error(cp + "/tolerance", "is a relative tolerance and must be below 1");
     const std::string loop = r.choice(*contact, cp, "loop", {"inner", "paper"}, "inner");
     c.loop = loop == "paper" ? ContactLoop::paper : ContactLoop::inner;
+    const std::string friction_loop = r.choice(*contact, cp, "friction_loop", {"inner", "passes"}, "inner");
+    c.friction_loop = friction_loop == "passes" ? FrictionLoop::passes : FrictionLoop::inner;
+    c.augmentation = r.positive(*contact, cp, "augmentation", c.augmentation);
     c.max_iterations = r.integer(*contact, cp, "max_iterations", 1, 1000000, c.max_iterations);
     c.max_tau_passes = r.integer(*contact, cp, "max_tau_passes", 1, 1000, c.max_tau_passes);
     c.tau_tolerance = r.positive(*contact, cp, "tau_tolerance", c.tau_tolerance);

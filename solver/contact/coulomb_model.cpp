@@ -1,0 +1,170 @@
+#include "solver/contact/coulomb_model.hpp"
+
+#include <Eigen/LU>
+#include <cmath>
+
+namespace grip {
+namespace {
+
+// One candidate's rows in the compliance block (-1 where absent).
+struct Rows {
+  int eta = -1, xi = -1;
+  double mu = 0.0;
+  double r_eta = 1.0, r_xi = 1.0;  // augmentation: a multiple of the component's own stiffness
+};
+
+class Model {
+ public:
+  Model(const Problem& problem, const Compliance& C, const Vector& p0, const Vector& s0, double augmentation)
+      : C_(C.block), p0_full_(p0), s0_full_(s0), problem_(problem) {
+    const int m = static_cast<int>(C.block.rows());
+    component_.assign(m, -1);
+    for (size_t j = 0; j < C.position.size(); ++j)
+      if (C.position[j] >= 0) component_[C.position[j]] = static_cast<int>(j);
+    for (const Candidate& c : problem.candidates) {
+      Rows r;
+      r.eta = C.position[c.eta];
+      r.xi = c.xi >= 0 ? C.position[c.xi] : -1;
+      if (r.eta < 0 && r.xi < 0) continue;
+      r.mu = problem.obstacles[c.obstacle].friction;
+      if (r.eta >= 0 && C.block(r.eta, r.eta) > 0) r.r_eta = augmentation / C.block(r.eta, r.eta);
+      if (r.xi >= 0 && C.block(r.xi, r.xi) > 0) r.r_xi = augmentation / C.block(r.xi, r.xi);
+      rows_.push_back(r);
+    }
+    x0_.resize(m);
+    s0_.resize(m);
+    for (int k = 0; k < m; ++k) {
+      x0_[k] = p0[component_[k]];
+      s0_[k] = s0[component_[k]];
+    }
+  }
+
+  const Vector& x0() const { return x0_; }
+  Vector s(const Vector& x) const { return s0_ + C_ * (x - x0_); }
+
+  // The Alart-Curnier function at x (with s = s(x)) and, if asked, a generalized Jacobian.
+  Vector residual(const Vector& x, const Vector& s, Matrix* J) const {
+    const int m = static_cast<int>(x.size());
+    Vector F = x;  // the rows of components with no force (open, free) are p itself
+    if (J) J->setIdentity(m, m);
+    for (const Rows& rw : rows_) {
+      double gn = 0.0;
+      const double rn = rw.r_eta, rt = rw.r_xi;
+      if (rw.eta >= 0) {
+        gn = x[rw.eta] - rn * s[rw.eta];
+        if (gn < 0) {  // pressing: s_eta = 0
+          F[rw.eta] = rn * s[rw.eta];
+          if (J) J->row(rw.eta) = rn * C_.row(rw.eta);
+        }
+      }
+      if (rw.xi < 0) continue;
+      const double tau = rw.eta >= 0 ? rw.mu * std::max(0.0, -gn) : 0.0;
+      if (tau <= 0) continue;  // no bound: p_xi = 0
+      const double g = x[rw.xi] - rt * s[rw.xi];
+      if (std::abs(g) < tau) {  // stick: s_xi = 0
+        F[rw.xi] = rt * s[rw.xi];
+        if (J) J->row(rw.xi) = rt * C_.row(rw.xi);
+      } else {  // slip: p_xi = sign(g) tau, tau moving with the augmented normal force
+        const double sg = g > 0 ? 1.0 : -1.0;
+        F[rw.xi] = x[rw.xi] - sg * tau;
+        if (J) {
+          // d tau = -mu (d p_eta - r C_eta. dp)
+          J->row(rw.xi) = sg * rw.mu * (-rn * C_.row(rw.eta));
+          (*J)(rw.xi, rw.eta) += sg * rw.mu;
+          (*J)(rw.xi, rw.xi) += 1.0;
+        }
+      }
+    }
+    return F;
+  }
+
+  // x projected onto the cone, and the full vectors of the model at it.
+  void full(const Vector& x, Vector& p_full, Vector& s_full) const {
+    p_full = p0_full_;
+    for (int k = 0; k < x.size(); ++k) p_full[component_[k]] = x[k];
+    project_to_cone(problem_, p_full);
+    Vector xp(x.size());
+    for (int k = 0; k < x.size(); ++k) xp[k] = p_full[component_[k]];
+    const Vector sb = s(xp);
+    s_full = s0_full_;
+    for (int k = 0; k < x.size(); ++k) s_full[component_[k]] = sb[k];
+  }
+
+ private:
+  const Matrix& C_;
+  const Vector& p0_full_;
+  const Vector& s0_full_;
+  const Problem& problem_;
+  std::vector<int> component_;
+  std::vector<Rows> rows_;
+  Vector x0_, s0_;
+};
+
+ContactError coulomb_error(const Problem& problem, const Vector& p, const Vector& s,
+                           const std::vector<char>& enabled) {
+  return contact_error(problem, p, s, friction_bounds(problem, p), enabled);
+}
+
+}  // namespace
+
+void project_to_cone(const Problem& problem, Vector& p) {
+  for (const Candidate& c : problem.candidates) {
+    p[c.eta] = std::min(0.0, p[c.eta]);
+    if (c.xi < 0) continue;
+    const double tau = problem.obstacles[c.obstacle].friction * std::abs(p[c.eta]);
+    p[c.xi] = std::clamp(p[c.xi], -tau, tau);
+  }
+}
+
+CoulombModelSolution solve_coulomb_model(const Problem& problem, const Compliance& C, const Vector& p0,
+                                         const Vector& s0, const std::vector<char>& enabled,
+                                         const CoulombModelParams& params) {
+  CoulombModelSolution out;
+  const Model model(problem, C, p0, s0, params.augmentation);
+  Vector x = model.x0(), s = model.s(x);
+  Matrix J;
+  auto finish = [&](const Vector& xf) {
+    model.full(xf, out.p, out.s);
+    out.error = coulomb_error(problem, out.p, out.s, enabled);
+    out.converged = out.error.norm2 <= params.target;
+    return out.converged;
+  };
+  for (out.iterations = 0;; ++out.iterations) {
+    const bool done = finish(x);
+    if (out.iterations >= params.max_iterations || x.size() == 0) break;
+    const Vector F = model.residual(x, s, &J);
+    const double phi = 0.5 * F.squaredNorm();
+    const Eigen::PartialPivLU<Matrix> lu(J);
+    const Vector dx = lu.solve(-F);
+    if (done) {
+      // Within the target: one more full step solves the model exactly where the sets are
+      // right, so that the answer is the model's to rounding, not to the target (a change of
+      // units then changes no digit that matters).
+      if (dx.allFinite()) {
+        const CoulombModelSolution kept = out;
+        if (!finish(Vector(x + dx)) || out.error.norm2 > kept.error.norm2) out = kept;
+        out.converged = true;
+      }
+      break;
+    }
+    if (!dx.allFinite()) break;
+    // Armijo on |F|^2 / 2 (its slope along the Newton direction is -|F|^2).
+    double a = 1.0;
+    bool decreased = false;
+    for (int k = 0; k <= params.max_halvings; ++k, a *= 0.5) {
+      const Vector xt = x + a * dx;
+      const Vector st = model.s(xt);
+      if (0.5 * model.residual(xt, st, nullptr).squaredNorm() <= (1 - 1e-4 * a) * phi) {
+        x = xt;
+        s = st;
+        decreased = true;
+        break;
+      }
+      ++out.halvings;
+    }
+    if (!decreased) break;
+  }
+  return out;
+}
+
+}  // namespace grip

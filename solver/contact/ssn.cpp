@@ -1,0 +1,204 @@
+// Strategy `ssn`: a semismooth Newton method on the Alart-Curnier function in the primal
+// unknowns (Alart & Curnier 1991; the generalized Newton that GetFEM, 4C and others use, the
+// same iterates as the primal-dual active set of Hueber, Stadler & Wohlmuth 2008). The
+// displacements q (free dofs) and the contact forces p are solved together, one sparse linear
+// system per iteration:
+//     R(q, p) = A(q) - lambda F - T(q) p = 0                    (equilibrium, eq. 1-2)
+//     F_eta = p_eta - min(0, p_eta - r s_eta(q)) = 0
+//     F_xi  = p_xi - clamp(p_xi - r s_xi(q), -tau, tau) = 0,   tau = mu max(0, -(p_eta - r s_eta))
+// with the same pairing, T(q) and follower-load stiffness d(T(q) p)/dq as the equilibrium
+// oracle. The active, stick and slip sets come from the complementarity function at each
+// iterate. Globalized by backtracking on |R|^2/2 + |F|^2/2 (residuals in force units). r is
+// the augmentation, r = augmentation x the largest diagonal entry of the body's stiffness: it
+// changes the path, not the answer. The step ends with one equilibrium solve (the oracle) at
+// the forces projected onto the Coulomb cone, so that its answer is judged exactly as cev's.
+#include <Eigen/SparseLU>
+#include <cmath>
+
+#include "solver/contact/coulomb_model.hpp"
+#include "solver/contact/step.hpp"
+
+namespace grip {
+namespace {
+
+class SsnStep : public StepSolver {
+ public:
+  SsnStep(Equilibrium& eq, const ContactParams& params, int step, const IterationObserver& obs,
+          const StopRequest& stop)
+      : StepSolver(eq, params, step, obs, stop) {
+    const int n = problem_.body->dof_count();
+    free_index_.assign(n, -1);
+    for (int i = 0; i < n; ++i)
+      if (eq.is_free(i)) free_index_[i] = free_count_++;
+    length_scales_ = problem_.body->dof_length_scales();
+  }
+
+ private:
+  void solve(const Vector& q_guess, const Vector& p_start, const Vector&) override {
+    coulomb_ = true;
+    pass_ = out_.passes = 1;
+    out_.p = p_start;
+    project_to_cone(problem_, out_.p);
+    if (!fresh_solve(q_guess)) return;
+    Vector q = out_.state.q, p = out_.p;
+    r_ = params_.augmentation * eq_.stiffness_scale(q);
+    const int components = problem_.component_count;
+    for (int it = 1; error_.norm2 > tol_; ++it) {
+      if (!budget_left()) return;
+      if (it > params_.max_iterations)
+        return void(fail("semismooth Newton did not converge in " + std::to_string(params_.max_iterations) +
+                         " iterations (contact error " + std::to_string(error_.norm2) + ")"));
+      Triplets tangent;
+      const EquilibriumState paired = eq_.evaluate(q);
+      const Vector R = eq_.residual(q, p, &tangent);
+      Triplets jacobian;
+      const Vector F = complementarity(paired, p, &jacobian);
+      const double phi = merit(R, F);
+      // The system [dR/dq  -T; dF/ds T^T  dF/dp] [dq; dp] = -[R; F] on the free dofs and p.
+      for (const auto& t : tangent)
+        if (free_index_[t.row()] >= 0 && free_index_[t.col()] >= 0)
+          jacobian.emplace_back(free_index_[t.row()], free_index_[t.col()], t.value());
+      add_t_columns(paired, jacobian);
+      Eigen::SparseMatrix<double> J(free_count_ + components, free_count_ + components);
+      J.setFromTriplets(jacobian.begin(), jacobian.end());
+      Eigen::SparseLU<Eigen::SparseMatrix<double>> lu;
+      lu.compute(J);
+      if (lu.info() != Eigen::Success)
+        return void(fail("semismooth Newton: singular system in iteration " + std::to_string(it)));
+      Vector rhs(free_count_ + components);
+      for (int i = 0; i < R.size(); ++i)
+        if (free_index_[i] >= 0) rhs[free_index_[i]] = -R[i];
+      rhs.tail(components) = -F;
+      const Vector x = lu.solve(rhs);
+      if (!x.allFinite()) return void(fail("semismooth Newton produced a non-finite correction"));
+      Vector dq = Vector::Zero(q.size());
+      for (int i = 0; i < q.size(); ++i)
+        if (free_index_[i] >= 0) dq[i] = x[free_index_[i]];
+      const Vector dp = x.tail(components);
+      // Backtracking on the merit function (its slope along the Newton direction is -2 phi).
+      double a = problem_.body->newton_step_fraction(q, dq);
+      int halvings = 0;
+      bool decreased = false;
+      for (; halvings <= params_.max_halvings; ++halvings, a *= 0.5) {
+        const Vector qt = q + a * dq, pt = p + a * dp;
+        const EquilibriumState pt_paired = eq_.evaluate(qt);
+        const double phi_t = merit(eq_.residual(qt, pt, nullptr), complementarity(pt_paired, pt, nullptr));
+        if (std::isfinite(phi_t) && phi_t <= (1 - 1e-4 * a) * phi) {
+          decreased = true;
+          break;
+        }
+      }
+      if (!decreased)
+        return void(fail("semismooth Newton: no decrease of the residual along the Newton direction"));
+      q += a * dq;
+      p += a * dp;
+      ++own_newton_iterations_;
+      // Close enough on the complementarity function: the oracle solves equilibrium at the
+      // forces projected onto the cone, and the contact error judges that state.
+      const EquilibriumState now = eq_.evaluate(q);
+      const Vector F_now = complementarity(now, p, nullptr);
+      Vector p_cone = p;
+      project_to_cone(problem_, p_cone);
+      if (F_now.norm() <= 0.1 * tol_ * r_) {
+        if (!budget_left()) return;
+        EquilibriumState solved = eq_.solve(q, p_cone);
+        if (!solved.converged) return void(fail("equilibrium solve failed: " + solved.reason));
+        q = solved.q;
+        accept(std::move(solved), p_cone);
+        ++m_;
+        emit(1, 0, halvings, 0, a, 1);
+      } else {
+        out_.p = p_cone;
+        out_.tau = friction_bounds(problem_, p_cone);
+        error_ = error_at(p_cone, now.s, now.enabled);
+        ++m_;
+        emit(0, 0, halvings, 0, a, 1);
+      }
+    }
+    out_.converged = true;
+    final_check();
+  }
+
+  // The Alart-Curnier function at (q's pairing, p) and, if asked, its generalized Jacobian
+  // rows (dF/dp and dF/ds ds/dq, at rows free_count_ + component).
+  Vector complementarity(const EquilibriumState& paired, const Vector& p, Triplets* J) const {
+    Vector F = p;  // open, free or disabled components: p = 0
+    const int base = free_count_;
+    auto add_ds = [&](int row, size_t candidate, bool normal, double factor) {
+      const PairedPoint& pp = paired.points[candidate];
+      const Vec2 dir = normal ? pp.eta : Vec2(pp.projection.zeta_rate * pp.xi);
+      for (const auto& j : pp.point.jacobian)
+        if (free_index_[j.dof] >= 0) J->emplace_back(row, free_index_[j.dof], factor * j.dx.dot(dir));
+    };
+    std::vector<char> identity(p.size(), 1);
+    for (size_t i = 0; i < problem_.candidates.size(); ++i) {
+      const Candidate& c = problem_.candidates[i];
+      if (!paired.enabled[c.eta]) continue;
+      const double gn = p[c.eta] - r_ * paired.s[c.eta];
+      if (gn < 0) {  // pressing: s_eta = 0
+        F[c.eta] = r_ * paired.s[c.eta];
+        identity[c.eta] = 0;
+        if (J) add_ds(base + c.eta, i, true, r_);
+      }
+      if (c.xi < 0 || !paired.enabled[c.xi]) continue;
+      const double tau = problem_.obstacles[c.obstacle].friction * std::max(0.0, -gn);
+      if (tau <= 0) continue;
+      const double g = p[c.xi] - r_ * paired.s[c.xi];
+      identity[c.xi] = 0;
+      if (std::abs(g) < tau) {  // stick: s_xi = 0
+        F[c.xi] = r_ * paired.s[c.xi];
+        if (J) add_ds(base + c.xi, i, false, r_);
+      } else {  // slip: p_xi = sign(g) tau
+        const double sg = g > 0 ? 1.0 : -1.0;
+        const double mu = problem_.obstacles[c.obstacle].friction;
+        F[c.xi] = p[c.xi] - sg * tau;
+        if (J) {
+          J->emplace_back(base + c.xi, base + c.xi, 1.0);
+          J->emplace_back(base + c.xi, base + c.eta, sg * mu);
+          add_ds(base + c.xi, i, true, -sg * mu * r_);
+        }
+      }
+    }
+    if (J)
+      for (int k = 0; k < p.size(); ++k)
+        if (identity[k]) J->emplace_back(base + k, base + k, 1.0);
+    return F;
+  }
+
+  // dR/dp = -T on the free dofs.
+  void add_t_columns(const EquilibriumState& paired, Triplets& J) const {
+    for (size_t i = 0; i < problem_.candidates.size(); ++i) {
+      const Candidate& c = problem_.candidates[i];
+      const PairedPoint& pp = paired.points[i];
+      for (const auto& j : pp.point.jacobian) {
+        const int f = free_index_[j.dof];
+        if (f < 0) continue;
+        J.emplace_back(f, free_count_ + c.eta, -j.dx.dot(pp.eta));
+        if (c.xi >= 0) J.emplace_back(f, free_count_ + c.xi, -j.dx.dot(pp.xi));
+      }
+    }
+  }
+
+  // |R|^2 / 2 over the free dofs (moments over their length scale) + |F|^2 / 2: force units.
+  double merit(const Vector& R, const Vector& F) const {
+    double sum = F.squaredNorm();
+    for (int i = 0; i < R.size(); ++i)
+      if (free_index_[i] >= 0) sum += (R[i] / length_scales_[i]) * (R[i] / length_scales_[i]);
+    return 0.5 * sum;
+  }
+
+  std::vector<int> free_index_;
+  int free_count_ = 0;
+  Vector length_scales_;
+  double r_ = 1.0;
+};
+
+}  // namespace
+
+StepOutcome solve_ssn_step(Equilibrium& eq, const Vector& q_guess, const Vector& p_start,
+                           const Vector& p_star, const ContactParams& params, int step,
+                           const IterationObserver& observer, const StopRequest& stop) {
+  return SsnStep(eq, params, step, observer, stop).run(q_guess, p_start, p_star);
+}
+
+}  // namespace grip
