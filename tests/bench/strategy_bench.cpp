@@ -337,7 +337,7 @@ struct Strategy {
   std::string name;
   json contact;       // solver.contact of the scene
   int max_cuts = -1;  // solver.max_cuts; -1: the scene's default
-  std::string family; // cev-inner, cev-paper, uzawa, penalty (for the plots)
+  std::string family; // cev, ssn, cev-inner (tau passes), cev-paper, uzawa, penalty (for the plots)
 };
 
 // Real solves per load step for the loops that are known to stall (the paper's literal loop
@@ -350,7 +350,9 @@ std::vector<Strategy> strategies(bool quick) {
   auto cev = [&](const std::string& n_text, const json& n, const std::string& eps, bool paper) {
     Strategy s;
     s.name = "cev-" + n_text + (eps.empty() ? "" : "-" + eps) + (paper ? "-paper" : "");
-    s.contact = {{"method", "cev"}, {"loop", paper ? "paper" : "inner"}};
+    // The acceleration level n matters with the tau passes (inner loop by eq. 13) and in the
+    // paper's loop; cev's default (the bound moving with p) does not use it.
+    s.contact = {{"method", "cev"}, {"loop", paper ? "paper" : "inner"}, {"friction_loop", "passes"}};
     s.contact["acceleration"] = {{"n", n}};
     if (!eps.empty()) s.contact["acceleration"]["epsilon"] = eps;
     if (paper) {
@@ -358,6 +360,13 @@ std::vector<Strategy> strategies(bool quick) {
       s.max_cuts = 0;
     }
     s.family = paper ? "cev-paper" : "cev-inner";
+    out.push_back(s);
+  };
+  auto newton_like = [&](const std::string& method) {  // cev's default, ssn
+    Strategy s;
+    s.name = method;
+    s.contact = {{"method", method}};
+    s.family = method;
     out.push_back(s);
   };
   auto uzawa = [&] {
@@ -377,6 +386,8 @@ std::vector<Strategy> strategies(bool quick) {
     s.family = "penalty";
     out.push_back(s);
   };
+  newton_like("cev");
+  newton_like("ssn");
   if (quick) {
     cev("inf", "inf", "", false);
     cev("auto", "auto", "exact", false);
