@@ -312,6 +312,17 @@ std::string free_rigid_motion(const PlaneMesh& mesh, const std::vector<char>& fi
   return all;
 }
 
+// Elements beyond a refinement's extent grow geometrically; faster than this from one to the
+// next spoils the answer (Hertz with one coarse element a side: a and p0 5 % off).
+constexpr double kMaxGrowth = 4.0;
+
+// The fewest elements that cover `rest` beyond a fine zone of elements h, growing at most
+// kMaxGrowth-fold: h (r + ... + r^n) >= rest at r = kMaxGrowth.
+int coarse_needed(double h, double rest) {
+  const double r = kMaxGrowth;
+  return std::max(1, static_cast<int>(std::ceil(std::log(1 + rest * (r - 1) / (h * r)) / std::log(r) - 1e-9)));
+}
+
 std::vector<double> graded_divisions(double lo, double hi, int n, std::optional<double> focus,
                                      const std::optional<Refinement>& refine) {
   std::vector<double> x;
@@ -323,22 +334,27 @@ std::vector<double> graded_divisions(double lo, double hi, int n, std::optional<
   const double len[2] = {f - lo, hi - f};  // below and above the focus
   int fine[2], coarse[2] = {0, 0};
   double fine_len[2], coarse_len[2];
-  int coarse_total = n, sides_needing = 0;
+  int coarse_total = n, sides_needing = 0, needed[2] = {0, 0};
   for (int s = 0; s < 2; ++s) {
     fine_len[s] = std::min(refine->extent, len[s]);
     fine[s] = fine_len[s] > 0 ? std::max(1, static_cast<int>(std::lround(fine_len[s] / refine->size))) : 0;
     coarse_len[s] = len[s] - fine_len[s];
     coarse_total -= fine[s];
-    sides_needing += coarse_len[s] > 1e-12 * (hi - lo);
+    if (coarse_len[s] > 1e-12 * (hi - lo)) {
+      ++sides_needing;
+      needed[s] = fine[s] > 0 ? coarse_needed(fine_len[s] / fine[s], coarse_len[s]) : 1;
+    }
   }
-  if (coarse_total < sides_needing)
+  if (coarse_total < needed[0] + needed[1])
     throw std::invalid_argument(std::to_string(n) + " divisions cannot hold the refinement: it takes " +
                                 std::to_string(n - coarse_total) + " within the extent and " +
-                                std::to_string(sides_needing) + " more outside it");
+                                std::to_string(needed[0] + needed[1]) +
+                                " more outside it (elements growing at most 4-fold): give at least " +
+                                std::to_string(n - coarse_total + needed[0] + needed[1]));
   const double total_coarse_len = coarse_len[0] + coarse_len[1];
   if (sides_needing == 2) {
-    coarse[0] = std::clamp(static_cast<int>(std::lround(coarse_total * coarse_len[0] / total_coarse_len)), 1,
-                           coarse_total - 1);
+    coarse[0] = std::clamp(static_cast<int>(std::lround(coarse_total * coarse_len[0] / total_coarse_len)),
+                           needed[0], coarse_total - needed[1]);
     coarse[1] = coarse_total - coarse[0];
   } else if (sides_needing == 1) {
     coarse[coarse_len[0] > coarse_len[1] ? 0 : 1] = coarse_total;
