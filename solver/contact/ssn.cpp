@@ -8,9 +8,10 @@
 //     F_xi  = p_xi - clamp(p_xi - r s_xi(q), -tau, tau) = 0,   tau = mu max(0, -(p_eta - r s_eta))
 // with the same pairing, T(q) and follower-load stiffness d(T(q) p)/dq as the equilibrium
 // oracle. The active, stick and slip sets come from the complementarity function at each
-// iterate. Globalized by backtracking on |R|^2/2 + |F|^2/2 (residuals in force units). r is
-// the augmentation, r = augmentation x the largest diagonal entry of the body's stiffness: it
-// changes the path, not the answer. The step ends with one equilibrium solve (the oracle) at
+// iterate. Globalized by backtracking on |R|^2/2 + |F|^2/2 (residuals in force units); where
+// that finds no decrease, one equilibrium solve at the current forces and Newton again. r is
+// the augmentation, r_i = augmentation / C_ii (each component's own contact stiffness, from
+// the compliance at the step's first solve): it changes the path, not the answer. The step ends with one equilibrium solve (the oracle) at
 // the forces projected onto the Coulomb cone, so that its answer is judged exactly as cev's.
 #include <Eigen/SparseLU>
 #include <cmath>
@@ -41,8 +42,10 @@ class SsnStep : public StepSolver {
     project_to_cone(problem_, out_.p);
     if (!fresh_solve(q_guess)) return;
     Vector q = out_.state.q, p = out_.p;
-    r_ = params_.augmentation * eq_.stiffness_scale(q);
+    augmentations(out_.state);
     const int components = problem_.component_count;
+    int restarts = 0;
+    // Only a state from the oracle ends the loop: the step is judged on a real solve.
     for (int it = 1; error_.norm2 > tol_; ++it) {
       if (!budget_left()) return;
       if (it > params_.max_iterations)
@@ -88,8 +91,24 @@ class SsnStep : public StepSolver {
           break;
         }
       }
-      if (!decreased)
-        return void(fail("semismooth Newton: no decrease of the residual along the Newton direction"));
+      if (!decreased) {
+        // Back onto equilibrium: the oracle at the current forces (projected onto the cone),
+        // then Newton again from there.
+        if (++restarts > kMaxRestarts)
+          return void(fail("semismooth Newton: no decrease of the residual along the Newton direction"));
+        Vector p_cone = p;
+        project_to_cone(problem_, p_cone);
+        if (!budget_left()) return;
+        EquilibriumState solved = eq_.solve(q, p_cone);
+        if (!solved.converged) return void(fail("equilibrium solve failed: " + solved.reason));
+        q = solved.q;
+        p = p_cone;
+        accept(std::move(solved), p_cone);
+        ++m_;
+        emit(1, 0, halvings, 0, 0.0);
+        continue;
+      }
+      restarts = 0;
       q += a * dq;
       p += a * dp;
       ++own_newton_iterations_;
@@ -99,7 +118,7 @@ class SsnStep : public StepSolver {
       const Vector F_now = complementarity(now, p, nullptr);
       Vector p_cone = p;
       project_to_cone(problem_, p_cone);
-      if (F_now.norm() <= 0.1 * tol_ * r_) {
+      if (scaled_length(F_now) <= 0.1 * tol_) {
         if (!budget_left()) return;
         EquilibriumState solved = eq_.solve(q, p_cone);
         if (!solved.converged) return void(fail("equilibrium solve failed: " + solved.reason));
@@ -108,11 +127,18 @@ class SsnStep : public StepSolver {
         ++m_;
         emit(1, 0, halvings, 0, a, 1);
       } else {
+        // Reported in the event, not accepted: out_.state stays the last real solve's.
+        const ContactError e = error_at(p_cone, now.s, now.enabled);
+        const ContactError kept = error_;
+        const Vector kept_p = out_.p, kept_tau = out_.tau;
         out_.p = p_cone;
         out_.tau = friction_bounds(problem_, p_cone);
-        error_ = error_at(p_cone, now.s, now.enabled);
+        error_ = e;
         ++m_;
         emit(0, 0, halvings, 0, a, 1);
+        error_ = kept;
+        out_.p = kept_p;
+        out_.tau = kept_tau;
       }
     }
     out_.converged = true;
@@ -134,20 +160,22 @@ class SsnStep : public StepSolver {
     for (size_t i = 0; i < problem_.candidates.size(); ++i) {
       const Candidate& c = problem_.candidates[i];
       if (!paired.enabled[c.eta]) continue;
-      const double gn = p[c.eta] - r_ * paired.s[c.eta];
+      const double rn = r_[c.eta];
+      const double gn = p[c.eta] - rn * paired.s[c.eta];
       if (gn < 0) {  // pressing: s_eta = 0
-        F[c.eta] = r_ * paired.s[c.eta];
+        F[c.eta] = rn * paired.s[c.eta];
         identity[c.eta] = 0;
-        if (J) add_ds(base + c.eta, i, true, r_);
+        if (J) add_ds(base + c.eta, i, true, rn);
       }
       if (c.xi < 0 || !paired.enabled[c.xi]) continue;
       const double tau = problem_.obstacles[c.obstacle].friction * std::max(0.0, -gn);
       if (tau <= 0) continue;
-      const double g = p[c.xi] - r_ * paired.s[c.xi];
+      const double rt = r_[c.xi];
+      const double g = p[c.xi] - rt * paired.s[c.xi];
       identity[c.xi] = 0;
       if (std::abs(g) < tau) {  // stick: s_xi = 0
-        F[c.xi] = r_ * paired.s[c.xi];
-        if (J) add_ds(base + c.xi, i, false, r_);
+        F[c.xi] = rt * paired.s[c.xi];
+        if (J) add_ds(base + c.xi, i, false, rt);
       } else {  // slip: p_xi = sign(g) tau
         const double sg = g > 0 ? 1.0 : -1.0;
         const double mu = problem_.obstacles[c.obstacle].friction;
@@ -155,7 +183,7 @@ class SsnStep : public StepSolver {
         if (J) {
           J->emplace_back(base + c.xi, base + c.xi, 1.0);
           J->emplace_back(base + c.xi, base + c.eta, sg * mu);
-          add_ds(base + c.xi, i, true, -sg * mu * r_);
+          add_ds(base + c.xi, i, true, -sg * mu * rn);
         }
       }
     }
@@ -187,10 +215,34 @@ class SsnStep : public StepSolver {
     return 0.5 * sum;
   }
 
+  // r_i = augmentation / C_ii, each component's own contact stiffness, from the compliance at
+  // the step's first solve (the mean of those where a component was out of reach then).
+  void augmentations(const EquilibriumState& state) {
+    const Compliance& C = eq_.compliance(state, relevant_components());
+    r_ = Vector::Zero(problem_.component_count);
+    double sum = 0.0;
+    int count = 0;
+    for (int k = 0; k < problem_.component_count; ++k) {
+      const int a = C.position[k];
+      if (a >= 0 && C.block(a, a) > 0) {
+        r_[k] = params_.augmentation / C.block(a, a);
+        sum += r_[k];
+        ++count;
+      }
+    }
+    const double fallback = count ? sum / count : params_.augmentation * eq_.stiffness_scale(state.q);
+    for (int k = 0; k < problem_.component_count; ++k)
+      if (r_[k] == 0.0) r_[k] = fallback;
+  }
+
+  // |F / r| over the components: the complementarity residual in length units.
+  double scaled_length(const Vector& F) const { return F.cwiseQuotient(r_).norm(); }
+
+  static constexpr int kMaxRestarts = 5;
   std::vector<int> free_index_;
   int free_count_ = 0;
   Vector length_scales_;
-  double r_ = 1.0;
+  Vector r_;
 };
 
 }  // namespace

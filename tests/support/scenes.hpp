@@ -43,11 +43,12 @@ inline Solved solve_scene(const nlohmann::json& j) {
 namespace grip::testing {
 
 // The Coulomb cone holds to 1e-9 of the largest normal force where the friction bound moves
-// with p_eta inside the iteration (cev's default); to the tau-pass tolerance with tau passes.
+// with p_eta inside the iteration (cev's default, ssn); to the tau-pass tolerance with tau passes.
 inline InvariantTolerances tolerances_of(const Scene& scene) {
   const ContactParams& c = scene.params.contact;
-  const bool bound_moves = c.method == ContactMethod::cev && c.loop == ContactLoop::inner &&
-                           c.friction_loop == FrictionLoop::inner;
+  const bool bound_moves = c.method == ContactMethod::ssn || (c.method == ContactMethod::cev &&
+                                                               c.loop == ContactLoop::inner &&
+                                                               c.friction_loop == FrictionLoop::inner);
   return {c.tolerance * scene.problem.body->characteristic_length(), bound_moves ? 1e-9 : c.tau_tolerance};
 }
 

@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <vector>
 
 #include "tests/support/result_checks.hpp"
 #include "tests/support/scenes.hpp"
@@ -73,6 +74,40 @@ TEST(CoulombLoop, BeamTakesAtMostFourRealSolvesPerStep) {
   std::printf("beam: %.2f real solves per step\n", per_step);
   EXPECT_LE(per_step, 4.0);
 }
+
+// ssn on the continua (the sliding block, Cattaneo-Mindlin): every step sound with the cone to
+// 1e-9, the same forces as cev's default to the contact tolerance (both are exact Coulomb
+// solutions judged by the same ||v||; 1e-5 of the largest normal force), and the augmentation
+// r changes the path only: r x 0.01 and r x 100 give the same forces (measured: 1e-11).
+// (On the paper's beam and sheet ssn is not robust yet: see the README.)
+class Ssn : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(Ssn, SameForcesAsCevAndIndependentOfTheAugmentation) {
+  const json scene = example_scene(GetParam());
+  const Solved cev = solve_scene(scene);
+  ASSERT_TRUE(cev.run.completed) << cev.run.reason;
+  std::vector<Solved> runs;
+  for (const double r : {1.0, 1e-2, 1e2}) {
+    json j = with_contact(scene, "method", "ssn");
+    j["solver"]["contact"]["augmentation"] = r;
+    runs.push_back(solve_scene(j));
+    print_work(std::string(GetParam()) + ", ssn, augmentation " + std::to_string(r), runs.back());
+    // Sound steps with the cone to 1e-9; not ||v|| falling at every event (a Newton method on
+    // equilibrium and contact together does not promise that).
+    ASSERT_TRUE(runs.back().run.completed) << runs.back().run.reason;
+    for (const StepRecord& rec : runs.back().run.steps)
+      EXPECT_TRUE(step_invariants(runs.back().scene.problem, rec, tolerances_of(runs.back().scene)));
+    ASSERT_EQ(runs.back().run.steps.size(), cev.run.steps.size());
+  }
+  const double d_cev = force_difference(runs[0], cev);
+  const double d_small = force_difference(runs[1], runs[0]), d_large = force_difference(runs[2], runs[0]);
+  std::printf("%s: ssn vs cev %.3g, r x 0.01 %.3g, r x 100 %.3g\n", GetParam(), d_cev, d_small, d_large);
+  EXPECT_LT(d_cev, 1e-5);
+  EXPECT_LT(d_small, 1e-5);
+  EXPECT_LT(d_large, 1e-5);
+}
+
+INSTANTIATE_TEST_SUITE_P(Continua, Ssn, ::testing::Values("sliding-block", "cattaneo-mindlin"));
 
 }  // namespace
 }  // namespace grip
