@@ -285,6 +285,16 @@ inline json beam_scene(int elements, int steps) {
   return scene;
 }
 
+// The result of an uninterrupted run: `grip solve` (the binary under test), which builds the
+// same result document as the service.
+inline json reference_result(const json& scene, const fs::path& dir, const std::string& name) {
+  const fs::path in = dir / (name + ".scene.json"), out = dir / (name + ".result.json");
+  std::ofstream(in) << scene.dump();
+  const std::string cmd = std::string(GRIP_BINARY) + " solve " + in.string() + " --out " + out.string() + " > /dev/null";
+  if (std::system(cmd.c_str()) != 0) throw std::runtime_error("grip solve failed for " + name);
+  return json::parse(read_text(out));
+}
+
 // Removes wall-clock fields, which differ between runs of the same scene.
 inline json without_timings(json j) {
   if (j.is_object()) {

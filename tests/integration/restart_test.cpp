@@ -8,15 +8,6 @@
 namespace grip::testing {
 namespace {
 
-// The result of an uninterrupted run: `grip solve`, which builds the same result document.
-json reference_result(const json& scene, const fs::path& dir, const std::string& name) {
-  const fs::path in = dir / (name + ".scene.json"), out = dir / (name + ".result.json");
-  std::ofstream(in) << scene.dump();
-  const std::string cmd = std::string(GRIP_BINARY) + " solve " + in.string() + " --out " + out.string() + " > /dev/null";
-  if (std::system(cmd.c_str()) != 0) throw std::runtime_error("grip solve failed for " + name);
-  return json::parse(read_text(out));
-}
-
 TEST(Restart, KillNineLosesNoAcceptedJobAndResultsEqualAnUninterruptedRun) {
   TempDir dir;
   const fs::path db = dir.path() / "grip.sqlite", log = dir.path() / "server.log";

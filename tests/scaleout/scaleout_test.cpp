@@ -76,14 +76,6 @@ class LoadBalancer {
   pid_t pid_ = -1;
 };
 
-json reference_result(const json& scene, const fs::path& dir, const std::string& name) {
-  const fs::path in = dir / (name + ".scene.json"), out = dir / (name + ".result.json");
-  std::ofstream(in) << scene.dump();
-  const std::string cmd = std::string(GRIP_BINARY) + " solve " + in.string() + " --out " + out.string() + " > /dev/null";
-  if (std::system(cmd.c_str()) != 0) throw std::runtime_error("grip solve failed for " + name);
-  return json::parse(read_text(out));
-}
-
 // Ids strictly contiguous, no repeats, the terminal event last and only there.
 void expect_complete(const std::vector<SseEvent>& events, const std::string& id) {
   ASSERT_FALSE(events.empty()) << id;
