@@ -302,10 +302,19 @@ TEST(Scaleout, ThreeReplicasOnePostgresNothingLostNothingRunTwice) {
     // the database then, plus those run before the dismissal reached the runner.
     // The runner's own account: the contact iteration at which it heard of the dismissal and
     // the iterations it ran in all.
-    const std::string log = read_text(dir.path() / ("replica" + runner.substr(1) + ".log"));
+    // The runner logs its account just after it commits the final status, so the stream can end
+    // a moment before the line is written: wait for it.
+    const std::regex heard_line("job " + id + ": dismissal heard at contact iteration (\\d+)");
+    const std::regex ran_line("job " + id + " dismissed in [0-9.]+ s: (\\d+) contact iterations");
+    std::string log;
     std::smatch heard, ran;
-    ASSERT_TRUE(std::regex_search(log, heard, std::regex("job " + id + ": dismissal heard at contact iteration (\\d+)")));
-    ASSERT_TRUE(std::regex_search(log, ran, std::regex("job " + id + " dismissed in [0-9.]+ s: (\\d+) contact iterations")));
+    for (auto until = std::chrono::steady_clock::now() + 10s; std::chrono::steady_clock::now() < until;
+         std::this_thread::sleep_for(50ms)) {
+      log = read_text(dir.path() / ("replica" + runner.substr(1) + ".log"));
+      if (std::regex_search(log, ran, ran_line)) break;
+    }
+    ASSERT_TRUE(std::regex_search(log, heard, heard_line));
+    ASSERT_TRUE(std::regex_search(log, ran, ran_line));
     EXPECT_LE(std::stoi(ran[1]) - std::stoi(heard[1]), 1);
     EXPECT_EQ(std::stoi(ran[1]), iterations);
     std::printf("[ info ] dismissed on %s through r%d: heard at iteration %s, stopped after %s; %zu iterations "
