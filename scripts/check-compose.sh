@@ -6,6 +6,9 @@
 # job still served and a new job solved; everything removed again.
 #   bash scripts/check-compose.sh      (as root: starts and stops its own dockerd)
 set -euo pipefail
+# Debian's docker.io client first: another docker client earlier on PATH (e.g. in /usr/local/bin)
+# may want a buildx plugin that Debian does not ship.
+export PATH=/usr/bin:/usr/sbin:$PATH
 cd "$(dirname "$0")/.."
 scratch=${SCRATCH:-$(mktemp -d "${TMPDIR:-/tmp}/grip-compose-XXXXXX")}
 DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \

@@ -161,7 +161,7 @@ SubmitResult JobService::submit(const json& scene_json,
   } size;
   {
     const Scene scene = read_scene(scene_json);  // throws SceneErrors
-    size = {scene.problem.body->site_count(), static_cast<int>(scene.steps.size())};
+    size = {scene.problem.body->node_count(), static_cast<int>(scene.steps.size())};
   }
   std::vector<SceneIssue> issues;
   if (size.nodes > lim.max_nodes)
@@ -596,7 +596,7 @@ void JobService::run_job(const std::shared_ptr<ActiveJob>& job, const JobRecord&
   }
   const JobLimits& lim = options_.limits;
   const int steps = static_cast<int>(scene->steps.size());
-  const int nodes = scene->problem.body->site_count();
+  const int nodes = scene->problem.body->node_count();
   if (nodes > lim.max_nodes || steps > lim.max_steps) {
     outcome.status = JobStatus::failed;
     outcome.message = "limit: the scene is over this service's node or step limit";

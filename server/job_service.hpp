@@ -44,7 +44,7 @@ namespace grip::server {
 // Per-job limits. Nodes and steps are checked at submission (422); iterations and wall time
 // while the job runs (the job fails with the limit as its reason).
 struct JobLimits {
-  int max_nodes = 100000;                 // sites of the body
+  int max_nodes = 100000;                 // nodes of the body's mesh
   int max_steps = 10000;                  // load steps of the scene
   std::int64_t max_iterations = 1000000;  // contact iterations (real solves), all steps together
   double max_seconds = 3600.0;            // wall time of one run

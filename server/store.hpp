@@ -54,7 +54,7 @@ struct JobRecord {
   std::string updated;
   std::string message;
   int steps = 0;         // load steps of the scene
-  int nodes = 0;         // sites of the body
+  int nodes = 0;         // nodes of the body's mesh
   std::optional<std::string> idempotency_key;
   std::int64_t last_seq = 0;  // highest event sequence number ever given out
   int attempts = 0;           // runs started; above 1 after an interrupted run

@@ -47,6 +47,9 @@ class Body {
 
   // Sites that can carry a contact candidate (beam and membrane: the element end nodes).
   virtual int site_count() const = 0;
+  // Nodes of the model's mesh (what the service's size limit counts): the sites themselves
+  // where every node is a site.
+  virtual int node_count() const { return site_count(); }
   // Reference (undeformed centre-line) position of a site.
   virtual Vec2 site_reference(int site) const = 0;
   // The node that carries a site: its row of site_fields and its index in cells. The site

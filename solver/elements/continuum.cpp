@@ -28,32 +28,39 @@ ContinuumBody::ContinuumBody(PlaneMesh mesh, const std::vector<int>& contact_set
     hi = hi.cwiseMax(x);
   }
   length_ = (hi - lo).norm();
+}
 
-  const int n = quad_node_count(shape_);
-  for (const auto& el : mesh_.elements) {
-    ShapeGradients X(n, 2);
-    for (int a = 0; a < n; ++a) X.row(a) = mesh_.nodes[el[a]].transpose();
-    points_.push_back(quad_points(shape_, X, options_.thickness));
-    centroids_.push_back(quad_point(shape_, X, 0.0, 0.0, 0.0));
-    if (options_.element == ContinuumElement::q4_bbar) mean_dN_.push_back(mean_gradients(points_.back()));
-  }
-
-  if (options_.kinematics == ContinuumKinematics::linear) {
-    const Eigen::Matrix3d D = material_->small_strain().D;
-    for (int e = 0; e < element_count(); ++e) {
-      const Matrix Ke = small_strain_stiffness(points_[e], D, mean_gradient(e));
-      const auto& el = mesh_.elements[e];
-      for (int i = 0; i < 2 * n; ++i)
-        for (int j = 0; j < 2 * n; ++j)
-          linear_tangent_.emplace_back(node_dof(el[i / 2], i % 2), node_dof(el[j / 2], j % 2), Ke(i, j));
+const ContinuumBody::Integration& ContinuumBody::integration() const {
+  std::call_once(integration_once_, [this] {
+    auto in = std::make_unique<Integration>();
+    const int n = quad_node_count(shape_);
+    for (const auto& el : mesh_.elements) {
+      ShapeGradients X(n, 2);
+      for (int a = 0; a < n; ++a) X.row(a) = mesh_.nodes[el[a]].transpose();
+      in->points.push_back(quad_points(shape_, X, options_.thickness));
+      in->centroids.push_back(quad_point(shape_, X, 0.0, 0.0, 0.0));
+      if (options_.element == ContinuumElement::q4_bbar) in->mean_dN.push_back(mean_gradients(in->points.back()));
     }
-    linear_K_.resize(dof_count(), dof_count());
-    linear_K_.setFromTriplets(linear_tangent_.begin(), linear_tangent_.end());
-  }
+    if (options_.kinematics == ContinuumKinematics::linear) {
+      const Eigen::Matrix3d D = material_->small_strain().D;
+      for (int e = 0; e < element_count(); ++e) {
+        const Matrix Ke = small_strain_stiffness(in->points[e], D, in->mean_dN.empty() ? nullptr : &in->mean_dN[e]);
+        const auto& el = mesh_.elements[e];
+        for (int i = 0; i < 2 * n; ++i)
+          for (int j = 0; j < 2 * n; ++j)
+            in->linear_tangent.emplace_back(node_dof(el[i / 2], i % 2), node_dof(el[j / 2], j % 2), Ke(i, j));
+      }
+      in->linear_K.resize(dof_count(), dof_count());
+      in->linear_K.setFromTriplets(in->linear_tangent.begin(), in->linear_tangent.end());
+    }
+    integration_ = std::move(in);
+  });
+  return *integration_;
 }
 
 const ShapeGradients* ContinuumBody::mean_gradient(int e) const {
-  return mean_dN_.empty() ? nullptr : &mean_dN_[e];
+  const auto& mean_dN = integration().mean_dN;
+  return mean_dN.empty() ? nullptr : &mean_dN[e];
 }
 
 ShapeGradients ContinuumBody::element_displacements(const Vector& q, int e) const {
@@ -65,14 +72,16 @@ ShapeGradients ContinuumBody::element_displacements(const Vector& q, int e) cons
 
 void ContinuumBody::internal_force(const Vector& q, Vector& force, Triplets* tangent) const {
   if (options_.kinematics == ContinuumKinematics::linear) {
-    force += linear_K_ * q;
-    if (tangent) tangent->insert(tangent->end(), linear_tangent_.begin(), linear_tangent_.end());
+    const Integration& in = integration();
+    force += in.linear_K * q;
+    if (tangent) tangent->insert(tangent->end(), in.linear_tangent.begin(), in.linear_tangent.end());
     return;
   }
+  const Integration& in = integration();
   Vector fe;
   Matrix Ke;
   for (int e = 0; e < element_count(); ++e) {
-    total_lagrangian(points_[e], element_displacements(q, e), *material_, fe, tangent ? &Ke : nullptr);
+    total_lagrangian(in.points[e], element_displacements(q, e), *material_, fe, tangent ? &Ke : nullptr);
     const auto& el = mesh_.elements[e];
     const int m = static_cast<int>(fe.size());
     for (int i = 0; i < m; ++i) {
@@ -127,7 +136,7 @@ FieldTable ContinuumBody::site_fields(const Vector& q) const {
 
 Eigen::Vector4d ContinuumBody::centroid_stress(const Vector& q, int e) const {
   const ShapeGradients u = element_displacements(q, e);
-  const QuadPoint& c = centroids_[e];
+  const QuadPoint& c = integration().centroids[e];
   if (options_.kinematics == ContinuumKinematics::linear) {
     const MaterialResponse r = material_->small_strain();
     Vector ue(2 * u.rows());

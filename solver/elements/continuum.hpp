@@ -15,6 +15,7 @@
 // dofs. Tributary area = integral of the node's shape function over the contact sides x
 // thickness (half the adjacent side lengths for q4).
 #include <memory>
+#include <mutex>
 #include <vector>
 
 #include "solver/core/body.hpp"
@@ -62,7 +63,7 @@ class ContinuumBody final : public Body {
   FieldTable element_fields(const Vector& q) const override;
 
   static int node_dof(int node, int component) { return 2 * node + component; }
-  int node_count() const { return static_cast<int>(mesh_.nodes.size()); }
+  int node_count() const override { return static_cast<int>(mesh_.nodes.size()); }
   int element_count() const { return static_cast<int>(mesh_.elements.size()); }
   const PlaneMesh& mesh() const { return mesh_; }
   const ContinuumOptions& options() const { return options_; }
@@ -75,17 +76,26 @@ class ContinuumBody final : public Body {
   ShapeGradients element_displacements(const Vector& q, int e) const;
   const ShapeGradients* mean_gradient(int e) const;
 
+  // Integration points and the linear stiffness: built at the first solve, not by the
+  // constructor, so that reading and validating a large scene stays cheap (the service reads
+  // every submission on its HTTP thread and builds the body again on a worker).
+  struct Integration {
+    std::vector<std::vector<QuadPoint>> points;  // per element, reference configuration
+    std::vector<QuadPoint> centroids;
+    std::vector<ShapeGradients> mean_dN;         // per element (q4_bbar)
+    Triplets linear_tangent;                     // linear kinematics: the constant K
+    Eigen::SparseMatrix<double> linear_K;
+  };
+  const Integration& integration() const;
+
   PlaneMesh mesh_;
   ContinuumOptions options_;
   QuadShape shape_;
   std::shared_ptr<const PlaneMaterial> material_;
   BoundaryPart contact_;
   double length_ = 0.0;
-  std::vector<std::vector<QuadPoint>> points_;  // per element, reference configuration
-  std::vector<QuadPoint> centroids_;
-  std::vector<ShapeGradients> mean_dN_;         // per element (q4_bbar)
-  Triplets linear_tangent_;                     // linear kinematics: the constant K
-  Eigen::SparseMatrix<double> linear_K_;
+  mutable std::once_flag integration_once_;
+  mutable std::unique_ptr<const Integration> integration_;
 };
 
 }  // namespace grip

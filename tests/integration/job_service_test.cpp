@@ -12,6 +12,7 @@
 #include "solver/io/scene.hpp"
 // clang-format off
 #include "grip_process.hpp"
+#include "tests/support/scenes.hpp"
 // clang-format on
 
 namespace grip::testing {
@@ -138,6 +139,44 @@ TEST(JobService, InvalidScenesAndLimitsThrowWithPointers) {
   bad["body"]["material"]["young"] = -1;
   EXPECT_THROW(service.submit(bad), SceneErrors);
   EXPECT_TRUE(service.list(std::nullopt, 10, std::nullopt).jobs.empty());  // nothing stored
+}
+
+// The node limit counts the mesh's nodes, not only those that can touch an obstacle: an
+// explicit 10 x 4 mesh has 55 nodes, 11 of them in its contact set.
+TEST(JobService, TheNodeLimitCountsEveryNodeOfAnExplicitMesh) {
+  nlohmann::json scene = grip::testing::example_scene("sliding-block");
+  const int nx = 10, ny = 4;
+  nlohmann::json nodes = nlohmann::json::array(), elements = nlohmann::json::array();
+  nlohmann::json bottom = nlohmann::json::array(), top = nlohmann::json::array();
+  for (int j = 0; j <= ny; ++j)
+    for (int i = 0; i <= nx; ++i) nodes.push_back({-10.0 + 2.0 * i, 2.5 * j});
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const int a = j * (nx + 1) + i;
+      elements.push_back({a, a + 1, a + nx + 2, a + nx + 1});
+    }
+  for (int i = 0; i <= nx; ++i) {
+    bottom.push_back(i);
+    top.push_back(ny * (nx + 1) + i);
+  }
+  scene["body"]["mesh"] = {{"nodes", nodes}, {"elements", elements}, {"sets", {{"bottom", bottom}, {"top", top}}}};
+  TempDir dir;
+  SqliteStore store((dir.path() / "grip.sqlite").string());
+  ServiceOptions options;
+  options.limits.max_nodes = 40;
+  JobService service(store, options);
+  try {
+    service.submit(scene);
+    FAIL() << "55 nodes over a limit of 40";
+  } catch (const SceneErrors& e) {
+    ASSERT_EQ(e.issues().size(), 1u);
+    EXPECT_EQ(e.issues()[0].pointer, "/body/mesh");
+    EXPECT_NE(e.issues()[0].detail.find("has 55 nodes"), std::string::npos) << e.issues()[0].detail;
+  }
+  ServiceOptions roomy;
+  roomy.limits.max_nodes = 55;
+  JobService accepting(store, roomy);
+  EXPECT_EQ(accepting.submit(scene).job.record.nodes, 55);
 }
 
 // Retry-After of a full queue is the time until a worker frees (a queue slot then frees too),
