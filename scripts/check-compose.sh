@@ -22,6 +22,8 @@ fi
 compose=(docker-compose -f deploy/compose.yaml -p grip-check)
 cleanup() {
   "${compose[@]}" down -v >/dev/null 2>&1 || true
+  docker rm -f grip-stop-check >/dev/null 2>&1 || true
+  docker volume rm grip-stop-check >/dev/null 2>&1 || true
   [ -n "$dockerd_pid" ] && kill "$dockerd_pid" && wait "$dockerd_pid" 2>/dev/null || true
 }
 trap cleanup EXIT
@@ -58,3 +60,36 @@ for _ in $(seq 1 60); do
 done
 curl -sf "$api/v1/jobs/$job2" | grep -q '"status":"successful"'
 echo "compose check: 3 replicas on PostgreSQL behind HAProxy; jobs solved and served with one replica killed"
+"${compose[@]}" down -v >/dev/null 2>&1
+
+# `docker stop` with a job running, five times: the image's grace (GRIP_GRACE=5) ends inside
+# Docker's default 10 s, so the service exits by itself (status 0) and requeues the job, never
+# SIGKILLed (137); a sixth start on the same volume runs the job to the end.
+python3 - "$scratch/long-job.json" <<'PY'
+import json, sys
+s = json.load(open("tests/load/small-job.json"))
+s["stages"][-1]["steps"] = 2000  # some 10 s of solving: longer than the grace
+json.dump(s, open(sys.argv[1], "w"))
+PY
+one=http://127.0.0.1:18080
+start() {
+  docker run -d --name grip-stop-check -p 127.0.0.1:18080:8080 -v grip-stop-check:/var/lib/grip grip >/dev/null
+  for _ in $(seq 1 60); do curl -sf "$one/v1/ready" >/dev/null && return; sleep 0.5; done
+  echo "the container did not become ready"; exit 1
+}
+start
+long=$(curl -sf -H 'Content-Type: application/json' --data @"$scratch/long-job.json" "$one/v1/jobs" |
+       sed -n 's/.*"jobID":"\([^"]*\)".*/\1/p')
+for try in 1 2 3 4 5; do
+  [ "$try" = 1 ] || start
+  for _ in $(seq 1 60); do curl -sf "$one/v1/jobs/$long" | grep -q '"status":"running"' && break; sleep 0.5; done
+  sleep 1
+  docker stop grip-stop-check >/dev/null
+  code=$(docker inspect -f '{{.State.ExitCode}}' grip-stop-check)
+  docker rm grip-stop-check >/dev/null
+  [ "$code" = 0 ] || { echo "docker stop, try $try: exit status $code (SIGKILL: 137)"; exit 1; }
+done
+start
+for _ in $(seq 1 120); do curl -sf "$one/v1/jobs/$long" | grep -q '"status":"successful"' && break; sleep 1; done
+curl -sf "$one/v1/jobs/$long" | grep -q '"status":"successful"'
+echo "docker stop during a job: 5 of 5 stops exited by themselves (status 0); the job finished after the restarts"
