@@ -2,6 +2,7 @@
 // A deformable body model: internal force A(q), its tangent K(q), and the surface points
 // where contact candidates sit (eq. 1-3).
 #include <Eigen/SparseCore>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -77,6 +78,8 @@ class Body {
     bool constant_tangent = false;
   };
   virtual Traits traits() const { return {}; }
+  // Shape of the elements of a plane mesh (none for line models).
+  virtual std::optional<ElementQuality> element_quality() const { return std::nullopt; }
 
   // Sites of each cell, for plots and VTK: pairs for lines, four corners (counter-clockwise)
   // for quadrilaterals.

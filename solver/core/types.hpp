@@ -14,6 +14,16 @@ using Matrix = Eigen::MatrixXd;
 // Rotation by +90 degrees: the obstacle tangent is rot90(outward normal).
 inline Vec2 rot90(const Vec2& a) { return {-a.y(), a.x()}; }
 
+// Shape of a plane mesh's elements, from their corners: the longest over the shortest side
+// of each element, and its interior angles in degrees (90 for a rectangle). The result's
+// effects block reports it, so that a badly shaped generated mesh does not go unnoticed.
+struct ElementQuality {
+  int elements = 0;
+  double max_aspect_ratio = 0.0;
+  double min_angle = 0.0;
+  double max_angle = 0.0;
+};
+
 // Bad input: carries the JSON pointer of the offending scene value.
 class SceneError : public std::runtime_error {
  public:

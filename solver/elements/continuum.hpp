@@ -56,6 +56,7 @@ class ContinuumBody final : public Body {
   Vector rigid_translation(const Vec2& d) const override;
   Vector rigid_rotation() const override;
   Traits traits() const override;
+  std::optional<ElementQuality> element_quality() const override { return grip::element_quality(mesh_); }
   std::vector<std::vector<int>> cells() const override;  // element corners (node ids)
   // Per node: x, y (deformed), ux, uy.
   FieldTable site_fields(const Vector& q) const override;

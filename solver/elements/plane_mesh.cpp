@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <functional>
 #include <numbers>
 #include <numeric>
@@ -240,6 +241,29 @@ BoundaryPart boundary_part(const PlaneMesh& mesh, QuadShape shape, const std::ve
       i = it->second;
     }
   return part;
+}
+
+ElementQuality element_quality(const PlaneMesh& mesh) {
+  ElementQuality q{.elements = static_cast<int>(mesh.elements.size()),
+                   .max_aspect_ratio = 0.0,
+                   .min_angle = 180.0,
+                   .max_angle = 0.0};
+  if (mesh.elements.empty()) return {};
+  const double degrees = 180.0 / std::acos(-1.0);
+  for (const auto& el : mesh.elements) {
+    double shortest = std::numeric_limits<double>::infinity(), longest = 0.0;
+    for (int a = 0; a < 4; ++a) {
+      const Vec2& here = mesh.nodes[el[a]];
+      const Vec2 next = mesh.nodes[el[(a + 1) % 4]] - here, previous = mesh.nodes[el[(a + 3) % 4]] - here;
+      shortest = std::min(shortest, next.norm());
+      longest = std::max(longest, next.norm());
+      const double angle = std::atan2(std::abs(next.x() * previous.y() - next.y() * previous.x()), next.dot(previous));
+      q.min_angle = std::min(q.min_angle, angle * degrees);
+      q.max_angle = std::max(q.max_angle, angle * degrees);
+    }
+    q.max_aspect_ratio = std::max(q.max_aspect_ratio, longest / shortest);
+  }
+  return q;
 }
 
 std::string free_rigid_motion(const PlaneMesh& mesh, const std::vector<char>& fixed_dof) {

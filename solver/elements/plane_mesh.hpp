@@ -50,6 +50,8 @@ BoundaryPart boundary_part(const PlaneMesh& mesh, QuadShape shape, const std::ve
 // about (0, -1)"); empty when none is free.
 std::string free_rigid_motion(const PlaneMesh& mesh, const std::vector<char>& fixed_dof);
 
+ElementQuality element_quality(const PlaneMesh& mesh);
+
 // Local refinement of a generated mesh: elements of about `size` within `extent` of a point,
 // growing geometrically beyond it so that the given divisions fill the body.
 struct Refinement {

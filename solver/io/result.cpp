@@ -112,7 +112,7 @@ json effects_json(const Scene& scene, const RunResult& run) {
   for (const Candidate& c : problem.candidates) tangential += c.xi >= 0;
   long passes = 0;
   for (const auto& rec : run.steps) passes += rec.passes;
-  return {{"friction", friction},
+  json effects = {{"friction", friction},
           {"geometric_nonlinearity", traits.geometric_nonlinearity},
           {"plasticity", traits.plasticity},
           {"moving_obstacles", moving},
@@ -125,6 +125,12 @@ json effects_json(const Scene& scene, const RunResult& run) {
             {"equilibrium_solves", run.counters.solves},
             {"newton_iterations", run.counters.newton_iterations},
             {"tau_passes", passes}}}};
+  if (const auto quality = problem.body->element_quality())
+    effects["element_quality"] = {{"elements", quality->elements},
+                                  {"max_aspect_ratio", quality->max_aspect_ratio},
+                                  {"min_angle", quality->min_angle},
+                                  {"max_angle", quality->max_angle}};
+  return effects;
 }
 
 json result_json(const Scene& scene, const RunResult& run) {

@@ -82,6 +82,21 @@ TEST(RectangleMesh, AreaSetsAndOrientation) {
   }
 }
 
+// A 2 x 1 rectangle and a parallelogram sheared by 45 degrees touching it at a corner: the worst aspect
+// ratio is the rectangle's 2 (the parallelogram's sides are 1 and sqrt 2), the angles 45
+// and 135 degrees are the parallelogram's.
+TEST(ElementQuality, AspectRatioAndCornerAngles) {
+  PlaneMesh mesh;
+  mesh.nodes = {{0, 0}, {2, 0}, {2, 1}, {0, 1}, {3, 0}, {4, 1}, {3, 1}};
+  mesh.elements = {{0, 1, 2, 3}, {1, 4, 5, 6}};
+  ASSERT_TRUE(check_mesh(mesh, QuadShape::q4).empty());
+  const ElementQuality q = element_quality(mesh);
+  EXPECT_EQ(q.elements, 2);
+  EXPECT_NEAR(q.max_aspect_ratio, 2.0, 1e-12);
+  EXPECT_NEAR(q.min_angle, 45.0, 1e-12);
+  EXPECT_NEAR(q.max_angle, 135.0, 1e-12);
+}
+
 // Strong refinements with few divisions beyond them stay valid (the columns fan out toward
 // the diameter only as far as they can).
 TEST(HalfDiscMesh, EveryElementIsValidOverARangeOfRefinements) {

@@ -129,6 +129,24 @@ TEST(SceneEffects, FrictionlessHasHalfTheUnknownsAndNoTauPasses) {
   EXPECT_TRUE(ea["geometric_nonlinearity"]);
 }
 
+// The effects block reports the shape of a continuum's elements: right angles throughout
+// the sliding block's rectangle; the half-disc's single mapped block puts two of its corners
+// on the smooth arc, where the corner elements are strongly skewed (reported, not hidden).
+TEST(SceneEffects, ContinuumReportsItsElementQuality) {
+  const Scene block = read_scene(example_scene("sliding-block"));
+  const json b = effects_json(block, RunResult{})["element_quality"];
+  EXPECT_EQ(b["elements"], block.problem.body->cells().size());
+  EXPECT_NEAR(b["min_angle"].get<double>(), 90.0, 1e-9);
+  EXPECT_NEAR(b["max_angle"].get<double>(), 90.0, 1e-9);
+  const json h = effects_json(read_scene(example_scene("hertz")), RunResult{})["element_quality"];
+  EXPECT_GT(h["min_angle"].get<double>(), 0.0);
+  EXPECT_LT(h["min_angle"].get<double>(), 90.0);
+  EXPECT_GT(h["max_angle"].get<double>(), 90.0);
+  EXPECT_LT(h["max_angle"].get<double>(), 180.0);
+  EXPECT_GT(h["max_aspect_ratio"].get<double>(), 1.0);
+  EXPECT_FALSE(effects_json(read_scene(example_scene("beam-on-cylinder")), RunResult{}).contains("element_quality"));
+}
+
 TEST(SceneEffects, LinearKinematicsFactorizesOnce) {
   json j = example_scene("beam-on-cylinder");
   j["body"]["kinematics"] = "linear";
