@@ -146,18 +146,19 @@ json result_head(const Scene& scene, const RunResult& run) {
 
 // A double as JSON reads it back exactly (shortest round trip), with a point or an exponent
 // as nlohmann writes floating-point numbers; null where not finite, as nlohmann does.
-void write_number(std::ostream& out, double v) {
+void append_number(std::string& out, double v) {
   if (!std::isfinite(v)) {
-    out << "null";
+    out += "null";
     return;
   }
   char buf[32];
   char* end = std::to_chars(buf, buf + sizeof buf, v).ptr;
-  out.write(buf, end - buf);
-  if (std::none_of(buf, end, [](char c) { return c == '.' || c == 'e'; })) out << ".0";
+  out.append(buf, end);
+  if (std::none_of(buf, end, [](char c) { return c == '.' || c == 'e'; })) out += ".0";
 }
 
-// table_json's rows, written as they are made: no document of the table's size in memory.
+// table_json's rows, written as they are made (in chunks): no document of the table's size in
+// memory, and no stream call per number.
 void write_table(std::ostream& out, const FieldTable& t, const std::string& index_name) {
   std::vector<std::pair<std::string, int>> keys{{index_name, -1}};  // -1: the row index
   for (size_t c = 0; c < t.names.size(); ++c)
@@ -165,19 +166,25 @@ void write_table(std::ostream& out, const FieldTable& t, const std::string& inde
   std::sort(keys.begin(), keys.end());  // an object's keys in nlohmann's order
   std::vector<std::string> quoted;
   for (const auto& k : keys) quoted.push_back(json(k.first).dump() + ":");
-  out << '[';
+  std::string chunk = "[";
   for (size_t i = 0; i < t.rows.size(); ++i) {
-    out << (i ? ",\n{" : "\n{");
+    chunk += i ? ",\n{" : "\n{";
     for (size_t k = 0; k < keys.size(); ++k) {
-      out << (k ? "," : "") << quoted[k];
+      if (k) chunk += ',';
+      chunk += quoted[k];
       if (keys[k].second < 0)
-        out << i;
+        chunk += std::to_string(i);
       else
-        write_number(out, t.rows[i][keys[k].second]);
+        append_number(chunk, t.rows[i][keys[k].second]);
     }
-    out << '}';
+    chunk += '}';
+    if (chunk.size() > (1 << 16)) {
+      out.write(chunk.data(), static_cast<std::streamsize>(chunk.size()));
+      chunk.clear();
+    }
   }
-  out << ']';
+  chunk += ']';
+  out.write(chunk.data(), static_cast<std::streamsize>(chunk.size()));
 }
 
 using Streamed = std::vector<std::pair<std::string, std::function<void()>>>;
