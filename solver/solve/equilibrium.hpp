@@ -134,13 +134,6 @@ class Equilibrium {
   // R = A(q) - lambda F - T(q) p on every dof, and (if asked) the triplets of dR/dq, with
   // the pairing evaluated at q.
   Vector residual(const Vector& q, const Vector& p, Triplets* tangent) const;
-  // R = A(q) - lambda F - T p on all dofs; tangent of R (with the contact load stiffness).
-  // force_scale (if asked): the largest of |A(q)|, |lambda F| and |T p| over all dofs, in
-  // force units (the scale Newton's residual test is relative to).
-  Vector residual(const Vector& q, const EquilibriumState& paired, const Vector& p,
-                  Triplets* tangent, double* force_scale = nullptr) const;
-  // The largest free residual in force units (moments over their dof's length scale).
-  double scaled_free_max(const Vector& r) const;
   // Residual forces at the fixed dofs (the reactions on the body), full dof vector.
   Vector reactions(const EquilibriumState& state, const Vector& p) const;
   // The surface coordinate of every candidate's pairing point (for the next step's slips).
@@ -156,12 +149,18 @@ class Equilibrium {
   void pair(const Vector& q, EquilibriumState& state) const;
   // A converged iterate: admissibility and the forces in equilibrium (penalty law).
   EquilibriumState& finish(EquilibriumState& state, const Vector& p) const;
+  // R = A(q) - lambda F - T p on all dofs; tangent of R (with the contact load stiffness).
+  // force_scale (if asked): the largest of |A(q)|, |lambda F| and |T p| over all dofs, in
+  // force units (the scale Newton's residual test is relative to).
+  Vector residual(const Vector& q, const EquilibriumState& paired, const Vector& p,
+                  Triplets* tangent, double* force_scale = nullptr) const;
   // p(q) of the penalty law at a paired state, and (if asked) its stiffness triplets.
   Vector penalty_forces(const EquilibriumState& paired, Triplets* tangent) const;
   // Step length along the Newton correction dq at q: the natural monotonicity test with the
   // factorization `solver` of the step's tangent; at most the body's trust-region fraction.
   double line_search(const Vector& q, const Vector& dq, const Vector& p, const FreeBlockSolver& solver) const;
   double free_length_norm(const Vector& dq) const;
+  double scaled_free_max(const Vector& r) const;
   // Adds free dofs to G's surface: one solve with the body's factorization per dof.
   void extend_surface_compliance(const std::vector<int>& added);
 
