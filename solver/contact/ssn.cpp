@@ -9,7 +9,9 @@
 // with the same pairing, T(q) and follower-load stiffness d(T(q) p)/dq as the equilibrium
 // oracle. The active, stick and slip sets come from the complementarity function at each
 // iterate. Globalized by backtracking on |R|^2/2 + |F|^2/2 (residuals in force units); where
-// that finds no decrease, one equilibrium solve at the current forces and Newton again. r is
+// that finds no decrease, one equilibrium solve at the current forces and Newton again. Forces
+// the function holds open are set to exactly zero before the oracle sees them (a -1e-22
+// normal force at a gap counts as pressing: that stalled the beam and the sheet). r is
 // the augmentation, r_i = augmentation / C_ii (each component's own contact stiffness, from
 // the compliance at the step's first solve): it changes the path, not the answer. The step ends with one equilibrium solve (the oracle) at
 // the forces projected onto the Coulomb cone, so that its answer is judged exactly as cev's.
@@ -117,6 +119,7 @@ class SsnStep : public StepSolver {
       const EquilibriumState now = eq_.evaluate(q);
       const Vector F_now = complementarity(now, p, nullptr);
       Vector p_cone = p;
+      release_open(now, p_cone);
       project_to_cone(problem_, p_cone);
       if (scaled_length(F_now) <= 0.1 * tol_) {
         if (!budget_left()) return;
@@ -191,6 +194,17 @@ class SsnStep : public StepSolver {
       for (int k = 0; k < p.size(); ++k)
         if (identity[k]) J->emplace_back(base + k, base + k, 1.0);
     return F;
+  }
+
+  // Where the Alart-Curnier function holds a component open (p_eta - r s_eta >= 0), its force
+  // is zero to the function's tolerance, not exactly: a normal force of -1e-22 at a gap would
+  // count as pressing in the contact error. Such forces are set to zero.
+  void release_open(const EquilibriumState& paired, Vector& p) const {
+    for (const Candidate& c : problem_.candidates)
+      if (!paired.enabled[c.eta] || p[c.eta] - r_[c.eta] * paired.s[c.eta] >= 0) {
+        p[c.eta] = 0.0;
+        if (c.xi >= 0) p[c.xi] = 0.0;
+      }
   }
 
   // dR/dp = -T on the free dofs.
