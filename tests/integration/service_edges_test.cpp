@@ -80,6 +80,12 @@ TEST(ServiceEdges, JobsStayReadableDuringTheGracePeriod) {
   const std::string id = api.submit(beam_scene(40, 150));
   api.wait_status(id, {"running"});
   ::kill(server.pid(), SIGTERM);
+  // The signal is handled asynchronously: wait (bounded) until readiness says so.
+  for (int i = 0; i < 250; ++i) {
+    auto ready = api.get("/v1/ready");
+    if (!ready || ready->status == 503) break;
+    std::this_thread::sleep_for(20ms);
+  }
   // The running job may finish; meanwhile its status answers, new work is refused.
   bool seen_in_grace = false;
   for (int i = 0; i < 200; ++i) {
