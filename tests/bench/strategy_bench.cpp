@@ -327,6 +327,40 @@ std::vector<SceneCase> scene_cases() {
   out.push_back(half_disc_case(true, {0.056, 0.028, 0.02}));
   out.push_back(strip_case("cantilever", "strip-cantilever"));
   out.push_back(strip_case("strip-cylinder", "strip-on-cylinder"));
+  {
+    // The block pressed and slid on a flat (20 x 10 elements as shipped).
+    SceneCase s;
+    s.name = "sliding-block";
+    s.file = "sliding-block";
+    s.mesh_label = [](const json& j) {
+      const json& d = j["body"]["mesh"]["rectangle"]["divisions"];
+      return std::to_string(d[0].get<int>()) + "x" + std::to_string(d[1].get<int>());
+    };
+    s.with_mesh = [](json j, int level) {
+      j["body"]["mesh"]["rectangle"]["divisions"] = {10 << level, 5 << level};
+      return j;
+    };
+    s.measure = [](const Scene& sc, const RunResult& run) {
+      const StepRecord& last = run.steps.back();
+      Quantities q;
+      const Vec2 reaction = testing::reaction_resultant(sc.problem, last);
+      q.force = std::abs(reaction.x());  // Q, mu N once every node slips
+      q.peak = peak_normal_stress(sc.problem, last);
+      return q;
+    };
+    s.quantities = "force: tangential reaction Q (N per mm); peak: peak normal contact stress (MPa)";
+    out.push_back(std::move(s));
+  }
+  // Frictionless twins of the scenes with friction (issue 15: each strategy with and without).
+  for (const char* name : {"beam", "sheet", "sliding-block"}) {
+    SceneCase s = *std::find_if(out.begin(), out.end(), [&](const SceneCase& c) { return c.name == name; });
+    s.name += "-mu0";
+    s.with_mesh = [mesh = s.with_mesh](json j, int level) {
+      for (json& o : j["obstacles"]) o["friction"] = 0.0;
+      return mesh(std::move(j), level);
+    };
+    out.push_back(std::move(s));
+  }
   return out;
 }
 
@@ -935,7 +969,7 @@ int main(int argc, char** argv) {
       } else {
         std::fprintf(stderr,
                      "usage: grip_bench [--quick] [--out DIR] [--runs N] [--jobs N] [--budget MINUTES] "
-                     "[--run-seconds S] [--scenes beam,sheet,hertz,cattaneo-mindlin,cantilever,strip-cylinder] [--levels 0,1,2] "
+                     "[--run-seconds S] [--scenes beam,sheet,hertz,cattaneo-mindlin,cantilever,strip-cylinder,sliding-block,beam-mu0,sheet-mu0,sliding-block-mu0] [--levels 0,1,2] "
                      "[--source DIR] [--label TEXT]\n");
         return a == "--help" ? 0 : 2;
       }
