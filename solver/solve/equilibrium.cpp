@@ -324,6 +324,8 @@ void Equilibrium::extend_surface_compliance(const std::vector<int>& added) {
     surface_free_.push_back(f);
   }
   const int m = static_cast<int>(surface_free_.size());
+  counters_.compliance_columns += m - m0;
+  if (m0 == 0 && body_lu_.inverse_block(surface_free_, g_)) return;  // a new G: sparse solves
   g_.conservativeResize(m, m);
   // Unit right-hand sides in blocks: the work storage stays (free dofs) x kBlock.
   constexpr int kBlock = 64;
@@ -341,7 +343,6 @@ void Equilibrium::extend_surface_compliance(const std::vector<int>& added) {
   }
   const Matrix added_block = g_.bottomRightCorner(m - m0, m - m0);
   g_.bottomRightCorner(m - m0, m - m0) = 0.5 * (added_block + added_block.transpose());
-  counters_.compliance_columns += m - m0;
 }
 
 namespace {
