@@ -15,7 +15,13 @@
 // K, K' the complete elliptic integrals of the first kind of modulus c/a and of the
 // complementary modulus sqrt(1 - (c/a)^2) (the log-weighted integral of the slip zones'
 // Hilbert transform is exactly pi/2 K'; checked numerically). nu = 0.3, mu = 0.3:
-// beta / mu = 0.952, c/a = 0.744.
+// beta / mu = 0.952, c/a = 0.744. A half-plane boundary-element model
+// (bench/spence_halfplane.cpp) reproduces it (stick set 0.744 at a/h = 160 without the
+// coupling) and shows what the finite element scene adds: the coupling of q into p lowers c/a
+// to 0.692 (peak pressure +8 %, a 2.5 % short, as the scene shows), the surface stretch of a
+// finite cylinder (R/a = 20) raises it back to 0.744, and the 0.99 mu p rule reads the stick
+// zone about 0.025 a short of the stick set (the margin closes slowly at c). The scene's c/a
+// near the relation is thus two effects of opposite sign, each of about 5 % of a.
 #include <algorithm>
 #include <cmath>
 
