@@ -1,6 +1,7 @@
 #include "solver/contact/coulomb_model.hpp"
 
 #include <Eigen/LU>
+#include <Eigen/QR>
 #include <cmath>
 
 namespace grip {
@@ -31,6 +32,14 @@ class Model {
       if (r.xi >= 0 && C.block(r.xi, r.xi) > 0) r.r_xi = augmentation / C.block(r.xi, r.xi);
       rows_.push_back(r);
     }
+    // The rigid amplitudes' rows (ALGORITHM.md 7): the body's equilibrium s = 0, an equality,
+    // scaled like a contact row by the largest contact compliance.
+    double c_max = 0.0;
+    for (const Rows& r : rows_)
+      c_max = std::max({c_max, r.eta >= 0 ? C.block(r.eta, r.eta) : 0.0, r.xi >= 0 ? C.block(r.xi, r.xi) : 0.0});
+    for (int k = 0; k < m; ++k)
+      if (problem.rigid.is_amplitude(component_[k])) equality_.push_back(k);
+    r_equality_ = c_max > 0 ? augmentation / c_max : 1.0;
     x0_.resize(m);
     s0_.resize(m);
     for (int k = 0; k < m; ++k) {
@@ -40,6 +49,7 @@ class Model {
   }
 
   const Vector& x0() const { return x0_; }
+  const std::vector<int>& equalities() const { return equality_; }
   Vector s(const Vector& x) const { return s0_ + C_ * (x - x0_); }
 
   // The Alart-Curnier function at x (with s = s(x)) and, if asked, a generalized Jacobian.
@@ -75,6 +85,10 @@ class Model {
         }
       }
     }
+    for (int k : equality_) {
+      F[k] = r_equality_ * s[k];
+      if (J) J->row(k) = r_equality_ * C_.row(k);
+    }
     return F;
   }
 
@@ -97,6 +111,8 @@ class Model {
   const Problem& problem_;
   std::vector<int> component_;
   std::vector<Rows> rows_;
+  std::vector<int> equality_;  // rows of the rigid amplitudes
+  double r_equality_ = 1.0;
   Vector x0_, s0_;
 };
 
@@ -135,7 +151,10 @@ CoulombModelSolution solve_coulomb_model(const Problem& problem, const Complianc
     const Vector F = model.residual(x, s, &J);
     const double phi = 0.5 * F.squaredNorm();
     const Eigen::PartialPivLU<Matrix> lu(J);
-    const Vector dx = lu.solve(-F);
+    Vector dx = lu.solve(-F);
+    // Singular where every point slips along a free rigid motion (its amplitude's column
+    // vanishes): the least-squares step, still a descent direction of |F|^2.
+    if (!dx.allFinite() && !model.equalities().empty()) dx = J.completeOrthogonalDecomposition().solve(-F);
     if (done) {
       // Within the target: one more full step solves the model exactly where the sets are
       // right, so that the answer is the model's to rounding, not to the target (a change of

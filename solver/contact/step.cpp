@@ -231,7 +231,7 @@ bool StepSolver::literal_pass(int first_level, double alpha_fixed) {
   return true;
 }
 
-// Every component with a force or a friction bound, and those of candidates penetrating or
+// Every component with a force or a friction bound, the rigid amplitudes, and those of candidates penetrating or
 // within a few per cent of the body's length of their obstacle. The others are frozen (a far
 // point that the real solve brings into contact joins at the next iteration).
 std::vector<int> StepSolver::relevant_components() const {
@@ -245,6 +245,7 @@ std::vector<int> StepSolver::relevant_components() const {
     out.push_back(c.eta);
     if (c.xi >= 0 && out_.state.enabled[c.xi]) out.push_back(c.xi);
   }
+  for (int k = 0; k < problem_.rigid.count(); ++k) out.push_back(problem_.rigid.first + k);
   return out;
 }
 

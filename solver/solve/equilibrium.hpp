@@ -134,6 +134,8 @@ class Equilibrium {
   // R = A(q) - lambda F - T(q) p on every dof, and (if asked) the triplets of dR/dq, with
   // the pairing evaluated at q.
   Vector residual(const Vector& q, const Vector& p, Triplets* tangent) const;
+  // The applied loads and the contact forces p on every dof at a paired state: F + T p.
+  Vector applied_forces(const EquilibriumState& paired, const Vector& p) const;
   // Residual forces at the fixed dofs (the reactions on the body), full dof vector.
   Vector reactions(const EquilibriumState& state, const Vector& p) const;
   // The surface coordinate of every candidate's pairing point (for the next step's slips).
@@ -161,6 +163,7 @@ class Equilibrium {
   double line_search(const Vector& q, const Vector& dq, const Vector& p, const FreeBlockSolver& solver) const;
   double free_length_norm(const Vector& dq) const;
   double scaled_free_max(const Vector& r) const;
+  void add_rigid_border(const EquilibriumState& state);
   // Adds free dofs to G's surface: one solve with the body's factorization per dof.
   void extend_surface_compliance(const std::vector<int>& added);
 
