@@ -2,6 +2,7 @@
 
 #include <Eigen/Cholesky>
 #include <cmath>
+#include <limits>
 
 #include "solver/contact/acceleration.hpp"
 
@@ -101,6 +102,39 @@ bool StepSolver::fresh_solve(const Vector& q) {
   m_ = 0;
   emit(1, 0, 0, 0, 0.0);
   return true;
+}
+
+bool StepSolver::approach_contact() {
+  const RigidModes& rigid = problem_.rigid;
+  Vector p = out_.p, dq = Vector::Zero(out_.state.q.size());
+  bool moved = false;
+  for (int k = 0; k < rigid.count(); ++k) {
+    const double push = out_.state.s[rigid.first + k];
+    if (push == 0.0) continue;
+    bool held = false;
+    double reach = std::numeric_limits<double>::infinity();
+    for (size_t i = 0; i < problem_.candidates.size(); ++i) {
+      const Candidate& c = problem_.candidates[i];
+      const PairedPoint& pp = out_.state.points[i];
+      double along_eta = 0.0, along_xi = 0.0;  // the gap's and the slip's rates along the mode
+      for (const auto& j : pp.point.jacobian) {
+        along_eta += j.dx.dot(pp.eta) * rigid.modes(j.dof, k);
+        along_xi += j.dx.dot(pp.xi) * rigid.modes(j.dof, k);
+      }
+      const bool frictional = c.xi >= 0 && problem_.obstacles[c.obstacle].friction > 0;
+      if (out_.p[c.eta] < 0 && (std::abs(along_eta) > 1e-12 || (frictional && std::abs(along_xi) > 1e-12)))
+        held = true;
+      if (along_eta * push > 1e-12 * std::abs(push)) reach = std::min(reach, std::max(0.0, -out_.state.s[c.eta]) / std::abs(along_eta));
+    }
+    if (held || !std::isfinite(reach)) continue;
+    const double move = (push > 0 ? 1.0 : -1.0) * (reach + tol_);
+    p[rigid.first + k] += move / rigid.scale;
+    dq += move * rigid.modes.col(k);
+    moved = true;
+  }
+  if (!moved) return true;
+  out_.p = p;
+  return fresh_solve(Vector(out_.state.q + dq));
 }
 
 void StepSolver::accept(EquilibriumState s, const Vector& p) {

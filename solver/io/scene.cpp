@@ -121,8 +121,6 @@ std::string format_point(const Vec2& p) {
   return os.str();
 }
 
-// ALGORITHM.md section 7: the scheme solves equilibrium for given contact forces, so the
-// supports alone must remove every rigid-body motion. Names each motion left free.
 // The rigid motions of the body as columns: translation x, translation y, and (where the body
 // has one) the rotation about the origin scaled to a length.
 std::vector<Vector> body_modes(const Body& body) {
@@ -133,14 +131,19 @@ std::vector<Vector> body_modes(const Body& body) {
 
 // The motion with coefficients c of body_modes() in words.
 std::string motion_name(const Vector& coefficients, double L) {
-  const Vector c = coefficients.normalized();
+  Vector c = coefficients.normalized();
+  for (int m = 0; m < c.size(); ++m)
+    if (std::abs(c[m]) < 1e-9) c[m] = 0.0;  // no "-0" or 1e-17 in the words
   const double omega = c.size() > 2 ? c[2] / L : 0.0;
   if (std::abs(omega) * L < 1e-9) {
     const Vec2 d = Vec2(c[0], c[1]).normalized();
     return std::abs(d.y()) < 1e-9 ? "translate along x" : std::abs(d.x()) < 1e-9 ? "translate along y"
                                                                                 : "translate along " + format_point(d);
   }
-  return "rotate about " + format_point(Vec2(-c[1] / omega, c[0] / omega));
+  Vec2 pivot(-c[1] / omega, c[0] / omega);
+  for (int d = 0; d < 2; ++d)
+    if (std::abs(pivot[d]) < 1e-9 * L) pivot[d] = 0.0;
+  return "rotate about " + format_point(pivot);
 }
 
 // The rigid motions the supports leave free, as coefficients of body_modes() (columns).
@@ -212,6 +215,14 @@ void hold_rigid_modes(Reader& r, Problem& problem) {
       }
     }
   }
+  const std::string unstoppable =
+      ", and no obstacle within reach can stop that motion (no contact point moves toward an obstacle or, with "
+      "friction, along it): fix a component that this motion moves, give the obstacle friction, or drive the body "
+      "by a prescribed displacement";
+  if (problem.candidates.empty()) {
+    for (const std::string& name : rigid.names) r.error("/body/supports", "leave the body free to " + name + unstoppable);
+    return;
+  }
   const Eigen::JacobiSVD<Matrix> svd(G, Eigen::ComputeFullV);
   const double largest = std::max(1.0, svd.singularValues().size() ? svd.singularValues()[0] : 0.0);
   for (int k = 0; k < count; ++k) {
@@ -220,13 +231,10 @@ void hold_rigid_modes(Reader& r, Problem& problem) {
     const Vector v = svd.matrixV().col(k);
     const Vector d = rigid.modes * v;
     const std::vector<Vector> modes = body_modes(body);
-    Vector c(modes.size());
-    for (size_t m = 0; m < modes.size(); ++m) c[m] = modes[m].dot(d) / modes[m].squaredNorm();
-    r.error("/body/supports",
-            "leave the body free to " + motion_name(c, body.characteristic_length()) +
-                ", and no obstacle within reach can stop that motion (no contact point moves toward an obstacle "
-                "or, with friction, along it): fix a component that this motion moves, give the obstacle friction, "
-                "or drive the body by a prescribed displacement");
+    Matrix B(d.size(), modes.size());
+    for (size_t m = 0; m < modes.size(); ++m) B.col(m) = modes[m];
+    const Vector c = B.colPivHouseholderQr().solve(d);
+    r.error("/body/supports", "leave the body free to " + motion_name(c, body.characteristic_length()) + unstoppable);
   }
   if (!r.issues.empty()) return;
   // Pins: the usable dofs that pin the modes best (column-pivoted QR of the modes' rows).
