@@ -160,6 +160,33 @@ Matrix free_motions(const Problem& problem) {
   return lu.kernel();
 }
 
+// A basis of the free motions (coefficients of body_modes()) that separates the pure
+// translations (the x and y axes where both are free) from at most one rotation.
+std::vector<Vector> motion_basis(const Matrix& free) {
+  std::vector<Vector> basis;
+  const int r = static_cast<int>(free.cols());
+  if (r == 0) return basis;
+  const Matrix K = free.householderQr().householderQ() * Matrix::Identity(free.rows(), r);  // orthonormal
+  const Vector w = K.rows() > 2 ? Vector(K.row(2).transpose()) : Vector::Zero(r);
+  Matrix translations = K;
+  if (w.norm() > 1e-9) {
+    const Matrix Q = w.householderQr().householderQ();  // first column along w, the rest across it
+    translations = K * Q.rightCols(r - 1);
+  }
+  if (translations.cols() == 2 && translations.rows() > 2) {
+    basis.push_back(Vector::Unit(K.rows(), 0));
+    basis.push_back(Vector::Unit(K.rows(), 1));
+  } else {
+    for (int j = 0; j < translations.cols(); ++j) {
+      Vector t = translations.col(j);
+      if (t.size() > 2) t[2] = 0.0;
+      basis.push_back(t.normalized());
+    }
+  }
+  if (w.norm() > 1e-9) basis.push_back((K * w).normalized());
+  return basis;
+}
+
 // Free rigid motions are held by contact (ALGORITHM.md section 7) where the model allows it:
 // translations always (internal forces are self-equilibrated at any state), rotations where
 // the tangent is constant (linear kinematics: an infinitesimal rotation is a null mode of K);
@@ -167,10 +194,9 @@ Matrix free_motions(const Problem& problem) {
 void check_rigid_modes(Reader& r, Problem& problem) {
   const Body& body = *problem.body;
   const double L = body.characteristic_length();
-  const Matrix free = free_motions(problem);
+  const std::vector<Vector> free = motion_basis(free_motions(problem));
   const std::vector<Vector> modes = body_modes(body);
-  for (Eigen::Index k = 0; k < free.cols(); ++k) {
-    const Vector c = free.col(k).normalized();
+  for (const Vector& c : free) {
     const bool rotates = c.size() > 2 && std::abs(c[2]) > 1e-9;
     std::string why;
     if (problem.start)
@@ -202,13 +228,13 @@ void hold_rigid_modes(Reader& r, Problem& problem) {
   if (count == 0) return;
   const Vector q0 = Vector::Zero(body.dof_count());
   Matrix G = Matrix::Zero(problem.component_count, count);
-  std::vector<char> unusable(body.dof_count(), 0);
-  for (const Constraint& c : problem.constraints) unusable[c.dof] = 1;
+  std::vector<char> supported(body.dof_count(), 0), on_contact(body.dof_count(), 0);
+  for (const Constraint& c : problem.constraints) supported[c.dof] = 1;
   for (const Candidate& c : problem.candidates) {
     const SurfacePoint sp = body.surface_point(q0, c.site, c.side);
     const Projection proj = problem.obstacles[c.obstacle].shape->project(sp.x);
     for (const auto& j : sp.jacobian) {
-      unusable[j.dof] = 1;
+      on_contact[j.dof] = 1;
       for (int k = 0; k < count; ++k) {
         G(c.eta, k) -= j.dx.dot(proj.normal) * rigid.modes(j.dof, k);
         if (c.xi >= 0) G(c.xi, k) += j.dx.dot(proj.tangent) * rigid.modes(j.dof, k);
@@ -237,23 +263,29 @@ void hold_rigid_modes(Reader& r, Problem& problem) {
     r.error("/body/supports", "leave the body free to " + motion_name(c, body.characteristic_length()) + unstoppable);
   }
   if (!r.issues.empty()) return;
-  // Pins: the usable dofs that pin the modes best (column-pivoted QR of the modes' rows).
-  std::vector<int> usable;
-  for (int d = 0; d < body.dof_count(); ++d)
-    if (!unusable[d]) usable.push_back(d);
-  Matrix rows(count, usable.size());
-  for (size_t a = 0; a < usable.size(); ++a) rows.col(a) = rigid.modes.row(usable[a]).transpose();
-  const Eigen::ColPivHouseholderQR<Matrix> qr(rows);
-  if (usable.size() < static_cast<size_t>(count) || qr.rank() < count) {
-    r.error("/body/supports", "leave the body free to " + rigid.names.front() +
-                                  ", and every node it could be held at in the solves is a contact node");
+  // Pins: the dofs that pin the modes best (column-pivoted QR of the modes' rows), off the
+  // contact points where possible (a beam has none off them; a contact component whose force
+  // acts on pins alone still takes part, through the border).
+  auto best_pins = [&](bool off_contact) {
+    std::vector<int> usable;
+    for (int d = 0; d < body.dof_count(); ++d)
+      if (!supported[d] && !(off_contact && on_contact[d])) usable.push_back(d);
+    Matrix rows(count, usable.size());
+    for (size_t a = 0; a < usable.size(); ++a) rows.col(a) = rigid.modes.row(usable[a]).transpose();
+    const Eigen::ColPivHouseholderQR<Matrix> qr(rows);
+    std::vector<int> pins;
+    if (static_cast<int>(usable.size()) >= count && qr.rank() == count)
+      for (int k = 0; k < count; ++k) pins.push_back(usable[qr.colsPermutation().indices()[k]]);
+    return pins;
+  };
+  rigid.pins = best_pins(true);
+  if (rigid.pins.empty()) rigid.pins = best_pins(false);
+  if (rigid.pins.empty()) {
+    r.error("/body/supports", "leave the body free to " + rigid.names.front() + ", and no free dof can hold it in the solves");
     return;
   }
   Matrix at_pins(count, count);
-  for (int k = 0; k < count; ++k) {
-    rigid.pins.push_back(usable[qr.colsPermutation().indices()[k]]);
-    at_pins.row(k) = rigid.modes.row(rigid.pins.back());
-  }
+  for (int k = 0; k < count; ++k) at_pins.row(k) = rigid.modes.row(rigid.pins[k]);
   rigid.modes = (rigid.modes * at_pins.inverse()).eval();
   problem.component_count += count;
 }
@@ -535,6 +567,12 @@ Scene read_checked_scene(const nlohmann::json& input) {
                                                       : scene.problem.body->characteristic_length();
   add_candidates(scene.problem, scene.steps, reach);
   hold_rigid_modes(r, scene.problem);
+  const ContactParams& cp = scene.params.contact;
+  if (scene.problem.rigid.count() && !(cp.method == ContactMethod::cev && cp.loop == ContactLoop::inner &&
+                                       cp.friction_loop == FrictionLoop::inner))
+    r.error("/solver/contact", "holds a body by contact (it is free to " + scene.problem.rigid.names.front() +
+                                   ") only with method cev, loop inner and friction_loop inner (the defaults) so "
+                                   "far: the other strategies assume a positive definite compliance");
   if (!r.issues.empty()) throw SceneErrors(std::move(r.issues));
   return scene;
 }

@@ -13,7 +13,11 @@ Equilibrium::Equilibrium(const Problem& problem, NewtonParams params, std::vecto
   free_index_.assign(n, 0);
   for (const Constraint& c : problem.constraints) free_index_[c.dof] = -1;
   for (const Constraint& c : extra_) free_index_[c.dof] = -1;
-  for (int pin : problem.rigid.pins) free_index_[pin] = -1;
+  is_pin_.assign(n, 0);
+  for (int pin : problem.rigid.pins) {
+    free_index_[pin] = -1;
+    is_pin_[pin] = 1;
+  }
   for (int i = 0; i < n; ++i)
     if (free_index_[i] == 0) free_index_[i] = free_count_++;
   length_scales_ = problem.body->dof_length_scales();
@@ -47,7 +51,7 @@ void Equilibrium::pair(const Vector& q, EquilibriumState& state) const {
     state.s[c.eta] = -pp.projection.gap;
     double eta_col = 0.0, xi_col = 0.0;
     for (const auto& j : pp.point.jacobian) {
-      if (free_index_[j.dof] < 0) continue;
+      if (free_index_[j.dof] < 0 && !is_pin_[j.dof]) continue;  // a pin moves with its amplitude
       eta_col += std::abs(j.dx.dot(pp.eta));
       xi_col += std::abs(j.dx.dot(pp.xi));
     }

@@ -174,6 +174,7 @@ class Equilibrium {
   std::vector<Constraint> extra_;
   std::optional<PenaltyLaw> penalty_;
   std::vector<int> free_index_;  // dof -> free index, -1 if prescribed
+  std::vector<char> is_pin_;     // dof holds a rigid amplitude (problem.rigid.pins)
   int free_count_ = 0;
   Vector length_scales_;
   EquilibriumCounters counters_;
