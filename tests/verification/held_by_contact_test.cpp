@@ -263,3 +263,51 @@ TEST(HeldByContact, BlockPushedOntoAWallByAForce) {
 
 }  // namespace
 }  // namespace grip
+
+namespace grip {
+namespace {
+
+// A Timoshenko beam (20 elements) lying on a flat (mu 0.3) with no supports, pressed by nodal
+// forces (N = 200), then pushed along x at its end through Q / (mu N) = 0.28, 0.56, 0.83, and
+// 1.17: the flat's reaction is the push until the last, which fails with the reason. Linear
+// kinematics: contact holds all three motions; von Karman: the translations (its rotation held
+// by theta at the middle node, since a finite rotation is no null mode).
+TEST(HeldByContact, BeamOnAFlatPushedAlongIt) {
+  json loads = json::array();
+  for (int n = 0; n <= 20; ++n)
+    loads.push_back({{"node", n}, {"force", {0.0, n == 0 || n == 20 ? -5.0 : -10.0}}, {"case", "press"}});
+  loads.push_back({{"node", 0}, {"force", {20.0, 0.0}}, {"case", "push"}});
+  json j = {{"body",
+             {{"model", "timoshenko_beam"}, {"kinematics", "linear"}, {"material", {{"young", 210000}, {"poisson", 0.3}}},
+              {"section", {{"width", 2}, {"depth", 2}}}, {"mesh", {{"origin", {0, 0}}, {"length", 20}, {"elements", 20}}},
+              {"loads", loads}}},
+            {"obstacles", json::array({{{"name", "flat"}, {"shape", {{"type", "segment"}, {"from", {100, -1}}, {"to", {-100, -1}}}},
+                                        {"friction", 0.3}}})},
+            {"stages", json::array({{{"steps", 1}, {"factors", {{"press", 1}}}},
+                                    {{"steps", 3}, {"factors", {{"press", 1}, {"push", 2.5}}}},
+                                    {{"steps", 1}, {"factors", {{"press", 1}, {"push", 3.5}}}}})},
+            {"solver", {{"contact", {{"method", "cev"}, {"tolerance", 1e-8}}}}}};
+  for (const char* kinematics : {"linear", "von_karman"}) {
+    j["body"]["kinematics"] = kinematics;
+    if (std::string(kinematics) == "von_karman") j["body"]["supports"] = json::array({{{"node", 10}, {"fix", {"theta"}}}});
+    const Solved s = solve_scene(j);
+    expect_held(s);
+    EXPECT_EQ(s.scene.problem.rigid.count(), std::string(kinematics) == "linear" ? 3 : 2);
+    ASSERT_EQ(s.run.steps.size(), 5u);
+    for (int k = 0; k < 4; ++k) {
+      const StepRecord& rec = s.run.steps[k];
+      ASSERT_TRUE(rec.converged) << kinematics << ": " << rec.reason;
+      const Vec2 R = contact_resultant(s.scene.problem, rec, 0);
+      EXPECT_NEAR(-R.x(), 20.0 * rec.factors[2], 1e-9 * 200) << kinematics << " step " << rec.index;
+      EXPECT_NEAR(R.y(), 200.0, 1e-9 * 200);
+      std::printf("%s beam, Q/(mu N) = %.3f: %d real solves, %d Newton\n", kinematics, 20.0 * rec.factors[2] / 60.0,
+                  rec.solves, rec.newton_iterations);
+    }
+    EXPECT_NE(s.run.steps.back().reason.find("the shear load exceeds what friction can hold: Q / (mu N) = 1.16667"),
+              std::string::npos)
+        << s.run.steps.back().reason;
+  }
+}
+
+}  // namespace
+}  // namespace grip
