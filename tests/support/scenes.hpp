@@ -30,30 +30,13 @@ inline nlohmann::json sheet(int elements, double mu) {
   return j;
 }
 
-// A 20 x 10 block on a flat (mu 0.3), no supports: a pressure N / 20 on its top, then a shear
-// traction on the top raised through Q / (mu N) = 0.25 ... 0.95, then 1.05.
+// schemas/examples/block-held-by-friction.json (a 20 x 10 block on a flat, mu 0.3, no
+// supports: a pressure N / 20 on its top, then a shear traction raised through Q / (mu N) =
+// 0.25 ... 0.95) with a last stage to 1.05, beyond what friction can hold.
 inline nlohmann::json block_under_shear() {
-  return nlohmann::json::parse(R"({
-    "body": {
-      "model": "continuum", "kinematics": "linear", "analysis": "plane_strain", "element": "q4", "thickness": 1,
-      "material": {"young": 200000, "poisson": 0.3},
-      "mesh": {"rectangle": {"origin": [-10, 0], "size": [20, 10], "divisions": [20, 10]}},
-      "contact_set": "bottom",
-      "loads": [{"set": "top", "traction": [0, -10], "case": "press"},
-                {"set": "top", "traction": [3, 0], "case": "shear"}]
-    },
-    "obstacles": [{"name": "flat", "shape": {"type": "segment", "from": [40, 0], "to": [-40, 0]}, "friction": 0.3}],
-    "stages": [
-      {"steps": 1, "factors": {"press": 1}},
-      {"steps": 1, "factors": {"press": 1, "shear": 0.25}},
-      {"steps": 1, "factors": {"press": 1, "shear": 0.5}},
-      {"steps": 1, "factors": {"press": 1, "shear": 0.75}},
-      {"steps": 1, "factors": {"press": 1, "shear": 0.9}},
-      {"steps": 1, "factors": {"press": 1, "shear": 0.95}},
-      {"steps": 1, "factors": {"press": 1, "shear": 1.05}}
-    ],
-    "solver": {"contact": {"method": "cev", "tolerance": 1e-8}}
-  })");
+  nlohmann::json j = example_scene("block-held-by-friction");
+  j["stages"].push_back({{"steps", 1}, {"factors", {{"press", 1}, {"shear", 1.05}}}});
+  return j;
 }
 
 inline Solved solve_scene(const nlohmann::json& j) {
