@@ -80,7 +80,7 @@ int solve(int argc, char** argv) {
               run.seconds);
   if (!out_path.empty()) {
     std::ofstream out(out_path);
-    out << grip::result_json(scene, run).dump(1) << '\n';
+    grip::write_result(out, scene, run);
     if (!out) {
       std::fprintf(stderr, "cannot write %s\n", out_path.c_str());
       return 2;

@@ -147,7 +147,7 @@ def main():
             scene = hertz_scene(ah, mu)
             cand = {10: 33, 20: 61, 40: 121}[ah]
             record("hertz", f"a/h {ah} mu {mu}", scene, cand * (2 if mu else 1), counts(scene)[1])
-    for nodes in ([25, 100] if args.quick else [25, 50, 100, 200, 500, 1000]):
+    for nodes in ([25, 100] if args.quick else [25, 50, 100, 200, 500, 1000, 2000]):
         scene = block_scene(nodes, 10)
         if record("flat", f"{nodes} contact nodes", scene, 2 * nodes, counts(scene)[1]) is None:
             break

@@ -1,8 +1,8 @@
 #include "solver/contact/coulomb_model.hpp"
 
-#include <Eigen/LU>
-#include <Eigen/QR>
 #include <cmath>
+
+#include "solver/contact/newton_rows.hpp"
 
 namespace grip {
 namespace {
@@ -17,7 +17,7 @@ struct Rows {
 class Model {
  public:
   Model(const Problem& problem, const Compliance& C, const Vector& p0, const Vector& s0, double augmentation)
-      : C_(C.block), p0_full_(p0), s0_full_(s0), problem_(problem) {
+      : compliance_(C), C_(C.block), p0_full_(p0), s0_full_(s0), problem_(problem) {
     const int m = static_cast<int>(C.block.rows());
     component_.assign(m, -1);
     for (size_t j = 0; j < C.position.size(); ++j)
@@ -49,14 +49,13 @@ class Model {
   }
 
   const Vector& x0() const { return x0_; }
-  const std::vector<int>& equalities() const { return equality_; }
   Vector s(const Vector& x) const { return s0_ + C_ * (x - x0_); }
 
-  // The Alart-Curnier function at x (with s = s(x)) and, if asked, a generalized Jacobian.
-  Vector residual(const Vector& x, const Vector& s, Matrix* J) const {
-    const int m = static_cast<int>(x.size());
+  // The Alart-Curnier function at x (with s = s(x)) and, if asked, the kinds of its
+  // generalized Jacobian's rows (NewtonRows).
+  Vector residual(const Vector& x, const Vector& s, NewtonRows* rows) const {
     Vector F = x;  // the rows of components with no force (open, free) are p itself
-    if (J) J->setIdentity(m, m);
+    if (rows) *rows = NewtonRows{};
     for (const Rows& rw : rows_) {
       double gn = 0.0;
       const double rn = rw.r_eta, rt = rw.r_xi;
@@ -64,7 +63,7 @@ class Model {
         gn = x[rw.eta] - rn * s[rw.eta];
         if (gn < 0) {  // pressing: s_eta = 0
           F[rw.eta] = rn * s[rw.eta];
-          if (J) J->row(rw.eta) = rn * C_.row(rw.eta);
+          if (rows) rows->active.push_back(rw.eta);
         }
       }
       if (rw.xi < 0) continue;
@@ -73,23 +72,23 @@ class Model {
       const double g = x[rw.xi] - rt * s[rw.xi];
       if (std::abs(g) < tau) {  // stick: s_xi = 0
         F[rw.xi] = rt * s[rw.xi];
-        if (J) J->row(rw.xi) = rt * C_.row(rw.xi);
+        if (rows) rows->active.push_back(rw.xi);
       } else {  // slip: p_xi = sign(g) tau, tau moving with the augmented normal force
         const double sg = g > 0 ? 1.0 : -1.0;
         F[rw.xi] = x[rw.xi] - sg * tau;
-        if (J) {
-          // d tau = -mu (d p_eta - r C_eta. dp)
-          J->row(rw.xi) = sg * rw.mu * (-rn * C_.row(rw.eta));
-          (*J)(rw.xi, rw.eta) += sg * rw.mu;
-          (*J)(rw.xi, rw.xi) += 1.0;
-        }
+        if (rows) rows->slip.push_back({rw.xi, rw.eta, -sg * rw.mu});
       }
     }
     for (int k : equality_) {
       F[k] = r_equality_ * s[k];
-      if (J) J->row(k) = r_equality_ * C_.row(k);
+      if (rows) rows->active.push_back(k);  // (C dx)_k = -s_k, like a pressing row
     }
     return F;
+  }
+
+  // The Newton correction: J dx = -F with the explicit rows eliminated (newton_rows.hpp).
+  Vector newton_step(const Vector& F, const Vector& s, const NewtonRows& rows, NewtonRowStats& stats) const {
+    return solve_newton_rows(compliance_, F, s, rows, stats);
   }
 
   // x projected onto the cone, and the full vectors of the model at it.
@@ -105,6 +104,7 @@ class Model {
   }
 
  private:
+  const Compliance& compliance_;
   const Matrix& C_;
   const Vector& p0_full_;
   const Vector& s0_full_;
@@ -138,7 +138,8 @@ CoulombModelSolution solve_coulomb_model(const Problem& problem, const Complianc
   CoulombModelSolution out;
   const Model model(problem, C, p0, s0, params.augmentation);
   Vector x = model.x0(), s = model.s(x);
-  Matrix J;
+  NewtonRows rows;
+  NewtonRowStats stats;
   auto finish = [&](const Vector& xf) {
     model.full(xf, out.p, out.s);
     out.error = coulomb_error(problem, out.p, out.s, enabled);
@@ -148,13 +149,9 @@ CoulombModelSolution solve_coulomb_model(const Problem& problem, const Complianc
   for (out.iterations = 0;; ++out.iterations) {
     const bool done = finish(x);
     if (out.iterations >= params.max_iterations || x.size() == 0) break;
-    const Vector F = model.residual(x, s, &J);
+    const Vector F = model.residual(x, s, &rows);
     const double phi = 0.5 * F.squaredNorm();
-    const Eigen::PartialPivLU<Matrix> lu(J);
-    Vector dx = lu.solve(-F);
-    // Singular where every point slips along a free rigid motion (its amplitude's column
-    // vanishes): the least-squares step, still a descent direction of |F|^2.
-    if (!dx.allFinite() && !model.equalities().empty()) dx = J.completeOrthogonalDecomposition().solve(-F);
+    const Vector dx = model.newton_step(F, s, rows, stats);
     if (done) {
       // Within the target: one more full step solves the model exactly where the sets are
       // right, so that the answer is the model's to rounding, not to the target (a change of
@@ -183,6 +180,8 @@ CoulombModelSolution solve_coulomb_model(const Problem& problem, const Complianc
     }
     if (!decreased) break;
   }
+  out.factorizations = stats.factorizations + stats.dense;
+  out.capacitances = stats.capacitances;
   return out;
 }
 

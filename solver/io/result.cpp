@@ -1,6 +1,9 @@
 #include "solver/io/result.hpp"
 
+#include <algorithm>
+#include <charconv>
 #include <cmath>
+#include <functional>
 
 #include "solver/contact/contact_error.hpp"
 #include "solver/solve/rigid_equilibrium.hpp"
@@ -135,9 +138,10 @@ json effects_json(const Scene& scene, const RunResult& run) {
             {"tau_passes", passes}}}};
 }
 
-json result_json(const Scene& scene, const RunResult& run) {
-  json steps = json::array();
-  for (const auto& rec : run.steps) steps.push_back(step_json(scene.problem, rec, scene.output));
+namespace {
+
+// Everything but the steps.
+json result_head(const Scene& scene, const RunResult& run) {
   return {{"scene", scene.effective},
           {"effects", effects_json(scene, run)},
           {"mesh", {{"cells", scene.problem.body->cells()}}},
@@ -145,8 +149,108 @@ json result_json(const Scene& scene, const RunResult& run) {
            {{"completed", run.completed}, {"reason", run.reason}, {"steps", run.steps.size()},
             {"contact_iterations", run.counters.solves},
             {"newton_iterations", run.counters.newton_iterations},
-            {"factorizations", run.counters.factorizations}, {"seconds", run.seconds}}},
-          {"steps", steps}};
+            {"factorizations", run.counters.factorizations}, {"seconds", run.seconds}}}};
+}
+
+// A double as JSON reads it back exactly (shortest round trip), with a point or an exponent
+// as nlohmann writes floating-point numbers; null where not finite, as nlohmann does.
+void append_number(std::string& out, double v) {
+  if (!std::isfinite(v)) {
+    out += "null";
+    return;
+  }
+  char buf[32];
+  char* end = std::to_chars(buf, buf + sizeof buf, v).ptr;
+  out.append(buf, end);
+  if (std::none_of(buf, end, [](char c) { return c == '.' || c == 'e'; })) out += ".0";
+}
+
+// table_json's rows, written as they are made (in chunks): no document of the table's size in
+// memory, and no stream call per number.
+void write_table(std::ostream& out, const FieldTable& t, const std::string& index_name) {
+  std::vector<std::pair<std::string, int>> keys{{index_name, -1}};  // -1: the row index
+  for (size_t c = 0; c < t.names.size(); ++c)
+    if (t.names[c] != index_name) keys.emplace_back(t.names[c], static_cast<int>(c));
+  std::sort(keys.begin(), keys.end());  // an object's keys in nlohmann's order
+  std::vector<std::string> quoted;
+  for (const auto& k : keys) quoted.push_back(json(k.first).dump() + ":");
+  std::string chunk = "[";
+  for (size_t i = 0; i < t.rows.size(); ++i) {
+    chunk += i ? ",\n{" : "\n{";
+    for (size_t k = 0; k < keys.size(); ++k) {
+      if (k) chunk += ',';
+      chunk += quoted[k];
+      if (keys[k].second < 0)
+        chunk += std::to_string(i);
+      else
+        append_number(chunk, t.rows[i][keys[k].second]);
+    }
+    chunk += '}';
+    if (chunk.size() > (1 << 16)) {
+      out.write(chunk.data(), static_cast<std::streamsize>(chunk.size()));
+      chunk.clear();
+    }
+  }
+  chunk += ']';
+  out.write(chunk.data(), static_cast<std::streamsize>(chunk.size()));
+}
+
+using Streamed = std::vector<std::pair<std::string, std::function<void()>>>;
+
+// The object `small` with the members `streamed` (written by their functions) among its keys.
+void write_object(std::ostream& out, const json& small, Streamed streamed) {
+  std::sort(streamed.begin(), streamed.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  auto it = small.begin();
+  auto st = streamed.begin();
+  out << '{';
+  for (bool first = true; it != small.end() || st != streamed.end(); first = false) {
+    if (!first) out << ',';
+    if (st == streamed.end() || (it != small.end() && it.key() < st->first)) {
+      out << json(it.key()).dump() << ':' << it.value().dump();
+      ++it;
+    } else {
+      out << json(st->first).dump() << ':';
+      st->second();
+      ++st;
+    }
+  }
+  out << '}';
+}
+
+void write_step(std::ostream& out, const Problem& problem, const StepRecord& rec, const OutputOptions& output) {
+  OutputOptions summary = output;
+  summary.fields.erase(std::remove_if(summary.fields.begin(), summary.fields.end(),
+                                      [](const std::string& f) { return f == "nodes" || f == "elements"; }),
+                       summary.fields.end());
+  Streamed tables;
+  if (rec.state.q.size() != 0 && !rec.site_fields.rows.empty()) {  // as step_json decides
+    if (output.wants("nodes")) tables.emplace_back("nodes", [&] { write_table(out, rec.site_fields, "node"); });
+    if (output.wants("elements"))
+      tables.emplace_back("elements", [&] { write_table(out, rec.element_fields, "element"); });
+  }
+  write_object(out, step_json(problem, rec, summary), std::move(tables));
+}
+
+}  // namespace
+
+json result_json(const Scene& scene, const RunResult& run) {
+  json steps = json::array();
+  for (const auto& rec : run.steps) steps.push_back(step_json(scene.problem, rec, scene.output));
+  json r = result_head(scene, run);
+  r["steps"] = std::move(steps);
+  return r;
+}
+
+void write_result(std::ostream& out, const Scene& scene, const RunResult& run) {
+  write_object(out, result_head(scene, run), {{"steps", [&] {
+                                                 out << '[';
+                                                 for (size_t k = 0; k < run.steps.size(); ++k) {
+                                                   out << (k ? ",\n" : "\n");
+                                                   write_step(out, scene.problem, run.steps[k], scene.output);
+                                                 }
+                                                 out << ']';
+                                               }}});
+  out << '\n';
 }
 
 }  // namespace grip

@@ -2,6 +2,7 @@
 // Results and events as JSON (DESIGN.md vocabulary). Events are the same objects whether
 // written to an NDJSON file by `grip solve --events` or streamed by the service.
 #include <nlohmann/json.hpp>
+#include <ostream>
 
 #include "solver/io/scene.hpp"
 
@@ -19,5 +20,8 @@ nlohmann::json step_json(const Problem& problem, const StepRecord& rec, const Ou
 nlohmann::json effects_json(const Scene& scene, const RunResult& run);
 // The whole result: the effective scene, a summary and every step.
 nlohmann::json result_json(const Scene& scene, const RunResult& run);
+// The same document written as it is made (the step tables row by row, never held as JSON):
+// for large meshes, where building the document took more time and memory than the solve.
+void write_result(std::ostream& out, const Scene& scene, const RunResult& run);
 
 }  // namespace grip

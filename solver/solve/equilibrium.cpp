@@ -349,6 +349,8 @@ void Equilibrium::extend_surface_compliance(const std::vector<int>& added) {
     surface_free_.push_back(f);
   }
   const int m = static_cast<int>(surface_free_.size());
+  counters_.compliance_columns += m - m0;
+  if (m0 == 0 && body_lu_.inverse_block(surface_free_, g_)) return;  // a new G: sparse solves
   g_.conservativeResize(m, m);
   // Unit right-hand sides in blocks: the work storage stays (free dofs) x kBlock.
   constexpr int kBlock = 64;
@@ -366,25 +368,43 @@ void Equilibrium::extend_surface_compliance(const std::vector<int>& added) {
   }
   const Matrix added_block = g_.bottomRightCorner(m - m0, m - m0);
   g_.bottomRightCorner(m - m0, m - m0) = 0.5 * (added_block + added_block.transpose());
-  counters_.compliance_columns += m - m0;
 }
+
+namespace {
+
+bool same_sparse(const Eigen::SparseMatrix<double>& a, const Eigen::SparseMatrix<double>& b) {
+  return a.rows() == b.rows() && a.cols() == b.cols() && a.nonZeros() == b.nonZeros() &&
+         std::equal(a.outerIndexPtr(), a.outerIndexPtr() + a.outerSize() + 1, b.outerIndexPtr()) &&
+         std::equal(a.innerIndexPtr(), a.innerIndexPtr() + a.nonZeros(), b.innerIndexPtr()) &&
+         std::equal(a.valuePtr(), a.valuePtr() + a.nonZeros(), b.valuePtr());
+}
+
+}  // namespace
 
 const Compliance& Equilibrium::compliance(const EquilibriumState& state,
                                           const std::vector<int>& components) {
   const int k = static_cast<int>(components.size());
-  c_.position.assign(problem_.component_count, -1);
-  for (int a = 0; a < k; ++a) c_.position[components[a]] = a;
-  c_.block.setZero(k, k);
-  t_surface_.resize(0, k);
-  if (components.empty()) return c_;
+  std::vector<int> position(problem_.component_count, -1);
+  for (int a = 0; a < k; ++a) position[components[a]] = a;
+  const bool same_components = position == c_.position;
+  c_.position = std::move(position);
+  auto empty = [&]() -> const Compliance& {
+    c_.block.setZero(k, k);
+    c_.factor.reset();
+    t_surface_.resize(0, k);
+    c_version_ = -1;
+    return c_;
+  };
+  if (components.empty()) return empty();
   if (!constant_tangent_ && !compliance_reuse_) g_valid_ = false;
   compliance_reused_ = g_valid_ && !constant_tangent_;
   if (!g_valid_) {  // a new G: from the tangent at this state
     surface_free_.clear();
     surface_row_.assign(free_count_, -1);
     g_.resize(0, 0);
-    if (!factorize_body_tangent(state.q)) return c_;
+    if (!factorize_body_tangent(state.q)) return empty();
     ++counters_.compliance_forms;
+    ++g_version_;
     g_valid_ = true;
   }
   // The surface dofs of these components that G does not cover yet join it.
@@ -401,7 +421,10 @@ const Compliance& Equilibrium::compliance(const EquilibriumState& state,
       }
     }
   }
-  if (!added.empty()) extend_surface_compliance(added);
+  if (!added.empty()) {
+    extend_surface_compliance(added);
+    ++g_version_;
+  }
   Triplets ts;
   for (size_t i = 0; i < problem_.candidates.size(); ++i) {
     const Candidate& c = problem_.candidates[i];
@@ -415,11 +438,25 @@ const Compliance& Equilibrium::compliance(const EquilibriumState& state,
       if (xi >= 0) ts.emplace_back(surface_row_[f], xi, j.dx.dot(pp.xi));
     }
   }
-  t_surface_.resize(g_.rows(), k);
-  t_surface_.setFromTriplets(ts.begin(), ts.end());
-  const Matrix gt = g_ * t_surface_;  // (surface dofs) x nnz(T_s) multiply-adds
-  c_.block.noalias() = t_surface_.transpose() * gt;
-  c_.block = (0.5 * (c_.block + c_.block.transpose())).eval();
+  Eigen::SparseMatrix<double> t_surface(g_.rows(), k);
+  t_surface.setFromTriplets(ts.begin(), ts.end());
+  // The same G, components and T_s (a constant tangent, a pairing that did not move): the same
+  // C, and the inner solver keeps its factorizations.
+  if (same_components && c_version_ == g_version_ && same_sparse(t_surface, t_surface_)) return c_;
+  t_surface_ = std::move(t_surface);
+  c_version_ = g_version_;
+  c_.factor.reset();
+  // C = T_s^T (G T_s) in column blocks: no temporary of the size of C.
+  constexpr int kBlock = 64;
+  c_.block.resize(k, k);
+  for (int start = 0; start < k; start += kBlock) {
+    const int cols = std::min(kBlock, k - start);
+    const Eigen::SparseMatrix<double> t_cols = t_surface_.middleCols(start, cols);
+    const Matrix gt = g_ * t_cols;
+    c_.block.middleCols(start, cols).noalias() = t_surface_.transpose() * gt;
+  }
+  for (int j = 0; j < k; ++j)
+    for (int i = 0; i < j; ++i) c_.block(i, j) = c_.block(j, i) = 0.5 * (c_.block(i, j) + c_.block(j, i));
   add_rigid_border(state);
   return c_;
 }
@@ -429,9 +466,11 @@ const Compliance& Equilibrium::compliance(const EquilibriumState& state,
 // equilibrium, changes with p by G^T.
 void Equilibrium::add_rigid_border(const EquilibriumState& state) {
   const RigidModes& rigid = problem_.rigid;
+  c_.bordered = false;
   for (int k = 0; k < rigid.count(); ++k) {
     const int col = c_.position[rigid.first + k];
     if (col < 0) continue;
+    c_.bordered = true;
     for (size_t i = 0; i < problem_.candidates.size(); ++i) {
       const Candidate& c = problem_.candidates[i];
       const PairedPoint& pp = state.points[i];

@@ -4,6 +4,7 @@
 // d(T(u) p)/du re-evaluated at every iterate. Also the contact compliance C = T^T K^-1 T.
 #include <Eigen/SparseCore>
 #include <Eigen/SparseLU>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -82,11 +83,18 @@ struct PenaltyLaw {
   Vector previous;          // the previous step's forces (the tangential springs start there)
 };
 
+// Factorizations of blocks of a compliance, kept by the inner contact solver (coulomb_model.cpp)
+// for as long as the compliance stays the same.
+struct ComplianceFactor;
+
 // The contact compliance C = T^T K^-1 T on a subset of the components (the ones that can
 // take part in this iteration); zero elsewhere.
 struct Compliance {
   std::vector<int> position;  // component -> row of `block`, -1 where not computed
   Matrix block;
+  mutable std::shared_ptr<ComplianceFactor> factor;  // reset whenever `block` changes
+  // With the rigid amplitudes' border [C G; G^T 0] (ALGORITHM.md 7): indefinite, no Cholesky.
+  bool bordered = false;
   double operator()(int a, int b) const {
     const int i = position[a], j = position[b];
     return i < 0 || j < 0 ? 0.0 : block(i, j);
@@ -193,6 +201,7 @@ class Equilibrium {
   bool compliance_reuse_ = false, compliance_reused_ = false;
   Eigen::SparseMatrix<double> t_surface_;  // the last compliance's T_s (surface rows x block)
   Compliance c_;
+  long g_version_ = 0, c_version_ = -1;  // G's content; the G that c_ was formed from
 };
 
 }  // namespace grip

@@ -70,4 +70,69 @@ bool FreeBlockSolver::factorize(const Triplets& triplets, const std::vector<int>
   return ok_;
 }
 
+bool CholmodFactor::inverse_block(const std::vector<int>& rows, Matrix& G) {
+  if (!m_cholmodFactor) return false;
+  cholmod_common* cc = &cholmod();
+  cholmod_factor* L = cholmod_copy_factor(m_cholmodFactor, cc);  // the partial solve makes it simplicial
+  if (!L) return false;
+  const int n = static_cast<int>(L->n), s = static_cast<int>(rows.size());
+  std::vector<int> position(n);  // row of P b that b's entry f lands in
+  const int* perm = static_cast<const int*>(L->Perm);
+  for (int k = 0; k < n; ++k) position[perm ? perm[k] : k] = k;
+  cholmod_dense* B = cholmod_zeros(n, 1, CHOLMOD_REAL, cc);
+  cholmod_sparse* bset = cholmod_allocate_sparse(n, 1, 1, true, true, 0, CHOLMOD_PATTERN, cc);
+  cholmod_dense *X = nullptr, *Y = nullptr, *E = nullptr;
+  cholmod_sparse* xset = nullptr;
+  std::vector<std::vector<std::pair<int, double>>> by_row(n);  // W's rows: (column, value)
+  // W^T W costs sum |row|^2 <= s^2 x (mean column length) multiply-adds; dense solves would
+  // cost 4 nnz(L) per row. Where W is not sparse enough (thin strips: long elimination-tree
+  // paths), give up after a few columns.
+  double nnz_l = 0.0;  // the entries a solve goes through (supernodal: its dense blocks)
+  if (L->is_super)
+    nnz_l = static_cast<double>(L->xsize);
+  else
+    for (int j = 0; j < n; ++j) nnz_l += static_cast<const int*>(L->nz)[j];
+  const double budget = 2.0 * nnz_l * s;  // half the dense solves' flops
+  double pairs = 0.0, reach = 0.0;
+  constexpr int kSample = 8;
+  bool ok = B && bset;
+  for (int a = 0; ok && a < s; ++a) {
+    const int k = position[rows[a]];
+    static_cast<double*>(B->x)[k] = 1.0;
+    static_cast<int*>(bset->p)[0] = 0;
+    static_cast<int*>(bset->p)[1] = 1;
+    static_cast<int*>(bset->i)[0] = k;
+    ok = cholmod_solve2(CHOLMOD_L, L, B, bset, &X, &xset, &Y, &E, cc);
+    static_cast<double*>(B->x)[k] = 0.0;
+    if (!ok) break;
+    reach += static_cast<const int*>(xset->p)[1];
+    if (a + 1 == std::min(s, kSample) && static_cast<double>(s) * s * reach / (a + 1) > budget) ok = false;
+    const int* xi = static_cast<const int*>(xset->i);
+    const double* xv = static_cast<const double*>(X->x);
+    for (int t = 0; t < static_cast<const int*>(xset->p)[1]; ++t)
+      if (xv[xi[t]] != 0.0) {
+        auto& row = by_row[xi[t]];
+        pairs += 2.0 * row.size() + 1.0;
+        row.emplace_back(a, xv[xi[t]]);
+      }
+    ok = ok && pairs < budget;
+  }
+  if (ok) {
+    G.setZero(s, s);
+    for (const auto& row : by_row)
+      for (const auto& [a, va] : row) {
+        double* column = &G(0, a);
+        for (const auto& [b, vb] : row) column[b] += va * vb;
+      }
+  }
+  cholmod_free_dense(&B, cc);
+  cholmod_free_dense(&X, cc);
+  cholmod_free_dense(&Y, cc);
+  cholmod_free_dense(&E, cc);
+  cholmod_free_sparse(&bset, cc);
+  cholmod_free_sparse(&xset, cc);
+  cholmod_free_factor(&L, cc);
+  return ok;
+}
+
 }  // namespace grip

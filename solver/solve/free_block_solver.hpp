@@ -19,6 +19,11 @@ class CholmodFactor : public Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<dou
  public:
   CholmodFactor() { cholmod().print = 0; }  // a non-SPD block is a result, not a message
   double rcond() { return m_cholmodFactor ? cholmod_rcond(m_cholmodFactor, &cholmod()) : 0.0; }
+  // K^-1 on the given rows, |rows|^2, as W^T W with W = L^-1 P E: each column of W is a sparse
+  // forward solve that touches only the elimination-tree path of its row (CHOLMOD's partial
+  // solve, on a simplicial copy of the factor), where a dense solve costs 2 nnz(L) flops per
+  // row. False where CHOLMOD fails.
+  bool inverse_block(const std::vector<int>& rows, Matrix& G);
 };
 
 class FreeBlockSolver {
@@ -32,6 +37,9 @@ class FreeBlockSolver {
                  double near_symmetric_tolerance = 0.0);
   Vector solve(const Vector& b) const { return symmetric_ ? Vector(llt_.solve(b)) : Vector(lu_.solve(b)); }
   Matrix solve(const Matrix& b) const { return symmetric_ ? Matrix(llt_.solve(b)) : Matrix(lu_.solve(b)); }
+  // K^-1 on the given rows where K is Cholesky-factorized (CholmodFactor::inverse_block);
+  // false otherwise (then solve() for unit right-hand sides).
+  bool inverse_block(const std::vector<int>& rows, Matrix& G) { return ok_ && symmetric_ && llt_.inverse_block(rows, G); }
   bool ok() const { return ok_; }
 
  private:

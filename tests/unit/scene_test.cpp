@@ -2,6 +2,8 @@
 // defaults filled in; only the effects a scene calls for are built.
 #include <gtest/gtest.h>
 
+#include <sstream>
+
 #include "solver/io/result.hpp"
 #include "tests/support/scenes.hpp"
 
@@ -184,6 +186,21 @@ TEST(SceneEffects, OutputsNotRequestedAreNotComputedOrStored) {
     EXPECT_FALSE(r["steps"][k].contains("history"));
     EXPECT_EQ(r["steps"][k].contains("contact_points"), k == 3);
   }
+}
+
+// grip solve writes the result as it makes it (write_result); it must read back as the
+// document result_json builds: the same members, the same numbers to the bit.
+TEST(SceneEffects, StreamedResultReadsBackAsTheBuiltOne) {
+  json j = testing::example_scene("hertz");
+  j["steps"] = 2;
+  j["output"] = {{"steps", "all"}};
+  const auto s = testing::solve_scene(j);
+  ASSERT_TRUE(s.run.completed);
+  std::ostringstream streamed;
+  write_result(streamed, s.scene, s.run);
+  const json built = result_json(s.scene, s.run);
+  ASSERT_FALSE(built["steps"][1]["elements"].empty());
+  EXPECT_EQ(json::parse(streamed.str()), built);
 }
 
 }  // namespace
