@@ -32,7 +32,7 @@ class CevStep : public StepSolver {
     pass_ = out_.passes = 1;
     out_.p = p_start;
     project_to_cone(problem_, out_.p);
-    if (!fresh_solve(q_guess)) return;
+    if (!fresh_solve(q_guess) || !approach_contact()) return;
     while (error_.norm2 > tol_) {
       if (!budget_left()) return;
       const Compliance& C = eq_.compliance(out_.state, relevant_components());

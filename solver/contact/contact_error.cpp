@@ -30,6 +30,11 @@ ContactError contact_error(const Problem& problem, const Vector& p, const Vector
       e.active[c.xi] = 1;
     }
   }
+  // The equilibrium of the whole body along each free rigid motion: an equality, always active.
+  for (int k = 0; k < problem.rigid.count(); ++k) {
+    e.v[problem.rigid.first + k] = s[problem.rigid.first + k];
+    e.active[problem.rigid.first + k] = 1;
+  }
   e.norm2 = e.v.norm();
   e.norm_inf = e.v.size() ? e.v.lpNorm<Eigen::Infinity>() : 0.0;
   return e;

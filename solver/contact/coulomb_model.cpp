@@ -32,6 +32,14 @@ class Model {
       if (r.xi >= 0 && C.block(r.xi, r.xi) > 0) r.r_xi = augmentation / C.block(r.xi, r.xi);
       rows_.push_back(r);
     }
+    // The rigid amplitudes' rows (ALGORITHM.md 7): the body's equilibrium s = 0, an equality,
+    // scaled like a contact row by the largest contact compliance.
+    double c_max = 0.0;
+    for (const Rows& r : rows_)
+      c_max = std::max({c_max, r.eta >= 0 ? C.block(r.eta, r.eta) : 0.0, r.xi >= 0 ? C.block(r.xi, r.xi) : 0.0});
+    for (int k = 0; k < m; ++k)
+      if (problem.rigid.is_amplitude(component_[k])) equality_.push_back(k);
+    r_equality_ = c_max > 0 ? augmentation / c_max : 1.0;
     x0_.resize(m);
     s0_.resize(m);
     for (int k = 0; k < m; ++k) {
@@ -71,6 +79,10 @@ class Model {
         if (rows) rows->slip.push_back({rw.xi, rw.eta, -sg * rw.mu});
       }
     }
+    for (int k : equality_) {
+      F[k] = r_equality_ * s[k];
+      if (rows) rows->active.push_back(k);  // (C dx)_k = -s_k, like a pressing row
+    }
     return F;
   }
 
@@ -99,6 +111,8 @@ class Model {
   const Problem& problem_;
   std::vector<int> component_;
   std::vector<Rows> rows_;
+  std::vector<int> equality_;  // rows of the rigid amplitudes
+  double r_equality_ = 1.0;
   Vector x0_, s0_;
 };
 

@@ -2,6 +2,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
+#include <Eigen/QR>
 #include <optional>
 
 namespace grip {
@@ -139,9 +140,13 @@ Vector solve_newton_rows(const Compliance& C, const Vector& F, const Vector& s, 
     Matrix M = gather(Cb, rows.active, rows.active);
     for (const SlipRow& r : rows.slip)
       for (int a = 0; a < n; ++a) M(a, pos[r.eta]) += r.c * Cb(rows.active[a], r.xi);
-    return spread(Eigen::PartialPivLU<Matrix>(M).solve(b));
+    Vector y = Eigen::PartialPivLU<Matrix>(M).solve(b);
+    // Singular where every point slips along a free rigid motion held by contact (ALGORITHM.md
+    // 7: its amplitude's column vanishes): the least-squares step, still a descent direction.
+    if (!y.allFinite()) y = M.completeOrthogonalDecomposition().solve(b);
+    return spread(y);
   };
-  if (n <= kDenseRows) return dense();
+  if (n <= kDenseRows || C.bordered) return dense();
 
   std::vector<char> in_active(m, 0), in_base(m, 0);
   for (int k : rows.active) in_active[k] = 1;

@@ -2,6 +2,7 @@
 
 #include <Eigen/Cholesky>
 #include <cmath>
+#include <limits>
 
 #include "solver/contact/acceleration.hpp"
 
@@ -101,6 +102,53 @@ bool StepSolver::fresh_solve(const Vector& q) {
   m_ = 0;
   emit(1, 0, 0, 0, 0.0);
   return true;
+}
+
+// How contact point i's gap (eta) and slip (xi) change along rigid mode k.
+Vec2 StepSolver::mode_rates(size_t i, int k) const {
+  const PairedPoint& pp = out_.state.points[i];
+  Vec2 rates = Vec2::Zero();
+  for (const auto& j : pp.point.jacobian) {
+    rates[0] += j.dx.dot(pp.eta) * problem_.rigid.modes(j.dof, k);
+    rates[1] += j.dx.dot(pp.xi) * problem_.rigid.modes(j.dof, k);
+  }
+  return rates;
+}
+
+// Some pressing point resists rigid mode k: across its obstacle, or along it with friction.
+bool StepSolver::mode_held(int k) const {
+  for (size_t i = 0; i < problem_.candidates.size(); ++i) {
+    const Candidate& c = problem_.candidates[i];
+    if (out_.p[c.eta] >= 0) continue;
+    const Vec2 rates = mode_rates(i, k);
+    const bool frictional = c.xi >= 0 && problem_.obstacles[c.obstacle].friction > 0;
+    if (std::abs(rates[0]) > 1e-12 || (frictional && std::abs(rates[1]) > 1e-12)) return true;
+  }
+  return false;
+}
+
+bool StepSolver::approach_contact() {
+  const RigidModes& rigid = problem_.rigid;
+  Vector p = out_.p, dq = Vector::Zero(out_.state.q.size());
+  bool moved = false;
+  for (int k = 0; k < rigid.count(); ++k) {
+    const double push = out_.state.s[rigid.first + k];
+    if (push == 0.0 || mode_held(k)) continue;
+    double reach = std::numeric_limits<double>::infinity();
+    for (size_t i = 0; i < problem_.candidates.size(); ++i) {
+      const double along = mode_rates(i, k)[0];
+      if (along * push > 1e-12 * std::abs(push))
+        reach = std::min(reach, std::max(0.0, -out_.state.s[problem_.candidates[i].eta]) / std::abs(along));
+    }
+    if (!std::isfinite(reach)) continue;
+    const double move = (push > 0 ? 1.0 : -1.0) * (reach + tol_);
+    p[rigid.first + k] += move / rigid.scale;
+    dq += move * rigid.modes.col(k);
+    moved = true;
+  }
+  if (!moved) return true;
+  out_.p = p;
+  return fresh_solve(Vector(out_.state.q + dq));
 }
 
 void StepSolver::accept(EquilibriumState s, const Vector& p) {
@@ -231,7 +279,7 @@ bool StepSolver::literal_pass(int first_level, double alpha_fixed) {
   return true;
 }
 
-// Every component with a force or a friction bound, and those of candidates penetrating or
+// Every component with a force or a friction bound, the rigid amplitudes, and those of candidates penetrating or
 // within a few per cent of the body's length of their obstacle. The others are frozen (a far
 // point that the real solve brings into contact joins at the next iteration).
 std::vector<int> StepSolver::relevant_components() const {
@@ -245,6 +293,7 @@ std::vector<int> StepSolver::relevant_components() const {
     out.push_back(c.eta);
     if (c.xi >= 0 && out_.state.enabled[c.xi]) out.push_back(c.xi);
   }
+  for (int k = 0; k < problem_.rigid.count(); ++k) out.push_back(problem_.rigid.first + k);
   return out;
 }
 
@@ -268,6 +317,12 @@ void StepSolver::final_check() {
     fail("contact error above tolerance at the end of the step");
     return;
   }
+  // A free motion that no pressing point resists has no determined amplitude (ALGORITHM.md 7).
+  for (int k = 0; k < problem_.rigid.count(); ++k)
+    if (!mode_held(k))
+      fail("no contact holds the body's free motion (" + problem_.rigid.names[k] +
+           "): no point presses against an obstacle in that direction, so its position is not determined; "
+           "no static equilibrium fixes it");
   for (size_t i = 0; i < problem_.candidates.size(); ++i) {
     const Candidate& c = problem_.candidates[i];
     if (out_.p[c.eta] > 0) fail("a normal contact force pulls");

@@ -46,6 +46,12 @@ class StepSolver {
 
   // One real solve at out_.p from q, accepted as the new state (an event with m = 0).
   bool fresh_solve(const Vector& q);
+  // A free rigid motion that no pressing contact holds yet, pushed by the load, is moved until
+  // its first contact point closes its gap (and presses by the tolerance), then solved again:
+  // while every point is open the linear model knows nothing that stops the motion.
+  bool approach_contact();
+  Vec2 mode_rates(size_t candidate, int mode) const;
+  bool mode_held(int mode) const;
   void accept(EquilibriumState s, const Vector& p);
   bool fail(std::string reason);
   // False (with the reason) once the step's real-solve budget is spent or a stop is asked.

@@ -46,7 +46,8 @@ void add_candidates(Problem& problem, const std::vector<LoadStep>& path, double 
       problem.candidates.push_back(c);
     }
   }
-  problem.component_count = next;
+  problem.rigid.first = next;
+  problem.component_count = next + problem.rigid.count();
 }
 
 }  // namespace grip

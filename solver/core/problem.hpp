@@ -64,11 +64,29 @@ struct StartUp {
   int obstacle;
 };
 
+// Rigid motions that the supports leave free and contact holds (ALGORITHM.md section 7). Each
+// equilibrium solve prescribes one pin dof per mode at the mode's amplitude, so the body is held
+// there and q = u + modes alpha, u zero at the pins; the amplitudes alpha join the contact
+// unknowns as the components first.., and the pins' reactions -R^T (F + T p) must vanish: that
+// equilibrium of the whole body is the component's s. In p an amplitude is stored divided by
+// `scale` (length per force: 1 / the largest stiffness), and its s multiplied by it, so the
+// compliance with its border [C, G; G^T, 0] stays symmetric and the error vector in length.
+struct RigidModes {
+  Matrix modes;                    // dof x count, column k is 1 at pins[k] and 0 at the other pins
+  std::vector<int> pins;
+  std::vector<std::string> names;  // "translate along x", ...
+  int first = 0;
+  double scale = 1.0;
+  int count() const { return static_cast<int>(pins.size()); }
+  bool is_amplitude(int component) const { return component >= first && component < first + count(); }
+};
+
 struct Problem {
   std::unique_ptr<Body> body;
   std::vector<ObstacleInstance> obstacles;
   std::vector<Constraint> constraints;
   std::vector<Vector> loads;  // generalized external force per load case at factor 1
+  std::vector<std::string> case_names;  // the load cases' names, in the order of the factors
   // The generalized external force at the given factors.
   Vector load(const LoadFactors& factors) const {
     Vector f = Vector::Zero(body->dof_count());
@@ -76,7 +94,8 @@ struct Problem {
     return f;
   }
   std::vector<Candidate> candidates;
-  int component_count = 0;  // number of contact unknowns
+  int component_count = 0;  // number of contact unknowns (with the rigid amplitudes, last)
+  RigidModes rigid;
   std::optional<StartUp> start;
 };
 

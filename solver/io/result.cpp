@@ -6,6 +6,7 @@
 #include <functional>
 
 #include "solver/contact/contact_error.hpp"
+#include "solver/solve/rigid_equilibrium.hpp"
 
 namespace grip {
 
@@ -58,6 +59,12 @@ json step_json(const Problem& problem, const StepRecord& rec, const OutputOption
     j["equilibrium"] = {{"relative_residual", rec.state.relative_residual},
                         {"at_round_off_floor", rec.state.at_floor}};
   if (!rec.epsilon_used.empty()) j["epsilon"] = rec.epsilon_used;
+  if (problem.rigid.count() && rec.converged) {
+    // The rigid motion fitted to the displacement (translation of the point at the origin).
+    const Vector a = rigid_amplitudes(body, rec.state.q);
+    j["rigid_motion"] = {{"translation", {a[0], a[1]}}};
+    if (a.size() > 2) j["rigid_motion"]["rotation"] = a[2];
+  }
   if (output.wants("history")) {
     json history = json::array();
     for (const auto& ev : rec.history) {
@@ -122,6 +129,7 @@ json effects_json(const Scene& scene, const RunResult& run) {
           {"constant_tangent", traits.constant_tangent},
           {"contact_candidates", problem.candidates.size()},
           {"contact_unknowns", problem.component_count},
+          {"held_by_contact", problem.rigid.names},
           {"unknowns_per_contact_point", tangential > 0 ? 2 : 1},
           {"counters",
            {{"factorizations", run.counters.factorizations},

@@ -1,6 +1,8 @@
 #include "solver/io/scene.hpp"
 
 #include <Eigen/LU>
+#include <Eigen/QR>
+#include <Eigen/SVD>
 #include <cmath>
 #include <fstream>
 #include <numbers>
@@ -119,13 +121,34 @@ std::string format_point(const Vec2& p) {
   return os.str();
 }
 
-// ALGORITHM.md section 7: the scheme solves equilibrium for given contact forces, so the
-// supports alone must remove every rigid-body motion. Names each motion left free.
-void check_rigid_modes(Reader& r, const Problem& problem) {
-  const Body& body = *problem.body;
-  const double L = body.characteristic_length();
+// The rigid motions of the body as columns: translation x, translation y, and (where the body
+// has one) the rotation about the origin scaled to a length.
+std::vector<Vector> body_modes(const Body& body) {
   std::vector<Vector> modes = {body.rigid_translation(Vec2::UnitX()), body.rigid_translation(Vec2::UnitY())};
-  if (const Vector rot = body.rigid_rotation(); rot.size()) modes.push_back(rot / L);  // scaled to a length
+  if (const Vector rot = body.rigid_rotation(); rot.size()) modes.push_back(rot / body.characteristic_length());
+  return modes;
+}
+
+// The motion with coefficients c of body_modes() in words.
+std::string motion_name(const Vector& coefficients, double L) {
+  Vector c = coefficients.normalized();
+  for (int m = 0; m < c.size(); ++m)
+    if (std::abs(c[m]) < 1e-9) c[m] = 0.0;  // no "-0" or 1e-17 in the words
+  const double omega = c.size() > 2 ? c[2] / L : 0.0;
+  if (std::abs(omega) * L < 1e-9) {
+    const Vec2 d = Vec2(c[0], c[1]).normalized();
+    return std::abs(d.y()) < 1e-9 ? "translate along x" : std::abs(d.x()) < 1e-9 ? "translate along y"
+                                                                                : "translate along " + format_point(d);
+  }
+  Vec2 pivot(-c[1] / omega, c[0] / omega);
+  for (int d = 0; d < 2; ++d)
+    if (std::abs(pivot[d]) < 1e-9 * L) pivot[d] = 0.0;
+  return "rotate about " + format_point(pivot);
+}
+
+// The rigid motions the supports leave free, as coefficients of body_modes() (columns).
+Matrix free_motions(const Problem& problem) {
+  const std::vector<Vector> modes = body_modes(*problem.body);
   std::vector<int> fixed;
   for (const Constraint& c : problem.constraints) fixed.push_back(c.dof);
   Matrix R = Matrix::Zero(std::max<size_t>(fixed.size(), 1), modes.size());
@@ -133,24 +156,138 @@ void check_rigid_modes(Reader& r, const Problem& problem) {
     for (size_t m = 0; m < modes.size(); ++m) R(i, m) = modes[m][fixed[i]];
   Eigen::FullPivLU<Matrix> lu(R);
   lu.setThreshold(1e-9);
-  const Matrix free = lu.kernel();
-  if (lu.rank() == static_cast<Eigen::Index>(modes.size())) return;
-  for (Eigen::Index k = 0; k < free.cols(); ++k) {
-    Vector c = free.col(k).normalized();
-    const double omega = c.size() > 2 ? c[2] / L : 0.0;
-    std::string motion;
-    if (std::abs(omega) * L < 1e-9) {
-      const Vec2 d = Vec2(c[0], c[1]).normalized();
-      motion = std::abs(d.y()) < 1e-9 ? "translate along x" : std::abs(d.x()) < 1e-9 ? "translate along y"
-                                                                                   : "translate along " + format_point(d);
-    } else {
-      motion = "rotate about " + format_point(Vec2(-c[1] / omega, c[0] / omega));
-    }
-    r.error("/body/supports", "leave the body free to " + motion +
-                                  ": contact cannot hold it, since the contact scheme solves equilibrium for "
-                                  "given contact forces (ALGORITHM.md section 7); fix a component that this "
-                                  "motion moves, or drive the body by a prescribed displacement");
+  if (lu.rank() == static_cast<Eigen::Index>(modes.size())) return Matrix(modes.size(), 0);
+  return lu.kernel();
+}
+
+// A basis of the free motions (coefficients of body_modes()) that separates the pure
+// translations (the x and y axes where both are free) from at most one rotation.
+std::vector<Vector> motion_basis(const Matrix& free) {
+  std::vector<Vector> basis;
+  const int r = static_cast<int>(free.cols());
+  if (r == 0) return basis;
+  const Matrix K = free.householderQr().householderQ() * Matrix::Identity(free.rows(), r);  // orthonormal
+  const Vector w = K.rows() > 2 ? Vector(K.row(2).transpose()) : Vector::Zero(r);
+  Matrix translations = K;
+  if (w.norm() > 1e-9) {
+    const Matrix Q = w.householderQr().householderQ();  // first column along w, the rest across it
+    translations = K * Q.rightCols(r - 1);
   }
+  if (translations.cols() == 2 && translations.rows() > 2) {
+    basis.push_back(Vector::Unit(K.rows(), 0));
+    basis.push_back(Vector::Unit(K.rows(), 1));
+  } else {
+    for (int j = 0; j < translations.cols(); ++j) {
+      Vector t = translations.col(j);
+      if (t.size() > 2) t[2] = 0.0;
+      basis.push_back(t.normalized());
+    }
+  }
+  if (w.norm() > 1e-9) basis.push_back((K * w).normalized());
+  return basis;
+}
+
+// Free rigid motions are held by contact (ALGORITHM.md section 7) where the model allows it:
+// translations always (internal forces are self-equilibrated at any state), rotations where
+// the tangent is constant (linear kinematics: an infinitesimal rotation is a null mode of K);
+// a membrane (no reference stiffness) never. Records them in problem.rigid (pins come later).
+void check_rigid_modes(Reader& r, Problem& problem) {
+  const Body& body = *problem.body;
+  const double L = body.characteristic_length();
+  const std::vector<Vector> free = motion_basis(free_motions(problem));
+  const std::vector<Vector> modes = body_modes(body);
+  for (const Vector& c : free) {
+    const bool rotates = c.size() > 2 && std::abs(c[2]) > 1e-9;
+    std::string why;
+    if (problem.start)
+      why = "a membrane has no stiffness of its own to carry a load to its contacts";
+    else if (rotates && !body.traits().constant_tangent)
+      why = "a free rotation is held by contact only with linear kinematics (its infinitesimal rotation is a "
+            "null mode of the stiffness; a finite one is not)";
+    if (!why.empty()) {
+      r.error("/body/supports", "leave the body free to " + motion_name(c, L) + ": " + why +
+                                    "; fix a component that this motion moves, or drive the body by a "
+                                    "prescribed displacement");
+      continue;
+    }
+    Vector mode = Vector::Zero(body.dof_count());
+    for (int m = 0; m < c.size(); ++m) mode += c[m] * modes[m];
+    problem.rigid.names.push_back(motion_name(c, L));
+    problem.rigid.modes.conservativeResize(body.dof_count(), problem.rigid.modes.cols() + 1);
+    problem.rigid.modes.col(problem.rigid.modes.cols() - 1) = mode;
+  }
+}
+
+// With the candidates known: every free motion must move some contact point toward or along
+// (with friction) an obstacle, else nothing can stop it; and each mode gets its pin, a dof
+// that no support and no contact point uses, with the modes normalized to 1 at their own pin.
+void hold_rigid_modes(Reader& r, Problem& problem) {
+  RigidModes& rigid = problem.rigid;
+  const Body& body = *problem.body;
+  const int count = static_cast<int>(rigid.modes.cols());
+  if (count == 0) return;
+  const Vector q0 = Vector::Zero(body.dof_count());
+  Matrix G = Matrix::Zero(problem.component_count, count);
+  std::vector<char> supported(body.dof_count(), 0), on_contact(body.dof_count(), 0);
+  for (const Constraint& c : problem.constraints) supported[c.dof] = 1;
+  for (const Candidate& c : problem.candidates) {
+    const SurfacePoint sp = body.surface_point(q0, c.site, c.side);
+    const Projection proj = problem.obstacles[c.obstacle].shape->project(sp.x);
+    for (const auto& j : sp.jacobian) {
+      on_contact[j.dof] = 1;
+      for (int k = 0; k < count; ++k) {
+        G(c.eta, k) -= j.dx.dot(proj.normal) * rigid.modes(j.dof, k);
+        if (c.xi >= 0) G(c.xi, k) += j.dx.dot(proj.tangent) * rigid.modes(j.dof, k);
+      }
+    }
+  }
+  const std::string unstoppable =
+      ", and no obstacle within reach can stop that motion (no contact point moves toward an obstacle or, with "
+      "friction, along it): fix a component that this motion moves, give the obstacle friction, or drive the body "
+      "by a prescribed displacement";
+  if (problem.candidates.empty()) {
+    for (const std::string& name : rigid.names) r.error("/body/supports", "leave the body free to " + name + unstoppable);
+    return;
+  }
+  const Eigen::JacobiSVD<Matrix> svd(G, Eigen::ComputeFullV);
+  const double largest = std::max(1.0, svd.singularValues().size() ? svd.singularValues()[0] : 0.0);
+  for (int k = 0; k < count; ++k) {
+    if (k < svd.singularValues().size() && svd.singularValues()[k] > 1e-6 * largest) continue;
+    // The motion that no contact point resists, in words: its coefficients of the body's modes.
+    const Vector v = svd.matrixV().col(k);
+    const Vector d = rigid.modes * v;
+    const std::vector<Vector> modes = body_modes(body);
+    Matrix B(d.size(), modes.size());
+    for (size_t m = 0; m < modes.size(); ++m) B.col(m) = modes[m];
+    const Vector c = B.colPivHouseholderQr().solve(d);
+    r.error("/body/supports", "leave the body free to " + motion_name(c, body.characteristic_length()) + unstoppable);
+  }
+  if (!r.issues.empty()) return;
+  // Pins: the dofs that pin the modes best (column-pivoted QR of the modes' rows), off the
+  // contact points where possible (a beam has none off them; a contact component whose force
+  // acts on pins alone still takes part, through the border).
+  auto best_pins = [&](bool off_contact) {
+    std::vector<int> usable;
+    for (int d = 0; d < body.dof_count(); ++d)
+      if (!supported[d] && !(off_contact && on_contact[d])) usable.push_back(d);
+    Matrix rows(count, usable.size());
+    for (size_t a = 0; a < usable.size(); ++a) rows.col(a) = rigid.modes.row(usable[a]).transpose();
+    const Eigen::ColPivHouseholderQR<Matrix> qr(rows);
+    std::vector<int> pins;
+    if (static_cast<int>(usable.size()) >= count && qr.rank() == count)
+      for (int k = 0; k < count; ++k) pins.push_back(usable[qr.colsPermutation().indices()[k]]);
+    return pins;
+  };
+  rigid.pins = best_pins(true);
+  if (rigid.pins.empty()) rigid.pins = best_pins(false);
+  if (rigid.pins.empty()) {
+    r.error("/body/supports", "leave the body free to " + rigid.names.front() + ", and no free dof can hold it in the solves");
+    return;
+  }
+  Matrix at_pins(count, count);
+  for (int k = 0; k < count; ++k) at_pins.row(k) = rigid.modes.row(rigid.pins[k]);
+  rigid.modes = (rigid.modes * at_pins.inverse()).eval();
+  problem.component_count += count;
 }
 
 void read_solver(Reader& r, json& scene, SteppingParams& params) {
@@ -418,6 +555,7 @@ Scene read_checked_scene(const nlohmann::json& input) {
   }
   scene.steps = read_load_path(r, e, scene.problem.obstacles);
   scene.load_cases = r.cases;
+  scene.problem.case_names = r.cases;
   if (scene.problem.body)
     for (size_t k = 0; k < r.cases.size(); ++k) scene_io::case_load(scene.problem, static_cast<int>(k));
   read_solver(r, e, scene.params);
@@ -428,6 +566,14 @@ Scene read_checked_scene(const nlohmann::json& input) {
   const double reach = scene.params.contact_reach > 0 ? scene.params.contact_reach
                                                       : scene.problem.body->characteristic_length();
   add_candidates(scene.problem, scene.steps, reach);
+  hold_rigid_modes(r, scene.problem);
+  const ContactParams& cp = scene.params.contact;
+  if (scene.problem.rigid.count() && !(cp.method == ContactMethod::cev && cp.loop == ContactLoop::inner &&
+                                       cp.friction_loop == FrictionLoop::inner))
+    r.error("/solver/contact", "holds a body by contact (it is free to " + scene.problem.rigid.names.front() +
+                                   ") only with method cev, loop inner and friction_loop inner (the defaults) so "
+                                   "far: the other strategies assume a positive definite compliance");
+  if (!r.issues.empty()) throw SceneErrors(std::move(r.issues));
   return scene;
 }
 

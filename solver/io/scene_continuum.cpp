@@ -330,17 +330,16 @@ void read_continuum(Reader& r, json& body, Problem& problem) {
   read_continuum_supports(r, body, ptr, *mesh, problem);
   read_continuum_loads(r, body, ptr, *mesh, shape, problem, options.thickness);
   if (!r.issues.empty()) return;
-  // ALGORITHM.md section 7: the contact forces are given to each equilibrium solve, so the
-  // supports alone must hold the body.
+  // ALGORITHM.md section 7: contact holds the free rigid motions of one connected body
+  // (scene.cpp); a mesh of several parts must have each part held by its supports.
   std::vector<char> fixed(problem.body->dof_count(), 0);
   for (const Constraint& c : problem.constraints) fixed[c.dof] = 1;
   const std::string free = free_rigid_motion(*mesh, fixed);
-  if (!free.empty())
+  if (free.rfind("the part containing", 0) == 0)
     r.error(ptr + "/supports",
-            "leave the body free to " + free +
-                ": contact alone cannot hold it, because each equilibrium solve takes the contact forces "
-                "as given. Prescribe the displacement of a boundary set to drive the body (the force is then "
-                "read from the reactions), or add supports");
+            "leave " + free +
+                ": contact holds the free rigid motions of a connected body only; add supports to each part, "
+                "or prescribe the displacement of a boundary set");
 }
 
 }  // namespace grip::scene_io

@@ -13,6 +13,11 @@ Equilibrium::Equilibrium(const Problem& problem, NewtonParams params, std::vecto
   free_index_.assign(n, 0);
   for (const Constraint& c : problem.constraints) free_index_[c.dof] = -1;
   for (const Constraint& c : extra_) free_index_[c.dof] = -1;
+  is_pin_.assign(n, 0);
+  for (int pin : problem.rigid.pins) {
+    free_index_[pin] = -1;
+    is_pin_[pin] = 1;
+  }
   for (int i = 0; i < n; ++i)
     if (free_index_[i] == 0) free_index_[i] = free_count_++;
   length_scales_ = problem.body->dof_length_scales();
@@ -31,6 +36,7 @@ void Equilibrium::pair(const Vector& q, EquilibriumState& state) const {
   state.points.resize(cands.size());
   state.s = Vector::Zero(problem_.component_count);
   state.enabled.assign(problem_.component_count, 0);
+  for (int k = 0; k < problem_.rigid.count(); ++k) state.enabled[problem_.rigid.first + k] = 1;
   for (size_t i = 0; i < cands.size(); ++i) {
     const Candidate& c = cands[i];
     const ObstacleInstance& obstacle = problem_.obstacles[c.obstacle];
@@ -45,7 +51,7 @@ void Equilibrium::pair(const Vector& q, EquilibriumState& state) const {
     state.s[c.eta] = -pp.projection.gap;
     double eta_col = 0.0, xi_col = 0.0;
     for (const auto& j : pp.point.jacobian) {
-      if (free_index_[j.dof] < 0) continue;
+      if (free_index_[j.dof] < 0 && !is_pin_[j.dof]) continue;  // a pin moves with its amplitude
       eta_col += std::abs(j.dx.dot(pp.eta));
       xi_col += std::abs(j.dx.dot(pp.xi));
     }
@@ -192,6 +198,8 @@ EquilibriumState Equilibrium::solve(const Vector& q_guess, const Vector& p) {
   for (const Constraint& c : problem_.constraints)
     state.q[c.dof] = c.load_case < static_cast<int>(factors_.size()) ? factors_[c.load_case] * c.value : 0.0;
   for (const Constraint& c : extra_) state.q[c.dof] = c.value;
+  const RigidModes& rigid = problem_.rigid;
+  for (int k = 0; k < rigid.count(); ++k) state.q[rigid.pins[k]] = rigid.scale * p[rigid.first + k];
   const double body_length = problem_.body->characteristic_length();
   constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
   // The penalty law adds stiffness that changes with the contact state: no reuse then.
@@ -270,7 +278,24 @@ EquilibriumState& Equilibrium::finish(EquilibriumState& state, const Vector& p) 
   state.reason = problem_.body->inadmissible(state.q);
   state.converged = state.reason.empty();
   state.p = penalty_ ? penalty_forces(state, nullptr) : p;
+  const RigidModes& rigid = problem_.rigid;
+  if (rigid.count()) {
+    const Vector applied = applied_forces(state, state.p);
+    for (int k = 0; k < rigid.count(); ++k)
+      state.s[rigid.first + k] = rigid.scale * rigid.modes.col(k).dot(applied);
+  }
   return state;
+}
+
+Vector Equilibrium::applied_forces(const EquilibriumState& paired, const Vector& p) const {
+  Vector f = problem_.load(factors_);
+  for (size_t i = 0; i < problem_.candidates.size(); ++i) {
+    const Candidate& c = problem_.candidates[i];
+    const PairedPoint& pp = paired.points[i];
+    const Vec2 force = p[c.eta] * pp.eta + (c.xi >= 0 ? p[c.xi] : 0.0) * pp.xi;
+    for (const auto& j : pp.point.jacobian) f[j.dof] += j.dx.dot(force);
+  }
+  return f;
 }
 
 double Equilibrium::line_search(const Vector& q, const Vector& dq, const Vector& p,
@@ -432,7 +457,33 @@ const Compliance& Equilibrium::compliance(const EquilibriumState& state,
   }
   for (int j = 0; j < k; ++j)
     for (int i = 0; i < j; ++i) c_.block(i, j) = c_.block(j, i) = 0.5 * (c_.block(i, j) + c_.block(j, i));
+  add_rigid_border(state);
   return c_;
+}
+
+// The border G = T^T R of the compliance (ALGORITHM.md 7), times the amplitudes' scale: the
+// rigid motion moves every contact point with it, and the amplitudes' s, the whole body's
+// equilibrium, changes with p by G^T.
+void Equilibrium::add_rigid_border(const EquilibriumState& state) {
+  const RigidModes& rigid = problem_.rigid;
+  c_.bordered = false;
+  for (int k = 0; k < rigid.count(); ++k) {
+    const int col = c_.position[rigid.first + k];
+    if (col < 0) continue;
+    c_.bordered = true;
+    for (size_t i = 0; i < problem_.candidates.size(); ++i) {
+      const Candidate& c = problem_.candidates[i];
+      const PairedPoint& pp = state.points[i];
+      const int eta = c_.position[c.eta], xi = c.xi >= 0 ? c_.position[c.xi] : -1;
+      double g_eta = 0.0, g_xi = 0.0;
+      for (const auto& j : pp.point.jacobian) {
+        g_eta += j.dx.dot(pp.eta) * rigid.modes(j.dof, k);
+        g_xi += j.dx.dot(pp.xi) * rigid.modes(j.dof, k);
+      }
+      if (eta >= 0) c_.block(eta, col) = c_.block(col, eta) = rigid.scale * g_eta;
+      if (xi >= 0) c_.block(xi, col) = c_.block(col, xi) = rigid.scale * g_xi;
+    }
+  }
 }
 
 Vector Equilibrium::predicted_change(const Compliance& C, const Vector& dp) const {
@@ -447,6 +498,8 @@ Vector Equilibrium::predicted_change(const Compliance& C, const Vector& dp) cons
   const Vector du_free = body_lu_.solve(force);
   for (size_t i = 0; i < free_index_.size(); ++i)
     if (free_index_[i] >= 0) du[i] = du_free[free_index_[i]];
+  const RigidModes& rigid = problem_.rigid;
+  for (int k = 0; k < rigid.count(); ++k) du += rigid.scale * dp[rigid.first + k] * rigid.modes.col(k);
   return du;
 }
 

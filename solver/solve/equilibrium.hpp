@@ -93,6 +93,8 @@ struct Compliance {
   std::vector<int> position;  // component -> row of `block`, -1 where not computed
   Matrix block;
   mutable std::shared_ptr<ComplianceFactor> factor;  // reset whenever `block` changes
+  // With the rigid amplitudes' border [C G; G^T 0] (ALGORITHM.md 7): indefinite, no Cholesky.
+  bool bordered = false;
   double operator()(int a, int b) const {
     const int i = position[a], j = position[b];
     return i < 0 || j < 0 ? 0.0 : block(i, j);
@@ -140,6 +142,8 @@ class Equilibrium {
   // R = A(q) - lambda F - T(q) p on every dof, and (if asked) the triplets of dR/dq, with
   // the pairing evaluated at q.
   Vector residual(const Vector& q, const Vector& p, Triplets* tangent) const;
+  // The applied loads and the contact forces p on every dof at a paired state: F + T p.
+  Vector applied_forces(const EquilibriumState& paired, const Vector& p) const;
   // Residual forces at the fixed dofs (the reactions on the body), full dof vector.
   Vector reactions(const EquilibriumState& state, const Vector& p) const;
   // The surface coordinate of every candidate's pairing point (for the next step's slips).
@@ -167,6 +171,7 @@ class Equilibrium {
   double line_search(const Vector& q, const Vector& dq, const Vector& p, const FreeBlockSolver& solver) const;
   double free_length_norm(const Vector& dq) const;
   double scaled_free_max(const Vector& r) const;
+  void add_rigid_border(const EquilibriumState& state);
   // Adds free dofs to G's surface: one solve with the body's factorization per dof.
   void extend_surface_compliance(const std::vector<int>& added);
 
@@ -177,6 +182,7 @@ class Equilibrium {
   std::vector<Constraint> extra_;
   std::optional<PenaltyLaw> penalty_;
   std::vector<int> free_index_;  // dof -> free index, -1 if prescribed
+  std::vector<char> is_pin_;     // dof holds a rigid amplitude (problem.rigid.pins)
   int free_count_ = 0;
   Vector length_scales_;
   EquilibriumCounters counters_;

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <optional>
 
+#include "solver/solve/rigid_equilibrium.hpp"
+
 namespace grip {
 namespace {
 
@@ -61,6 +63,8 @@ RunResult run_load_steps(Problem& problem, const std::vector<LoadStep>& steps,
   RunResult result;
   Equilibrium eq(problem, params.newton);
   const int ndof = problem.body->dof_count();
+  // The rigid amplitudes' unit: length per force of the stiffest dof (problem.hpp).
+  if (problem.rigid.count()) problem.rigid.scale = 1.0 / eq.stiffness_scale(Vector::Zero(ndof));
   const size_t cases = steps.empty() ? 1 : steps.front().factors.size();
   Vector q = Vector::Zero(ndof), q_before = q;
   Vector p = Vector::Zero(problem.component_count);
@@ -102,6 +106,11 @@ RunResult run_load_steps(Problem& problem, const std::vector<LoadStep>& steps,
                            : last > 0 ? Vector(q + (q - q_before) * (distance(target, current) / last))
                                       : q;
       eq.set_step(target, zeta);
+      // A load that no static equilibrium can carry: no cut of the increment can help.
+      if (std::string why = unreachable_equilibrium(problem, eq.evaluate(guess), target); !why.empty()) {
+        rec.reason = std::move(why);
+        break;
+      }
       StepOutcome out = solve_contact_step(eq, guess, p, p, params.contact, step,
                                            observer.iteration, observer.stop_requested);
       rec.passes += out.passes;

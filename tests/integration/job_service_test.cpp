@@ -83,6 +83,29 @@ TEST(JobService, DismissalStopsARunningJobWithinOneIterationAndFreesTheWorker) {
   EXPECT_EQ(service.job(next)->record.status, JobStatus::successful);
 }
 
+// A body held only by contact under a shear load above mu N (ALGORITHM.md 7): a failed job
+// whose reason says why, with the steps solved before it in its result.
+TEST(JobService, AShearLoadAboveWhatFrictionHoldsFailsTheJobWithItsReason) {
+  TempDir dir;
+  SqliteStore store((dir.path() / "grip.sqlite").string());
+  JobService service(store, ServiceOptions{});
+  service.start();
+  const std::string id = service.submit(block_under_shear()).job.record.id;
+  const auto events = events_to_end(service, id);
+  EXPECT_EQ(events.back().type, "job_failed");
+  const std::string reason = nlohmann::json::parse(events.back().data)["reason"];
+  EXPECT_NE(reason.find("step 7 failed: the shear load exceeds what friction can hold: Q / (mu N) = 1.05"),
+            std::string::npos)
+      << reason;
+  EXPECT_EQ(service.job(id)->record.status, JobStatus::failed);
+  const auto result = service.result(id);
+  ASSERT_TRUE(result);
+  const nlohmann::json r = nlohmann::json::parse(*result);
+  ASSERT_EQ(r["steps"].size(), 7u);
+  for (int k = 0; k < 6; ++k) EXPECT_TRUE(r["steps"][k]["converged"].get<bool>());
+  EXPECT_EQ(r["effects"]["held_by_contact"].size(), 3u);
+}
+
 TEST(JobService, RecoveryRunsInterruptedJobsAgainAboveTheirOldEventIds) {
   TempDir dir;
   const std::string path = (dir.path() / "grip.sqlite").string();

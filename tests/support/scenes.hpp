@@ -30,6 +30,15 @@ inline nlohmann::json sheet(int elements, double mu) {
   return j;
 }
 
+// schemas/examples/block-held-by-friction.json (a 20 x 10 block on a flat, mu 0.3, no
+// supports: a pressure N / 20 on its top, then a shear traction raised through Q / (mu N) =
+// 0.25 ... 0.95) with a last stage to 1.05, beyond what friction can hold.
+inline nlohmann::json block_under_shear() {
+  nlohmann::json j = example_scene("block-held-by-friction");
+  j["stages"].push_back({{"steps", 1}, {"factors", {{"press", 1}, {"shear", 1.05}}}});
+  return j;
+}
+
 inline Solved solve_scene(const nlohmann::json& j) {
   Solved s{read_scene(j), {}};
   s.run = run_load_steps(s.scene.problem, s.scene.steps, s.scene.params);

@@ -128,13 +128,33 @@ TEST(ContinuumScene, ExplicitMeshNeedsAContactSet) {
   EXPECT_TRUE(has_issue(issues_of(j), "/body/contact_set", "names no node set (sets: \"diagonal\", \"top\")"));
 }
 
-TEST(ContinuumScene, UnsupportedBodyIsRejectedWithItsFreeMotion) {
+TEST(ContinuumScene, FreeMotionThatNoObstacleStopsIsRejected) {
   json j = block();
+  // Held in y; the frictionless flat cannot stop a slide along x.
   j["body"]["supports"] = json::parse(R"([{"set": "top", "fix": ["y"], "values": {"y": -0.01}}])");
-  EXPECT_TRUE(has_issue(issues_of(j), "/body/supports", "leave the body free to translate along x"));
+  EXPECT_TRUE(has_issue(issues_of(j), "/body/supports",
+                        "leave the body free to translate along x, and no obstacle within reach can stop that motion"));
+  // With friction the flat holds it: read, with the motion held by contact recorded.
+  j["obstacles"][0]["friction"] = 0.3;
+  Scene s = read_scene(j);
+  EXPECT_EQ(s.problem.rigid.names, std::vector<std::string>{"translate along x"});
+  ASSERT_EQ(s.problem.rigid.count(), 1);
+  EXPECT_EQ(s.problem.component_count, 2 * 5 + 1);
+  // The mode is 1 at its own pin, on a dof that no support and no contact point uses.
+  EXPECT_DOUBLE_EQ(s.problem.rigid.modes(s.problem.rigid.pins[0], 0), 1.0);
+  EXPECT_EQ(s.problem.rigid.pins[0] % 2, 0);
+  EXPECT_GE(s.problem.rigid.pins[0] / 2, 5);
+  // No supports: finite kinematics cannot hold a free rotation by contact.
   j["body"].erase("supports");
   EXPECT_TRUE(has_issue(issues_of(j), "/body/supports",
-                        "free to translate along x, translate along y and rotate about (2, 0.5)"));
+                        "a free rotation is held by contact only with linear kinematics"));
+  // Linear kinematics: all three motions are held (the flat resists the rotation, friction the slide).
+  j["body"]["kinematics"] = "linear";
+  s = read_scene(j);
+  EXPECT_EQ(s.problem.rigid.count(), 3);
+  // The flat out of reach: nothing stops the body falling.
+  j["obstacles"][0]["shape"] = json::parse(R"({"type": "segment", "from": [10, -50], "to": [-10, -50]})");
+  EXPECT_TRUE(has_issue(issues_of(j), "/body/supports", "leave the body free to translate along y, and no obstacle"));
 }
 
 TEST(ContinuumScene, SupportErrors) {

@@ -550,6 +550,16 @@ TEST(SchemaEvents, TheMembraneAndContinuumResultsValidate) {
   expect_valid(block.result, SchemaName::result);
 }
 
+// A body held only by contact: held_by_contact, rigid_motion, and the step that fails because
+// no equilibrium can carry its load.
+TEST(SchemaEvents, TheResultOfABodyHeldByContactValidates) {
+  const Produced p = solve_with_events(testing::block_under_shear());
+  for (const json& ev : p.events) expect_valid(ev, SchemaName::event);
+  expect_valid(p.result, SchemaName::result);
+  EXPECT_EQ(p.result["effects"]["held_by_contact"].size(), 3u);
+  EXPECT_TRUE(p.result["steps"][0].contains("rigid_motion"));
+}
+
 struct InvalidDocument {
   const char* what;
   SchemaName schema;

@@ -1,0 +1,313 @@
+// Bodies held only by contact, loaded by forces (ALGORITHM.md section 7): the rigid motions
+// that the supports leave free are held by the contact forces, whose resultant must balance
+// the load. Closed forms: Hertz's line contact under a given force, the reaction of a flat that
+// holds a block under pressure and shear (equal to the load below mu N, no equilibrium above),
+// a disc squeezed between two flats, a block pushed onto a wall.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+
+#include "solver/elements/continuum.hpp"
+#include "tests/support/contact_profile.hpp"
+#include "tests/support/result_checks.hpp"
+
+namespace grip {
+namespace {
+
+using nlohmann::json;
+using namespace grip::testing;
+
+// The applied load and the contact forces on the body's free rigid motions, relative to the
+// load's size: the whole body's equilibrium, which no support helps with.
+double free_motion_unbalance(const Problem& problem, const StepRecord& rec) {
+  Vector f = problem.load(rec.factors);
+  double scale = f.cwiseAbs().sum();
+  for (size_t i = 0; i < problem.candidates.size(); ++i) {
+    const Candidate& c = problem.candidates[i];
+    const PairedPoint& pp = rec.state.points[i];
+    const Vec2 force = rec.p[c.eta] * pp.eta + (c.xi >= 0 ? rec.p[c.xi] : 0.0) * pp.xi;
+    for (const auto& j : pp.point.jacobian) f[j.dof] += j.dx.dot(force);
+    scale += force.norm();
+  }
+  double worst = 0.0;
+  for (int k = 0; k < problem.rigid.count(); ++k) worst = std::max(worst, std::abs(problem.rigid.modes.col(k).dot(f)));
+  return worst / scale;
+}
+
+// Every converged step is sound and balances the load on its free motions to 1e-9.
+void expect_held(const Solved& s) {
+  EXPECT_TRUE(result_is_finite(s));
+  ASSERT_GT(s.scene.problem.rigid.count(), 0);
+  for (const StepRecord& rec : s.run.steps) {
+    if (!rec.converged) continue;
+    EXPECT_TRUE(step_invariants(s.scene.problem, rec, tolerances_of(s.scene)));
+    EXPECT_TRUE(monotone_contact_error(rec));
+    EXPECT_LT(free_motion_unbalance(s.scene.problem, rec), 1e-9) << "step " << rec.index;
+    const json step = step_json(s.scene.problem, rec, s.scene.output);
+    EXPECT_TRUE(step.contains("rigid_motion")) << "step " << rec.index;
+  }
+}
+
+Vec2 contact_resultant(const Problem& problem, const StepRecord& rec, int obstacle) {
+  Vec2 total = Vec2::Zero();
+  for (size_t i = 0; i < problem.candidates.size(); ++i) {
+    const Candidate& c = problem.candidates[i];
+    if (c.obstacle != obstacle) continue;
+    const PairedPoint& pp = rec.state.points[i];
+    total += rec.p[c.eta] * pp.eta + (c.xi >= 0 ? rec.p[c.xi] : 0.0) * pp.xi;
+  }
+  return total;
+}
+
+// The node of a continuum scene's mesh at `x`.
+int node_at(const json& scene, const Vec2& x) {
+  const Scene s = read_scene(scene);
+  const auto& mesh = dynamic_cast<const ContinuumBody&>(*s.problem.body).mesh();
+  for (size_t i = 0; i < mesh.nodes.size(); ++i)
+    if ((mesh.nodes[i] - x).norm() < 1e-9) return static_cast<int>(i);
+  ADD_FAILURE() << "no node at (" << x.x() << ", " << x.y() << ")";
+  return 0;
+}
+
+// The shipped Hertz half-disc with its diameter held in x only, pressed by a force P at the
+// centre of its diameter; or, with `prescribed`, by that node's displacement instead.
+json hertz_by_force(double P, std::optional<double> prescribed = std::nullopt) {
+  json j = example_scene("hertz");
+  j["steps"] = 1;
+  const int centre = node_at(j, Vec2::Zero());
+  j["body"]["supports"] = json::array({{{"set", "diameter"}, {"fix", {"x"}}}});
+  if (prescribed)
+    j["body"]["supports"].push_back({{"node", centre}, {"fix", {"y"}}, {"values", {{"y", *prescribed}}}});
+  else
+    j["body"]["loads"] = json::array({{{"node", centre}, {"force", {0.0, -P}}}});
+  return j;
+}
+
+TEST(HeldByContact, HertzUnderAForceMatchesTheClosedFormAndDisplacementControl) {
+  const double P = 5000.0;  // N / mm: a = 0.54 mm, about 11 elements
+  const Solved f = solve_scene(hertz_by_force(P));
+  expect_held(f);
+  ASSERT_TRUE(f.run.completed) << f.run.reason;
+  // x held on the diameter, which lies on y = 0: the flat holds the body's y translation and
+  // its (infinitesimal) rotation about the origin.
+  EXPECT_EQ(f.scene.problem.rigid.names, (std::vector<std::string>{"translate along y", "rotate about (0, 0)"}));
+  const StepRecord& rec = f.run.steps.back();
+  const auto nodes = contact_profile(f.scene.problem, rec);
+  double contact = 0.0;
+  for (const auto& n : nodes) contact -= n.p_n;
+  EXPECT_NEAR(contact, P, 1e-9 * P);  // the flat carries the whole load: no support helps
+  const HertzContact closed = hertz_contact(f.scene.effective["body"], P);
+  const EllipseFit fit = fit_semi_ellipse(nodes);
+  std::printf("force P = %.0f N/mm: a = %.4f mm (fit %+.3f %%), p0 = %.1f MPa (fit %+.3f %%); %d real solves, %d Newton\n",
+              P, closed.a, 100 * (fit.a / closed.a - 1), closed.p0, 100 * (fit.p0 / closed.p0 - 1), rec.solves,
+              rec.newton_iterations);
+  EXPECT_LT(std::abs(fit.a / closed.a - 1), 0.01);
+  EXPECT_LT(std::abs(fit.p0 / closed.p0 - 1), 0.01);
+  EXPECT_TRUE(contact_zone(nodes).brackets(closed.a, 1e-9));
+
+  // The same state by displacement control: the loaded node held where the force put it.
+  const int centre = node_at(f.scene.effective, Vec2::Zero());
+  const double delta = rec.state.q[2 * centre + 1];
+  const Solved d = solve_scene(hertz_by_force(P, delta));
+  ASSERT_TRUE(d.run.completed) << d.run.reason;
+  const StepRecord& drec = d.run.steps.back();
+  EXPECT_EQ(d.scene.problem.rigid.names, std::vector<std::string>{"rotate about (0, 0)"});
+  std::printf("displacement control (delta = %.6g mm): %d real solves, %d Newton\n", delta, drec.solves,
+              drec.newton_iterations);
+  double p_max = 0.0, p_diff = 0.0;
+  for (const Candidate& c : f.scene.problem.candidates) {
+    p_max = std::max(p_max, std::abs(rec.p[c.eta]));
+    p_diff = std::max(p_diff, std::abs(rec.p[c.eta] - drec.p[c.eta]));
+  }
+  const double q_diff = (rec.state.q - drec.state.q).lpNorm<Eigen::Infinity>();
+  const double q_max = rec.state.q.lpNorm<Eigen::Infinity>();
+  std::printf("force vs displacement control: forces differ by %.2e, displacements by %.2e (relative)\n",
+              p_diff / p_max, q_diff / q_max);
+  EXPECT_LT(p_diff, 1e-6 * p_max);
+  EXPECT_LT(q_diff, 1e-6 * q_max);
+  EXPECT_NEAR(-reaction_resultant(d.scene.problem, drec).y(), P, 1e-6 * P);
+  // The rigid motion in the result (fitted to every node): down, less than the loaded node,
+  // which also carries the compression; no rotation (symmetry).
+  const json step = step_json(f.scene.problem, rec, f.scene.output);
+  const double down = step["rigid_motion"]["translation"][1].get<double>();
+  EXPECT_LT(down, 0.0);
+  EXPECT_GT(down, delta);
+  EXPECT_LT(std::abs(step["rigid_motion"]["rotation"].get<double>()), 1e-9 * std::abs(delta));
+}
+
+TEST(HeldByContact, BlockUnderShearHoldsBelowMuNAndFailsAbove) {
+  const Solved s = solve_scene(block_under_shear());
+  expect_held(s);
+  ASSERT_EQ(s.run.steps.size(), 7u);
+  const double N = 200.0, mu = 0.3;
+  const double ratios[] = {0, 0.25, 0.5, 0.75, 0.9, 0.95};
+  int slip_before = 0;
+  for (int k = 0; k < 6; ++k) {
+    const StepRecord& rec = s.run.steps[k];
+    ASSERT_TRUE(rec.converged) << rec.reason;
+    const Vec2 R = contact_resultant(s.scene.problem, rec, 0);
+    const double Q = ratios[k] * mu * N;
+    EXPECT_NEAR(-R.x(), Q, 1e-9 * N);  // the flat's horizontal reaction is the shear load
+    EXPECT_NEAR(-R.y(), -N, 1e-9 * N);
+    std::string zones;
+    int slip = 0;
+    for (const auto& n : contact_profile(s.scene.problem, rec)) {
+      zones += n.state == ContactState::stick ? 'T' : n.state == ContactState::slip ? 'L' : '.';
+      slip += n.state == ContactState::slip;
+    }
+    std::printf("Q/(mu N) = %.2f: reaction %.9g (Q = %.4g), %d real solves, zones %s\n", ratios[k], -R.x(), Q,
+                rec.solves, zones.c_str());
+    if (k > 1) EXPECT_GE(slip, slip_before);  // the slip zones grow with the load
+    slip_before = slip;
+  }
+  EXPECT_GT(slip_before, 10);  // near mu N most of the bottom slips
+  const StepRecord& last = s.run.steps.back();
+  EXPECT_FALSE(last.converged);
+  EXPECT_NE(last.reason.find("the shear load exceeds what friction can hold: Q / (mu N) = 1.05 at load factors "
+                             "press 1, shear 1.05"),
+            std::string::npos)
+      << last.reason;
+  EXPECT_FALSE(s.run.completed);
+}
+
+// A disc (R = 10, an elliptic grid) between two flats with friction 0.3; the upper flat moves
+// down by `delta`. No supports: only the two contacts hold it (friction its sideways motion and
+// rotation). nu = 0.49 (with the mean-dilatation q4_bbar): friction on a rigid flat narrows the
+// contact of a compressible body below Hertz's width (with nu = 0.3 by 6 % here), which the
+// closed form neglects; the coupling vanishes as nu -> 1/2 (as in cattaneo-mindlin.json).
+json disc_between_flats(int n, double delta) {
+  json nodes = json::array(), elements = json::array(), rim = json::array();
+  auto id = [n](int i, int k) { return k * (n + 1) + i; };
+  for (int k = 0; k <= n; ++k)
+    for (int i = 0; i <= n; ++i) {
+      const double u = -1 + 2.0 * i / n, v = -1 + 2.0 * k / n;  // the square mapped onto the disc
+      nodes.push_back({10 * u * std::sqrt(1 - v * v / 2), 10 * v * std::sqrt(1 - u * u / 2)});
+      if (i == 0 || k == 0 || i == n || k == n) rim.push_back(id(i, k));
+    }
+  for (int k = 0; k < n; ++k)
+    for (int i = 0; i < n; ++i) elements.push_back({id(i, k), id(i + 1, k), id(i + 1, k + 1), id(i, k + 1)});
+  json j = {
+      {"body",
+       {{"model", "continuum"}, {"kinematics", "linear"}, {"analysis", "plane_strain"}, {"element", "q4_bbar"},
+        {"thickness", 1}, {"material", {{"young", 200000}, {"poisson", 0.49}}},
+        {"mesh", {{"nodes", nodes}, {"elements", elements}, {"sets", {{"rim", rim}}}}},
+        {"contact_set", "rim"}}},
+      {"obstacles",
+       json::array({{{"name", "lower"}, {"shape", {{"type", "segment"}, {"from", {40, -10}}, {"to", {-40, -10}}}},
+                     {"friction", 0.3}},
+                    {{"name", "upper"}, {"shape", {{"type", "segment"}, {"from", {-40, 10}}, {"to", {40, 10}}}},
+                     {"friction", 0.3}, {"motion", {{"translation", {0, -delta}}}}}})},
+      {"steps", 1},
+      {"solver", {{"contact", {{"method", "cev"}, {"tolerance", 1e-8}, {"reach", 1.0}}}}}};
+  return j;
+}
+
+TEST(HeldByContact, DiscBetweenTwoFlatsCarriesEqualForcesWithHertzWidths) {
+  const Solved s = solve_scene(disc_between_flats(96, 0.5));
+  expect_held(s);
+  ASSERT_TRUE(s.run.completed) << s.run.reason;
+  EXPECT_EQ(s.scene.problem.rigid.count(), 3);
+  const StepRecord& rec = s.run.steps.back();
+  const Vec2 lower = contact_resultant(s.scene.problem, rec, 0), upper = contact_resultant(s.scene.problem, rec, 1);
+  const double P = lower.y();
+  EXPECT_GT(P, 0);
+  EXPECT_NEAR(upper.y(), -P, 1e-9 * P);  // equal and opposite: nothing else holds the disc
+  EXPECT_NEAR(lower.x(), 0, 1e-9 * P);
+  json body = s.scene.effective["body"];
+  body["mesh"] = {{"half_disc", {{"radius", 10}}}};
+  const HertzContact closed = hertz_contact(body, P);
+  for (int o = 0; o < 2; ++o) {
+    const auto nodes = contact_profile(s.scene.problem, rec, o);
+    const Zone zone = contact_zone(nodes);
+    ASSERT_TRUE(zone.found);
+    const EllipseFit fit = fit_semi_ellipse(nodes);
+    std::printf("%s flat: P = %.0f N/mm, Hertz a = %.4f mm, fitted %+.2f %%, p0 fitted %+.2f %%; contact ends "
+                "between %.3f and %.3f\n",
+                o ? "upper" : "lower", P, closed.a, 100 * (fit.a / closed.a - 1), 100 * (fit.p0 / closed.p0 - 1),
+                zone.right.inner, zone.right.outer);
+    EXPECT_LT(std::abs(fit.a / closed.a - 1), 0.02);
+    // The closed-form edge lies between the last node that touches and the first that does not.
+    EXPECT_TRUE(zone.brackets(closed.a, 0.02 * closed.a)) << "a = " << closed.a;
+  }
+  std::printf("disc: %d real solves, %d Newton\n", rec.solves, rec.newton_iterations);
+}
+
+// A block held in y by rollers on its bottom, free in x, pushed by a traction on its left face
+// onto a frictionless wall at its right: the wall's reaction is the push.
+TEST(HeldByContact, BlockPushedOntoAWallByAForce) {
+  const json j = json::parse(R"({
+    "body": {
+      "model": "continuum", "kinematics": "linear", "analysis": "plane_strain", "element": "q4", "thickness": 1,
+      "material": {"young": 200000, "poisson": 0.3},
+      "mesh": {"rectangle": {"origin": [0, 0], "size": [10, 5], "divisions": [10, 5]}},
+      "contact_set": "right",
+      "supports": [{"set": "bottom", "fix": ["y"]}],
+      "loads": [{"set": "left", "traction": [40, 0]}]
+    },
+    "obstacles": [{"name": "wall", "shape": {"type": "segment", "from": [10.01, 20], "to": [10.01, -20]}}],
+    "steps": 2,
+    "solver": {"contact": {"method": "cev", "tolerance": 1e-8}}
+  })");
+  const Solved s = solve_scene(j);
+  expect_held(s);
+  ASSERT_TRUE(s.run.completed) << s.run.reason;
+  EXPECT_EQ(s.scene.problem.rigid.names, std::vector<std::string>{"translate along x"});
+  for (const StepRecord& rec : s.run.steps) {
+    const double F = 40.0 * 5.0 * rec.load_factor;
+    EXPECT_NEAR(-contact_resultant(s.scene.problem, rec, 0).x(), F, 1e-9 * F);
+    // The body crossed the 0.01 gap: its rigid translation is at least that.
+    const json step = step_json(s.scene.problem, rec, s.scene.output);
+    EXPECT_GT(step["rigid_motion"]["translation"][0].get<double>(), 0.01);
+  }
+}
+
+}  // namespace
+}  // namespace grip
+
+namespace grip {
+namespace {
+
+// A Timoshenko beam (20 elements) lying on a flat (mu 0.3) with no supports, pressed by nodal
+// forces (N = 200), then pushed along x at its end through Q / (mu N) = 0.28, 0.56, 0.83, and
+// 1.17: the flat's reaction is the push until the last, which fails with the reason. Linear
+// kinematics: contact holds all three motions; von Karman: the translations (its rotation held
+// by theta at the middle node, since a finite rotation is no null mode).
+TEST(HeldByContact, BeamOnAFlatPushedAlongIt) {
+  json loads = json::array();
+  for (int n = 0; n <= 20; ++n)
+    loads.push_back({{"node", n}, {"force", {0.0, n == 0 || n == 20 ? -5.0 : -10.0}}, {"case", "press"}});
+  loads.push_back({{"node", 0}, {"force", {20.0, 0.0}}, {"case", "push"}});
+  json j = {{"body",
+             {{"model", "timoshenko_beam"}, {"kinematics", "linear"}, {"material", {{"young", 210000}, {"poisson", 0.3}}},
+              {"section", {{"width", 2}, {"depth", 2}}}, {"mesh", {{"origin", {0, 0}}, {"length", 20}, {"elements", 20}}},
+              {"loads", loads}}},
+            {"obstacles", json::array({{{"name", "flat"}, {"shape", {{"type", "segment"}, {"from", {100, -1}}, {"to", {-100, -1}}}},
+                                        {"friction", 0.3}}})},
+            {"stages", json::array({{{"steps", 1}, {"factors", {{"press", 1}}}},
+                                    {{"steps", 3}, {"factors", {{"press", 1}, {"push", 2.5}}}},
+                                    {{"steps", 1}, {"factors", {{"press", 1}, {"push", 3.5}}}}})},
+            {"solver", {{"contact", {{"method", "cev"}, {"tolerance", 1e-8}}}}}};
+  for (const char* kinematics : {"linear", "von_karman"}) {
+    j["body"]["kinematics"] = kinematics;
+    if (std::string(kinematics) == "von_karman") j["body"]["supports"] = json::array({{{"node", 10}, {"fix", {"theta"}}}});
+    const Solved s = solve_scene(j);
+    expect_held(s);
+    EXPECT_EQ(s.scene.problem.rigid.count(), std::string(kinematics) == "linear" ? 3 : 2);
+    ASSERT_EQ(s.run.steps.size(), 5u);
+    for (int k = 0; k < 4; ++k) {
+      const StepRecord& rec = s.run.steps[k];
+      ASSERT_TRUE(rec.converged) << kinematics << ": " << rec.reason;
+      const Vec2 R = contact_resultant(s.scene.problem, rec, 0);
+      EXPECT_NEAR(-R.x(), 20.0 * rec.factors[2], 1e-9 * 200) << kinematics << " step " << rec.index;
+      EXPECT_NEAR(R.y(), 200.0, 1e-9 * 200);
+      std::printf("%s beam, Q/(mu N) = %.3f: %d real solves, %d Newton\n", kinematics, 20.0 * rec.factors[2] / 60.0,
+                  rec.solves, rec.newton_iterations);
+    }
+    EXPECT_NE(s.run.steps.back().reason.find("the shear load exceeds what friction can hold: Q / (mu N) = 1.16667"),
+              std::string::npos)
+        << s.run.steps.back().reason;
+  }
+}
+
+}  // namespace
+}  // namespace grip
