@@ -7,8 +7,8 @@
 // point. `Rc` > 0 adds the surface stretch of a finite cylinder of radius Rc (the full disc's
 // uniform tension P / (pi Rc) at its load point). Prints c/a by the 0.99 mu p rule (as the
 // tests read it) and by the stick set.
-//   g++ -O2 -std=c++17 -I/usr/include/eigen3 bench/spence_halfplane.cpp -o /tmp/hp
-//   /tmp/hp mu per_a increments coupled Rc        e.g. /tmp/hp 0.3 80 100 1 20
+//   build/tests/bench/spence_halfplane mu per_a increments coupled Rc   (built with the project)
+//   e.g. build/tests/bench/spence_halfplane 0.3 80 100 1 20
 // Measured (nu = 0.3, mu = 0.3, a/h = 80, 100 increments; a/h = 120 and 160 the same):
 //   uncoupled, half-plane:  stick set 0.750 (a/h 160: 0.744 = K'/K relation), 0.99 rule 0.713
 //   coupled, half-plane:    stick set 0.692, 0.99 rule 0.667; a 2.5 % below Hertz, peak +8 %
