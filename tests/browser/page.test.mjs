@@ -98,7 +98,9 @@ async function cuttingProxy(target, cutAfter) {
       if (limit !== null && sent + d.length >= limit) {
         client.write(d.subarray(0, limit - sent));
         sent = limit;
-        setTimeout(() => { client.destroy(); upstream.destroy(); }, 500);
+        // A FIN, not a reset: a reset makes the receiving kernel drop what the page has not
+        // read yet, and the page would then rightly restart from nothing.
+        setTimeout(() => { client.end(); upstream.destroy(); }, 500);
         return;
       }
       sent += d.length;
@@ -203,7 +205,9 @@ test("a running job: the plot grows live, and resumes across a server restart wi
   // Dismiss from the list; the page ends with job_failed (dismissed), holding exactly the
   // server's iteration events of the run.
   await page.waitForSelector(`#jobs-table tr[data-job="${job.jobID}"] button[aria-label^="dismiss"]`);
-  await page.click(`#jobs-table tr[data-job="${job.jobID}"] button[aria-label^="dismiss"]`);
+  // Clicked inside the page in one go: the list re-renders its rows every 2 s, and a click
+  // from outside (find, scroll, then press) can land on a row that was just replaced.
+  await page.$eval(`#jobs-table tr[data-job="${job.jobID}"] button[aria-label^="dismiss"]`, (b) => b.click());
   await page.waitForFunction(() => document.getElementById("job-panel").dataset.state !== "watching", { timeout: 30000 });
   assert.match(await text("#job-status"), /failed: dismissed/);
   assert.equal((await server.api(`/v1/jobs/${job.jobID}`)).body.status, "dismissed");
@@ -331,7 +335,21 @@ test("a bad scene: errors next to the pointers the server names, nothing queued"
   assert.equal((await server.api("/v1/jobs?limit=1000")).body.jobs.length, before);
 });
 
+// The page cannot resume what it never read: when the browser surfaces nothing of the cut
+// response before its end (Chromium does that for a part of a chunk now and then), the page
+// rightly starts again from the first event. So the cut is tried again, up to five times, until
+// the page reconnects with Last-Event-ID; every attempt must show every event once.
 test("a stream dropped mid-way resumes with Last-Event-ID: every event once, none missing", async () => {
+  const heads = [];
+  for (let attempt = 1; attempt <= 5; attempt++) {
+    const resumedAt = await cutStreamOnce();
+    heads.push(resumedAt.head);
+    if (resumedAt.id > 0) return;
+  }
+  assert.fail(`no attempt reconnected with Last-Event-ID:\n${heads.join("\n----\n")}`);
+});
+
+async function cutStreamOnce() {
   const job = (await server.submit(example("beam-on-cylinder"))).body;
   const proxy = await cuttingProxy(server.port, 6000);
   const tab = await browser.newPage();
@@ -341,19 +359,19 @@ test("a stream dropped mid-way resumes with Last-Event-ID: every event once, non
     await plotCaughtUp(tab);
     const streams = proxy.heads.filter((h) => /^GET [^ ]*\/events/.test(h));
     assert.ok(streams.length >= 2, `the page reconnected: ${streams.length} stream requests`);
-    const resumedAt = Number(streams[1].match(/last-event-id: (\d+)/i)?.[1]);
-    assert.ok(resumedAt > 0, `the second request carries Last-Event-ID:\n${streams[1]}`);
+    const resumedAt = Number(streams[1].match(/last-event-id: (\d+)/i)?.[1] || 0);
     const serverSeqs = (await server.events(job.jobID)).filter((e) => e.type === "iteration").map((e) => e.seq);
     const pageSeqs = await tab.$$eval("#conv-plot circle.pt", (els) => els.map((e) => Number(e.dataset.seq)));
-    assert.ok(pageSeqs.some((q) => q < resumedAt) && pageSeqs.some((q) => q > resumedAt), "points on both sides of the cut");
+    if (resumedAt > 0) assert.ok(pageSeqs.some((q) => q < resumedAt) && pageSeqs.some((q) => q > resumedAt), "points on both sides of the cut");
     assert.deepEqual(pageSeqs, serverSeqs);
     const steps = await tab.$$eval("#step-table tbody tr", (rows) => rows.map((r) => Number(r.dataset.step)));
     assert.deepEqual(steps, Array.from({ length: 20 }, (_, k) => k + 1));
+    return { id: resumedAt, head: streams[1] };
   } finally {
     await tab.close();
     proxy.server.close();
   }
-});
+}
 
 test("the job list: newest first, ten to a page, Older and Newer", async () => {
   const tiny = example("beam-on-cylinder");
