@@ -138,6 +138,13 @@ class CevStep : public StepSolver {
     return change < 0;
   }
 
+  // The bordered model (a body held by contact) is a saddle point, not a minimum of q: there a
+  // step must lower ||v|| on the model instead.
+  bool lowers_model_error(const Compliance& C, const Vector& p, const Vector& s, const Vector& dp,
+                          const Vector& tau, const ContactError& e) const {
+    return contact_error(problem_, p + dp, s + model_change(C, dp), tau, out_.state.enabled).norm2 < e.norm2;
+  }
+
   // eq. 13 with the bounds tau iterated on s(p) = s0 + C (p - p0), accepted by the decrease
   // of q(p) = p.C.p/2 + (s0 - C p0).p; returns the predicted force.
   Vector predict(const Compliance& C, const Vector& p0, const Vector& s0, const Vector& tau, int& inner,
@@ -158,7 +165,7 @@ class CevStep : public StepSolver {
         double a = 1.0;
         for (int k = 0; k <= params_.max_halvings; ++k, a *= 0.5) {
           dp = project_forces(problem_, pl, pl - a * dir.d, e, tau) - pl;
-          if (decreases_q(C, sl, dp)) {
+          if (C.bordered ? lowers_model_error(C, pl, sl, dp, tau, e) : decreases_q(C, sl, dp)) {
             descended = true;
             n_used = dir.n;
             alpha_used = dir.alpha * a;
@@ -188,7 +195,7 @@ class CevStep : public StepSolver {
       const Compliance& C = eq_.compliance(out_.state, relevant_components());
       const Direction dir = direction(C, error_, 1, params_.warmup_alpha);
       if (!dir.ok) break;
-      const Vector pt = project_forces(problem_, out_.p, out_.p - dir.d, error_, out_.tau);
+      const Vector pt = project(C, out_.p, out_.p - dir.d, error_, out_.tau);
       EquilibriumState trial = eq_.solve(out_.state.q, pt);
       if (!trial.converged) break;
       accept(std::move(trial), pt);

@@ -54,6 +54,8 @@ Vector project_forces(const Problem& problem, const Vector& p, const Vector& pba
     else  // slipping: stays on the bound, on its side
       out[c.xi] = sign(p[c.xi]) * tau[i];
   }
+  // The rigid amplitudes have no bound (ALGORITHM.md 7).
+  for (int k = 0; k < problem.rigid.count(); ++k) out[problem.rigid.first + k] = pbar[problem.rigid.first + k];
   return out;
 }
 

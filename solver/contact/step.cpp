@@ -70,7 +70,7 @@ void StepSolver::tau_passes(const Vector& q_guess, const Vector& p_start, const 
       accept(std::move(out_.state), unclipped);
       m_ = 0;
       emit(0, 0, 0, 0, 0.0);
-    } else if (!fresh_solve(pass_index == 1 ? q_guess : out_.state.q)) {
+    } else if (!fresh_solve(pass_index == 1 ? q_guess : out_.state.q) || (pass_index == 1 && !approach_contact())) {
       break;
     }
     if (!pass()) break;
@@ -197,6 +197,7 @@ bool StepSolver::line_search(const Vector& pl, const Vector& du, int& trials) {
 
 Direction StepSolver::direction(const Compliance& C, const ContactError& err, int level,
                                 double alpha_fixed) {
+  if (C.bordered) return bordered_direction(C, err, level, alpha_fixed);
   Direction dir;
   const std::vector<int> idx = active_indices(err);
   dir.d = Vector::Zero(err.v.size());
@@ -253,7 +254,7 @@ bool StepSolver::literal_pass(int first_level, double alpha_fixed) {
       const Direction dir = direction(C, e, level, alpha_fixed);
       if (!dir.ok) return fail("the active block of the compliance is not positive definite");
       if (!budget_left()) return false;
-      const Vector pt = project_forces(problem_, out_.p, out_.p - a * dir.d, e, out_.tau);
+      const Vector pt = project(C, out_.p, out_.p - a * dir.d, e, out_.tau);
       ++trials;
       EquilibriumState trial = eq_.solve(out_.state.q, pt);
       if (trial.converged) {
@@ -301,6 +302,13 @@ double StepSolver::force_precision() {
   if (error_.norm2 == 0.0) return 0.0;
   const std::vector<int> idx = active_indices(error_);
   const Compliance& C = eq_.compliance(out_.state, idx);
+  if (C.bordered) {  // a body held by contact: the bordered system's solution
+    const Vector dp = bordered_direction(C, error_, kAccelerationInfinity, 0.0).d;
+    double largest = 0.0;
+    for (int j : idx)
+      if (is_normal_[j]) largest = std::max(largest, std::abs(dp[j]));
+    return largest;
+  }
   Vector v_e(idx.size());
   for (size_t a = 0; a < idx.size(); ++a) v_e[a] = error_.v[idx[a]];
   Eigen::LLT<Matrix> llt(C.sub(idx));

@@ -66,6 +66,12 @@ class StepSolver {
   // uses the polynomial accelerator (normalized, section 8); level 1 with alpha_fixed > 0 is
   // the multiplier update.
   Direction direction(const Compliance& C, const ContactError& err, int level, double alpha_fixed);
+  // The same on the bordered block of a body held by contact (bordered_direction.cpp): the
+  // amplitudes eliminated, eq. 13 on the positive definite block of the null space of G^T.
+  Direction bordered_direction(const Compliance& C, const ContactError& err, int level, double alpha_fixed);
+  // eq. 13's projection of pbar (project_forces), keeping a held body's equilibrium rows met.
+  Vector project(const Compliance& C, const Vector& p, const Vector& pbar, const ContactError& e,
+                 const Vector& tau) const;
 
   // The paper's literal loop: one real solve per eq. 13 update at acceleration `level` (cev's
   // `loop: paper`), or the multiplier update with a fixed alpha (uzawa).

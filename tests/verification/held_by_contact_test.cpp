@@ -5,6 +5,7 @@
 // a disc squeezed between two flats, a block pushed onto a wall.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 
 #include "solver/elements/continuum.hpp"
@@ -35,12 +36,17 @@ double free_motion_unbalance(const Problem& problem, const StepRecord& rec) {
 }
 
 // Every converged step is sound and balances the load on its free motions to 1e-9.
+// A strategy that ends each tau pass at ||v|| <= tol (a finite n, uzawa) settles p* only to
+// about C^-1 v (here up to 3e-4 of the largest normal force): its cone holds to that.
 void expect_held(const Solved& s) {
   EXPECT_TRUE(result_is_finite(s));
   ASSERT_GT(s.scene.problem.rigid.count(), 0);
+  InvariantTolerances tolerances = tolerances_of(s.scene);
+  const ContactParams& c = s.scene.params.contact;
+  if (c.method == ContactMethod::uzawa || c.acceleration != kAccelerationInfinity) tolerances.tau_relative = 1e-3;
   for (const StepRecord& rec : s.run.steps) {
     if (!rec.converged) continue;
-    EXPECT_TRUE(step_invariants(s.scene.problem, rec, tolerances_of(s.scene)));
+    EXPECT_TRUE(step_invariants(s.scene.problem, rec, tolerances));
     EXPECT_TRUE(monotone_contact_error(rec));
     EXPECT_LT(free_motion_unbalance(s.scene.problem, rec), 1e-9) << "step " << rec.index;
     const json step = step_json(s.scene.problem, rec, s.scene.output);
@@ -69,6 +75,49 @@ int node_at(const json& scene, const Vec2& x) {
   return 0;
 }
 
+// The strategies that hold a body by contact, each a solver.contact block over the defaults.
+// `not_for`: the cases a strategy is not run on, and why (measured, in the README).
+struct Strategy {
+  const char* name;
+  json contact;
+  std::vector<std::string> not_for = {};
+  const char* why_not = "";
+};
+
+const char* const kPaperBeam =
+    "the paper's literal loop on the beam lying on a flat: alpha halved 40 times without a decrease of the "
+    "contact error once the push slides it (one real solve per update on a stiff, badly conditioned compliance)";
+const char* const kUzawaSlow =
+    "uzawa's fixed alpha needs more than the 500 real solves of a step on this compliance";
+
+const Strategy kStrategies[] = {
+    {"cev", json::object()},
+    {"cev_passes", {{"friction_loop", "passes"}}},
+    {"cev_paper", {{"loop", "paper"}}, {"beam"}, kPaperBeam},
+    {"cev_paper_n3", {{"loop", "paper"}, {"acceleration", {{"n", 3}}}}, {"beam"}, kPaperBeam},
+    {"uzawa", {{"method", "uzawa"}}, {"disc", "beam"}, kUzawaSlow},
+};
+
+json with_strategy(json j, const Strategy& strategy) {
+  for (const auto& [key, value] : strategy.contact.items()) j["solver"]["contact"][key] = value;
+  return j;
+}
+
+class HeldByContactStrategy : public ::testing::TestWithParam<Strategy> {
+ protected:
+  json with(json j) const { return with_strategy(std::move(j), GetParam()); }
+  const char* name() const { return GetParam().name; }
+  bool runs_on(const std::string& scene) const {
+    const auto& no = GetParam().not_for;
+    return std::find(no.begin(), no.end(), scene) == no.end();
+  }
+  // Whether each linear model is solved to rounding (n = infinity), not to the tolerance.
+  bool exact_model() const {
+    const json& c = GetParam().contact;
+    return c.value("method", "cev") == "cev" && !c.contains("acceleration");
+  }
+};
+
 // The shipped Hertz half-disc with its diameter held in x only, pressed by a force P at the
 // centre of its diameter; or, with `prescribed`, by that node's displacement instead.
 json hertz_by_force(double P, std::optional<double> prescribed = std::nullopt) {
@@ -83,9 +132,10 @@ json hertz_by_force(double P, std::optional<double> prescribed = std::nullopt) {
   return j;
 }
 
-TEST(HeldByContact, HertzUnderAForceMatchesTheClosedFormAndDisplacementControl) {
+TEST_P(HeldByContactStrategy, HertzUnderAForceMatchesTheClosedFormAndDisplacementControl) {
+  if (!runs_on("hertz")) GTEST_SKIP() << GetParam().why_not;
   const double P = 5000.0;  // N / mm: a = 0.54 mm, about 11 elements
-  const Solved f = solve_scene(hertz_by_force(P));
+  const Solved f = solve_scene(with(hertz_by_force(P)));
   expect_held(f);
   ASSERT_TRUE(f.run.completed) << f.run.reason;
   // x held on the diameter, which lies on y = 0: the flat holds the body's y translation and
@@ -98,8 +148,8 @@ TEST(HeldByContact, HertzUnderAForceMatchesTheClosedFormAndDisplacementControl) 
   EXPECT_NEAR(contact, P, 1e-9 * P);  // the flat carries the whole load: no support helps
   const HertzContact closed = hertz_contact(f.scene.effective["body"], P);
   const EllipseFit fit = fit_semi_ellipse(nodes);
-  std::printf("force P = %.0f N/mm: a = %.4f mm (fit %+.3f %%), p0 = %.1f MPa (fit %+.3f %%); %d real solves, %d Newton\n",
-              P, closed.a, 100 * (fit.a / closed.a - 1), closed.p0, 100 * (fit.p0 / closed.p0 - 1), rec.solves,
+  std::printf("%s: force P = %.0f N/mm: a = %.4f mm (fit %+.3f %%), p0 = %.1f MPa (fit %+.3f %%); %d real solves, %d Newton\n",
+              name(), P, closed.a, 100 * (fit.a / closed.a - 1), closed.p0, 100 * (fit.p0 / closed.p0 - 1), rec.solves,
               rec.newton_iterations);
   EXPECT_LT(std::abs(fit.a / closed.a - 1), 0.01);
   EXPECT_LT(std::abs(fit.p0 / closed.p0 - 1), 0.01);
@@ -108,11 +158,11 @@ TEST(HeldByContact, HertzUnderAForceMatchesTheClosedFormAndDisplacementControl) 
   // The same state by displacement control: the loaded node held where the force put it.
   const int centre = node_at(f.scene.effective, Vec2::Zero());
   const double delta = rec.state.q[2 * centre + 1];
-  const Solved d = solve_scene(hertz_by_force(P, delta));
+  const Solved d = solve_scene(with(hertz_by_force(P, delta)));
   ASSERT_TRUE(d.run.completed) << d.run.reason;
   const StepRecord& drec = d.run.steps.back();
   EXPECT_EQ(d.scene.problem.rigid.names, std::vector<std::string>{"rotate about (0, 0)"});
-  std::printf("displacement control (delta = %.6g mm): %d real solves, %d Newton\n", delta, drec.solves,
+  std::printf("%s: displacement control (delta = %.6g mm): %d real solves, %d Newton\n", name(), delta, drec.solves,
               drec.newton_iterations);
   double p_max = 0.0, p_diff = 0.0;
   for (const Candidate& c : f.scene.problem.candidates) {
@@ -123,8 +173,11 @@ TEST(HeldByContact, HertzUnderAForceMatchesTheClosedFormAndDisplacementControl) 
   const double q_max = rec.state.q.lpNorm<Eigen::Infinity>();
   std::printf("force vs displacement control: forces differ by %.2e, displacements by %.2e (relative)\n",
               p_diff / p_max, q_diff / q_max);
-  EXPECT_LT(p_diff, 1e-6 * p_max);
-  EXPECT_LT(q_diff, 1e-6 * q_max);
+  // n = infinity solves each linear model to rounding: both runs end on the same state. A
+  // finite n or uzawa stops at ||v|| <= tol, which pins the forces only to about C^-1 v.
+  const double agree = exact_model() ? 1e-6 : 2e-4;
+  EXPECT_LT(p_diff, agree * p_max);
+  EXPECT_LT(q_diff, agree * q_max);
   EXPECT_NEAR(-reaction_resultant(d.scene.problem, drec).y(), P, 1e-6 * P);
   // The rigid motion in the result (fitted to every node): down, less than the loaded node,
   // which also carries the compression; no rotation (symmetry).
@@ -135,10 +188,11 @@ TEST(HeldByContact, HertzUnderAForceMatchesTheClosedFormAndDisplacementControl) 
   EXPECT_LT(std::abs(step["rigid_motion"]["rotation"].get<double>()), 1e-9 * std::abs(delta));
 }
 
-TEST(HeldByContact, BlockUnderShearHoldsBelowMuNAndFailsAbove) {
-  const Solved s = solve_scene(block_under_shear());
+TEST_P(HeldByContactStrategy, BlockUnderShearHoldsBelowMuNAndFailsAbove) {
+  if (!runs_on("block")) GTEST_SKIP() << GetParam().why_not;
+  const Solved s = solve_scene(with(block_under_shear()));
   expect_held(s);
-  ASSERT_EQ(s.run.steps.size(), 7u);
+  ASSERT_EQ(s.run.steps.size(), 7u) << s.run.reason;
   const double N = 200.0, mu = 0.3;
   const double ratios[] = {0, 0.25, 0.5, 0.75, 0.9, 0.95};
   int slip_before = 0;
@@ -155,7 +209,7 @@ TEST(HeldByContact, BlockUnderShearHoldsBelowMuNAndFailsAbove) {
       zones += n.state == ContactState::stick ? 'T' : n.state == ContactState::slip ? 'L' : '.';
       slip += n.state == ContactState::slip;
     }
-    std::printf("Q/(mu N) = %.2f: reaction %.9g (Q = %.4g), %d real solves, zones %s\n", ratios[k], -R.x(), Q,
+    std::printf("%s: Q/(mu N) = %.2f: reaction %.9g (Q = %.4g), %d real solves, zones %s\n", name(), ratios[k], -R.x(), Q,
                 rec.solves, zones.c_str());
     if (k > 1) EXPECT_GE(slip, slip_before);  // the slip zones grow with the load
     slip_before = slip;
@@ -202,8 +256,9 @@ json disc_between_flats(int n, double delta) {
   return j;
 }
 
-TEST(HeldByContact, DiscBetweenTwoFlatsCarriesEqualForcesWithHertzWidths) {
-  const Solved s = solve_scene(disc_between_flats(96, 0.5));
+TEST_P(HeldByContactStrategy, DiscBetweenTwoFlatsCarriesEqualForcesWithHertzWidths) {
+  if (!runs_on("disc")) GTEST_SKIP() << GetParam().why_not;
+  const Solved s = solve_scene(with(disc_between_flats(96, 0.5)));
   expect_held(s);
   ASSERT_TRUE(s.run.completed) << s.run.reason;
   EXPECT_EQ(s.scene.problem.rigid.count(), 3);
@@ -229,12 +284,13 @@ TEST(HeldByContact, DiscBetweenTwoFlatsCarriesEqualForcesWithHertzWidths) {
     // The closed-form edge lies between the last node that touches and the first that does not.
     EXPECT_TRUE(zone.brackets(closed.a, 0.02 * closed.a)) << "a = " << closed.a;
   }
-  std::printf("disc: %d real solves, %d Newton\n", rec.solves, rec.newton_iterations);
+  std::printf("%s disc: %d real solves, %d Newton\n", name(), rec.solves, rec.newton_iterations);
 }
 
 // A block held in y by rollers on its bottom, free in x, pushed by a traction on its left face
 // onto a frictionless wall at its right: the wall's reaction is the push.
-TEST(HeldByContact, BlockPushedOntoAWallByAForce) {
+TEST_P(HeldByContactStrategy, BlockPushedOntoAWallByAForce) {
+  if (!runs_on("wall")) GTEST_SKIP() << GetParam().why_not;
   const json j = json::parse(R"({
     "body": {
       "model": "continuum", "kinematics": "linear", "analysis": "plane_strain", "element": "q4", "thickness": 1,
@@ -248,7 +304,7 @@ TEST(HeldByContact, BlockPushedOntoAWallByAForce) {
     "steps": 2,
     "solver": {"contact": {"method": "cev", "tolerance": 1e-8}}
   })");
-  const Solved s = solve_scene(j);
+  const Solved s = solve_scene(with(j));
   expect_held(s);
   ASSERT_TRUE(s.run.completed) << s.run.reason;
   EXPECT_EQ(s.scene.problem.rigid.names, std::vector<std::string>{"translate along x"});
@@ -272,7 +328,8 @@ namespace {
 // 1.17: the flat's reaction is the push until the last, which fails with the reason. Linear
 // kinematics: contact holds all three motions; von Karman: the translations (its rotation held
 // by theta at the middle node, since a finite rotation is no null mode).
-TEST(HeldByContact, BeamOnAFlatPushedAlongIt) {
+TEST_P(HeldByContactStrategy, BeamOnAFlatPushedAlongIt) {
+  if (!runs_on("beam")) GTEST_SKIP() << GetParam().why_not;
   json loads = json::array();
   for (int n = 0; n <= 20; ++n)
     loads.push_back({{"node", n}, {"force", {0.0, n == 0 || n == 20 ? -5.0 : -10.0}}, {"case", "press"}});
@@ -290,17 +347,17 @@ TEST(HeldByContact, BeamOnAFlatPushedAlongIt) {
   for (const char* kinematics : {"linear", "von_karman"}) {
     j["body"]["kinematics"] = kinematics;
     if (std::string(kinematics) == "von_karman") j["body"]["supports"] = json::array({{{"node", 10}, {"fix", {"theta"}}}});
-    const Solved s = solve_scene(j);
+    const Solved s = solve_scene(with(j));
     expect_held(s);
     EXPECT_EQ(s.scene.problem.rigid.count(), std::string(kinematics) == "linear" ? 3 : 2);
-    ASSERT_EQ(s.run.steps.size(), 5u);
+    ASSERT_EQ(s.run.steps.size(), 5u) << s.run.reason;
     for (int k = 0; k < 4; ++k) {
       const StepRecord& rec = s.run.steps[k];
       ASSERT_TRUE(rec.converged) << kinematics << ": " << rec.reason;
       const Vec2 R = contact_resultant(s.scene.problem, rec, 0);
       EXPECT_NEAR(-R.x(), 20.0 * rec.factors[2], 1e-9 * 200) << kinematics << " step " << rec.index;
       EXPECT_NEAR(R.y(), 200.0, 1e-9 * 200);
-      std::printf("%s beam, Q/(mu N) = %.3f: %d real solves, %d Newton\n", kinematics, 20.0 * rec.factors[2] / 60.0,
+      std::printf("%s: %s beam, Q/(mu N) = %.3f: %d real solves, %d Newton\n", name(), kinematics, 20.0 * rec.factors[2] / 60.0,
                   rec.solves, rec.newton_iterations);
     }
     EXPECT_NE(s.run.steps.back().reason.find("the shear load exceeds what friction can hold: Q / (mu N) = 1.16667"),
@@ -308,6 +365,15 @@ TEST(HeldByContact, BeamOnAFlatPushedAlongIt) {
         << s.run.steps.back().reason;
   }
 }
+
+}  // namespace
+}  // namespace grip
+
+namespace grip {
+namespace {
+
+INSTANTIATE_TEST_SUITE_P(Strategies, HeldByContactStrategy, ::testing::ValuesIn(kStrategies),
+                         [](const ::testing::TestParamInfo<Strategy>& info) { return std::string(info.param.name); });
 
 }  // namespace
 }  // namespace grip
