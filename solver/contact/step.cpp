@@ -128,8 +128,15 @@ bool StepSolver::mode_held(int k) const {
 }
 
 bool StepSolver::approach_contact() {
+  Vector dq;
+  if (!approach_motion(dq)) return true;
+  return fresh_solve(Vector(out_.state.q + dq));
+}
+
+bool StepSolver::approach_motion(Vector& dq) {
   const RigidModes& rigid = problem_.rigid;
-  Vector p = out_.p, dq = Vector::Zero(out_.state.q.size());
+  Vector p = out_.p;
+  dq = Vector::Zero(out_.state.q.size());
   bool moved = false;
   for (int k = 0; k < rigid.count(); ++k) {
     const double push = out_.state.s[rigid.first + k];
@@ -146,9 +153,8 @@ bool StepSolver::approach_contact() {
     dq += move * rigid.modes.col(k);
     moved = true;
   }
-  if (!moved) return true;
   out_.p = p;
-  return fresh_solve(Vector(out_.state.q + dq));
+  return moved;
 }
 
 void StepSolver::accept(EquilibriumState s, const Vector& p) {

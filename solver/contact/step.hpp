@@ -50,6 +50,8 @@ class StepSolver {
   // its first contact point closes its gap (and presses by the tolerance), then solved again:
   // while every point is open the linear model knows nothing that stops the motion.
   bool approach_contact();
+  // That motion alone (dq, and the amplitudes in out_.p), from out_.state; false if none.
+  bool approach_motion(Vector& dq);
   Vec2 mode_rates(size_t candidate, int mode) const;
   bool mode_held(int mode) const;
   void accept(EquilibriumState s, const Vector& p);

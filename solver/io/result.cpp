@@ -136,6 +136,15 @@ json effects_json(const Scene& scene, const RunResult& run) {
             {"equilibrium_solves", run.counters.solves},
             {"newton_iterations", run.counters.newton_iterations},
             {"tau_passes", passes}}}};
+  // How the free motions were held (ALGORITHM.md 7), and that no regularization is left.
+  if (problem.rigid.count())
+    effects["held_by_contact_by"] =
+        scene.params.contact.method == ContactMethod::penalty
+            ? "the penalty springs: the rigid amplitudes are solved with the deformation, first with springs of "
+              "1e-2, 1e-4 and 1e-6 x the largest stiffness on the free motions' pins, then without them; none is "
+              "left in the answer"
+            : "the contact forces: the rigid amplitudes are contact unknowns and the whole body's equilibrium "
+              "their condition; no regularization";
   if (const auto quality = problem.body->element_quality())
     effects["element_quality"] = {{"elements", quality->elements},
                                   {"max_aspect_ratio", quality->max_aspect_ratio},

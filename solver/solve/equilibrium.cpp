@@ -10,19 +10,38 @@ namespace grip {
 Equilibrium::Equilibrium(const Problem& problem, NewtonParams params, std::vector<Constraint> extra)
     : problem_(problem), params_(params), extra_(std::move(extra)) {
   const int n = problem.body->dof_count();
-  free_index_.assign(n, 0);
-  for (const Constraint& c : problem.constraints) free_index_[c.dof] = -1;
-  for (const Constraint& c : extra_) free_index_[c.dof] = -1;
   is_pin_.assign(n, 0);
-  for (int pin : problem.rigid.pins) {
-    free_index_[pin] = -1;
-    is_pin_[pin] = 1;
-  }
-  for (int i = 0; i < n; ++i)
-    if (free_index_[i] == 0) free_index_[i] = free_count_++;
+  for (int pin : problem.rigid.pins) is_pin_[pin] = 1;
+  index_free_dofs();
   length_scales_ = problem.body->dof_length_scales();
   constant_tangent_ = problem.body->traits().constant_tangent;
   zeta_previous_.assign(problem.candidates.size(), 0.0);
+}
+
+void Equilibrium::index_free_dofs() {
+  const int n = problem_.body->dof_count();
+  free_index_.assign(n, 0);
+  free_count_ = 0;
+  for (const Constraint& c : problem_.constraints) free_index_[c.dof] = -1;
+  for (const Constraint& c : extra_) free_index_[c.dof] = -1;
+  if (!pins_free_)
+    for (int pin : problem_.rigid.pins) free_index_[pin] = -1;
+  for (int i = 0; i < n; ++i)
+    if (free_index_[i] == 0) free_index_[i] = free_count_++;
+}
+
+void Equilibrium::set_penalty(std::optional<PenaltyLaw> law) {
+  penalty_ = std::move(law);
+  const bool free = penalty_ && problem_.rigid.count() > 0;
+  if (free == pins_free_) return;
+  pins_free_ = free;
+  index_free_dofs();
+  // Factorizations and G belong to the old free set.
+  lu_.forget_pattern();
+  body_lu_.forget_pattern();
+  body_factorized_ = false;
+  g_valid_ = false;
+  surface_free_.clear();
 }
 
 void Equilibrium::set_step(LoadFactors factors, std::vector<double> zeta_previous) {
@@ -149,6 +168,11 @@ Vector Equilibrium::residual(const Vector& q, const EquilibriumState& paired, co
     *force_scale = r.size() ? std::max({largest(r), largest(external), largest(contact)}) : 0.0;
   }
   r -= external + contact;
+  if (pins_free_)
+    for (int pin : problem_.rigid.pins) {
+      r[pin] += penalty_->pin_spring * q[pin];
+      if (tangent) tangent->emplace_back(pin, pin, penalty_->pin_spring);
+    }
   return r;
 }
 
@@ -199,7 +223,8 @@ EquilibriumState Equilibrium::solve(const Vector& q_guess, const Vector& p) {
     state.q[c.dof] = c.load_case < static_cast<int>(factors_.size()) ? factors_[c.load_case] * c.value : 0.0;
   for (const Constraint& c : extra_) state.q[c.dof] = c.value;
   const RigidModes& rigid = problem_.rigid;
-  for (int k = 0; k < rigid.count(); ++k) state.q[rigid.pins[k]] = rigid.scale * p[rigid.first + k];
+  if (!pins_free_)
+    for (int k = 0; k < rigid.count(); ++k) state.q[rigid.pins[k]] = rigid.scale * p[rigid.first + k];
   const double body_length = problem_.body->characteristic_length();
   constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
   // The penalty law adds stiffness that changes with the contact state: no reuse then.
@@ -279,6 +304,8 @@ EquilibriumState& Equilibrium::finish(EquilibriumState& state, const Vector& p) 
   state.converged = state.reason.empty();
   state.p = penalty_ ? penalty_forces(state, nullptr) : p;
   const RigidModes& rigid = problem_.rigid;
+  if (pins_free_)  // the amplitudes were solved for: they are the pins' displacements
+    for (int k = 0; k < rigid.count(); ++k) state.p[rigid.first + k] = state.q[rigid.pins[k]] / rigid.scale;
   if (rigid.count()) {
     const Vector applied = applied_forces(state, state.p);
     for (int k = 0; k < rigid.count(); ++k)

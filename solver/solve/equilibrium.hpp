@@ -81,6 +81,10 @@ struct PenaltyLaw {
   double normal = 0.0;      // k_n, force / length
   double tangential = 0.0;  // k_t, force / length
   Vector previous;          // the previous step's forces (the tangential springs start there)
+  // A body held by contact (problem.rigid): its amplitudes are solved with the deformation (the
+  // pins are free dofs), held by the springs; `pin_spring` (force / length) on each pin keeps
+  // Newton non-singular while fewer points press or stick than hold every motion.
+  double pin_spring = 0.0;
 };
 
 // Factorizations of blocks of a compliance, kept by the inner contact solver (coulomb_model.cpp)
@@ -115,7 +119,8 @@ class Equilibrium {
 
   EquilibriumState solve(const Vector& q_guess, const Vector& p);
   // With a penalty law set, solve() ignores its p and finds p(q) from the law.
-  void set_penalty(std::optional<PenaltyLaw> law) { penalty_ = std::move(law); }
+  // A body held by contact then has its pins free (PenaltyLaw::pin_spring).
+  void set_penalty(std::optional<PenaltyLaw> law);
   // The largest diagonal entry of the body's stiffness at q: a scale for penalty stiffnesses.
   double stiffness_scale(const Vector& q) const;
   // The pairing and s at q, without solving (e.g. the reference configuration).
@@ -172,6 +177,9 @@ class Equilibrium {
   double free_length_norm(const Vector& dq) const;
   double scaled_free_max(const Vector& r) const;
   void add_rigid_border(const EquilibriumState& state);
+  // free_index_ from the supports, the start-up's dofs and (unless pins_free_) the pins.
+  void index_free_dofs();
+  bool pins_free_ = false;
   // Adds free dofs to G's surface: one solve with the body's factorization per dof.
   void extend_surface_compliance(const std::vector<int>& added);
 

@@ -41,6 +41,12 @@ class FreeBlockSolver {
   // false otherwise (then solve() for unit right-hand sides).
   bool inverse_block(const std::vector<int>& rows, Matrix& G) { return ok_ && symmetric_ && llt_.inverse_block(rows, G); }
   bool ok() const { return ok_; }
+  // The next factorize() builds its pattern afresh (the free set changed).
+  void forget_pattern() {
+    rows_.clear();
+    cols_.clear();
+    ok_ = false;
+  }
 
  private:
   Eigen::SparseMatrix<double> matrix_;
