@@ -30,9 +30,12 @@ class SsnStep : public StepSolver {
           const StopRequest& stop)
       : StepSolver(eq, params, step, obs, stop) {
     const int n = problem_.body->dof_count();
+    // A body held by contact: its pins join the unknowns, the rigid amplitudes with them.
+    std::vector<char> pin(n, 0);
+    for (int d : problem_.rigid.pins) pin[d] = 1;
     free_index_.assign(n, -1);
     for (int i = 0; i < n; ++i)
-      if (eq.is_free(i)) free_index_[i] = free_count_++;
+      if (eq.is_free(i) || pin[i]) free_index_[i] = free_count_++;
     length_scales_ = problem_.body->dof_length_scales();
   }
 
@@ -42,7 +45,7 @@ class SsnStep : public StepSolver {
     pass_ = out_.passes = 1;
     out_.p = p_start;
     project_to_cone(problem_, out_.p);
-    if (!fresh_solve(q_guess)) return;
+    if (!fresh_solve(q_guess) || !approach_contact()) return;
     Vector q = out_.state.q, p = out_.p;
     augmentations(out_.state);
     const int components = problem_.component_count;
@@ -189,6 +192,13 @@ class SsnStep : public StepSolver {
           add_ds(base + c.xi, i, true, -sg * mu * rn);
         }
       }
+    }
+    // A rigid amplitude is its pin's displacement (in its unit): p_a - q_pin / scale = 0.
+    const RigidModes& rigid = problem_.rigid;
+    for (int k = 0; k < rigid.count(); ++k) {
+      const int a = rigid.first + k, pin = rigid.pins[k];
+      F[a] = p[a] - paired.q[pin] / rigid.scale;
+      if (J) J->emplace_back(base + a, free_index_[pin], -1.0 / rigid.scale);
     }
     if (J)
       for (int k = 0; k < p.size(); ++k)

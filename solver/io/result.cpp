@@ -143,6 +143,9 @@ json effects_json(const Scene& scene, const RunResult& run) {
             ? "the penalty springs: the rigid amplitudes are solved with the deformation, first with springs of "
               "1e-2, 1e-4 and 1e-6 x the largest stiffness on the free motions' pins, then without them; none is "
               "left in the answer"
+        : scene.params.contact.method == ContactMethod::ssn
+            ? "the contact forces: the rigid amplitudes are Newton unknowns with the displacements and contact "
+              "forces, the whole body's equilibrium their rows; no regularization"
             : "the contact forces: the rigid amplitudes are contact unknowns and the whole body's equilibrium "
               "their condition; no regularization";
   if (const auto quality = problem.body->element_quality())

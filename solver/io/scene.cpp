@@ -567,10 +567,6 @@ Scene read_checked_scene(const nlohmann::json& input) {
                                                       : scene.problem.body->characteristic_length();
   add_candidates(scene.problem, scene.steps, reach);
   hold_rigid_modes(r, scene.problem);
-  const ContactParams& cp = scene.params.contact;
-  if (scene.problem.rigid.count() && cp.method == ContactMethod::ssn)
-    r.error("/solver/contact/method", "holds a body by contact (it is free to " + scene.problem.rigid.names.front() +
-                                          ") only with methods cev, uzawa and penalty so far");
   if (!r.issues.empty()) throw SceneErrors(std::move(r.issues));
   return scene;
 }

@@ -63,7 +63,8 @@ void expect_held(const Solved& s) {
       tolerances.length = (1 + 1e-6) * rec.p.head(s.scene.problem.rigid.first).cwiseAbs().maxCoeff() *
                           s.scene.problem.rigid.scale / c.penalty_factor;
     EXPECT_TRUE(step_invariants(s.scene.problem, rec, tolerances));
-    EXPECT_TRUE(monotone_contact_error(rec));
+    // ssn's events report its Newton iterates, which no ||v|| test accepts.
+    if (c.method != ContactMethod::ssn) EXPECT_TRUE(monotone_contact_error(rec));
     EXPECT_LT(free_motion_unbalance(s.scene.problem, rec), balance(s.scene)) << "step " << rec.index;
     const json step = step_json(s.scene.problem, rec, s.scene.output);
     EXPECT_TRUE(step.contains("rigid_motion")) << "step " << rec.index;
@@ -116,6 +117,7 @@ const Strategy kStrategies[] = {
      "penalty: Newton does not converge in the disc's first step (its friction springs at two flats switch "
      "between stick and slip), and balances the beam's load only to 1e-6 (a system 1e3 times stiffer than the "
      "beam)"},
+    {"ssn", {{"method", "ssn"}}},
 };
 
 json with_strategy(json j, const Strategy& strategy) {
