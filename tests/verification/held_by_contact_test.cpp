@@ -336,6 +336,7 @@ TEST_P(HeldByContactStrategy, BlockPushedOntoAWallByAForce) {
     // The body crossed the 0.01 gap: its rigid translation is at least that.
     const json step = step_json(s.scene.problem, rec, s.scene.output);
     EXPECT_GT(step["rigid_motion"]["translation"][0].get<double>(), 0.01);
+    std::printf("%s wall, step %d: %d real solves, %d Newton\n", name(), rec.index, rec.solves, rec.newton_iterations);
   }
 }
 
