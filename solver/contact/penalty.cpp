@@ -2,7 +2,8 @@
 // of eq. 10 (with tau = nu |p_eta|) measures how far its answer is from the contact
 // conditions (it falls as the penalty stiffness grows). A body held by contact is held by the
 // penalty springs: its rigid amplitudes are solved with the deformation (Equilibrium with the
-// pins free), first with a spring of 1e-6 x the largest stiffness on each pin, then without.
+// pins free), first with springs of 1e-2, 1e-4, 1e-6 x the largest stiffness on its pins,
+// each solve from the last, then without them.
 #include "solver/contact/step.hpp"
 
 namespace grip {
@@ -23,6 +24,7 @@ class PenaltyStep : public StepSolver {
     touch(q0, p_start);
     EquilibriumState s;
     s.converged = true;
+    int solves = 1;
     if (problem_.rigid.count())
       // Springs on the pins, weakened a hundredfold a solve, each solve from the last: the
       // answer carries no regularization, only the penalty springs hold the body.
@@ -31,6 +33,7 @@ class PenaltyStep : public StepSolver {
         eq_.set_penalty(law);
         s = eq_.solve(q0, p_start);
         if (s.converged) q0 = s.q;
+        ++solves;
       }
     law.pin_spring = 0.0;
     eq_.set_penalty(law);
@@ -47,7 +50,7 @@ class PenaltyStep : public StepSolver {
     const Vector p = s.p;
     accept(std::move(s), p);
     out_.converged = true;
-    emit(1, 0, 0, 0, 0.0);
+    emit(solves, 0, 0, 0, 0.0);
   }
 
   // A body held by contact with no point pressing yet (its first step): nothing but the pin
