@@ -40,9 +40,17 @@ def main():
     # The block as slave: it is the body that stays when the foundation becomes rigid.
     block_slave = copy.deepcopy(block)
     block_slave["contacts"] = [{"slave": "block.bottom", "master": "foundation.top"}]
+    # Refined: elements of 0.025 mm within 0.8 mm of the poles (a/h 14 and 21 at the two steps).
+    fine = copy.deepcopy(cyl)
+    for b in fine["bodies"]:
+        b["mesh"]["half_disc"]["refine"]["size"] = 0.025
+        b["mesh"]["half_disc"]["divisions"] = [88, 44]
+    rigid_lower = {"name": "lower", "shape": {"type": "circle", "centre": [0, -10], "radius": 10}}
     cases = [
         ("two cylinders (E 200/70 GPa)", cyl),
-        ("upper cylinder on a rigid cylinder", one_body(cyl, {"name": "lower", "shape": {"type": "circle", "centre": [0, -10], "radius": 10}})),
+        ("upper cylinder on a rigid cylinder", one_body(cyl, rigid_lower)),
+        ("two cylinders, refined (h 0.025 mm)", fine),
+        ("upper cylinder on a rigid cylinder, refined", one_body(fine, rigid_lower)),
         ("block on foundation (foundation slave)", block),
         ("block on foundation (block slave)", block_slave),
         ("block on a rigid flat", one_body(block_slave, {"name": "flat", "shape": {"type": "segment", "from": [10, 0], "to": [-10, 0]}})),
