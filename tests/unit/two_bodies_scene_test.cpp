@@ -1,9 +1,11 @@
 // Scenes of several bodies (issue 19): the reader's errors name the JSON pointer of the value,
 // the result of a two-body scene validates against schemas/result.schema.json and tells each
-// body's rows, contact points carry their body and master, and the CSV tables name the body.
+// body's rows, contact points carry their body and master, the CSV tables name the body and
+// the VTK cells carry it.
 #include <gtest/gtest.h>
 
 #include "solver/io/export_csv.hpp"
+#include "solver/io/export_vtk.hpp"
 #include "solver/io/result.hpp"
 #include "solver/io/schema_validation.hpp"
 #include "tests/support/scenes.hpp"
@@ -85,6 +87,9 @@ TEST(TwoBodiesScene, ResultValidatesAndNamesTheBodies) {
   const std::string csv = result_csv(r, "nodes");
   EXPECT_EQ(csv.substr(0, csv.find('\n')).find("step,load_factor,body,node"), 0u) << csv.substr(0, 80);
   EXPECT_NE(csv.find(",lower,"), std::string::npos);
+  // VTK: one grid, each cell with its body's index.
+  const std::string vtu = step_vtu(r, 0);
+  EXPECT_NE(vtu.find("Name=\"body\""), std::string::npos);
 }
 
 }  // namespace
