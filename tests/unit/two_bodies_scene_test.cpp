@@ -92,5 +92,29 @@ TEST(TwoBodiesScene, ResultValidatesAndNamesTheBodies) {
   EXPECT_NE(vtu.find("Name=\"body\""), std::string::npos);
 }
 
+// A pair whose surfaces lie beyond the contact reach (the set's length by default) has no
+// unknowns; an obstacle named by a contact pairs with that slave set only, one named by none
+// with every body.
+TEST(TwoBodiesScene, OnlyPairsThatCanMeetHaveUnknowns) {
+  json far = example_scene("two-cylinders");
+  far["bodies"][1]["mesh"]["half_disc"]["centre"] = {0, -40};
+  EXPECT_EQ(read_scene(far).problem.component_count, 0);
+  const int pair = read_scene(example_scene("two-cylinders")).problem.component_count;
+  EXPECT_GT(pair, 0);
+  json wall = example_scene("block-on-foundation");
+  wall["obstacles"] = json::parse(R"([{"name": "wall", "shape": {"type": "segment", "from": [6, 10], "to": [6, -10]}}])");
+  const Scene everyone = read_scene(wall);
+  wall["contacts"].push_back({{"slave", "block.bottom"}, {"master", "wall"}});
+  const Scene named = read_scene(wall);
+  auto on_wall = [](const Scene& s) {
+    int n = 0;
+    for (const Candidate& c : s.problem.candidates) n += s.problem.obstacles[c.obstacle].name == "wall";
+    return n;
+  };
+  const int block = 8, foundation = 21;  // contact set nodes
+  EXPECT_EQ(on_wall(everyone), block + foundation);
+  EXPECT_EQ(on_wall(named), block);
+}
+
 }  // namespace
 }  // namespace grip
