@@ -2,6 +2,7 @@
 // A deformable body model: internal force A(q), its tangent K(q), and the surface points
 // where contact candidates sit (eq. 1-3).
 #include <Eigen/SparseCore>
+#include <array>
 #include <optional>
 #include <string>
 #include <vector>
@@ -59,6 +60,10 @@ class Body {
   virtual int site_node(int site) const { return site; }
   // The surface point of `site` on side +1 (upper) or -1 (lower), at state q.
   virtual SurfacePoint surface_point(const Vector& q, int site, int side) const = 0;
+  // The straight pieces of the contact surface between sites, each [a, b] with the body on
+  // the left of a -> b: what a slave point of another body pairs with (node-to-segment).
+  // Empty where the model offers no master surface.
+  virtual std::vector<std::array<int, 2>> surface_segments() const { return {}; }
   // Surface area that a site's contact force acts on (tributary length x width).
   virtual double tributary_area(int site) const = 0;
   // Characteristic length (size of the undeformed body): the scale of relative tolerances.

@@ -28,17 +28,24 @@ void add_candidates(Problem& problem, const std::vector<LoadStep>& path, double 
   int next = 0;
   const Body& body = *problem.body;
   const std::vector<LoadFactors> samples = sampled_path(path);
+  const Vector q0 = Vector::Zero(body.dof_count());
   for (int o = 0; o < static_cast<int>(problem.obstacles.size()); ++o) {
     const ObstacleInstance& obstacle = problem.obstacles[o];
-    for (int site = 0; site < body.site_count(); ++site) {
+    std::vector<int> sites = obstacle.slaves;
+    if (sites.empty())
+      for (int site = 0; site < body.site_count(); ++site) sites.push_back(site);
+    std::optional<DeformedMaster> master;
+    if (obstacle.master) master.emplace(body, q0, *obstacle.master);
+    for (int site : sites) {
       const Vec2 x = body.site_reference(site);
-      if (reach > 0 && !samples.empty()) {
+      const Projection proj = master ? master->project(x).projection : obstacle.shape->project(x);
+      if (reach > 0 && master && std::abs(proj.gap) > reach) continue;
+      if (reach > 0 && !master && !samples.empty()) {
         double nearest = std::numeric_limits<double>::infinity();
         for (const LoadFactors& f : samples)
           nearest = std::min(nearest, std::abs(obstacle.shape->project(x - obstacle.offset(f)).gap));
         if (nearest > reach) continue;
       }
-      const Projection proj = obstacle.shape->project(x);
       // The side whose outward surface normal (+y or -y) points toward the obstacle.
       const int side = (proj.point - x).y() >= 0 ? +1 : -1;
       Candidate c{site, side, o, next++};

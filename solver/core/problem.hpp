@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "solver/core/body.hpp"
+#include "solver/obstacles/master_surface.hpp"
 #include "solver/obstacles/obstacle.hpp"
 
 namespace grip {
@@ -15,6 +16,8 @@ namespace grip {
 // gives every case a factor (one case, "main", unless the scene has stages).
 using LoadFactors = std::vector<double>;
 
+// What a body's surface points pair with: a rigid obstacle (`shape`), or in a scene of several
+// bodies a contact pair whose master is another body's surface (`master`, no shape).
 struct ObstacleInstance {
   std::string name;
   std::unique_ptr<Obstacle> shape;
@@ -23,6 +26,10 @@ struct ObstacleInstance {
   double friction = 0.0;
   bool frictional = false;            // friction > 0 in some stage: tangential unknowns exist
   std::vector<Vec2> translations;     // prescribed translation per load case at factor 1
+  std::optional<MasterSurface> master;
+  // The sites that pair with it (a contact's slave set); empty: every site of the body.
+  std::vector<int> slaves;
+  int slave_body = -1;  // the slave body of a contact pair (index into the scene's bodies)
   Vec2 offset(const LoadFactors& factors) const {
     Vec2 d = Vec2::Zero();
     for (size_t k = 0; k < translations.size() && k < factors.size(); ++k) d += factors[k] * translations[k];

@@ -119,6 +119,15 @@ Body::Traits ContinuumBody::traits() const {
   return {.geometric_nonlinearity = !linear, .plasticity = false, .constant_tangent = linear};
 }
 
+std::vector<std::array<int, 2>> ContinuumBody::surface_segments() const {
+  std::vector<int> site_of(node_count(), -1);
+  for (int s = 0; s < site_count(); ++s) site_of[contact_.nodes[s]] = s;
+  std::vector<std::array<int, 2>> segments;
+  for (const auto& side : contact_.sides)
+    for (size_t k = 0; k + 1 < side.size(); ++k) segments.push_back({site_of[side[k]], site_of[side[k + 1]]});
+  return segments;
+}
+
 std::vector<std::vector<int>> ContinuumBody::cells() const {
   std::vector<std::vector<int>> c;
   for (const auto& el : mesh_.elements) c.push_back({el[0], el[1], el[2], el[3]});

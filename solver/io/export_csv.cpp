@@ -41,15 +41,32 @@ const json& steps_of(const json& result) {
   return result.contains("steps") && result["steps"].is_array() ? result["steps"] : empty;
 }
 
-// Prefixes each item of steps[k][key] with the step number and load factor.
+// The body of each row of the nodes or elements table (scenes of several bodies: the result's
+// bodies[] ranges); empty for one body.
+std::vector<std::string> row_bodies(const json& result, const std::string& key) {
+  std::vector<std::string> names;
+  if (!result.contains("bodies") || (key != "nodes" && key != "elements")) return names;
+  const std::string first = key == "nodes" ? "first_node" : "first_element";
+  for (const json& b : result["bodies"]) {
+    names.resize(b.value(first, 0), names.empty() ? "" : names.back());
+    names.resize(b.value(first, 0) + b.value(key, 0), b.value("name", ""));
+  }
+  return names;
+}
+
+// Prefixes each item of steps[k][key] with the step number and load factor (and its body).
 std::vector<json> per_step_items(const json& result, const char* key, bool with_load_factor) {
   std::vector<json> rows;
+  const std::vector<std::string> bodies = row_bodies(result, key);
   for (const json& step : steps_of(result)) {
     if (!step.contains(key)) continue;
+    size_t k = 0;
     for (const json& item : step[key]) {
       json row = json::object();
       row["step"] = step.value("step", 0);
       if (with_load_factor) row["load_factor"] = step.value("load_factor", 0.0);
+      if (k < bodies.size()) row["body"] = bodies[k];
+      ++k;
       for (auto it = item.begin(); it != item.end(); ++it) row[it.key()] = it.value();
       rows.push_back(std::move(row));
     }
@@ -95,7 +112,7 @@ std::string result_csv(const json& result, std::string_view table) {
 
 std::string objects_csv(const std::vector<json>& rows) {
   // JSON objects keep their keys sorted: the identifying columns go first.
-  static const std::vector<std::string> leading = {"step", "load_factor", "pass", "m",
+  static const std::vector<std::string> leading = {"step", "load_factor", "pass", "m", "body",
                                                    "node", "element", "obstacle"};
   std::vector<std::string> columns;
   std::map<std::string, size_t> index;

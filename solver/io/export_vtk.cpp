@@ -105,6 +105,16 @@ Grid grid_of(const json& result, size_t k) {
   }
   if (step.contains("elements") && step["elements"].size() == g.cells.size())
     g.cell_data = numeric_arrays(step["elements"], {"element"});
+  // Several bodies: each cell's body (its index in the result's bodies[]), to split or colour by.
+  if (result.contains("bodies") && result["bodies"].is_array()) {
+    Array body{"body", std::vector<double>(g.cells.size(), 0.0)};
+    for (size_t b = 0; b < result["bodies"].size(); ++b) {
+      const json& entry = result["bodies"][b];
+      const size_t first = entry.value("first_element", 0), count = entry.value("elements", 0);
+      for (size_t c = first; c < first + count && c < g.cells.size(); ++c) body.values[c] = static_cast<double>(b);
+    }
+    g.cell_data.push_back(std::move(body));
+  }
   return g;
 }
 

@@ -6,6 +6,7 @@
 #include <functional>
 
 #include "solver/contact/contact_error.hpp"
+#include "solver/core/body_set.hpp"
 #include "solver/solve/rigid_equilibrium.hpp"
 
 namespace grip {
@@ -98,13 +99,19 @@ json step_json(const Problem& problem, const StepRecord& rec, const OutputOption
     const PairedPoint& pp = rec.state.points[i];
     const double area = body.tributary_area(c.site);
     const double p_n = rec.p[c.eta], p_t = c.xi >= 0 ? rec.p[c.xi] : 0.0;
-    points.push_back({{"node", body.site_node(c.site)}, {"obstacle", problem.obstacles[c.obstacle].name},
+    json point = {{"node", body.site_node(c.site)}, {"obstacle", problem.obstacles[c.obstacle].name},
                       {"x", pp.point.x.x()}, {"y", pp.point.x.y()},
                       {"pair", {pp.projection.point.x(), pp.projection.point.y()}},
                       {"normal", {pp.projection.normal.x(), pp.projection.normal.y()}},
                       {"p_n", p_n}, {"p_t", p_t}, {"sigma_n", p_n / area}, {"sigma_t", p_t / area},
                       {"gap", pp.projection.gap}, {"slip", c.xi >= 0 ? rec.state.s[c.xi] : 0.0},
-                      {"state", to_string(contact_state(problem, i, rec.p, rec.tau))}});
+                      {"state", to_string(contact_state(problem, i, rec.p, rec.tau))}};
+    if (const auto* all = dynamic_cast<const BodySet*>(&body)) {  // several bodies: who touches whom
+      const ObstacleInstance& o = problem.obstacles[c.obstacle];
+      point["body"] = all->name(all->body_of_site(c.site));
+      point["master"] = o.master ? all->name(o.master->body) : o.name;
+    }
+    points.push_back(std::move(point));
   }
   j["contact_points"] = points;
   return j;
@@ -148,6 +155,26 @@ json effects_json(const Scene& scene, const RunResult& run) {
               "forces, the whole body's equilibrium their rows; no regularization"
             : "the contact forces: the rigid amplitudes are contact unknowns and the whole body's equilibrium "
               "their condition; no regularization";
+  if (const auto* all = dynamic_cast<const BodySet*>(problem.body.get())) {
+    // Per body what it simulates, and per contact pair its candidates.
+    json bodies = json::array(), pairs = json::array();
+    for (int b = 0; b < all->count(); ++b) {
+      const Body::Traits t = all->part(b).traits();
+      bodies.push_back({{"name", all->name(b)}, {"geometric_nonlinearity", t.geometric_nonlinearity},
+                        {"plasticity", t.plasticity}, {"constant_tangent", t.constant_tangent},
+                        {"dofs", all->part(b).dof_count()}});
+    }
+    for (size_t o = 0; o < problem.obstacles.size(); ++o) {
+      const ObstacleInstance& pair = problem.obstacles[o];
+      if (!pair.master) continue;
+      int candidates = 0;
+      for (const Candidate& c : problem.candidates) candidates += c.obstacle == static_cast<int>(o);
+      pairs.push_back({{"name", pair.name}, {"slave", all->name(pair.slave_body)}, {"master", all->name(pair.master->body)},
+                       {"friction", pair.frictional}, {"contact_candidates", candidates}});
+    }
+    effects["bodies"] = bodies;
+    effects["contacts"] = pairs;
+  }
   if (const auto quality = problem.body->element_quality())
     effects["element_quality"] = {{"elements", quality->elements},
                                   {"max_aspect_ratio", quality->max_aspect_ratio},
@@ -160,7 +187,7 @@ namespace {
 
 // Everything but the steps.
 json result_head(const Scene& scene, const RunResult& run) {
-  return {{"scene", scene.effective},
+  json head = {{"scene", scene.effective},
           {"effects", effects_json(scene, run)},
           {"mesh", {{"cells", scene.problem.body->cells()}}},
           {"summary",
@@ -168,6 +195,19 @@ json result_head(const Scene& scene, const RunResult& run) {
             {"contact_iterations", run.counters.solves},
             {"newton_iterations", run.counters.newton_iterations},
             {"factorizations", run.counters.factorizations}, {"seconds", run.seconds}}}};
+  if (const auto* all = dynamic_cast<const BodySet*>(scene.problem.body.get())) {
+    // Each body's rows of the nodes and elements tables and of mesh.cells.
+    json bodies = json::array();
+    int first_element = 0;
+    for (int b = 0; b < all->count(); ++b) {
+      const int elements = static_cast<int>(all->part(b).cells().size());
+      bodies.push_back({{"name", all->name(b)}, {"first_node", all->node_offset(b)}, {"nodes", all->part(b).node_count()},
+                        {"first_element", first_element}, {"elements", elements}});
+      first_element += elements;
+    }
+    head["bodies"] = bodies;
+  }
+  return head;
 }
 
 // A double as JSON reads it back exactly (shortest round trip), with a point or an exponent

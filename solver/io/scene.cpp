@@ -78,7 +78,8 @@ std::unique_ptr<Obstacle> read_shape(Reader& r, json& j, const std::string& ptr)
 // solver.start: {"node", "component": "x" | "y", "value", "obstacle"} (ALGORITHM.md section 9):
 // the first step starts from a solve with that displacement prescribed and no contact.
 void read_start(Reader& r, json& scene, Problem& problem) {
-  const bool membrane = scene["body"].is_object() && scene["body"].value("model", "") == "rigid_plastic_membrane";
+  const bool membrane = scene.contains("body") && scene["body"].is_object() &&
+                        scene["body"].value("model", "") == "rigid_plastic_membrane";
   json* solver = r.object(scene, "", "solver", false);
   if (!solver) return;
   if (!solver->contains("start")) {
@@ -146,8 +147,10 @@ std::string motion_name(const Vector& coefficients, double L) {
   return "rotate about " + format_point(pivot);
 }
 
+}  // namespace
+
 // The rigid motions the supports leave free, as coefficients of body_modes() (columns).
-Matrix free_motions(const Problem& problem) {
+Matrix scene_io::free_motions(const Problem& problem) {
   const std::vector<Vector> modes = body_modes(*problem.body);
   std::vector<int> fixed;
   for (const Constraint& c : problem.constraints) fixed.push_back(c.dof);
@@ -159,6 +162,8 @@ Matrix free_motions(const Problem& problem) {
   if (lu.rank() == static_cast<Eigen::Index>(modes.size())) return Matrix(modes.size(), 0);
   return lu.kernel();
 }
+
+namespace {
 
 // A basis of the free motions (coefficients of body_modes()) that separates the pure
 // translations (the x and y axes where both are free) from at most one rotation.
@@ -194,7 +199,7 @@ std::vector<Vector> motion_basis(const Matrix& free) {
 void check_rigid_modes(Reader& r, Problem& problem) {
   const Body& body = *problem.body;
   const double L = body.characteristic_length();
-  const std::vector<Vector> free = motion_basis(free_motions(problem));
+  const std::vector<Vector> free = motion_basis(scene_io::free_motions(problem));
   const std::vector<Vector> modes = body_modes(body);
   for (const Vector& c : free) {
     const bool rotates = c.size() > 2 && std::abs(c[2]) > 1e-9;
@@ -510,22 +515,17 @@ Scene read_checked_scene(const nlohmann::json& input) {
   scene.effective = input;
   json& e = scene.effective;
   if (!e.is_object()) throw SceneErrors(std::vector<SceneIssue>{{"/", "a scene is a JSON object"}});
-  if (json* body = r.object(e, "", "body", true)) {
-    // The registry of body models: the scene's name -> its reader.
-    using ModelReader = void (*)(Reader&, json&, Problem&);
-    static const std::vector<std::pair<std::string, ModelReader>> models = {
-        {"timoshenko_beam", scene_io::read_timoshenko_beam},
-        {"rigid_plastic_membrane", scene_io::read_rigid_plastic_membrane},
-        {"continuum", scene_io::read_continuum},
-    };
-    std::vector<std::string> names;
-    for (const auto& m : models) names.push_back(m.first);
-    const std::string model = r.choice(*body, "/body", "model", names, std::nullopt);
-    for (const auto& m : models)
-      if (m.first == model && r.issues.empty()) m.second(r, *body, scene.problem);
+  const bool several = e.contains("bodies");
+  if (several && e.contains("body")) r.error("/body", "cannot be given together with bodies (body is the one-body shorthand)");
+  if (!several && e.contains("contacts")) r.error("/contacts", "pairs the surfaces of bodies: give bodies, not body");
+  if (several) {
+    if (json* bodies = r.array(e, "", "bodies", true)) scene_io::read_bodies(r, *bodies, scene.problem);
+  } else if (json* body = r.object(e, "", "body", true)) {
+    scene_io::read_body(r, *body, scene.problem, "/body");
   }
-  if (json* obs = r.array(e, "", "obstacles", true)) {
-    if (obs->empty()) r.error("/obstacles", "needs at least one obstacle");
+  json* obs = several && !e.contains("obstacles") ? nullptr : r.array(e, "", "obstacles", !several);
+  if (obs) {
+    if (obs->empty() && !several) r.error("/obstacles", "needs at least one obstacle");
     for (size_t i = 0; i < obs->size(); ++i) {
       const std::string op = "/obstacles/" + std::to_string(i);
       json& o = (*obs)[i];
@@ -553,6 +553,7 @@ Scene read_checked_scene(const nlohmann::json& input) {
       scene.problem.obstacles.push_back(std::move(inst));
     }
   }
+  if (several && r.issues.empty()) scene_io::read_contacts(r, e, scene.problem);
   scene.steps = read_load_path(r, e, scene.problem.obstacles);
   scene.load_cases = r.cases;
   scene.problem.case_names = r.cases;
@@ -560,7 +561,7 @@ Scene read_checked_scene(const nlohmann::json& input) {
     for (size_t k = 0; k < r.cases.size(); ++k) scene_io::case_load(scene.problem, static_cast<int>(k));
   read_solver(r, e, scene.params);
   read_output(r, e, scene);
-  if (r.issues.empty() && scene.problem.body) check_rigid_modes(r, scene.problem);
+  if (r.issues.empty() && scene.problem.body && !several) check_rigid_modes(r, scene.problem);
   if (r.issues.empty()) read_start(r, e, scene.problem);
   if (!r.issues.empty()) throw SceneErrors(std::move(r.issues));
   const double reach = scene.params.contact_reach > 0 ? scene.params.contact_reach

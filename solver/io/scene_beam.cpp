@@ -9,8 +9,7 @@ namespace {
 
 }  // namespace
 
-void read_timoshenko_beam(Reader& r, json& body, Problem& problem) {
-  const std::string ptr = "/body";
+void read_timoshenko_beam(Reader& r, json& body, Problem& problem, const std::string& ptr) {
   const std::string kin = r.choice(body, ptr, "kinematics", {"von_karman", "linear"}, "von_karman");
   json* mat = r.object(body, ptr, "material", true);
   json* sec = r.object(body, ptr, "section", true);

@@ -255,8 +255,7 @@ void read_continuum_loads(Reader& r, json& body, const std::string& ptr, const P
 
 }  // namespace
 
-void read_continuum(Reader& r, json& body, Problem& problem) {
-  const std::string ptr = "/body";
+void read_continuum(Reader& r, json& body, Problem& problem, const std::string& ptr) {
   const std::string kin = r.choice(body, ptr, "kinematics", {"finite", "linear"}, "finite");
   const std::string analysis = r.choice(body, ptr, "analysis", {"plane_strain", "plane_stress"}, "plane_strain");
   const std::string element = r.choice(body, ptr, "element", {"q4", "q4_bbar", "q9"}, "q4");

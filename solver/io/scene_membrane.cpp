@@ -6,8 +6,7 @@ namespace grip::scene_io {
 // body: {"model": "rigid_plastic_membrane", "material": {r, M, H, a0, n, regularization},
 //        "thickness", "width", "mesh": {"origin", "length", "elements"} | {"nodes": [[x, y]...]},
 //        "supports": [{"node", "fix": ["x", "y"]}], "loads": [{"node", "force", "case"}]}
-void read_rigid_plastic_membrane(Reader& r, json& body, Problem& problem) {
-  const std::string ptr = "/body";
+void read_rigid_plastic_membrane(Reader& r, json& body, Problem& problem, const std::string& ptr) {
   json* mat = r.object(body, ptr, "material", true);
   json* mesh = r.object(body, ptr, "mesh", true);
   HillMaterial m;

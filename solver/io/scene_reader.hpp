@@ -214,9 +214,22 @@ void read_supports(Reader& r, json& body, const std::string& ptr, int nodes,
                    const std::vector<std::string>& components, int (*dof)(int, int),
                    Problem& problem);
 
-// Body model readers: fill problem.body, constraints and load from scene["body"].
-void read_timoshenko_beam(Reader& r, json& body, Problem& problem);
-void read_rigid_plastic_membrane(Reader& r, json& body, Problem& problem);
-void read_continuum(Reader& r, json& body, Problem& problem);
+// Body model readers: fill problem.body, constraints and load from the body at `ptr`
+// (scene["body"], or an entry of scene["bodies"]).
+void read_timoshenko_beam(Reader& r, json& body, Problem& problem, const std::string& ptr = "/body");
+void read_rigid_plastic_membrane(Reader& r, json& body, Problem& problem, const std::string& ptr = "/body");
+void read_continuum(Reader& r, json& body, Problem& problem, const std::string& ptr = "/body");
+// One body at `ptr` by its model's reader.
+void read_body(Reader& r, json& body, Problem& problem, const std::string& ptr);
+
+// scene["bodies"]: every body read on its own, then joined into one BodySet (dofs, sites and
+// load vectors at each body's offsets); each body must be held by its own supports.
+void read_bodies(Reader& r, json& bodies, Problem& problem);
+// scene["contacts"]: [{slave: "BODY.SET", master: "BODY.SET" | "OBSTACLE", friction, name}]
+// (after the obstacles): a pair with a body master joins problem.obstacles (no shape); one with
+// an obstacle master restricts that obstacle to the slave sets that name it.
+void read_contacts(Reader& r, json& scene, Problem& problem);
+// The rigid motions (coefficients of translation x, y and rotation) the supports leave free.
+Matrix free_motions(const Problem& problem);
 
 }  // namespace grip::scene_io

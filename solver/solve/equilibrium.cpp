@@ -56,14 +56,25 @@ void Equilibrium::pair(const Vector& q, EquilibriumState& state) const {
   state.s = Vector::Zero(problem_.component_count);
   state.enabled.assign(problem_.component_count, 0);
   for (int k = 0; k < problem_.rigid.count(); ++k) state.enabled[problem_.rigid.first + k] = 1;
+  // Deformable masters in their current configuration (node-to-segment).
+  std::vector<std::optional<DeformedMaster>> masters(problem_.obstacles.size());
+  for (size_t o = 0; o < masters.size(); ++o)
+    if (problem_.obstacles[o].master) masters[o].emplace(*problem_.body, q, *problem_.obstacles[o].master);
   for (size_t i = 0; i < cands.size(); ++i) {
     const Candidate& c = cands[i];
     const ObstacleInstance& obstacle = problem_.obstacles[c.obstacle];
     PairedPoint& pp = state.points[i];
     pp.point = problem_.body->surface_point(q, c.site, c.side);
-    const Vec2 offset = obstacle.offset(factors_);
-    pp.projection = obstacle.shape->project(pp.point.x - offset);
-    pp.projection.point += offset;
+    if (const auto& master = masters[c.obstacle]) {
+      // The Jacobian of the relative point x - x_m: the pair's forces act on both bodies.
+      MasterPoint mp = master->project(pp.point.x);
+      pp.projection = mp.projection;
+      pp.point.jacobian.insert(pp.point.jacobian.end(), mp.jacobian.begin(), mp.jacobian.end());
+    } else {
+      const Vec2 offset = obstacle.offset(factors_);
+      pp.projection = obstacle.shape->project(pp.point.x - offset);
+      pp.projection.point += offset;
+    }
     pp.projection.gap -= pp.point.clearance;
     pp.eta = -pp.projection.normal;
     pp.xi = pp.projection.tangent;
@@ -77,7 +88,8 @@ void Equilibrium::pair(const Vector& q, EquilibriumState& state) const {
     // A column of T that vanishes on the free dofs (a force on a support) is never active.
     state.enabled[c.eta] = eta_col > 1e-12;
     if (c.xi >= 0) {
-      state.s[c.xi] = obstacle.shape->zeta_difference(pp.projection.zeta, zeta_previous_[i]);
+      state.s[c.xi] = obstacle.master ? pp.projection.zeta - zeta_previous_[i]
+                                      : obstacle.shape->zeta_difference(pp.projection.zeta, zeta_previous_[i]);
       state.enabled[c.xi] = xi_col > 1e-12;
     }
   }

@@ -1,0 +1,187 @@
+// Scenes of several bodies: "bodies": [{"name", ...what "body" is}] and "contacts":
+// [{"slave": "BODY.SET", "master": "BODY.SET" | "OBSTACLE", "friction", "name"}].
+#include <algorithm>
+#include <set>
+
+#include "solver/core/body_set.hpp"
+#include "solver/elements/continuum.hpp"
+#include "solver/io/scene_reader.hpp"
+
+namespace grip::scene_io {
+
+void read_body(Reader& r, json& body, Problem& problem, const std::string& ptr) {
+  // The registry of body models: the scene's name -> its reader.
+  using ModelReader = void (*)(Reader&, json&, Problem&, const std::string&);
+  static const std::vector<std::pair<std::string, ModelReader>> models = {
+      {"timoshenko_beam", read_timoshenko_beam},
+      {"rigid_plastic_membrane", read_rigid_plastic_membrane},
+      {"continuum", read_continuum},
+  };
+  std::vector<std::string> names;
+  for (const auto& m : models) names.push_back(m.first);
+  const std::string model = r.choice(body, ptr, "model", names, std::nullopt);
+  for (const auto& m : models)
+    if (m.first == model && r.issues.empty()) m.second(r, body, problem, ptr);
+}
+
+void read_bodies(Reader& r, json& bodies, Problem& problem) {
+  if (bodies.empty()) r.error("/bodies", "needs at least one body");
+  std::vector<Problem> parts;
+  std::vector<std::string> names;
+  for (size_t b = 0; b < bodies.size(); ++b) {
+    const std::string bp = "/bodies/" + std::to_string(b);
+    json& body = bodies[b];
+    if (!body.is_object()) {
+      r.error(bp, "is not an object");
+      continue;
+    }
+    if (!body.contains("name")) {
+      r.error(bp + "/name", "is required: contacts name the body's sets as \"BODY.SET\"");
+      continue;
+    }
+    const json& name = body["name"];
+    if (!name.is_string() || name.get<std::string>().empty() || name.get<std::string>().find('.') != std::string::npos) {
+      r.error(bp + "/name", show(name) + " is not a name (a non-empty string without '.')");
+      continue;
+    }
+    for (const std::string& other : names)
+      if (other == name) r.error(bp + "/name", show(name) + " names another body already");
+    if (body.value("model", "") == "rigid_plastic_membrane")
+      r.error(bp + "/model", "a rigid_plastic_membrane starts from a prescribed depth against an obstacle: it is for "
+                             "one-body scenes (body) so far");
+    if (!r.issues.empty()) continue;
+    Problem part;
+    read_body(r, body, part, bp);
+    if (!r.issues.empty() || !part.body) continue;
+    // Contact holds the free rigid motions of one body only (ALGORITHM.md 7), not yet of one of several.
+    if (free_motions(part).cols() > 0)
+      r.error(bp + "/supports", "leave the body free to move rigidly: in a scene of several bodies each body must be "
+                                "held by its own supports (fix a component, or prescribe a displacement) so far");
+    names.push_back(name.get<std::string>());
+    parts.push_back(std::move(part));
+  }
+  if (!r.issues.empty()) return;
+  std::vector<std::unique_ptr<Body>> bodies_owned;
+  for (Problem& part : parts) bodies_owned.push_back(std::move(part.body));
+  auto set = std::make_unique<BodySet>(std::move(bodies_owned), names);
+  problem.body = std::move(set);
+  const BodySet& all = static_cast<const BodySet&>(*problem.body);
+  for (int b = 0; b < all.count(); ++b) {
+    const int offset = all.dof_offset(b), n = all.part(b).dof_count();
+    for (Constraint c : parts[b].constraints) {
+      c.dof += offset;
+      problem.constraints.push_back(c);
+    }
+    for (size_t k = 0; k < parts[b].loads.size(); ++k) case_load(problem, static_cast<int>(k)).segment(offset, n) += parts[b].loads[k];
+  }
+}
+
+namespace {
+
+// "BODY.SET" of a continuum body: the body's index and the set's nodes; nullopt after an error.
+struct SetRef {
+  int body = -1;
+  std::vector<int> sites;  // sites of the BodySet whose nodes are in the set
+};
+
+std::optional<SetRef> find_set(Reader& r, const BodySet& all, const std::string& text, const std::string& ptr) {
+  const size_t dot = text.find('.');
+  const std::string body = text.substr(0, dot), set = dot == std::string::npos ? "" : text.substr(dot + 1);
+  for (int b = 0; b < all.count(); ++b) {
+    if (all.name(b) != body) continue;
+    const auto* continuum = dynamic_cast<const ContinuumBody*>(&all.part(b));
+    if (!continuum) {
+      r.error(ptr, "body \"" + body + "\" is not a continuum: contact pairs between bodies are for continuum bodies so far");
+      return std::nullopt;
+    }
+    const auto& sets = continuum->mesh().sets;
+    if (!sets.count(set)) {
+      std::vector<std::string> names;
+      for (const auto& [n, ids] : sets) names.push_back(n);
+      r.error(ptr, "\"" + set + "\" names no node set of body \"" + body + "\" (sets: " + Reader::list(names) + ")");
+      return std::nullopt;
+    }
+    const std::set<int> nodes(sets.at(set).begin(), sets.at(set).end());
+    SetRef ref{b, {}};
+    for (int s = 0; s < all.part(b).site_count(); ++s)
+      if (nodes.count(all.part(b).site_node(s))) ref.sites.push_back(all.site_offset(b) + s);
+    if (ref.sites.empty()) {
+      r.error(ptr, "set \"" + set + "\" shares no node with the contact_set of body \"" + body + "\"");
+      return std::nullopt;
+    }
+    return ref;
+  }
+  std::vector<std::string> names;
+  for (int b = 0; b < all.count(); ++b) names.push_back(all.name(b));
+  r.error(ptr, show(text) + " names no body (\"BODY.SET\", bodies: " + Reader::list(names) + ")");
+  return std::nullopt;
+}
+
+}  // namespace
+
+void read_contacts(Reader& r, json& scene, Problem& problem) {
+  json* contacts = r.array(scene, "", "contacts", false);
+  if (!contacts) return;
+  const auto& all = static_cast<const BodySet&>(*problem.body);
+  const size_t rigid = problem.obstacles.size();
+  std::vector<std::vector<int>> obstacle_slaves(rigid);
+  for (size_t i = 0; i < contacts->size(); ++i) {
+    const std::string cp = "/contacts/" + std::to_string(i);
+    json& c = (*contacts)[i];
+    if (!c.is_object()) {
+      r.error(cp, "is not an object");
+      continue;
+    }
+    if (!c.contains("slave") || !c["slave"].is_string()) r.error(cp + "/slave", "is required: \"BODY.SET\"");
+    if (!c.contains("master") || !c["master"].is_string()) r.error(cp + "/master", "is required: \"BODY.SET\" or an obstacle's name");
+    if (!r.issues.empty()) continue;
+    const auto slave = find_set(r, all, c["slave"].get<std::string>(), cp + "/slave");
+    const std::string master = c["master"].get<std::string>();
+    int obstacle = -1;
+    for (size_t o = 0; o < rigid; ++o)
+      if (problem.obstacles[o].name == master) obstacle = static_cast<int>(o);
+    if (obstacle >= 0) {
+      if (c.contains("friction"))
+        r.error(cp + "/friction", "is the obstacle's: give it in /obstacles/" + std::to_string(obstacle) + "/friction");
+      if (slave) obstacle_slaves[obstacle].insert(obstacle_slaves[obstacle].end(), slave->sites.begin(), slave->sites.end());
+      continue;
+    }
+    const auto master_set = find_set(r, all, master, cp + "/master");
+    if (!slave || !master_set) continue;
+    if (slave->body == master_set->body) {
+      r.error(cp + "/master", "is on the slave's own body: self-contact is not supported");
+      continue;
+    }
+    // The master's segments: the contact sides of its body with both ends in the set.
+    const std::set<int> in_set(master_set->sites.begin(), master_set->sites.end());
+    std::vector<std::array<int, 2>> segments;
+    for (const auto& s : all.surface_segments())
+      if (in_set.count(s[0]) && in_set.count(s[1])) segments.push_back(s);
+    if (segments.empty()) {
+      r.error(cp + "/master", "set " + show(master) + " spans no side of its body's contact surface");
+      continue;
+    }
+    ObstacleInstance pair;
+    if (!c.contains("name")) c["name"] = c["slave"].get<std::string>() + " on " + master;
+    if (!c["name"].is_string()) r.error(cp + "/name", "is not a string");
+    else pair.name = c["name"].get<std::string>();
+    for (const auto& other : problem.obstacles)
+      if (other.name == pair.name) r.error(cp + "/name", show(c["name"]) + " names an obstacle or another contact already");
+    pair.friction = r.number(c, cp, "friction", 0.0);
+    if (pair.friction < 0) r.error(cp + "/friction", show(c["friction"]) + " is negative");
+    pair.frictional = pair.friction > 0;
+    pair.master = make_master_surface(all, master_set->body, segments);
+    pair.slaves = slave->sites;
+    pair.slave_body = slave->body;
+    problem.obstacles.push_back(std::move(pair));
+  }
+  // An obstacle that no contact names pairs with every body's sites (as in a one-body scene).
+  for (size_t o = 0; o < rigid; ++o) {
+    std::vector<int>& sites = obstacle_slaves[o];
+    std::sort(sites.begin(), sites.end());
+    sites.erase(std::unique(sites.begin(), sites.end()), sites.end());
+    problem.obstacles[o].slaves = std::move(sites);
+  }
+}
+
+}  // namespace grip::scene_io

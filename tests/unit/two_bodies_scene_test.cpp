@@ -1,0 +1,120 @@
+// Scenes of several bodies (issue 19): the reader's errors name the JSON pointer of the value,
+// the result of a two-body scene validates against schemas/result.schema.json and tells each
+// body's rows, contact points carry their body and master, the CSV tables name the body and
+// the VTK cells carry it.
+#include <gtest/gtest.h>
+
+#include "solver/io/export_csv.hpp"
+#include "solver/io/export_vtk.hpp"
+#include "solver/io/result.hpp"
+#include "solver/io/schema_validation.hpp"
+#include "tests/support/scenes.hpp"
+
+namespace grip {
+namespace {
+
+using nlohmann::json;
+using namespace grip::testing;
+
+// The pointers of the issues read_scene reports for `scene`.
+std::vector<std::string> error_pointers(const json& scene) {
+  try {
+    read_scene(scene);
+  } catch (const SceneErrors& e) {
+    std::vector<std::string> pointers;
+    for (const SceneIssue& i : e.issues()) pointers.push_back(i.pointer + ": " + i.detail);
+    return pointers;
+  }
+  return {};
+}
+
+bool has_error(const json& scene, const std::string& pointer) {
+  for (const std::string& e : error_pointers(scene))
+    if (e.rfind(pointer + ": ", 0) == 0) return true;
+  return false;
+}
+
+TEST(TwoBodiesScene, ErrorsNameThePointerOfTheValue) {
+  const json ok = example_scene("two-cylinders");
+  EXPECT_TRUE(error_pointers(ok).empty());
+  json j = ok;
+  j["contacts"][0]["master"] = "nobody.arc";
+  EXPECT_TRUE(has_error(j, "/contacts/0/master"));
+  j = ok;
+  j["contacts"][0]["master"] = "lower.nothing";
+  EXPECT_TRUE(has_error(j, "/contacts/0/master"));
+  j = ok;
+  j["contacts"][0]["slave"] = "upper";
+  EXPECT_TRUE(has_error(j, "/contacts/0/slave"));
+  j = ok;
+  j["contacts"][0]["master"] = "upper.arc_refined";  // the slave's own body
+  EXPECT_TRUE(has_error(j, "/contacts/0/master"));
+  j = ok;
+  j["bodies"][1]["name"] = "upper";
+  EXPECT_TRUE(has_error(j, "/bodies/1/name"));
+  j = ok;
+  j["bodies"][1].erase("name");
+  EXPECT_TRUE(has_error(j, "/bodies/1/name"));
+  j = ok;
+  j["bodies"][1]["supports"][0]["fix"] = {"y"};  // free to slide along x
+  EXPECT_TRUE(has_error(j, "/bodies/1/supports"));
+  j = ok;
+  j["body"] = ok["bodies"][0];
+  EXPECT_TRUE(has_error(j, "/body"));
+  j = ok;
+  j["contacts"][0]["friction"] = -1;
+  EXPECT_TRUE(has_error(j, "/contacts/0/friction"));
+}
+
+TEST(TwoBodiesScene, ResultValidatesAndNamesTheBodies) {
+  json scene = example_scene("two-cylinders");
+  scene["steps"] = 1;
+  Scene solved = read_scene(scene);
+  const RunResult run = run_load_steps(solved.problem, solved.steps, solved.params);
+  ASSERT_TRUE(run.completed) << run.reason;
+  const json r = result_json(solved, run);
+  const auto issues = validate_against(r, SchemaName::result);
+  EXPECT_TRUE(issues.empty()) << (issues.empty() ? "" : issues.front().pointer + ": " + issues.front().detail);
+  ASSERT_EQ(r["bodies"].size(), 2u);
+  EXPECT_EQ(r["bodies"][1]["first_node"], r["bodies"][0]["nodes"]);
+  const int nodes = r["bodies"][0]["nodes"].get<int>() + r["bodies"][1]["nodes"].get<int>();
+  EXPECT_EQ(r["steps"][0]["nodes"].size(), static_cast<size_t>(nodes));
+  for (const json& p : r["steps"][0]["contact_points"]) {
+    EXPECT_EQ(p["body"], "upper");
+    EXPECT_EQ(p["master"], "lower");
+  }
+  EXPECT_EQ(r["effects"]["contacts"][0]["contact_candidates"], r["effects"]["contact_candidates"]);
+  const std::string csv = result_csv(r, "nodes");
+  EXPECT_EQ(csv.substr(0, csv.find('\n')).find("step,load_factor,body,node"), 0u) << csv.substr(0, 80);
+  EXPECT_NE(csv.find(",lower,"), std::string::npos);
+  // VTK: one grid, each cell with its body's index.
+  const std::string vtu = step_vtu(r, 0);
+  EXPECT_NE(vtu.find("Name=\"body\""), std::string::npos);
+}
+
+// A pair whose surfaces lie beyond the contact reach (the set's length by default) has no
+// unknowns; an obstacle named by a contact pairs with that slave set only, one named by none
+// with every body.
+TEST(TwoBodiesScene, OnlyPairsThatCanMeetHaveUnknowns) {
+  json far = example_scene("two-cylinders");
+  far["bodies"][1]["mesh"]["half_disc"]["centre"] = {0, -40};
+  EXPECT_EQ(read_scene(far).problem.component_count, 0);
+  const int pair = read_scene(example_scene("two-cylinders")).problem.component_count;
+  EXPECT_GT(pair, 0);
+  json wall = example_scene("block-on-foundation");
+  wall["obstacles"] = json::parse(R"([{"name": "wall", "shape": {"type": "segment", "from": [6, 10], "to": [6, -10]}}])");
+  const Scene everyone = read_scene(wall);
+  wall["contacts"].push_back({{"slave", "block.bottom"}, {"master", "wall"}});
+  const Scene named = read_scene(wall);
+  auto on_wall = [](const Scene& s) {
+    int n = 0;
+    for (const Candidate& c : s.problem.candidates) n += s.problem.obstacles[c.obstacle].name == "wall";
+    return n;
+  };
+  const int block = 8, foundation = 21;  // contact set nodes
+  EXPECT_EQ(on_wall(everyone), block + foundation);
+  EXPECT_EQ(on_wall(named), block);
+}
+
+}  // namespace
+}  // namespace grip

@@ -1,0 +1,242 @@
+// Two deformable bodies in contact (node-to-segment, issue 19).
+// Hertz between two elastic cylinders in plane strain: two half-discs facing each other (the
+// shipped schemas/examples/two-cylinders.json), the upper one pressed down by its diameter,
+// the lower one held at its diameter. Closed form with the combined radius and modulus:
+// 1/R = 1/R1 + 1/R2, 1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2, a = sqrt(4 P R / (pi E*)),
+// p0 = 2 P / (pi a), P the load per unit thickness from the upper body's reactions.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <numbers>
+
+#include "tests/support/two_bodies.hpp"
+
+namespace grip {
+namespace {
+
+using nlohmann::json;
+using namespace grip::testing;
+
+HertzContact combined_hertz(const json& scene, double P) {
+  double inverse_R = 0, inverse_E = 0;
+  for (const json& b : scene["bodies"]) {
+    const double E = b["material"]["young"], nu = b["material"]["poisson"];
+    inverse_R += 1 / b["mesh"]["half_disc"]["radius"].get<double>();
+    inverse_E += (1 - nu * nu) / E;
+  }
+  const double a = std::sqrt(4 * P / inverse_R * inverse_E / std::numbers::pi);
+  return {P, a, 2 * P / (std::numbers::pi * a)};
+}
+
+// The forces of every pair cancel over the two bodies, and each body is in equilibrium with
+// its own reactions.
+void expect_pairs_balanced(const Solved& s, const StepRecord& rec) {
+  const Problem& problem = s.scene.problem;
+  const Vector f = contact_forces(problem, rec);
+  double scale = 0.0;
+  for (size_t i = 0; i < problem.candidates.size(); ++i) scale += std::abs(rec.p[problem.candidates[i].eta]);
+  Vec2 total = Vec2::Zero();
+  for (int b = 0; b < body_set(problem).count(); ++b) {
+    const Vec2 on_body = body_resultant(problem, b, f);
+    total += on_body;
+    const Vec2 reaction = body_resultant(problem, b, rec.reactions) + body_resultant(problem, b, problem.load(rec.factors));
+    EXPECT_LT((on_body + reaction).norm(), 1e-7 * scale) << "body " << b << " step " << rec.index;
+  }
+  EXPECT_LT(total.norm(), 1e-12 * scale) << "step " << rec.index;
+}
+
+struct CylinderReading {
+  HertzContact closed;
+  EllipseFit slave, master;
+};
+
+CylinderReading read_cylinders(const Solved& s, const StepRecord& rec) {
+  const json& scene = s.scene.effective;
+  const double P = -body_resultant(s.scene.problem, 0, rec.reactions).y() / scene["bodies"][0]["thickness"].get<double>();
+  CylinderReading r{combined_hertz(scene, P), fit_semi_ellipse(contact_profile(s.scene.problem, rec)), {}};
+  const int master = scene["contacts"][0]["master"].get<std::string>().rfind("lower", 0) == 0 ? 1 : 0;
+  const json& disc = scene["bodies"][master]["mesh"]["half_disc"];
+  const Vec2 centre(disc["centre"][0].get<double>(), disc["centre"][1].get<double>());
+  r.master = fit_semi_ellipse(master_profile(s.scene.problem, rec, master, [&](const Vec2& x) { return Vec2((x - centre).normalized()); }));
+  std::printf("step %d: P %.2f N/mm, a %.4f mm (slave %+.2f %%, master %+.2f %%), p0 %.1f MPa (slave %+.2f %%, master %+.2f %%)\n",
+              rec.index, P, r.closed.a, 100 * (r.slave.a / r.closed.a - 1), 100 * (r.master.a / r.closed.a - 1),
+              r.closed.p0, 100 * (r.slave.p0 / r.closed.p0 - 1), 100 * (r.master.p0 / r.closed.p0 - 1));
+  return r;
+}
+
+// The slave's contact stresses against the closed form (a / h 7 and 10 at the two steps);
+// the master's nodal stresses against the slave's within `master_a` and `master_p0`.
+void expect_cylinders_hertz(const json& scene, double master_a, double master_p0) {
+  const Solved s = solve_scene(scene);
+  expect_every_step_sound(s);
+  ASSERT_TRUE(s.run.completed);
+  for (const StepRecord& rec : s.run.steps) {
+    expect_pairs_balanced(s, rec);
+    const CylinderReading r = read_cylinders(s, rec);
+    EXPECT_NEAR(r.slave.a, r.closed.a, 0.01 * r.closed.a);
+    EXPECT_NEAR(r.slave.p0, r.closed.p0, 0.01 * r.closed.p0);
+    EXPECT_NEAR(r.master.a, r.slave.a, master_a * r.slave.a);
+    EXPECT_NEAR(r.master.p0, r.slave.p0, master_p0 * r.slave.p0);
+  }
+}
+
+// Unequal materials slide against each other (frictionless): the slave nodes end between the
+// master's, and node-to-segment hands each slave force to two master nodes by (1 - t, t).
+// The master's nodal stresses are then the slave's smeared over one element: the same
+// resultant (to 1e-12) and peak (2 % at a / h 7, 0.7 % at 10), a contact edge read up to one
+// node wider (a +5.9 %, +1.4 %).
+TEST(TwoBodies, CylindersOfUnequalMaterialsMatchHertz) { expect_cylinders_hertz(example_scene("two-cylinders"), 0.07, 0.025); }
+
+// Swapping slave and master (the soft lower cylinder's nodes as slaves) moves the load by
+// 0.02 %, far less than the discretization error of the readings (0.3-0.8 %); a and p0 read
+// from the other body's nodes stay within 1 % of Hertz (they move by 0.4-1 %: each
+// orientation reads the semi-ellipse at different nodes).
+TEST(TwoBodies, SwappingSlaveAndMasterChangesTheCylindersLittle) {
+  json scene = example_scene("two-cylinders");
+  const Solved upper = solve_scene(scene);
+  scene["contacts"][0] = {{"slave", "lower.arc_refined"}, {"master", "upper.arc_refined"}};
+  const Solved lower = solve_scene(scene);
+  expect_every_step_sound(lower);
+  ASSERT_TRUE(upper.run.completed && lower.run.completed);
+  for (size_t k = 0; k < upper.run.steps.size(); ++k) {
+    const CylinderReading a = read_cylinders(upper, upper.run.steps[k]), b = read_cylinders(lower, lower.run.steps[k]);
+    EXPECT_NEAR(b.closed.P, a.closed.P, 1e-3 * a.closed.P);
+    EXPECT_NEAR(b.slave.a, b.closed.a, 0.01 * b.closed.a);
+    EXPECT_NEAR(b.slave.p0, b.closed.p0, 0.01 * b.closed.p0);
+  }
+}
+
+// Equal materials: mirror images, the nodes stay face to face (t = 0 or 1), and the pressure
+// read from either body is the same.
+TEST(TwoBodies, CylindersOfEqualMaterialsMatchHertz) {
+  json j = example_scene("two-cylinders");
+  j["bodies"][1]["material"] = j["bodies"][0]["material"];
+  expect_cylinders_hertz(j, 0.002, 0.002);
+}
+
+}  // namespace
+}  // namespace grip
+
+namespace grip {
+namespace {
+
+using nlohmann::json;
+using namespace grip::testing;
+
+// schemas/examples/block-on-foundation.json: a uniform compression, which q4 meshes carry
+// exactly; the interface pressure and the load against the exact series springs.
+struct BlockReading {
+  double exact = 0, mean = 0, spread = 0, load = 0;  // stresses; spread: largest |sigma - mean| / |mean|
+};
+
+BlockReading read_block(const json& scene) {
+  const Solved s = solve_scene(scene);
+  expect_every_step_sound(s);
+  const StepRecord& rec = s.run.steps.back();
+  expect_pairs_balanced(s, rec);
+  const json& bodies = s.scene.effective["bodies"];
+  double compliance = 0.0;
+  for (const json& b : bodies) {
+    const double E = b["material"]["young"], nu = b["material"]["poisson"];
+    compliance += b["mesh"]["rectangle"]["size"][1].get<double>() * (1 - nu * nu) / E;
+  }
+  BlockReading r;
+  r.exact = 0.01 / compliance;
+  std::vector<double> sigma;
+  for (const ContactNode& n : contact_profile(s.scene.problem, rec))
+    if (n.p_n < 0) sigma.push_back(-n.sigma_n);
+  for (double v : sigma) r.mean += v / sigma.size();
+  for (double v : sigma) r.spread = std::max(r.spread, std::abs(v / r.mean - 1));
+  r.load = -body_resultant(s.scene.problem, 0, rec.reactions).y() / bodies[0]["mesh"]["rectangle"]["size"][0].get<double>();
+  std::printf("slave %s: %zu nodes press, mean %.3f MPa (exact %.3f, %+.3f %%), spread %.2f %%, load %.3f MPa (%+.3f %%)\n",
+              s.scene.effective["contacts"][0]["slave"].get<std::string>().c_str(), sigma.size(), r.mean, r.exact,
+              100 * (r.mean / r.exact - 1), 100 * r.spread, r.load, 100 * (r.load / r.exact - 1));
+  return r;
+}
+
+// Node-to-segment passes this patch test only approximately: the slave nodes meet the master
+// segments where they are, and the master takes each slave force by (1 - t, t), which is not
+// the master's consistent load of a uniform traction. With the finer surface as slave (h_s /
+// h_m = 0.35 here) the master's nodal loads are close to consistent: pressure uniform to
+// 0.7 %, load exact to 1e-5. With the coarser one as slave the finer master's surface ripples
+// between the slave nodes: the pressure spreads by 14 % and the load is 6 % low, so here
+// swapping changes the result by more than the (vanishing) discretization error of the
+// uniform state. Make the finer surface the slave.
+TEST(TwoBodies, BlockOnFoundationCarriesAUniformPressure) {
+  const json scene = example_scene("block-on-foundation");
+  const BlockReading fine = read_block(scene);
+  EXPECT_LT(fine.spread, 0.02);
+  EXPECT_NEAR(fine.mean, fine.exact, 0.01 * fine.exact);
+  EXPECT_NEAR(fine.load, fine.exact, 0.01 * fine.exact);
+  // Swapped: the coarse block's nodes as slaves.
+  json swapped = scene;
+  swapped["contacts"][0] = {{"slave", "block.bottom"}, {"master", "foundation.top"}};
+  const BlockReading coarse = read_block(swapped);
+  EXPECT_GT(coarse.spread, 5 * fine.spread);
+  EXPECT_GT(std::abs(coarse.load / coarse.exact - 1), 5 * std::abs(fine.load / fine.exact - 1));
+}
+
+}  // namespace
+}  // namespace grip
+
+namespace grip {
+namespace {
+
+using nlohmann::json;
+using namespace grip::testing;
+
+// Cattaneo-Mindlin between two identical elastic half-cylinders (q4, nu = 0.3): for identical
+// materials the normal and tangential problems uncouple exactly (no Dundurs coupling), so the
+// closed form holds at any nu: c = a sqrt(1 - Q / (mu P)) with a from the combined radius and
+// modulus. The upper one is pressed without friction (0.1 mm), then moved sideways by its
+// diameter (0.04 mm) with friction 0.3; the lower one is held at its diameter.
+json two_cylinders_sheared() {
+  json one = example_scene("cattaneo-mindlin")["body"];
+  one["element"] = "q4";
+  one["material"]["poisson"] = 0.3;
+  json upper = one, lower = one;
+  upper["name"] = "upper";
+  upper["mesh"]["half_disc"]["centre"] = {0, 10};
+  upper["supports"][0]["values"]["y"] = -0.1;
+  upper["supports"][1]["values"]["x"] = 0.04;
+  lower["name"] = "lower";
+  lower["mesh"]["half_disc"]["centre"] = {0, -10};
+  lower["mesh"]["half_disc"]["facing"] = "up";
+  lower["supports"] = {{{"set", "diameter"}, {"fix", {"x", "y"}}}};
+  json j = {{"bodies", {upper, lower}},
+            {"contacts", {{{"slave", "upper.arc_refined"}, {"master", "lower.arc_refined"}, {"name", "pair"}, {"friction", 0.3}}}},
+            {"stages", {{{"steps", 2}, {"factors", {{"press", 1}}}, {"friction", {{"pair", 0}}}},
+                        {{"steps", 2}, {"factors", {{"shear", 1}}}}}},
+            {"solver", {{"contact", {{"method", "cev"}, {"tolerance", 1e-8}}}}}};
+  return j;
+}
+
+TEST(TwoBodies, CattaneoMindlinStickZoneBetweenIdenticalCylinders) {
+  const Solved s = solve_scene(two_cylinders_sheared());
+  expect_every_step_sound(s);
+  ASSERT_TRUE(s.run.completed);
+  const json& body = s.scene.effective["bodies"][0];
+  const double mu = 0.3, E = body["material"]["young"], nu = body["material"]["poisson"];
+  const double R = body["mesh"]["half_disc"]["radius"].get<double>() / 2, E_star = E / (2 * (1 - nu * nu));
+  for (size_t k = 2; k < s.run.steps.size(); ++k) {
+    const StepRecord& rec = s.run.steps[k];
+    expect_pairs_balanced(s, rec);
+    const Vec2 reaction = body_resultant(s.scene.problem, 0, rec.reactions);
+    const double P = -reaction.y(), Q = std::abs(reaction.x());
+    const double a = std::sqrt(4 * P * R / (std::numbers::pi * E_star)), c = a * std::sqrt(1 - Q / (mu * P));
+    const auto nodes = contact_profile(s.scene.problem, rec);
+    const Zone stick = stick_zone(nodes, mu);
+    ASSERT_TRUE(stick.found);
+    std::printf("step %d: P %.1f, Q/(mu P) %.3f, a %.4f, c %.4f (c/a %.3f); stick zone %.4f (%+.2f %% of a), "
+                "between nodes %.4f (%+.2f %% of a)\n",
+                rec.index, P, Q / (mu * P), a, c, c / a, stick.half_width(), 100 * (stick.half_width() - c) / a,
+                stick.midpoint_half_width(), 100 * (stick.midpoint_half_width() - c) / a);
+    EXPECT_GT(Q, 0.2 * mu * P);
+    EXPECT_LT(Q, mu * P);
+    EXPECT_LT(std::abs(stick.half_width() - c), 0.03 * a);
+    EXPECT_TRUE(stick.brackets(c, 0.03 * a));
+  }
+}
+
+}  // namespace
+}  // namespace grip
