@@ -54,7 +54,15 @@ bool FreeBlockSolver::factorize(const Triplets& triplets, const std::vector<int>
       if (mirror_[k] > k) w[k] = w[mirror_[k]] = 0.5 * (w[k] + w[mirror_[k]]);
   }
   if (symmetric_) {
-    if (!llt_analysed_) llt_.analyzePattern(matrix_);  // the ordering: once per pattern
+    if (!llt_analysed_) {  // the ordering: once per pattern
+      // CHOLMOD's own choice: supernodal where dense blocks pay (2D continua), simplicial for
+      // banded blocks (beams, membranes), where the supernodal BLAS calls on tiny blocks cost
+      // more than the arithmetic (the beam's compliance: 30 % of its time in dtrsm). L L^T
+      // either way (inverse_block reads L).
+      llt_.cholmod().supernodal = CHOLMOD_AUTO;
+      llt_.cholmod().final_ll = 1;
+      llt_.analyzePattern(matrix_);
+    }
     llt_analysed_ = true;
     llt_.factorize(matrix_);
     // Not positive definite, or a pivot at round-off (the supports do not hold the body):
