@@ -116,6 +116,8 @@ def style(strategy, family):
         return dict(color="black", linestyle="-", marker="s")
     if family == "penalty":
         return dict(color="tab:gray", linestyle="-", marker="D")
+    if family in ("cev", "ssn"):  # cev's default (Coulomb inside the iteration), the semismooth Newton
+        return dict(color="tab:cyan" if family == "cev" else "tab:pink", linestyle="-", marker="o")
     parts = strategy.split("-")
     level = parts[1]
     kw = dict(color=colours.get(level, "tab:cyan"), linestyle="--" if family == "cev-paper" else "-",
