@@ -342,7 +342,8 @@ bool Equilibrium::factorize_body_tangent(const Vector& q) {
   problem_.body->internal_force(q, force, &triplets);
   ++counters_.factorizations;
   body_factorized_ = true;
-  body_tangent_norm_ = free_row_sum_norm(triplets, free_index_, free_count_, length_scales_);
+  // Read by Newton only for a constant tangent (a changing one has its own triplets).
+  if (constant_tangent_) body_tangent_norm_ = free_row_sum_norm(triplets, free_index_, free_count_, length_scales_);
   return body_lu_.factorize(triplets, free_index_, free_count_);
 }
 
