@@ -14,12 +14,12 @@ class PenaltyStep : public StepSolver {
   using StepSolver::StepSolver;
 
  private:
-  void solve(const Vector& q_guess, const Vector& p_start, const Vector&) override {
+  void solve(const Vector& q_guess, const Vector& p_start, const Vector& p_previous) override {
     PenaltyLaw law;
     law.normal = params_.penalty_normal > 0 ? params_.penalty_normal
                                             : params_.penalty_factor * eq_.stiffness_scale(q_guess);
     law.tangential = params_.penalty_tangential > 0 ? params_.penalty_tangential : law.normal;
-    law.previous = p_start;
+    law.previous = p_previous;  // the springs start from the last step's force
     Vector q0 = q_guess;
     touch(q0, p_start);
     EquilibriumState s;

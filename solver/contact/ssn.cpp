@@ -40,10 +40,12 @@ class SsnStep : public StepSolver {
   }
 
  private:
-  void solve(const Vector& q_guess, const Vector& p_start, const Vector&) override {
+  // Starts from the previous step's force (p_previous): from the extrapolated one, small
+  // augmentations led it to other equilibria of the beam's steps.
+  void solve(const Vector& q_guess, const Vector&, const Vector& p_previous) override {
     coulomb_ = true;
     pass_ = out_.passes = 1;
-    out_.p = p_start;
+    out_.p = p_previous;
     project_to_cone(problem_, out_.p);
     if (!fresh_solve(q_guess) || !approach_contact()) return;
     Vector q = out_.state.q, p = out_.p;

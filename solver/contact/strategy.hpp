@@ -99,8 +99,9 @@ struct StepOutcome {
   std::vector<IterationEvent> history;
 };
 
-// One load step: p_start is the previous step's force (the first guess), p_star its normal
-// part (the first pass's friction bound), q_guess the displacement to start Newton from.
+// One load step: p_start is the first guess of the force (the previous steps' forces
+// extrapolated, like q_guess, the displacement to start Newton from), p_star the previous
+// step's force (the first pass's friction bound, penalty's springs).
 StepOutcome solve_contact_step(Equilibrium& equilibrium, const Vector& q_guess,
                                const Vector& p_start, const Vector& p_star,
                                const ContactParams& params, int step,

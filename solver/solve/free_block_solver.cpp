@@ -54,7 +54,15 @@ bool FreeBlockSolver::factorize(const Triplets& triplets, const std::vector<int>
       if (mirror_[k] > k) w[k] = w[mirror_[k]] = 0.5 * (w[k] + w[mirror_[k]]);
   }
   if (symmetric_) {
-    if (!llt_analysed_) llt_.analyzePattern(matrix_);  // the ordering: once per pattern
+    if (!llt_analysed_) {  // the ordering: once per pattern
+      // CHOLMOD's own choice: supernodal where dense blocks pay (2D continua), simplicial for
+      // banded blocks (beams, membranes), where the supernodal BLAS calls on tiny blocks cost
+      // more than the arithmetic (the beam's compliance: 30 % of its time in dtrsm). L L^T
+      // either way (inverse_block reads L).
+      llt_.cholmod().supernodal = CHOLMOD_AUTO;
+      llt_.cholmod().final_ll = 1;
+      llt_.analyzePattern(matrix_);
+    }
     llt_analysed_ = true;
     llt_.factorize(matrix_);
     // Not positive definite, or a pivot at round-off (the supports do not hold the body):
@@ -70,8 +78,36 @@ bool FreeBlockSolver::factorize(const Triplets& triplets, const std::vector<int>
   return ok_;
 }
 
+// A simplicial factor tells beforehand whether the partial solves pay: the solve from row k
+// reaches the path from k to the root of the elimination tree (parent of column j: its first
+// row below the diagonal), so their work, |rows|^2 x the mean path length, is known without
+// copying the factor (a beam's or a membrane's banded block: the dense solves win).
+namespace {
+
+bool partial_solves_pay(const cholmod_factor* L, const std::vector<int>& rows) {
+  if (L->is_super) return true;  // sampled in inverse_block
+  const int n = static_cast<int>(L->n);
+  const int *lp = static_cast<const int*>(L->p), *li = static_cast<const int*>(L->i),
+            *lnz = static_cast<const int*>(L->nz), *perm = static_cast<const int*>(L->Perm);
+  std::vector<int> path(n, 1), position(n);
+  double nnz_l = 0.0;
+  for (int j = n - 1; j >= 0; --j) {  // a parent's index is larger than its child's
+    int parent = n;
+    for (int t = lp[j] + 1; t < lp[j] + lnz[j]; ++t) parent = std::min(parent, li[t]);
+    if (parent < n) path[j] = path[parent] + 1;
+    nnz_l += lnz[j];
+  }
+  for (int k = 0; k < n; ++k) position[perm ? perm[k] : k] = k;
+  double reach = 0.0;
+  for (int r : rows) reach += path[position[r]];
+  const double s = static_cast<double>(rows.size());
+  return s * reach <= 2.0 * nnz_l * s;
+}
+
+}  // namespace
+
 bool CholmodFactor::inverse_block(const std::vector<int>& rows, Matrix& G) {
-  if (!m_cholmodFactor) return false;
+  if (!m_cholmodFactor || !partial_solves_pay(m_cholmodFactor, rows)) return false;
   cholmod_common* cc = &cholmod();
   cholmod_factor* L = cholmod_copy_factor(m_cholmodFactor, cc);  // the partial solve makes it simplicial
   if (!L) return false;

@@ -67,7 +67,7 @@ RunResult run_load_steps(Problem& problem, const std::vector<LoadStep>& steps,
   if (problem.rigid.count()) problem.rigid.scale = 1.0 / eq.stiffness_scale(Vector::Zero(ndof));
   const size_t cases = steps.empty() ? 1 : steps.front().factors.size();
   Vector q = Vector::Zero(ndof), q_before = q;
-  Vector p = Vector::Zero(problem.component_count);
+  Vector p = Vector::Zero(problem.component_count), p_before = p;
   LoadFactors current(cases, 0.0), before = current;
   eq.set_step(current, std::vector<double>(problem.candidates.size(), 0.0));
   std::vector<double> zeta = eq.zetas(eq.evaluate(q));
@@ -96,22 +96,25 @@ RunResult run_load_steps(Problem& problem, const std::vector<LoadStep>& steps,
     const LoadFactors from = current;
     double done = 0.0, increment = 1.0;
     int depth = 0;
+    bool from_previous_force = false;  // after a failure from the extrapolated force
     while (true) {
       const double t = std::min(1.0, done + increment);
       const LoadFactors target = t == 1.0 ? target_step.factors : blend(from, target_step.factors, t);
       // Newton starts from the previous increment scaled to this one (section 9): a zero
       // guess would leave a membrane without transverse stiffness.
       const double last = distance(current, before);
-      const Vector guess = start_q ? *start_q
-                           : last > 0 ? Vector(q + (q - q_before) * (distance(target, current) / last))
-                                      : q;
+      const double ratio = !start_q && last > 0 ? distance(target, current) / last : 0.0;
+      const Vector guess = start_q ? *start_q : Vector(q + (q - q_before) * ratio);
+      // The contact forces start from the same extrapolation (the strategies bring it back
+      // into the cone): a step then starts near its answer, not a whole increment away.
+      const Vector p_guess = from_previous_force ? p : Vector(p + (p - p_before) * ratio);
       eq.set_step(target, zeta);
       // A load that no static equilibrium can carry: no cut of the increment can help.
       if (std::string why = unreachable_equilibrium(problem, eq.evaluate(guess), target); !why.empty()) {
         rec.reason = std::move(why);
         break;
       }
-      StepOutcome out = solve_contact_step(eq, guess, p, p, params.contact, step,
+      StepOutcome out = solve_contact_step(eq, guess, p_guess, p, params.contact, step,
                                            observer.iteration, observer.stop_requested);
       rec.passes += out.passes;
       rec.solves += out.solves;
@@ -121,6 +124,13 @@ RunResult run_load_steps(Problem& problem, const std::vector<LoadStep>& steps,
       if (!out.epsilon_used.empty()) rec.epsilon_used = out.epsilon_used;
       if (!out.converged) {
         if (out.stopped) result.stopped = true;
+        // A poor extrapolation (after the start-up step, or where contact changes) is retried
+        // from the previous force before the increment is cut: a cut changes the load path.
+        if (!out.stopped && !from_previous_force && p_guess != p) {
+          from_previous_force = true;
+          ++rec.restarts;
+          continue;
+        }
         if (depth >= params.max_cuts || out.stopped) {
           rec.reason = out.reason + (depth ? " (after " + std::to_string(depth) + " cuts of the increment)" : "");
           rec.p = out.p;
@@ -147,6 +157,7 @@ RunResult run_load_steps(Problem& problem, const std::vector<LoadStep>& steps,
       // Commit.
       start_q.reset();
       q_before = q;
+      p_before = p;
       before = current;
       q = out.state.q;
       p = out.p;

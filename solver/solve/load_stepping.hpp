@@ -30,6 +30,7 @@ struct StepRecord {
   std::string reason;
   std::string warning;         // the converged state lies beyond the model's accurate range
   int cuts = 0;                // sub-increments this step needed beyond one
+  int restarts = 0;            // attempts from the extrapolated force retried from the last one
   int passes = 0, solves = 0, newton_iterations = 0, inner_iterations = 0;
   double seconds = 0.0;
   std::string epsilon_used;
