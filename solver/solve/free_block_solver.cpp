@@ -70,6 +70,16 @@ bool FreeBlockSolver::factorize(const Triplets& triplets, const std::vector<int>
   return ok_;
 }
 
+bool FreeBlockSolver::inverse_block(const std::vector<int>& rows, Matrix& G) {
+  if (!ok_ || !symmetric_) return false;
+  if (llt_.inverse_block(rows, G)) return true;
+  CholmodFactor dissected;
+  dissected.cholmod().nmethods = 1;
+  dissected.cholmod().method[0].ordering = CHOLMOD_NESDIS;
+  dissected.compute(matrix_);
+  return dissected.info() == Eigen::Success && dissected.inverse_block(rows, G);
+}
+
 bool CholmodFactor::inverse_block(const std::vector<int>& rows, Matrix& G) {
   if (!m_cholmodFactor) return false;
   cholmod_common* cc = &cholmod();
