@@ -106,6 +106,16 @@ bool partial_solves_pay(const cholmod_factor* L, const std::vector<int>& rows) {
 
 }  // namespace
 
+bool FreeBlockSolver::inverse_block(const std::vector<int>& rows, Matrix& G) {
+  if (!ok_ || !symmetric_) return false;
+  if (llt_.inverse_block(rows, G)) return true;
+  CholmodFactor dissected;
+  dissected.cholmod().nmethods = 1;
+  dissected.cholmod().method[0].ordering = CHOLMOD_NESDIS;
+  dissected.compute(matrix_);
+  return dissected.info() == Eigen::Success && dissected.inverse_block(rows, G);
+}
+
 bool CholmodFactor::inverse_block(const std::vector<int>& rows, Matrix& G) {
   if (!m_cholmodFactor || !partial_solves_pay(m_cholmodFactor, rows)) return false;
   cholmod_common* cc = &cholmod();

@@ -38,8 +38,10 @@ class FreeBlockSolver {
   Vector solve(const Vector& b) const { return symmetric_ ? Vector(llt_.solve(b)) : Vector(lu_.solve(b)); }
   Matrix solve(const Matrix& b) const { return symmetric_ ? Matrix(llt_.solve(b)) : Matrix(lu_.solve(b)); }
   // K^-1 on the given rows where K is Cholesky-factorized (CholmodFactor::inverse_block);
-  // false otherwise (then solve() for unit right-hand sides).
-  bool inverse_block(const std::vector<int>& rows, Matrix& G) { return ok_ && symmetric_ && llt_.inverse_block(rows, G); }
+  // false otherwise (then solve() for unit right-hand sides). Where the factor's own ordering
+  // gives the rows long elimination-tree paths (thin strips: a fill-reducing ordering there is
+  // nearly banded), a second factorization in nested-dissection order, for G only.
+  bool inverse_block(const std::vector<int>& rows, Matrix& G);
   bool ok() const { return ok_; }
   // The next factorize() builds its pattern afresh (the free set changed).
   void forget_pattern() {

@@ -155,6 +155,21 @@ TEST(Compliance, FromGEqualsTheDenseOneOnAContinuum) {
   }
 }
 
+// A thin strip on a flat, 101 contact nodes on its bottom and 4 element rows: the body's
+// fill-reducing ordering is nearly banded there (long elimination-tree paths from the surface
+// rows), so G comes from a second factorization in nested-dissection order.
+TEST(Compliance, FromGEqualsTheDenseOneOnAThinStrip) {
+  const Scene scene = read_scene(nlohmann::json::parse(R"({
+    "units": {"force": "N", "length": "mm"},
+    "body": {"model": "continuum", "kinematics": "linear", "analysis": "plane_strain", "element": "q4",
+             "thickness": 1, "material": {"young": 200000, "poisson": 0.3},
+             "mesh": {"rectangle": {"size": [1, 0.04], "divisions": [100, 4]}},
+             "supports": [{"set": "top", "fix": ["x", "y"], "values": {"y": -1e-6}}]},
+    "obstacles": [{"name": "flat", "shape": {"type": "segment", "from": [2, 0], "to": [-1, 0]}, "friction": 0.3}],
+    "steps": 1})"));
+  expect_compliance_from_g_is_dense(scene.problem, small_random_displacement(scene.problem, 1e-5), "thin strip");
+}
+
 // A constant tangent: one factorization and one G serve every call, whatever the state.
 TEST(Compliance, ConstantTangentFormsGOnce) {
   const Scene scene = coarse_half_disc("linear");
