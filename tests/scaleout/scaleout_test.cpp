@@ -273,7 +273,9 @@ TEST(Scaleout, ThreeReplicasOnePostgresNothingLostNothingRunTwice) {
   note("all checked");
   note("dismissals");
   // Dismissal across replicas: a long job, dismissed through a replica that does not run it.
-  const json long_job = beam_scene(40, 400);
+  // Long enough to be still running 300 ms in on a fast machine (a step takes about 0.1 ms).
+  constexpr int kLongSteps = 4000;
+  const json long_job = beam_scene(40, kLongSteps);
   for (int d = 0; d < 2; ++d) {
     const std::string id = Api(ports[d]).submit(long_job);  // the queue is empty by now
     const json running = Api(ports[d]).wait_status(id, {"running"}, 120s);
@@ -297,7 +299,7 @@ TEST(Scaleout, ThreeReplicasOnePostgresNothingLostNothingRunTwice) {
       iterations += e.type == "iteration";
       steps += e.type == "step_finished";
     }
-    EXPECT_LT(steps, 400);  // stopped early
+    EXPECT_LT(steps, kLongSteps);  // stopped early
     // Iterations stored after the snapshot taken just before the DELETE: the ones in flight to
     // the database then, plus those run before the dismissal reached the runner.
     // The runner's own account: the contact iteration at which it heard of the dismissal and
