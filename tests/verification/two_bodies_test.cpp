@@ -114,15 +114,6 @@ TEST(TwoBodies, CylindersOfEqualMaterialsMatchHertz) {
   expect_cylinders_hertz(j, 0.002, 0.002);
 }
 
-}  // namespace
-}  // namespace grip
-
-namespace grip {
-namespace {
-
-using nlohmann::json;
-using namespace grip::testing;
-
 // schemas/examples/block-on-foundation.json: a uniform compression, which q4 meshes carry
 // exactly; the interface pressure and the load against the exact series springs.
 struct BlockReading {
@@ -175,15 +166,6 @@ TEST(TwoBodies, BlockOnFoundationCarriesAUniformPressure) {
   EXPECT_GT(coarse.spread, 5 * fine.spread);
   EXPECT_GT(std::abs(coarse.load / coarse.exact - 1), 5 * std::abs(fine.load / fine.exact - 1));
 }
-
-}  // namespace
-}  // namespace grip
-
-namespace grip {
-namespace {
-
-using nlohmann::json;
-using namespace grip::testing;
 
 // Cattaneo-Mindlin between two identical elastic half-cylinders (q4, nu = 0.3): for identical
 // materials the normal and tangential problems uncouple exactly (no Dundurs coupling), so the
