@@ -1,5 +1,6 @@
 #include "solver/solve/load_stepping.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <optional>
@@ -68,6 +69,11 @@ RunResult run_load_steps(Problem& problem, const std::vector<LoadStep>& steps,
   const size_t cases = steps.empty() ? 1 : steps.front().factors.size();
   Vector q = Vector::Zero(ndof), q_before = q;
   Vector p = Vector::Zero(problem.component_count), p_before = p;
+  // Node-to-segment pairs start from the last force: from the extrapolated one, the slave
+  // nodes' forces land on other master segments and the loop wanders (two cylinders of
+  // unequal materials, step 2: 59 real solves and 1958 Newton iterations instead of 4 and 24).
+  const bool extrapolate_forces =
+      std::none_of(problem.obstacles.begin(), problem.obstacles.end(), [](const ObstacleInstance& o) { return o.master.has_value(); });
   LoadFactors current(cases, 0.0), before = current;
   eq.set_step(current, std::vector<double>(problem.candidates.size(), 0.0));
   std::vector<double> zeta = eq.zetas(eq.evaluate(q));
@@ -107,7 +113,7 @@ RunResult run_load_steps(Problem& problem, const std::vector<LoadStep>& steps,
       const Vector guess = start_q ? *start_q : Vector(q + (q - q_before) * ratio);
       // The contact forces start from the same extrapolation (the strategies bring it back
       // into the cone): a step then starts near its answer, not a whole increment away.
-      const Vector p_guess = from_previous_force ? p : Vector(p + (p - p_before) * ratio);
+      const Vector p_guess = from_previous_force || !extrapolate_forces ? p : Vector(p + (p - p_before) * ratio);
       eq.set_step(target, zeta);
       // A load that no static equilibrium can carry: no cut of the increment can help.
       if (std::string why = unreachable_equilibrium(problem, eq.evaluate(guess), target); !why.empty()) {
