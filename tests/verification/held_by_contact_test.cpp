@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <ostream>
 
 #include "solver/elements/continuum.hpp"
 #include "tests/support/contact_profile.hpp"
@@ -100,6 +101,8 @@ struct Strategy {
   std::vector<std::string> not_for = {};
   const char* why_not = "";
 };
+// ctest and gtest name the parameter by its strategy, not by its bytes.
+void PrintTo(const Strategy& s, std::ostream* os) { *os << s.name; }
 
 const char* const kPaperBeam =
     "the paper's literal loop on the beam lying on a flat: alpha halved 40 times without a decrease of the "
