@@ -131,25 +131,19 @@ std::vector<std::vector<int>> BodySet::cells() const {
   return all;
 }
 
-FieldTable BodySet::site_fields(const Vector& q) const {
+FieldTable BodySet::stacked(FieldTable (Body::*fields)(const Vector&) const, const Vector& q) const {
   FieldTable all;
   for (int b = 0; b < count(); ++b) {
-    FieldTable t = parts_[b]->site_fields(part_q(q, b));
+    FieldTable t = (parts_[b].get()->*fields)(part_q(q, b));
     if (b == 0) all.names = t.names;
     for (auto& row : t.rows) all.rows.push_back(std::move(row));
   }
   return all;
 }
 
-FieldTable BodySet::element_fields(const Vector& q) const {
-  FieldTable all;
-  for (int b = 0; b < count(); ++b) {
-    FieldTable t = parts_[b]->element_fields(part_q(q, b));
-    if (b == 0) all.names = t.names;
-    for (auto& row : t.rows) all.rows.push_back(std::move(row));
-  }
-  return all;
-}
+FieldTable BodySet::site_fields(const Vector& q) const { return stacked(&Body::site_fields, q); }
+
+FieldTable BodySet::element_fields(const Vector& q) const { return stacked(&Body::element_fields, q); }
 
 Vector BodySet::start_guess(const Vector& prescribed, const std::vector<char>& is_prescribed) const {
   Vector q(dof_count());

@@ -53,6 +53,8 @@ class BodySet final : public Body {
   void commit(const Vector& q) override;
 
  private:
+  // The parts' tables of `fields` one below the other (the names of the first part).
+  FieldTable stacked(FieldTable (Body::*fields)(const Vector&) const, const Vector& q) const;
   std::vector<std::unique_ptr<Body>> parts_;
   std::vector<std::string> names_;
   std::vector<int> dof_offset_, site_offset_, node_offset_;  // count() + 1 entries each
