@@ -1,12 +1,18 @@
 #pragma once
 // Readings of scenes of several bodies (BodySet): the contact forces on every dof, each
 // body's share of forces, and the contact pressure read on the master side of a pair.
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <string>
 #include <vector>
 
 #include "solver/core/body_set.hpp"
 #include "tests/support/contact_profile.hpp"
+#include "tests/support/scenes.hpp"
 
 namespace grip::testing {
 
@@ -64,6 +70,55 @@ std::vector<ContactNode> master_profile(const Problem& problem, const StepRecord
     if (-n.p_n < 1e-3 * peak) n.state = ContactState::open, n.p_n = n.sigma_n = 0.0;
   std::sort(nodes.begin(), nodes.end(), [](const auto& a, const auto& c) { return a.x < c.x; });
   return nodes;
+}
+
+// Hertz between two elastic half-discs of the scene (1/R = 1/R1 + 1/R2, 1/E* = sum of
+// (1 - nu^2)/E) at load P per unit thickness.
+inline HertzContact combined_hertz(const nlohmann::json& scene, double P) {
+  double inverse_R = 0, inverse_E = 0;
+  for (const nlohmann::json& b : scene["bodies"]) {
+    const double E = b["material"]["young"], nu = b["material"]["poisson"];
+    inverse_R += 1 / b["mesh"]["half_disc"]["radius"].get<double>();
+    inverse_E += (1 - nu * nu) / E;
+  }
+  const double a = std::sqrt(4 * P / inverse_R * inverse_E / std::numbers::pi);
+  return {P, a, 2 * P / (std::numbers::pi * a)};
+}
+
+// The forces of every pair cancel over the two bodies, and each body is in equilibrium with
+// its own reactions.
+inline void expect_pairs_balanced(const Solved& s, const StepRecord& rec) {
+  const Problem& problem = s.scene.problem;
+  const Vector f = contact_forces(problem, rec);
+  double scale = 0.0;
+  for (size_t i = 0; i < problem.candidates.size(); ++i) scale += std::abs(rec.p[problem.candidates[i].eta]);
+  Vec2 total = Vec2::Zero();
+  for (int b = 0; b < body_set(problem).count(); ++b) {
+    const Vec2 on_body = body_resultant(problem, b, f);
+    total += on_body;
+    const Vec2 reaction = body_resultant(problem, b, rec.reactions) + body_resultant(problem, b, problem.load(rec.factors));
+    EXPECT_LT((on_body + reaction).norm(), 1e-7 * scale) << "body " << b << " step " << rec.index;
+  }
+  EXPECT_LT(total.norm(), 1e-12 * scale) << "step " << rec.index;
+}
+
+struct CylinderReading {
+  HertzContact closed;
+  EllipseFit slave, master;
+};
+
+inline CylinderReading read_cylinders(const Solved& s, const StepRecord& rec) {
+  const nlohmann::json& scene = s.scene.effective;
+  const double P = -body_resultant(s.scene.problem, 0, rec.reactions).y() / scene["bodies"][0]["thickness"].get<double>();
+  CylinderReading r{combined_hertz(scene, P), fit_semi_ellipse(contact_profile(s.scene.problem, rec)), {}};
+  const int master = scene["contacts"][0]["master"].get<std::string>().rfind("lower", 0) == 0 ? 1 : 0;
+  const nlohmann::json& disc = scene["bodies"][master]["mesh"]["half_disc"];
+  const Vec2 centre(disc["centre"][0].get<double>(), disc["centre"][1].get<double>());
+  r.master = fit_semi_ellipse(master_profile(s.scene.problem, rec, master, [&](const Vec2& x) { return Vec2((x - centre).normalized()); }));
+  std::printf("step %d: P %.2f N/mm, a %.4f mm (slave %+.2f %%, master %+.2f %%), p0 %.1f MPa (slave %+.2f %%, master %+.2f %%)\n",
+              rec.index, P, r.closed.a, 100 * (r.slave.a / r.closed.a - 1), 100 * (r.master.a / r.closed.a - 1),
+              r.closed.p0, 100 * (r.slave.p0 / r.closed.p0 - 1), 100 * (r.master.p0 / r.closed.p0 - 1));
+  return r;
 }
 
 }  // namespace grip::testing

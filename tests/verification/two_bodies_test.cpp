@@ -17,53 +17,6 @@ namespace {
 using nlohmann::json;
 using namespace grip::testing;
 
-HertzContact combined_hertz(const json& scene, double P) {
-  double inverse_R = 0, inverse_E = 0;
-  for (const json& b : scene["bodies"]) {
-    const double E = b["material"]["young"], nu = b["material"]["poisson"];
-    inverse_R += 1 / b["mesh"]["half_disc"]["radius"].get<double>();
-    inverse_E += (1 - nu * nu) / E;
-  }
-  const double a = std::sqrt(4 * P / inverse_R * inverse_E / std::numbers::pi);
-  return {P, a, 2 * P / (std::numbers::pi * a)};
-}
-
-// The forces of every pair cancel over the two bodies, and each body is in equilibrium with
-// its own reactions.
-void expect_pairs_balanced(const Solved& s, const StepRecord& rec) {
-  const Problem& problem = s.scene.problem;
-  const Vector f = contact_forces(problem, rec);
-  double scale = 0.0;
-  for (size_t i = 0; i < problem.candidates.size(); ++i) scale += std::abs(rec.p[problem.candidates[i].eta]);
-  Vec2 total = Vec2::Zero();
-  for (int b = 0; b < body_set(problem).count(); ++b) {
-    const Vec2 on_body = body_resultant(problem, b, f);
-    total += on_body;
-    const Vec2 reaction = body_resultant(problem, b, rec.reactions) + body_resultant(problem, b, problem.load(rec.factors));
-    EXPECT_LT((on_body + reaction).norm(), 1e-7 * scale) << "body " << b << " step " << rec.index;
-  }
-  EXPECT_LT(total.norm(), 1e-12 * scale) << "step " << rec.index;
-}
-
-struct CylinderReading {
-  HertzContact closed;
-  EllipseFit slave, master;
-};
-
-CylinderReading read_cylinders(const Solved& s, const StepRecord& rec) {
-  const json& scene = s.scene.effective;
-  const double P = -body_resultant(s.scene.problem, 0, rec.reactions).y() / scene["bodies"][0]["thickness"].get<double>();
-  CylinderReading r{combined_hertz(scene, P), fit_semi_ellipse(contact_profile(s.scene.problem, rec)), {}};
-  const int master = scene["contacts"][0]["master"].get<std::string>().rfind("lower", 0) == 0 ? 1 : 0;
-  const json& disc = scene["bodies"][master]["mesh"]["half_disc"];
-  const Vec2 centre(disc["centre"][0].get<double>(), disc["centre"][1].get<double>());
-  r.master = fit_semi_ellipse(master_profile(s.scene.problem, rec, master, [&](const Vec2& x) { return Vec2((x - centre).normalized()); }));
-  std::printf("step %d: P %.2f N/mm, a %.4f mm (slave %+.2f %%, master %+.2f %%), p0 %.1f MPa (slave %+.2f %%, master %+.2f %%)\n",
-              rec.index, P, r.closed.a, 100 * (r.slave.a / r.closed.a - 1), 100 * (r.master.a / r.closed.a - 1),
-              r.closed.p0, 100 * (r.slave.p0 / r.closed.p0 - 1), 100 * (r.master.p0 / r.closed.p0 - 1));
-  return r;
-}
-
 // The slave's contact stresses against the closed form (a / h 7 and 10 at the two steps);
 // the master's nodal stresses against the slave's within `master_a` and `master_p0`.
 void expect_cylinders_hertz(const json& scene, double master_a, double master_p0) {
