@@ -152,11 +152,15 @@ void read_contacts(Reader& r, json& scene, Problem& problem) {
       r.error(cp + "/master", "is on the slave's own body: self-contact is not supported");
       continue;
     }
-    // The master's segments: the contact sides of its body with both ends in the set.
-    const std::set<int> in_set(master_set->sites.begin(), master_set->sites.end());
-    std::vector<std::array<int, 2>> segments;
-    for (const auto& s : all.surface_segments())
-      if (in_set.count(s[0]) && in_set.count(s[1])) segments.push_back(s);
+    // Each side's segments: the contact sides of its body with both ends in its set.
+    auto sides_in = [&](const std::vector<int>& sites) {
+      const std::set<int> in_set(sites.begin(), sites.end());
+      std::vector<std::array<int, 2>> segments;
+      for (const auto& s : all.surface_segments())
+        if (in_set.count(s[0]) && in_set.count(s[1])) segments.push_back(s);
+      return segments;
+    };
+    const std::vector<std::array<int, 2>> segments = sides_in(master_set->sites);
     if (segments.empty()) {
       r.error(cp + "/master", "set " + show(master) + " spans no side of its body's contact surface");
       continue;
@@ -170,7 +174,7 @@ void read_contacts(Reader& r, json& scene, Problem& problem) {
     pair.friction = r.number(c, cp, "friction", 0.0);
     if (pair.friction < 0) r.error(cp + "/friction", show(c["friction"]) + " is negative");
     pair.frictional = pair.friction > 0;
-    pair.master = make_master_surface(all, master_set->body, segments);
+    pair.master = make_master_surface(all, master_set->body, segments, sides_in(slave->sites));
     pair.slaves = slave->sites;
     pair.slave_body = slave->body;
     problem.obstacles.push_back(std::move(pair));

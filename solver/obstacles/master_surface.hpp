@@ -1,14 +1,29 @@
 #pragma once
-// A deformable master surface (node-to-segment pairing): boundary segments of a body of the
-// problem, in the current configuration. A slave point projects onto the polyline through the
-// master sites' current positions as onto a rigid profile (make_profile: the same corners,
-// ends and extensions, no NaN), and its pairing carries the Jacobian of the master point
-// x_m = (1 - t) x_a + t x_b, so that the relative point x_slave - x_m moves with both bodies:
-// T p = J^T f then puts f on the slave and -f, shared by (1 - t, t), on the master.
+// A deformable master surface: boundary segments of a body of the problem, in the current
+// configuration, paired segment-to-segment with a slave surface (a mortar method with dual
+// Lagrange multipliers, Wohlmuth 2000, Popp et al. 2010, in 2D).
+//
+// The unknown of slave site j stays a force at that site (p_j = D_j lambda_j, D_j = int N_j
+// its tributary length): the dual basis psi_j (2 N_j - N_other on each slave segment,
+// int psi_j N_i = delta_ij D_j) makes the slave's side of the mortar coupling diagonal. The
+// master takes -w_jk p_j at its site k, w_jk = M_jk / D_j, M_jk = int psi_j N_k over the slave
+// segments: the consistent load of the slave's traction field, whichever side is finer. So a
+// uniform pressure across a flat interface is carried exactly with either surface as slave
+// (the patch test), where node-to-segment's split (1 - t, t) of each slave force between the
+// two ends of one master segment is not consistent unless the slave is the finer side.
+// The gap of site j is (x_j - x_m) . n with the mortar point x_m = sum_k w_jk x_k (the
+// psi_j-weighted mean of the master surface over the slave segments around j: int psi_j
+// (x_slave - x_master) . n / D_j), so T p = J^T f with the Jacobian of x_j - x_m.
+// Integration: each slave segment is cut at the projections of the master sites onto its
+// line; on each piece the integrand is quadratic, and two Gauss points make it exact.
+// A slave site whose slave segments the master covers by less than half of D_j (a surface
+// end beyond the master's) pairs node-to-segment: its closest point on the polyline through
+// the master sites, as on a rigid profile (make_profile: corners, ends and extensions, no
+// NaN), shared by (1 - t, t).
 // The normal is smoothed: interpolated along each segment between the sites' mean normals
-// (so it is continuous across the sites; the polyline's own corner normal, (x - x_site) /
-// |x - x_site|, turns with a stiffness of force / gap, unbounded as the gap closes). The
-// gap is (x - x_m) . n; the stiffness of the normal's turn is left out of dnormal_dx.
+// (so it is continuous across the sites; the polyline's own corner normal turns with a
+// stiffness of force / gap, unbounded as the gap closes); its turn is left out of dnormal_dx.
+#include <map>
 #include <memory>
 #include <vector>
 
@@ -21,22 +36,26 @@ struct MasterSurface {
   int body = -1;                         // the master body (index into the scene's bodies)
   std::vector<std::vector<int>> chains;  // sites of the problem's body along each run, body on the left
   std::vector<std::vector<double>> reference_zeta;  // per chain and site: reference arc length
+  std::vector<std::vector<int>> slave_chains;       // the slave surface's runs (sites, body on the left)
 };
 
 // The chains through the given segments ([a, b], body on the left of a -> b), each followed
 // from a segment that no other segment ends at (or any, for a closed loop); zeta from 0 along
-// them in the reference configuration, continuing from one chain to the next.
-MasterSurface make_master_surface(const Body& body, int body_index, const std::vector<std::array<int, 2>>& segments);
+// the master's chains in the reference configuration, continuing from one chain to the next.
+MasterSurface make_master_surface(const Body& body, int body_index, const std::vector<std::array<int, 2>>& segments,
+                                  const std::vector<std::array<int, 2>>& slave_segments);
 
 struct MasterPoint {
   Projection projection;  // zeta: the master's reference arc length (material, for slips)
-  std::vector<PointJacobianEntry> jacobian;  // of -x_m: -(1 - t) dx_a and -t dx_b
+  std::vector<PointJacobianEntry> jacobian;  // of -x_m: -w_k dx_k over the master sites
 };
 
 class DeformedMaster {
  public:
   DeformedMaster(const Body& body, const Vector& q, const MasterSurface& surface);
-  MasterPoint project(const Vec2& x) const;
+  // The pairing of slave point x; `slave_site` (a site of a slave chain, or -1) selects its
+  // mortar weights where it has them.
+  MasterPoint project(const Vec2& x, int slave_site = -1) const;
 
  private:
   struct Chain {
@@ -46,7 +65,16 @@ class DeformedMaster {
     std::vector<Vec2> normal;            // outward normal at each site: the mean of its sides' normals
     const std::vector<double>* reference;
   };
+  struct Closest {
+    Projection projection;
+    int chain = 0, segment = 0;
+    double t = 0.0;  // along the segment, unclamped beyond the chain's ends
+  };
+  Closest closest(const Vec2& x) const;
+  void integrate_mortar(const Body& body, const Vector& q, const MasterSurface& surface);
   std::vector<Chain> chains_;
+  // Per slave site: (chain, index) of master sites and the weights w_jk.
+  std::map<int, std::vector<std::pair<std::array<int, 2>, double>>> mortar_;
 };
 
 }  // namespace grip

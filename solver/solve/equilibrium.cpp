@@ -67,7 +67,7 @@ void Equilibrium::pair(const Vector& q, EquilibriumState& state) const {
     pp.point = problem_.body->surface_point(q, c.site, c.side);
     if (const auto& master = masters[c.obstacle]) {
       // The Jacobian of the relative point x - x_m: the pair's forces act on both bodies.
-      MasterPoint mp = master->project(pp.point.x);
+      MasterPoint mp = master->project(pp.point.x, c.site);
       pp.projection = mp.projection;
       pp.point.jacobian.insert(pp.point.jacobian.end(), mp.jacobian.begin(), mp.jacobian.end());
     } else {

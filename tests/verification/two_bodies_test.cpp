@@ -17,9 +17,10 @@ namespace {
 using nlohmann::json;
 using namespace grip::testing;
 
-// The slave's contact stresses against the closed form (a / h 7 and 10 at the two steps);
-// the master's nodal stresses against the slave's within `master_a` and `master_p0`.
-void expect_cylinders_hertz(const json& scene, double master_a, double master_p0) {
+// The contact stresses against the closed form (a / h 7 and 10 at the two steps), read from
+// either body: the slave's nodal stresses, and the same traction field read at the master's
+// sites (master_field_profile), both within 1 % of a and p0.
+void expect_cylinders_hertz(const json& scene) {
   const Solved s = solve_scene(scene);
   expect_every_step_sound(s);
   ASSERT_TRUE(s.run.completed);
@@ -28,17 +29,17 @@ void expect_cylinders_hertz(const json& scene, double master_a, double master_p0
     const CylinderReading r = read_cylinders(s, rec);
     EXPECT_NEAR(r.slave.a, r.closed.a, 0.01 * r.closed.a);
     EXPECT_NEAR(r.slave.p0, r.closed.p0, 0.01 * r.closed.p0);
-    EXPECT_NEAR(r.master.a, r.slave.a, master_a * r.slave.a);
-    EXPECT_NEAR(r.master.p0, r.slave.p0, master_p0 * r.slave.p0);
+    EXPECT_NEAR(r.master.a, r.closed.a, 0.01 * r.closed.a);
+    EXPECT_NEAR(r.master.p0, r.closed.p0, 0.01 * r.closed.p0);
   }
 }
 
 // Unequal materials slide against each other (frictionless): the slave nodes end between the
-// master's, and node-to-segment hands each slave force to two master nodes by (1 - t, t).
-// The master's nodal stresses are then the slave's smeared over one element: the same
-// resultant (to 1e-12) and peak (2 % at a / h 7, 0.7 % at 10), a contact edge read up to one
-// node wider (a +5.9 %, +1.4 %).
-TEST(TwoBodies, CylindersOfUnequalMaterialsMatchHertz) { expect_cylinders_hertz(example_scene("two-cylinders"), 0.07, 0.025); }
+// master's. The master's own nodal forces (the mortar's consistent loads of the slave's
+// traction) have the same resultant (to 1e-12) but reach one slave element beyond the last
+// pressing slave node, so a fit to them reads the edge wider (a +5.9 %, +1.5 %); the
+// traction field read at the master's sites is Hertz's within 1 %.
+TEST(TwoBodies, CylindersOfUnequalMaterialsMatchHertz) { expect_cylinders_hertz(example_scene("two-cylinders")); }
 
 // Swapping slave and master (the soft lower cylinder's nodes as slaves) moves the load by
 // 0.02 %, far less than the discretization error of the readings (0.3-0.8 %); a and p0 read
@@ -56,6 +57,8 @@ TEST(TwoBodies, SwappingSlaveAndMasterChangesTheCylindersLittle) {
     EXPECT_NEAR(b.closed.P, a.closed.P, 1e-3 * a.closed.P);
     EXPECT_NEAR(b.slave.a, b.closed.a, 0.01 * b.closed.a);
     EXPECT_NEAR(b.slave.p0, b.closed.p0, 0.01 * b.closed.p0);
+    EXPECT_NEAR(b.master.a, b.closed.a, 0.01 * b.closed.a);
+    EXPECT_NEAR(b.master.p0, b.closed.p0, 0.01 * b.closed.p0);
   }
 }
 
@@ -64,7 +67,7 @@ TEST(TwoBodies, SwappingSlaveAndMasterChangesTheCylindersLittle) {
 TEST(TwoBodies, CylindersOfEqualMaterialsMatchHertz) {
   json j = example_scene("two-cylinders");
   j["bodies"][1]["material"] = j["bodies"][0]["material"];
-  expect_cylinders_hertz(j, 0.002, 0.002);
+  expect_cylinders_hertz(j);
 }
 
 // schemas/examples/block-on-foundation.json: a uniform compression, which q4 meshes carry
@@ -98,26 +101,29 @@ BlockReading read_block(const json& scene) {
   return r;
 }
 
-// Node-to-segment passes this patch test only approximately: the slave nodes meet the master
-// segments where they are, and the master takes each slave force by (1 - t, t), which is not
-// the master's consistent load of a uniform traction. With the finer surface as slave (h_s /
-// h_m = 0.35 here) the master's nodal loads are close to consistent: pressure uniform to
-// 0.7 %, load exact to 1e-5. With the coarser one as slave the finer master's surface ripples
-// between the slave nodes: the pressure spreads by 14 % and the load is 6 % low, so here
-// swapping changes the result by more than the (vanishing) discretization error of the
-// uniform state. Make the finer surface the slave.
+// The patch test, with either surface as slave. The mortar coupling hands each slave force to
+// the master as the consistent load of the slave's traction (M_jk = int psi_j N_k), so a
+// uniform pressure is carried exactly whichever side is finer: q4 meshes hold the uniform
+// state, and the only departure from it is the foundation's end, which expands 4.6e-3 mm
+// (nu (1 + nu) sigma / E over 10 mm, steel against aluminium) beyond the block's and carries
+// nothing there: 0.3-0.5 % at the end nodes. (Node-to-segment, the earlier pairing, split
+// each slave force (1 - t, t) between one master segment's ends: 0.7 % with the finer
+// foundation as slave, 13.8 % spread and the load 5.9 % low with the coarse block as slave.)
+// Swapping slave and master changes the mean pressure by less than either orientation's
+// spread (the discretization error here) and the load by less than 1e-5.
 TEST(TwoBodies, BlockOnFoundationCarriesAUniformPressure) {
   const json scene = example_scene("block-on-foundation");
   const BlockReading fine = read_block(scene);
-  EXPECT_LT(fine.spread, 0.02);
-  EXPECT_NEAR(fine.mean, fine.exact, 0.01 * fine.exact);
-  EXPECT_NEAR(fine.load, fine.exact, 0.01 * fine.exact);
-  // Swapped: the coarse block's nodes as slaves.
   json swapped = scene;
   swapped["contacts"][0] = {{"slave", "block.bottom"}, {"master", "foundation.top"}};
   const BlockReading coarse = read_block(swapped);
-  EXPECT_GT(coarse.spread, 5 * fine.spread);
-  EXPECT_GT(std::abs(coarse.load / coarse.exact - 1), 5 * std::abs(fine.load / fine.exact - 1));
+  for (const BlockReading& r : {fine, coarse}) {
+    EXPECT_LT(r.spread, 0.01);
+    EXPECT_NEAR(r.mean, r.exact, 1e-3 * r.exact);
+    EXPECT_NEAR(r.load, r.exact, 1e-5 * r.exact);
+  }
+  EXPECT_LT(std::abs(coarse.mean - fine.mean), std::min(coarse.spread, fine.spread) * fine.exact);
+  EXPECT_NEAR(coarse.load, fine.load, 1e-5 * fine.exact);
 }
 
 // Cattaneo-Mindlin between two identical elastic half-cylinders (q4, nu = 0.3): for identical
