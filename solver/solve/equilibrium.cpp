@@ -56,7 +56,7 @@ void Equilibrium::pair(const Vector& q, EquilibriumState& state) const {
   state.s = Vector::Zero(problem_.component_count);
   state.enabled.assign(problem_.component_count, 0);
   for (int k = 0; k < problem_.rigid.count(); ++k) state.enabled[problem_.rigid.first + k] = 1;
-  // Deformable masters in their current configuration (node-to-segment).
+  // Deformable masters in their current configuration (mortar, segment-to-segment).
   std::vector<std::optional<DeformedMaster>> masters(problem_.obstacles.size());
   for (size_t o = 0; o < masters.size(); ++o)
     if (problem_.obstacles[o].master) masters[o].emplace(*problem_.body, q, *problem_.obstacles[o].master);

@@ -1,4 +1,4 @@
-// Two deformable bodies in contact (node-to-segment, issue 19).
+// Two deformable bodies in contact (segment-to-segment mortar pairing, issue 19).
 // Hertz between two elastic cylinders in plane strain: two half-discs facing each other (the
 // shipped schemas/examples/two-cylinders.json), the upper one pressed down by its diameter,
 // the lower one held at its diameter. Closed form with the combined radius and modulus:
