@@ -96,6 +96,23 @@ def initial_xy(result: dict, step: dict) -> Tuple[List[float], List[float]]:
     return ([n["x"] - n[ku] for n in step["nodes"]], [n["y"] - n[kv] for n in step["nodes"]])
 
 
+def body_ranges(result: dict, step: dict) -> List[Tuple[Optional[str], int, int]]:
+    """(name, first node, node count) of each body: the result's `bodies[]` in a scene of
+    several bodies (their rows follow each other in `nodes`), else one nameless body."""
+    bodies = result.get("bodies") or []
+    if not bodies:
+        return [(None, 0, len(step["nodes"]))]
+    return [(b["name"], b["first_node"], b["nodes"]) for b in bodies]
+
+
+def contact_names(result: dict) -> List[str]:
+    """What contact points pair with: the obstacles, then the contact pairs between bodies."""
+    scene = result.get("scene", {})
+    names = [o["name"] for o in scene.get("obstacles", [])]
+    names += [c["name"] for c in scene.get("contacts", []) if c.get("name") and c["name"] not in names]
+    return names
+
+
 def characteristic_length(result: dict) -> float:
     """The body length the contact tolerance is relative to (the mesh length; else the extent
     of the undeformed nodes)."""
@@ -316,7 +333,17 @@ def shapes(result: dict, steps: Optional[Sequence[int]] = None):
     cmap = plt.get_cmap("plasma")
     x0, y0 = initial_xy(result, chosen[0])
     data = {"initial": {"x": x0, "y": y0}, "steps": {}}
-    ax.plot(x0, y0, color="0.6", ls="--", lw=1.2, label="undeformed", gid="initial")
+    # One line per body (several bodies: gids and labels carry the body's name).
+    ranges = body_ranges(result, chosen[0])
+
+    def per_body(xs, ys, gid, **style):
+        label = style.pop("label", None)
+        for name, first, count in ranges:
+            ax.plot(xs[first:first + count], ys[first:first + count], **style,
+                    label=label if name is None else f"{label}, {name}" if label else None,
+                    gid=gid if name is None else f"{gid}-{name}")
+
+    per_body(x0, y0, "initial", color="0.6", ls="--", lw=1.2, label="undeformed")
     draw_obstacles(ax, result, None, color="0.75", label=False, linestyle=":")
     allx, ally = list(x0), list(y0)
     for i, s in enumerate(chosen):
@@ -324,13 +351,16 @@ def shapes(result: dict, steps: Optional[Sequence[int]] = None):
         x, y = node_xy(s)
         label = step_label(result, s)
         data["steps"][s["step"]] = {"x": x, "y": y, "offsets": obstacle_offsets(s), "label": label}
+        if ranges[0][0] is not None:
+            data["steps"][s["step"]]["bodies"] = {
+                name: {"x": x[first:first + count], "y": y[first:first + count]} for name, first, count in ranges}
         if body_model(result) == "timoshenko_beam":
             band = beam_band(s)
             if band:  # the beam's lower and upper surfaces, thin
                 for surface in band:
                     ax.plot([p[0] for p in surface], [p[1] for p in surface], color=colour,
                             lw=0.6, alpha=0.7)
-        ax.plot(x, y, "-o", ms=2.5, lw=1.6, color=colour, label=label, gid=f"step-{s['step']}")
+        per_body(x, y, f"step-{s['step']}", marker="o", ms=2.5, lw=1.6, color=colour, label=label)
         if moving_obstacle(result):
             draw_obstacles(ax, result, s, color=colour, alpha=0.6, label=False)
         allx += x
@@ -459,7 +489,7 @@ def contact_stress(result: dict, component: str = "normal", step: Optional[int] 
     plt = pyplot()
     key = {"normal": "sigma_n", "friction": "sigma_t"}[component]
     s = find_step(result, step)
-    names = [o["name"] for o in result.get("scene", {}).get("obstacles", [])]
+    names = contact_names(result)
     data = {"step": s["step"], "label": step_label(result, s), "component": component,
             "key": key, "obstacles": {}}
     fig, (ax_shape, ax_line) = plt.subplots(2, 1, figsize=(9, 8.5),
@@ -472,7 +502,10 @@ def contact_stress(result: dict, component: str = "normal", step: Optional[int] 
             poly = lower + upper[::-1]
             ax_shape.fill([p[0] for p in poly], [p[1] for p in poly], color="tab:blue",
                           alpha=0.2, lw=0)
-    ax_shape.plot(x, y, "-", color="tab:blue", lw=1.4, label="body (deformed)")
+    for name, first, count in body_ranges(result, s):
+        ax_shape.plot(x[first:first + count], y[first:first + count], "-", lw=1.4,
+                      color="tab:blue" if name is None else None,
+                      label="body (deformed)" if name is None else f"{name} (deformed)")
     draw_obstacles(ax_shape, result, s)
     allx, ally = list(x), list(y)
     peak = max((abs(c[key]) for c in s.get("contact_points", []) or []), default=0.0)
@@ -588,7 +621,8 @@ def applicable(result: dict) -> List[str]:
     if last.get("contact_points"):
         names.append("contact_normal")
         if any(c.get("sigma_t", 0) != 0 for c in last["contact_points"]) or any(
-                o.get("friction", 0) > 0 for o in result.get("scene", {}).get("obstacles", [])):
+                o.get("friction", 0) > 0 for o in result.get("scene", {}).get("obstacles", [])
+                + result.get("scene", {}).get("contacts", [])):
             names.append("contact_friction")
     if total_load(result)[0] > 0:
         names.append("load_deflection")

@@ -191,5 +191,60 @@ class Plots(unittest.TestCase):
         self.assertEqual(p.returncode, 2)
 
 
+@unittest.skipUnless(HAVE_MPL, "matplotlib is not importable by this python "
+                               "(use /usr/bin/python3 with python3-matplotlib)")
+class TwoBodyPlots(unittest.TestCase):
+    """A scene of several bodies (schemas/examples/two-cylinders.json, solved by `grip solve`):
+    each body is its own line, named, with exactly its rows of `nodes`, and the contact stress
+    is drawn per contact pair."""
+
+    @classmethod
+    def setUpClass(cls):
+        import subprocess
+
+        cls.tmp = tempfile.TemporaryDirectory()
+        out = os.path.join(cls.tmp.name, "result.json")
+        scene = os.path.join(support.EXAMPLES, "two-cylinders.json")
+        subprocess.run([support.grip_binary(), "solve", scene, "--out", out], check=True,
+                       capture_output=True, timeout=120)
+        with open(out, encoding="utf-8") as f:
+            cls.result = json.load(f)
+        from grip_client import plots
+
+        cls.plots = plots
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.tmp.cleanup()
+
+    def tearDown(self):
+        self.plots.pyplot().close("all")
+
+    def test_each_body_is_its_own_line(self):
+        fig, data = self.plots.shapes(self.result)
+        lines = lines_by_gid(fig)
+        bodies = self.result["bodies"]
+        self.assertEqual([b["name"] for b in bodies], ["upper", "lower"])
+        for k in data["steps"]:
+            nodes = self.result["steps"][k - 1]["nodes"]
+            for b in bodies:
+                rows = nodes[b["first_node"]:b["first_node"] + b["nodes"]]
+                line = lines[f"step-{k}-{b['name']}"]
+                self.assertEqual(floats(line.get_xdata()), [p["x"] for p in rows])
+                self.assertEqual(floats(line.get_ydata()), [p["y"] for p in rows])
+                self.assertEqual(data["steps"][k]["bodies"][b["name"]]["x"], [p["x"] for p in rows])
+        self.assertEqual(sum(b["nodes"] for b in bodies), len(self.result["steps"][-1]["nodes"]))
+
+    def test_contact_stress_per_pair(self):
+        last = self.result["steps"][-1]
+        pair = self.result["scene"]["contacts"][0]["name"]
+        fig, data = self.plots.contact_stress(self.result, "normal")
+        line = lines_by_gid(fig)[f"sigma_n-{pair}"]
+        pts = sorted((c for c in last["contact_points"] if c["obstacle"] == pair), key=lambda c: c["node"])
+        self.assertTrue(any(c["sigma_n"] < 0 for c in pts))
+        self.assertEqual(floats(line.get_ydata()), [c["sigma_n"] for c in pts])
+        self.assertIn("contact_normal", self.plots.applicable(self.result))
+
+
 if __name__ == "__main__":
     unittest.main()
