@@ -61,7 +61,7 @@ class Body {
   // The surface point of `site` on side +1 (upper) or -1 (lower), at state q.
   virtual SurfacePoint surface_point(const Vector& q, int site, int side) const = 0;
   // The straight pieces of the contact surface between sites, each [a, b] with the body on
-  // the left of a -> b: what a slave point of another body pairs with (node-to-segment).
+  // the left of a -> b: what a slave surface of another body pairs with (mortar segments).
   // Empty where the model offers no master surface.
   virtual std::vector<std::array<int, 2>> surface_segments() const { return {}; }
   // Surface area that a site's contact force acts on (tributary length x width).
