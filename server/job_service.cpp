@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 
 #include "server/util.hpp"
 #include "solver/io/result.hpp"
@@ -688,7 +689,11 @@ void JobService::run_job(const std::shared_ptr<ActiveJob>& job, const JobRecord&
   }
   if (outcome.status != JobStatus::dismissed && !run.steps.empty()) {
     try {
-      outcome.result = result_json(*scene, run).dump();
+      // Written as it is made (write_result), not built as a JSON document first: the document
+      // took several times the text's memory and more time than writing it.
+      std::ostringstream text;
+      write_result(text, *scene, run);
+      outcome.result = std::move(text).str();
     } catch (const std::exception& e) {
       spdlog::error("job {}: cannot build its result: {}", id, e.what());
     }
