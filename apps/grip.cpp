@@ -4,6 +4,8 @@
 //   grip healthcheck [--host H] [--port P]
 // Exit codes of solve: 0 solved, 1 a step failed, 2 usage or scene error.
 #include <cstdio>
+#include <chrono>
+#include <ctime>
 #include <fstream>
 #include <iostream>
 #include <string>
@@ -35,6 +37,15 @@ int solve(int argc, char** argv) {
   }
   if (scene_path.empty()) return usage();
 
+  // Wall and CPU seconds of the phases around the solver (reading, writing), printed last.
+  auto now = [] {
+    timespec cpu;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &cpu);
+    return std::pair<double, double>{
+        std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count(),
+        cpu.tv_sec + 1e-9 * cpu.tv_nsec};
+  };
+  const auto start = now();
   grip::Scene scene;
   try {
     scene = grip::read_scene_file(scene_path);
@@ -71,8 +82,10 @@ int solve(int argc, char** argv) {
                               : rec.reason.c_str());
     std::fflush(stdout);
   };
+  const auto read = now();
   const grip::RunResult run =
       grip::run_load_steps(scene.problem, scene.steps, scene.params, observer);
+  const auto solved = now();
   emit(run.completed ? nlohmann::json{{"type", "job_finished"}}
                      : nlohmann::json{{"type", "job_failed"}, {"reason", run.reason}});
   std::printf("total: %ld contact iterations, %ld Newton iterations, %ld factorizations, %.3f s\n",
@@ -86,6 +99,10 @@ int solve(int argc, char** argv) {
       return 2;
     }
   }
+  const auto written = now();
+  std::printf("read %.3f s (cpu %.3f), solve %.3f s (cpu %.3f), write %.3f s (cpu %.3f)\n", read.first - start.first,
+              read.second - start.second, solved.first - read.first, solved.second - read.second,
+              written.first - solved.first, written.second - solved.second);
   if (!run.completed) std::fprintf(stderr, "%s\n", run.reason.c_str());
   return run.completed ? 0 : 1;
 }

@@ -34,13 +34,23 @@ LIMIT_S = 400  # a run longer than this ends its sweep
 RESULTS = ROOT / "bench" / "results"
 
 
+def fewest_half_disc_divisions(radius, size, extent, growth=1.4):
+    """The fewest [2 (fine + coarse), fine + coarse] the half-disc generator accepts: coarse
+    elements growing at most `growth`-fold from the fine size, along the arc (half-length
+    pi R / 2) and down the axis (R) (solver/elements/half_disc_mesh.cpp, graded_divisions)."""
+    fine = round(extent / size)
+    h = extent / fine
+    needed = lambda rest: max(1, math.ceil(math.log(1 + rest * (growth - 1) / (h * growth)) / math.log(growth) - 1e-9))
+    coarse = max(needed(math.pi * radius / 2 - extent), needed(radius - extent))
+    return [2 * (fine + coarse), fine + coarse]
+
+
 def hertz_scene(a_over_h, mu):
     j = json.loads((ROOT / "schemas/examples/hertz.json").read_text())
     disc = j["body"]["mesh"]["half_disc"]
     size = {10: 0.05, 20: 0.0265, 40: 0.01325}[a_over_h]  # 33, 61, 121 candidates (issue 14)
-    fine = round(disc["refine"]["extent"] / size)
     disc["refine"]["size"] = size
-    disc["divisions"] = [2 * (fine + 12), fine + 12]
+    disc["divisions"] = fewest_half_disc_divisions(disc["radius"], size, disc["refine"]["extent"])
     j["body"]["supports"] = [{"set": "diameter", "fix": ["y"], "values": {"y": -0.05}},
                              {"set": "centre", "fix": ["x"]}]
     j["obstacles"][0]["friction"] = mu

@@ -9,6 +9,8 @@ and seconds per real solve. Usage: bench/two_bodies.py [--repeat N] (from the re
 """
 import argparse, copy, json, subprocess, tempfile, os
 
+from scaling import fewest_half_disc_divisions  # the fewest divisions the half-disc generator accepts
+
 def one_body(scene, obstacle):
     s = copy.deepcopy(scene)
     body = s.pop("bodies")[0]
@@ -43,8 +45,9 @@ def main():
     # Refined: elements of 0.025 mm within 0.8 mm of the poles (a/h 14 and 21 at the two steps).
     fine = copy.deepcopy(cyl)
     for b in fine["bodies"]:
-        b["mesh"]["half_disc"]["refine"]["size"] = 0.025
-        b["mesh"]["half_disc"]["divisions"] = [88, 44]
+        disc = b["mesh"]["half_disc"]
+        disc["refine"]["size"] = 0.025
+        disc["divisions"] = fewest_half_disc_divisions(disc["radius"], 0.025, disc["refine"]["extent"])
     rigid_lower = {"name": "lower", "shape": {"type": "circle", "centre": [0, -10], "radius": 10}}
     cases = [
         ("two cylinders (E 200/70 GPa)", cyl),

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 
 #include "server/util.hpp"
 #include "solver/io/result.hpp"
@@ -40,9 +41,11 @@ StoredEvent stored(std::int64_t seq, const json& event) {
   return {seq, event.at("type").get<std::string>(), event.dump()};
 }
 
-// The fewest nodes a generated mesh ({"rectangle" | "half_disc": {"divisions": [a, b]}}) can
-// have: (a + 1)(b + 1). Building a mesh far over the node limit before counting its nodes
-// held the HTTP thread for minutes (a 1000 x 1000 rectangle).
+// The fewest nodes a generated mesh can have: a rectangle {"divisions": [a, b]} (a + 1)(b + 1);
+// a half-disc {"divisions": [ns, nt]} (ns + 1)(nt - m + 1) + (ns - 2 m - 1) m for a ring of m
+// rows (plane_mesh.hpp), fewest at the most rows it can have, min(ns / 2, nt) - 1. Building a
+// mesh far over the node limit before counting its nodes held the HTTP thread for minutes (a
+// 1000 x 1000 rectangle).
 std::optional<std::int64_t> least_generated_nodes(const json& scene) {
   if (!scene.is_object() || !scene.contains("body") || !scene["body"].is_object()) return std::nullopt;
   const json& body = scene["body"];
@@ -54,7 +57,9 @@ std::optional<std::int64_t> least_generated_nodes(const json& scene) {
     if (!d.is_array() || d.size() != 2 || !d[0].is_number_integer() || !d[1].is_number_integer()) continue;
     const std::int64_t a = d[0].get<std::int64_t>(), b = d[1].get<std::int64_t>();
     if (a < 1 || b < 1 || a > 1000000 || b > 1000000) continue;  // the schema's to report
-    return (a + 1) * (b + 1);
+    if (std::string(kind) == "rectangle") return (a + 1) * (b + 1);
+    const std::int64_t m = std::max<std::int64_t>(0, std::min(a / 2, b) - 1);
+    return (a + 1) * (b - m + 1) + std::max<std::int64_t>(0, a - 2 * m - 1) * m;
   }
   return std::nullopt;
 }
@@ -684,7 +689,11 @@ void JobService::run_job(const std::shared_ptr<ActiveJob>& job, const JobRecord&
   }
   if (outcome.status != JobStatus::dismissed && !run.steps.empty()) {
     try {
-      outcome.result = result_json(*scene, run).dump();
+      // Written as it is made (write_result), not built as a JSON document first: the document
+      // took several times the text's memory and more time than writing it.
+      std::ostringstream text;
+      write_result(text, *scene, run);
+      outcome.result = std::move(text).str();
     } catch (const std::exception& e) {
       spdlog::error("job {}: cannot build its result: {}", id, e.what());
     }

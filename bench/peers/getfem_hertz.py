@@ -3,13 +3,13 @@
 schemas/examples/hertz.json (R 10 mm, E 200 GPa, nu 0.3, plane strain, small strain) with
 its diameter lowered 0.05 mm in 10 equal steps and held in x at the centre, against a rigid
 flat with friction MU, by GetFEM's integral contact brick with a rigid obstacle (augmented
-Lagrangian, Alart-Curnier, Newton). The mesh is grip's half-disc map (columns fanned out
-evenly to the diameter, rows and columns graded toward the pole: elements of SIZE within
-EXTENT of it, geometric growth beyond), with Q1 or Q2 elements.
+Lagrangian, Alart-Curnier, Newton). The mesh is grip's (MESH.json: reference node positions
+and counter-clockwise quadrilaterals, written by compare.py from grip's result on the same
+scene), with Q1 or Q2 elements; SIZE (the element size near the pole) sets the augmentation.
 
 Prints one JSON line: P (N/mm), a and p0 from a semi-ellipse fitted to the contact pressure
 at the contact boundary's nodes, their closed-form values at that P, and the seconds.
-Usage: getfem_hertz.py MU SIZE DEGREE [COARSE] [--profile]
+Usage: getfem_hertz.py MU SIZE DEGREE MESH.json [--profile]
 """
 import json
 import math
@@ -23,67 +23,17 @@ import getfem as gf
 gf.util("trace level", 0)
 
 START = time.monotonic()
-MU, SIZE, DEGREE = float(sys.argv[1]), float(sys.argv[2]), int(sys.argv[3])
-COARSE = int(sys.argv[4]) if len(sys.argv) > 4 and sys.argv[4].isdigit() else 12
+MU, SIZE, DEGREE, MESH = float(sys.argv[1]), float(sys.argv[2]), int(sys.argv[3]), sys.argv[4]
 R, E, NU, DEPTH, STEPS, EXTENT = 10.0, 200000.0, 0.3, 0.05, 10, 0.8
 
-
-def one_sided(length, fine_length, n_fine, n_coarse):
-    """grip's one_sided (solver/elements/plane_mesh.cpp): fine zone, then geometric growth."""
-    x = [fine_length * k / n_fine for k in range(n_fine + 1)]
-    h, rest = fine_length / n_fine, length - fine_length
-    lo, hi = 1e-6, 2.0
-    total = lambda g: h * sum(g ** (k + 1) for k in range(n_coarse))
-    while total(hi) < rest:
-        hi *= 2
-    for _ in range(200):
-        mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if total(mid) < rest else (lo, mid)
-    r, step, pos = 0.5 * (lo + hi), h, fine_length
-    for k in range(1, n_coarse + 1):
-        step *= r
-        pos = length if k == n_coarse else pos + step
-        x.append(pos)
-    return np.array(x)
-
-
-fine = round(EXTENT / SIZE)
-quarter = math.pi * R / 4
-side = one_sided(quarter, EXTENT, fine, COARSE)
-sigma = (np.concatenate([-side[::-1], side[1:]]) + quarter) / (2 * quarter)
-depth = one_sided(R, EXTENT, fine, COARSE) / R
-ns, nt = len(sigma) - 1, len(depth) - 1
-u_top = np.arange(ns + 1) / ns  # the diameter divided evenly (fan 1)
-even = np.arange(nt + 1) / nt
-
-
-def circle(angle):
-    return np.array([R * math.cos(angle), R * math.sin(angle)])
-
-
-b0, b1 = circle(1.25 * math.pi), circle(1.75 * math.pi)
-t0, t1 = np.array([-R, 0.0]), np.array([R, 0.0])
-nodes = np.zeros((nt + 1, ns + 1, 2))
-for I in range(ns + 1):
-    s = sigma[I]
-    w = math.sin(math.pi * s) ** 2
-    for J in range(nt + 1):
-        t = w * depth[J] + (1 - w) * even[J]
-        v = (1 - t) * s + t * u_top[I]
-        bottom = circle(1.25 * math.pi + 0.5 * math.pi * s)
-        top = np.array([-R + 2 * R * u_top[I], 0.0])
-        left = circle(1.25 * math.pi - 0.25 * math.pi * t)
-        right = circle(1.75 * math.pi + 0.25 * math.pi * t)
-        nodes[J, I] = ((1 - t) * bottom + t * top + (1 - v) * left + v * right -
-                       ((1 - v) * (1 - t) * b0 + v * (1 - t) * b1 + (1 - v) * t * t0 + v * t * t1))
-
+with open(MESH) as f:
+    grip_mesh = json.load(f)
+nodes = np.array(grip_mesh["nodes"])
 mesh = gf.Mesh("empty", 2)
 gt = gf.GeoTrans("GT_QK(2,1)")
-for J in range(nt):
-    for I in range(ns):
-        # GetFEM's QK(2,1) node order: (0,0), (1,0), (0,1), (1,1)
-        pts = np.array([nodes[J, I], nodes[J, I + 1], nodes[J + 1, I], nodes[J + 1, I + 1]]).T
-        mesh.add_convex(gt, pts)
+for cell in grip_mesh["cells"]:
+    # GetFEM's QK(2,1) node order: (0,0), (1,0), (0,1), (1,1); grip's: counter-clockwise.
+    mesh.add_convex(gt, nodes[[cell[0], cell[1], cell[3], cell[2]]].T)
 
 # Boundary regions: the arc faces within EXTENT of the pole (contact), the diameter (y = 0).
 border = mesh.outer_faces()

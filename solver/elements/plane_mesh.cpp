@@ -100,17 +100,7 @@ std::vector<double> one_sided(double length, double fine_length, int n_fine, int
   return x;
 }
 
-// Parameters of a q9 grid: the midpoints inserted between consecutive values.
-std::vector<double> refine_for(QuadShape shape, const std::vector<double>& v) {
-  if (shape == QuadShape::q4) return v;
-  std::vector<double> out;
-  for (size_t i = 0; i + 1 < v.size(); ++i) {
-    out.push_back(v[i]);
-    out.push_back(0.5 * (v[i] + v[i + 1]));
-  }
-  out.push_back(v.back());
-  return out;
-}
+
 
 // A structured mesh of ni x nj elements on a grid of (m ni + 1) x (m nj + 1) nodes (m = 1 for
 // q4, 2 for q9), node (I, J) at `at(I, J)`, I along the first and J along the second
@@ -140,7 +130,39 @@ std::vector<int> grid_line(int NI, int I0, int J0, int dI, int dJ, int count) {
   return ids;
 }
 
+std::string growth_text(double growth) {
+  std::ostringstream os;
+  os << growth;
+  return os.str();
+}
+
+// The fewest elements that cover `rest` beyond a fine zone of elements h, growing at most
+// `growth`-fold from one to the next: h (r + ... + r^n) >= rest at r = growth.
+int coarse_needed(double h, double rest, double growth) {
+  const double r = growth;
+  return std::max(1, static_cast<int>(std::ceil(std::log(1 + rest * (r - 1) / (h * r)) / std::log(r) - 1e-9)));
+}
+
 }  // namespace
+
+std::vector<double> refine_for(QuadShape shape, const std::vector<double>& v) {
+  if (shape == QuadShape::q4) return v;
+  std::vector<double> out;
+  for (size_t i = 0; i + 1 < v.size(); ++i) {
+    out.push_back(v[i]);
+    out.push_back(0.5 * (v[i] + v[i + 1]));
+  }
+  out.push_back(v.back());
+  return out;
+}
+
+void reverse_element(std::vector<int>& element, QuadShape shape) {
+  std::swap(element[1], element[3]);
+  if (shape == QuadShape::q9) {
+    std::swap(element[4], element[7]);
+    std::swap(element[5], element[6]);
+  }
+}
 
 std::vector<MeshIssue> check_mesh(const PlaneMesh& mesh, QuadShape shape) {
   std::vector<MeshIssue> issues;
@@ -188,19 +210,32 @@ std::vector<MeshIssue> check_mesh(const PlaneMesh& mesh, QuadShape shape) {
 }
 
 std::vector<std::vector<int>> boundary_sides(const PlaneMesh& mesh, QuadShape shape) {
-  std::map<std::pair<int, int>, std::pair<int, std::vector<int>>> seen;
-  for (const auto& el : mesh.elements)
-    for (const auto& local : local_sides(shape)) {
-      std::vector<int> side;
-      for (int a : local) side.push_back(el[a]);
-      const auto key = std::minmax(side.front(), side.back());
-      auto& entry = seen[key];
-      ++entry.first;
-      entry.second = side;
+  // Every element side by its end nodes, sorted (a vector, not a map: this ran for every
+  // scene read, 46,000 sides at a/h 40); the sides that appear once.
+  struct Side {
+    std::pair<int, int> key;
+    int element, local;
+  };
+  const auto& locals = local_sides(shape);
+  std::vector<Side> all;
+  all.reserve(mesh.elements.size() * locals.size());
+  for (int e = 0; e < static_cast<int>(mesh.elements.size()); ++e)
+    for (int l = 0; l < static_cast<int>(locals.size()); ++l) {
+      const auto& el = mesh.elements[e];
+      all.push_back({std::minmax(el[locals[l].front()], el[locals[l].back()]), e, l});
     }
+  std::sort(all.begin(), all.end(), [](const Side& a, const Side& b) { return a.key < b.key; });
   std::vector<std::vector<int>> sides;
-  for (const auto& [key, entry] : seen)
-    if (entry.first == 1) sides.push_back(entry.second);
+  for (size_t k = 0; k < all.size();) {
+    size_t end = k + 1;
+    while (end < all.size() && all[end].key == all[k].key) ++end;
+    if (end == k + 1) {
+      std::vector<int> side;
+      for (int a : locals[all[k].local]) side.push_back(mesh.elements[all[k].element][a]);
+      sides.push_back(side);
+    }
+    k = end;
+  }
   return sides;
 }
 
@@ -336,19 +371,8 @@ std::string free_rigid_motion(const PlaneMesh& mesh, const std::vector<char>& fi
   return all;
 }
 
-// Elements beyond a refinement's extent grow geometrically; faster than this from one to the
-// next spoils the answer (Hertz with one coarse element a side: a and p0 5 % off).
-constexpr double kMaxGrowth = 4.0;
-
-// The fewest elements that cover `rest` beyond a fine zone of elements h, growing at most
-// kMaxGrowth-fold: h (r + ... + r^n) >= rest at r = kMaxGrowth.
-int coarse_needed(double h, double rest) {
-  const double r = kMaxGrowth;
-  return std::max(1, static_cast<int>(std::ceil(std::log(1 + rest * (r - 1) / (h * r)) / std::log(r) - 1e-9)));
-}
-
 std::vector<double> graded_divisions(double lo, double hi, int n, std::optional<double> focus,
-                                     const std::optional<Refinement>& refine) {
+                                     const std::optional<Refinement>& refine, double max_growth) {
   std::vector<double> x;
   if (!refine || !focus) {
     for (int k = 0; k <= n; ++k) x.push_back(lo + (hi - lo) * k / n);
@@ -366,14 +390,14 @@ std::vector<double> graded_divisions(double lo, double hi, int n, std::optional<
     coarse_total -= fine[s];
     if (coarse_len[s] > 1e-12 * (hi - lo)) {
       ++sides_needing;
-      needed[s] = fine[s] > 0 ? coarse_needed(fine_len[s] / fine[s], coarse_len[s]) : 1;
+      needed[s] = fine[s] > 0 ? coarse_needed(fine_len[s] / fine[s], coarse_len[s], max_growth) : 1;
     }
   }
   if (coarse_total < needed[0] + needed[1])
     throw std::invalid_argument(std::to_string(n) + " divisions cannot hold the refinement: it takes " +
                                 std::to_string(n - coarse_total) + " within the extent and " +
                                 std::to_string(needed[0] + needed[1]) +
-                                " more outside it (elements growing at most 4-fold): give at least " +
+                                " more outside it (elements growing at most " + growth_text(max_growth) + "-fold): give at least " +
                                 std::to_string(n - coarse_total + needed[0] + needed[1]));
   const double total_coarse_len = coarse_len[0] + coarse_len[1];
   if (sides_needing == 2) {
@@ -407,88 +431,6 @@ PlaneMesh rectangle_mesh(const RectangleSpec& spec, QuadShape shape) {
   mesh.sets["right"] = grid_line(NI, NI - 1, 0, 0, 1, NJ);
   mesh.sets["top"] = grid_line(NI, NI - 1, NJ - 1, -1, 0, NI);
   mesh.sets["left"] = grid_line(NI, 0, NJ - 1, 0, -1, NJ);
-  return mesh;
-}
-
-// The half-disc map with columns that fan out toward the diameter by `fan` (0: each column
-// meets the diameter at its own parameter along the arc; 1: the diameter divided evenly).
-PlaneMesh half_disc_grid(const HalfDiscSpec& spec, QuadShape shape, const std::vector<double>& sigma,
-                         const std::vector<double>& depth, double fan) {
-  using std::numbers::pi;
-  const double R = spec.radius;
-  std::vector<double> u(spec.ns + 1), even(spec.nt + 1);
-  for (int i = 0; i <= spec.ns; ++i) u[i] = (1 - fan) * sigma[i] + fan * i / spec.ns;
-  for (int j = 0; j <= spec.nt; ++j) even[j] = static_cast<double>(j) / spec.nt;
-  const std::vector<double> s_ = refine_for(shape, sigma), u_ = refine_for(shape, u);
-  const std::vector<double> d_ = refine_for(shape, depth), e_ = refine_for(shape, even);
-  const Vec2 c = spec.centre;
-  auto on_circle = [&](double angle) { return Vec2(c + R * Vec2(std::cos(angle), std::sin(angle))); };
-  auto bottom = [&](double s) { return on_circle(1.25 * pi + 0.5 * pi * s); };  // 225 -> 315 degrees
-  auto top = [&](double s) { return Vec2(c + Vec2(-R + 2 * R * s, 0)); };
-  auto left = [&](double t) { return on_circle(1.25 * pi - 0.25 * pi * t); };   // 225 -> 180
-  auto right = [&](double t) { return on_circle(1.75 * pi + 0.25 * pi * t); };  // 315 -> 360
-  const Vec2 b0 = bottom(0), b1 = bottom(1), t0 = top(0), t1 = top(1);
-  return grid_mesh(spec.ns, spec.nt, shape, [&](int I, int J) {  // facing down
-    const double s = s_[I], w = std::pow(std::sin(pi * s), 2);
-    // Rows crowd toward the arc near the pole only; at the ends they are evenly spaced.
-    const double t = w * d_[J] + (1 - w) * e_[J];
-    const double v = (1 - t) * s + t * u_[I];  // blends the parametrizations of bottom and top
-    Vec2 p = (1 - t) * bottom(s) + t * top(u_[I]) + (1 - v) * left(t) + v * right(t) -
-             ((1 - v) * (1 - t) * b0 + v * (1 - t) * b1 + (1 - v) * t * t0 + v * t * t1);
-    return p;
-  });
-}
-
-PlaneMesh half_disc_mesh(const HalfDiscSpec& spec, QuadShape shape) {
-  using std::numbers::pi;
-  if (spec.ns < 2 || spec.ns % 2) throw std::invalid_argument("ns must be even (a node sits at the pole)");
-  const double R = spec.radius;
-  // sigma: along the middle quarter of the arc (graded toward the pole); depth: from the arc
-  // toward the diameter (graded toward the arc).
-  const double quarter = pi * R / 4;
-  std::vector<double> sigma = graded_divisions(-quarter, quarter, spec.ns, 0.0, spec.refine);
-  for (double& v : sigma) v = (v + quarter) / (2 * quarter);
-  std::vector<double> depth = graded_divisions(0, R, spec.nt, 0.0, spec.refine);
-  for (double& v : depth) v /= R;
-  // The columns fan out toward an evenly divided diameter as far as the elements stay valid
-  // (a strongly graded arc and an even diameter would cross columns near the ends).
-  PlaneMesh mesh;
-  for (const double fan : {1.0, 0.75, 0.5, 0.25, 0.0}) {
-    mesh = half_disc_grid(spec, shape, sigma, depth, fan);
-    if (fan == 0.0 || check_mesh(mesh, shape).empty()) break;
-  }
-  sigma = refine_for(shape, sigma);
-  depth = refine_for(shape, depth);
-  const Vec2 c = spec.centre;
-  const int NI = static_cast<int>(sigma.size()), NJ = static_cast<int>(depth.size());
-  std::vector<int> arc = grid_line(NI, 0, NJ - 1, 0, -1, NJ);
-  for (int id : grid_line(NI, 1, 0, 1, 0, NI - 1)) arc.push_back(id);
-  for (int id : grid_line(NI, NI - 1, 1, 0, 1, NJ - 1)) arc.push_back(id);
-  mesh.sets["diameter"] = grid_line(NI, 0, NJ - 1, 1, 0, NI);
-  mesh.sets["pole"] = {(NI - 1) / 2};
-  mesh.sets["centre"] = {(NJ - 1) * NI + (NI - 1) / 2};
-  if (spec.facing_up) {
-    // Mirror; that turns the elements clockwise: reverse them (and the arc's direction).
-    for (Vec2& x : mesh.nodes) x.y() = 2 * c.y() - x.y();
-    for (auto& el : mesh.elements) {
-      std::swap(el[1], el[3]);
-      if (shape == QuadShape::q9) {
-        std::swap(el[4], el[7]);
-        std::swap(el[5], el[6]);
-      }
-    }
-    std::reverse(arc.begin(), arc.end());
-  }
-  mesh.sets["arc"] = arc;
-  if (spec.refine) {
-    // The arc nodes within the refinement's extent of the pole (measured along the arc).
-    const Vec2 pole = mesh.nodes[mesh.sets["pole"][0]] - c;
-    std::vector<int>& near = mesh.sets["arc_refined"];
-    for (int id : arc)
-      if (R * std::acos(std::clamp((mesh.nodes[id] - c).dot(pole) / (R * R), -1.0, 1.0)) <=
-          spec.refine->extent * (1 + 1e-9))
-        near.push_back(id);
-  }
   return mesh;
 }
 

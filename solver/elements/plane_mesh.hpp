@@ -70,26 +70,36 @@ struct RectangleSpec {
 };
 PlaneMesh rectangle_mesh(const RectangleSpec& spec, QuadShape shape);
 
-// A half-disc: the arc below the diameter (facing down; `facing_up` mirrors it). A blended
-// (transfinite) map of a ns x nt grid: ns divisions along the middle quarter-circle of the arc
-// and along the diameter, nt from the arc to the diameter (each end quarter of the arc has
-// nt). ns must be even, so that a node sits at the pole (the middle of the arc). Refinement
-// is toward the pole, along the arc and in depth. Sets: "arc" (counter-clockwise),
-// "diameter", "pole" (one node), "centre" (the middle of the diameter, one node), and with a
-// refinement "arc_refined" (the arc nodes within its extent of the pole, along the arc).
+// A half-disc: the arc below the diameter (facing down; `facing_up` mirrors it). Four mapped
+// blocks (half_disc_mesh.cpp): a pole block under the pole, ringed by two side blocks and a
+// core. ns divisions along the arc (even, so that a node sits at the pole), graded toward the
+// pole with a refinement; the pole block takes those within the refinement's extent (at most
+// the middle half of the arc; without a refinement, the middle half) and each side the rest.
+// nt divisions from the pole to the centre: the ring's rows (ns less the pole block's, halved)
+// and the pole block's below them. Sets: "arc" (counter-clockwise), "diameter", "pole" (one
+// node), "centre" (the middle of the diameter, one node), and with a refinement "arc_refined"
+// (the arc nodes within its extent of the pole, along the arc).
 struct HalfDiscSpec {
   Vec2 centre = Vec2::Zero();
   double radius = 1.0;
-  int ns = 2, nt = 1;
+  int ns = 4, nt = 2;
   bool facing_up = false;
   std::optional<Refinement> refine;
 };
 PlaneMesh half_disc_mesh(const HalfDiscSpec& spec, QuadShape shape);
 
+// The values of a q9 grid's lines: the midpoints inserted between consecutive values (q4: as given).
+std::vector<double> refine_for(QuadShape shape, const std::vector<double>& v);
+
+// An element's nodes in the opposite turning sense (clockwise <-> counter-clockwise).
+void reverse_element(std::vector<int>& element, QuadShape shape);
+
 // Node coordinates of n divisions of [lo, hi]: uniform, or refined toward `focus` (a point of
 // [lo, hi]) with elements of about refine.size within refine.extent of it, growing
-// geometrically outside. Throws if the divisions cannot hold the refinement.
+// geometrically outside. Throws if the divisions cannot hold the refinement with elements
+// growing at most `max_growth`-fold from one to the next (faster than 4-fold spoils the
+// answer: Hertz with one coarse element a side put a and p0 5 % off).
 std::vector<double> graded_divisions(double lo, double hi, int n, std::optional<double> focus,
-                                     const std::optional<Refinement>& refine);
+                                     const std::optional<Refinement>& refine, double max_growth = 4.0);
 
 }  // namespace grip

@@ -5,7 +5,7 @@
 //   "mesh": one of
 //     {"nodes": [[x, y], ...], "elements": [[n0, n1, n2, n3(, ...9)], ...], "sets": {name: [ids]}}
 //     {"rectangle": {"origin", "size", "divisions": [nx, ny], "refine": {"towards", "size", "extent"}}}
-//     {"half_disc": {"centre", "radius", "divisions": [ns, nt], "facing": "down" | "up",
+//     {"half_disc": {"centre", "radius", "divisions": [ns (arc), nt (pole to centre)], "facing": "down" | "up",
 //                    "refine": {"size", "extent"}}}
 //   "contact_set": a node set on the boundary (default "bottom" for a rectangle, "arc" for a
 //     half-disc); its nodes are the contact candidates
@@ -122,7 +122,9 @@ std::optional<PlaneMesh> read_generated_mesh(Reader& r, json& mesh, const std::s
       spec.centre = r.vec2(*gen, gp, "centre", Vec2::Zero());
       spec.radius = r.positive(*gen, gp, "radius");
       const auto div = integer_pair(r, *gen, gp, "divisions", 1, 2000);
-      if (div && div->first % 2) r.error(gp + "/divisions/0", "must be even: a node sits at the pole");
+      if (div && (div->first % 2 || div->first < 4))
+        r.error(gp + "/divisions/0", "must be an even integer from 4: a node sits at the pole, and the arc has a block at each end");
+      if (div && div->second < 2) r.error(gp + "/divisions/1", "must be at least 2: a pole block and a ring round it");
       spec.facing_up = r.choice(*gen, gp, "facing", {"down", "up"}, "down") == "up";
       spec.refine = read_refinement(r, *gen, gp, nullptr);
       if (r.issues.size() > before || !div) return std::nullopt;

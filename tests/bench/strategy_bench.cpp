@@ -131,13 +131,8 @@ struct SceneCase {
 };
 
 // The continuum scenes (a half-disc refined near its pole) set the element size near the
-// contact and keep the shipped number of divisions beyond the refined zone.
-json with_pole_size(json j, double size) {
-  const json& disc = j["body"]["mesh"]["half_disc"];
-  const double shipped = disc["refine"]["size"], extent = disc["refine"]["extent"];
-  const int coarse = disc["divisions"][1].get<int>() - static_cast<int>(std::lround(extent / shipped));
-  return testing::with_pole_elements(std::move(j), size, coarse);
-}
+// contact, with the fewest divisions beyond the refined zone that the generator accepts.
+json with_pole_size(json j, double size) { return testing::with_pole_elements(std::move(j), size); }
 
 std::string half_disc_label(const json& j) {
   const json& disc = j["body"]["mesh"]["half_disc"];

@@ -8,23 +8,44 @@
 #include <cmath>
 #include <cstdio>
 #include <numbers>
+#include <stdexcept>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "solver/contact/contact_error.hpp"
+#include "solver/elements/plane_mesh.hpp"
 #include "solver/solve/load_stepping.hpp"
 #include "tests/support/scenes.hpp"
 
 namespace grip::testing {
 
-// A half-disc scene with elements of `size` within its refinement extent of the pole and
-// `coarse` divisions beyond it on each side and in depth.
-inline nlohmann::json with_pole_elements(nlohmann::json scene, double size, int coarse) {
-  nlohmann::json& disc = scene["body"]["mesh"]["half_disc"];
-  const int fine = static_cast<int>(std::lround(disc["refine"]["extent"].get<double>() / size));
+// A half_disc mesh (its JSON object) with elements of `size` within its refinement extent of
+// the pole and the fewest divisions beyond it that the generator accepts (the ring's elements
+// growing at most 1.4-fold, solver/elements/half_disc_mesh.cpp): [2 (fine + coarse), fine + coarse].
+inline void refine_pole(nlohmann::json& disc, double size) {
+  const double extent = disc["refine"]["extent"];
+  const int fine = static_cast<int>(std::lround(extent / size));
   disc["refine"]["size"] = size;
-  disc["divisions"] = {2 * (fine + coarse), fine + coarse};
+  HalfDiscSpec spec;
+  spec.radius = disc["radius"];
+  spec.refine = Refinement{size, extent};
+  for (int coarse = 1; coarse <= 1000; ++coarse) {
+    spec.ns = 2 * (fine + coarse);
+    spec.nt = fine + coarse;
+    try {
+      half_disc_mesh(spec, QuadShape::q4);
+      disc["divisions"] = {spec.ns, spec.nt};
+      return;
+    } catch (const std::invalid_argument&) {
+    }
+  }
+  throw std::invalid_argument("no divisions hold the refinement");
+}
+
+// The one-body half-disc scene with elements of `size` near the pole (refine_pole).
+inline nlohmann::json with_pole_elements(nlohmann::json scene, double size) {
+  refine_pole(scene["body"]["mesh"]["half_disc"], size);
   return scene;
 }
 
@@ -85,6 +106,10 @@ struct Zone {
   bool found = false;
   ZoneEnd left, right;
   double half_width() const { return 0.5 * (right.edge - left.edge); }
+  // The longer of the two elements the zone ends in. A nodal force carries the traction over
+  // half an element either side of its node, so a closed-form edge is resolved to within half
+  // of it beyond the bracket: brackets(w, 0.5 * edge_element()).
+  double edge_element() const { return std::max(right.outer - right.inner, left.inner - left.outer); }
   double midpoint_half_width() const {
     return 0.25 * ((right.inner + right.outer) - (left.inner + left.outer));
   }

@@ -47,7 +47,7 @@ inline double spence_stick_ratio(double beta_over_mu) {
 // elements of `size` near the pole, friction mu, the diameter held in y only and its centre in
 // x, `steps` equal steps of the diameter's displacement (0.05 mm).
 inline nlohmann::json frictional_hertz(double size, int steps, double mu) {
-  nlohmann::json j = with_pole_elements(example_scene("hertz"), size, 12);
+  nlohmann::json j = with_pole_elements(example_scene("hertz"), size);
   j["obstacles"][0]["friction"] = mu;
   j["body"]["supports"] = nlohmann::json::parse(
       R"([{"set": "diameter", "fix": ["y"], "values": {"y": -0.05}}, {"set": "centre", "fix": ["x"]}])");

@@ -74,6 +74,13 @@ std::vector<ContactNode> master_profile(const Problem& problem, const StepRecord
   return nodes;
 }
 
+// The shipped two cylinders with elements of `size` near both poles (refine_pole).
+inline nlohmann::json cylinders_with_pole_elements(double size) {
+  nlohmann::json j = example_scene("two-cylinders");
+  for (auto& b : j["bodies"]) refine_pole(b["mesh"]["half_disc"], size);
+  return j;
+}
+
 // Hertz between two elastic half-discs of the scene (1/R = 1/R1 + 1/R2, 1/E* = sum of
 // (1 - nu^2)/E) at load P per unit thickness.
 inline HertzContact combined_hertz(const nlohmann::json& scene, double P) {

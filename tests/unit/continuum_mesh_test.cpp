@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <cstdio>
 #include <set>
 
 #include "solver/elements/plane_mesh.hpp"
@@ -97,13 +98,15 @@ TEST(ElementQuality, AspectRatioAndCornerAngles) {
   EXPECT_NEAR(q.max_angle, 135.0, 1e-12);
 }
 
-// Strong refinements with few divisions beyond them stay valid (the columns fan out toward
-// the diameter only as far as they can).
-TEST(HalfDiscMesh, EveryElementIsValidOverARangeOfRefinements) {
+// From the fewest divisions a refinement admits up, weak and strong, every element is valid
+// and well shaped: no block corner sits alone on the arc (the single mapped block had corner
+// elements of 3-7 and 173-177 degrees there), and the pole block's corners V inside the body,
+// where the ring turns round 270 degrees, leave about 135 to each element beside them.
+TEST(HalfDiscMesh, EveryElementIsValidAndWellShapedOverARangeOfRefinements) {
   int checked = 0;
   for (const double size : {0.1, 0.02})
     for (const double extent : {0.3, 0.66, 2.0})
-      for (const int coarse : {0, 8, 24})  // 0: the fewest divisions the generator accepts
+      for (const int extra : {0, 8, 24})  // divisions beyond the fewest the generator accepts
         for (const bool up : {false, true}) {
           const int fine = static_cast<int>(std::lround(extent / size));
           HalfDiscSpec spec;
@@ -111,23 +114,61 @@ TEST(HalfDiscMesh, EveryElementIsValidOverARangeOfRefinements) {
           spec.facing_up = up;
           spec.refine = Refinement{size, extent};
           PlaneMesh mesh;
-          for (int c = std::max(coarse, 1);; ++c) {
+          for (int c = 1;; ++c) {
             spec.ns = 2 * (fine + c);
             spec.nt = fine + c;
             try {
               mesh = half_disc_mesh(spec, QuadShape::q4);
-              break;
             } catch (const std::invalid_argument& e) {
-              ASSERT_EQ(coarse, 0) << e.what();  // only the search for the fewest is refused
               ASSERT_NE(std::string(e.what()).find("give at least"), std::string::npos) << e.what();
+              continue;
             }
+            if (extra == 0) break;
+            spec.ns += 2 * extra;
+            spec.nt += extra;
+            mesh = half_disc_mesh(spec, QuadShape::q4);
+            break;
           }
           const auto issues = check_mesh(mesh, QuadShape::q4);
-          EXPECT_TRUE(issues.empty()) << "size " << size << " extent " << extent << " coarse " << coarse << ": "
+          EXPECT_TRUE(issues.empty()) << "size " << size << " extent " << extent << " extra " << extra << ": "
                                       << (issues.empty() ? "" : issues[0].detail);
+          const ElementQuality q = element_quality(mesh);
+          EXPECT_GT(q.min_angle, 40.0) << "size " << size << " extent " << extent << " extra " << extra;
+          EXPECT_LT(q.max_angle, 140.0) << "size " << size << " extent " << extent << " extra " << extra;
           ++checked;
         }
   EXPECT_EQ(checked, 36);
+}
+
+// Without a refinement: [ns, nt] from the smallest the reader accepts ([4, 2]) to far more rows
+// than the arc divisions call for (the pole block then half the radius deep).
+TEST(HalfDiscMesh, UniformDivisionsAreValidAndWellShaped) {
+  for (const auto& [ns, nt] : std::vector<std::pair<int, int>>{{4, 2}, {8, 4}, {24, 12}, {40, 20}, {24, 30}}) {
+    HalfDiscSpec spec;
+    spec.radius = 3;
+    spec.ns = ns;
+    spec.nt = nt;
+    const PlaneMesh mesh = half_disc_mesh(spec, QuadShape::q4);
+    EXPECT_TRUE(check_mesh(mesh, QuadShape::q4).empty()) << ns << " x " << nt;
+    EXPECT_EQ(static_cast<int>(mesh.sets.at("arc").size()), ns + 1);
+    const ElementQuality q = element_quality(mesh);
+    std::printf("[%d, %d]: %d elements, angles %.1f-%.1f, aspect %.2f\n", ns, nt, q.elements, q.min_angle,
+                q.max_angle, q.max_aspect_ratio);
+    EXPECT_GT(q.min_angle, 40.0) << ns << " x " << nt;
+    EXPECT_LT(q.max_angle, 140.0) << ns << " x " << nt;
+  }
+  // 8 arc divisions and 20 rows: 18 pole block rows under 2 ring rows would make corners of
+  // 23 and 162 degrees; refused, naming the arc divisions that shape them well.
+  HalfDiscSpec uneven;
+  uneven.radius = 3;
+  uneven.ns = 8;
+  uneven.nt = 20;
+  try {
+    half_disc_mesh(uneven, QuadShape::q4);
+    ADD_FAILURE() << "[8, 20] accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("give at least"), std::string::npos) << e.what();
+  }
 }
 
 TEST(HalfDiscMesh, AreaArcAndRefinement) {
@@ -137,8 +178,8 @@ TEST(HalfDiscMesh, AreaArcAndRefinement) {
       HalfDiscSpec spec;
       spec.centre = {1, -1};
       spec.radius = R;
-      spec.ns = 24;
-      spec.nt = 12;
+      spec.ns = 36;
+      spec.nt = 18;
       spec.facing_up = up;
       spec.refine = Refinement{0.03, 0.2};
       const PlaneMesh mesh = half_disc_mesh(spec, shape);

@@ -408,7 +408,7 @@ const InvalidScene kInvalidScenes[] = {
      "/body/supports/0", "needs exactly one of \"set\" (a node set's name) and \"node\" (a node id)",
      Reader::same_pointer},
     {"a continuum mesh with a rectangle and a half-disc", "continuum",
-     R"([{"op": "add", "path": "/body/mesh/half_disc", "value": {"radius": 1, "divisions": [2, 2]}}])",
+     R"([{"op": "add", "path": "/body/mesh/half_disc", "value": {"radius": 1, "divisions": [4, 2]}}])",
      "/body/mesh", "needs exactly one of \"nodes\" (with \"elements\"), \"rectangle\" and \"half_disc\"",
      Reader::same_pointer},
     {"q4_bbar with finite kinematics", "continuum",

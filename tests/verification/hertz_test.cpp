@@ -17,8 +17,8 @@ namespace {
 using nlohmann::json;
 using namespace grip::testing;
 
-// The shipped scene with elements of `size` near the pole (12 divisions beyond, as shipped).
-json hertz(double size) { return with_pole_elements(example_scene("hertz"), size, 12); }
+// The shipped scene with elements of `size` near the pole and the fewest divisions beyond.
+json hertz(double size) { return with_pole_elements(example_scene("hertz"), size); }
 
 struct HertzReading {
   double P = 0, a = 0, p0 = 0;  // closed form at the computed load
@@ -74,7 +74,14 @@ TEST(Hertz, MatchesTheClosedFormOnAModerateMesh) {
   }
 }
 
-// Three meshes, a / h of about 5, 10 and 21 near the contact: the errors fall.
+// Three meshes, a / h of about 5, 10 and 21 near the contact: the error of a falls (1.2 % to
+// 0.03 %). p0 and the peak stress are at their floor from the coarsest mesh on (0.03-0.16 %,
+// not monotone): a nodal stress is the force over its tributary length, which samples the
+// pressure's average over an element and not its point value (at the centre of the zone
+// h^2 / (24 a^2) lower: 0.15 % at a / h 5), and the finite element pressure's own error there
+// is of that order; each is held within 0.2 % at every mesh. The closed-form edge lies within
+// half an edge element of the nodes where the contact ends: the last node that touches carries
+// the pressure over half an element either side of it.
 TEST(Hertz, ErrorFallsAsTheMeshIsRefined) {
   std::vector<HertzReading> r;
   std::printf("%7s %6s %9s %8s %9s %9s %9s %9s %7s %8s\n", "size", "a/h", "P", "a", "a err %", "p0",
@@ -86,20 +93,17 @@ TEST(Hertz, ErrorFallsAsTheMeshIsRefined) {
     r.push_back(read_hertz(s, s.run.steps.back()));
     const HertzReading& h = r.back();
     EXPECT_TRUE(h.set_ends_open);
-    EXPECT_TRUE(h.zone.brackets(h.a, 1e-9)) << "a = " << h.a;
+    EXPECT_TRUE(h.zone.brackets(h.a, 0.5 * h.zone.edge_element())) << "a = " << h.a;
     std::printf("%7.3f %6.1f %9.2f %8.4f %+9.3f %9.1f %+9.3f %+9.3f %7ld %8.3f\n", size, h.a / size, h.P, h.a,
                 100 * h.a_error(), h.p0, 100 * h.p0_error(), 100 * h.peak_error(), s.run.counters.solves,
                 s.run.seconds);
   }
-  for (size_t k = 1; k < r.size(); ++k) {
+  for (size_t k = 1; k < r.size(); ++k)
     EXPECT_GT(std::abs(r[k - 1].a_error()), std::abs(r[k].a_error())) << "mesh " << k;
-    EXPECT_GT(std::abs(r[k - 1].p0_error()), std::abs(r[k].p0_error())) << "mesh " << k;
-  }
-  EXPECT_GT(std::abs(r.front().peak_error()), std::abs(r.back().peak_error()));
   for (const auto& h : r) {
     EXPECT_LT(std::abs(h.a_error()), 0.02);
-    EXPECT_LT(std::abs(h.p0_error()), 0.02);
-    EXPECT_LT(std::abs(h.peak_error()), 0.02);
+    EXPECT_LT(std::abs(h.p0_error()), 0.002);
+    EXPECT_LT(std::abs(h.peak_error()), 0.002);
   }
 }
 
@@ -114,7 +118,7 @@ TEST(Hertz, CevAndUzawaAgree) {
 TEST(Hertz, LinearAndFiniteAgreeForSmallLoads) {
   json j = example_scene("hertz");
   j["body"]["mesh"]["half_disc"]["refine"]["extent"] = 0.4;
-  j = with_pole_elements(j, 0.03, 8);
+  j = with_pole_elements(j, 0.03);
   j["body"]["supports"][0]["values"]["y"] = -0.01;  // a = 0.22 mm, contact strains of 0.5 %
   const Solved lin = solve_scene(j);
   j["body"]["kinematics"] = "finite";
@@ -131,9 +135,11 @@ TEST(Hertz, LinearAndFiniteAgreeForSmallLoads) {
   EXPECT_LT((pa - pb).lpNorm<Eigen::Infinity>(), 5e-3 * pa.lpNorm<Eigen::Infinity>());
 }
 
-// The generator refuses divisions that would grow the elements beyond the refinement more
-// than 4-fold from one to the next, naming the count that does not: at the smallest count it
-// accepts, the shipped scene matches Hertz (one coarse element a side put a and p0 5 % off).
+// The generator refuses divisions that would grow the ring's elements more than 1.4-fold from
+// one to the next, naming the count that does not: at the smallest count it accepts (the
+// shipped one) the scene matches Hertz within 1 % in a and p0, and its load at the prescribed
+// displacement is within 1 % of a refined mesh's (q9 elements, 24 more divisions beyond the
+// refinement). The single mapped block of before was 13 % stiff at its smallest count.
 TEST(Hertz, SmallestAcceptedDivisionsMatchTheClosedForm) {
   json j = example_scene("hertz");
   std::string refusal;
@@ -149,17 +155,24 @@ TEST(Hertz, SmallestAcceptedDivisionsMatchTheClosedForm) {
   }
   std::printf("smallest accepted: [%d, %d]; one fewer: %s\n", ns, ns / 2, refusal.c_str());
   EXPECT_NE(refusal.find("give at least " + std::to_string(ns)), std::string::npos) << refusal;
+  EXPECT_EQ(j["body"]["mesh"]["half_disc"]["divisions"], example_scene("hertz")["body"]["mesh"]["half_disc"]["divisions"]);
   const Solved s = solve_scene(j);
   expect_every_step_sound(s);
   ASSERT_TRUE(s.run.completed);
   const HertzReading h = read_hertz(s, s.run.steps.back());
-  std::printf("P = %.1f N/mm; a fitted %+.2f %%; p0 fitted %+.2f %%, peak %+.2f %%\n", h.P, 100 * h.a_error(),
-              100 * h.p0_error(), 100 * h.peak_error());
+  json refined = j;
+  refined["body"]["element"] = "q9";
+  refined["body"]["mesh"]["half_disc"]["divisions"] = {ns + 48, ns / 2 + 24};
+  const Solved r = solve_scene(refined);
+  ASSERT_TRUE(r.run.completed);
+  const double P_refined = read_hertz(r, r.run.steps.back()).P;
+  std::printf("P = %.1f N/mm (refined mesh %.1f, %+.2f %%); a fitted %+.2f %%; p0 fitted %+.2f %%, peak %+.2f %%\n",
+              h.P, P_refined, 100 * (h.P / P_refined - 1), 100 * h.a_error(), 100 * h.p0_error(),
+              100 * h.peak_error());
+  EXPECT_NEAR(h.P, P_refined, 0.01 * P_refined);
+  EXPECT_LT(std::abs(h.a_error()), 0.01);
   EXPECT_LT(std::abs(h.p0_error()), 0.01);
   EXPECT_LT(std::abs(h.peak_error()), 0.01);
-  // The fit of a at a / h = 10 reads 1-1.5 % short on every mesh (the shipped one too): the
-  // closed-form edge must lie between the last node that touches and the first that does not.
-  EXPECT_LT(std::abs(h.a_error()), 0.02);
   EXPECT_TRUE(h.zone.brackets(h.a, 1e-9)) << "a = " << h.a;
 }
 
@@ -167,7 +180,7 @@ TEST(Hertz, SmallestAcceptedDivisionsMatchTheClosedForm) {
 // a step's real solves changes the path, not the answer (to what the contact tolerance pins
 // it), and forms G fewer times.
 TEST(Hertz, ComplianceReuseKeepsTheAnswer) {
-  json j = with_pole_elements(example_scene("hertz"), 0.1, 8);
+  json j = with_pole_elements(example_scene("hertz"), 0.1);
   j["body"]["kinematics"] = "finite";
   j["obstacles"][0]["friction"] = 0.3;
   j["body"]["supports"] = json::parse(
