@@ -50,8 +50,9 @@ TEST(HeldByContactHard, SlenderFreeStripShearedToTheFrictionLimit) {
 // fixed alpha = 1 / ||Z^T C Z||_inf converges at 1 - lambda_min / ||Z^T C Z||_inf per solve, and
 // the reduced compliance's condition is about 60 (lambda 1.4e-6 .. 8.1e-5, ||.||_inf 1.0e-4;
 // C's own is about 400: the elimination does not worsen it). The budget is raised to 1000 here:
-// the same equal and opposite forces as cev's, and the same load to uzawa's precision.
-TEST(HeldByContactHard, UzawaSqueezesTheDiscBetweenTwoFlats) {
+// the same equal and opposite forces as cev's, and the same load to uzawa's precision. 8.5 s
+// of CPU, 44 s wall under load 9 (ctest -j2 alongside): a Slow case (label hard_slow).
+TEST(HeldByContactHardSlow, UzawaSqueezesTheDiscBetweenTwoFlats) {
   json j = disc_between_flats(96, 0.5);
   const Solved cev = solve_scene(j);
   ASSERT_TRUE(cev.run.completed) << cev.run.reason;
