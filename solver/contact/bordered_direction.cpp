@@ -12,6 +12,7 @@
 // bordered system; with a finite n the reduced contact error contracts as eq. 23 says while
 // the equilibrium rows are met at once. A motion that no active row holds (a rank-deficient
 // G, e.g. a slide before friction has a bound) keeps its amplitude.
+#include <Eigen/LU>
 #include <Eigen/QR>
 
 #include "solver/contact/step.hpp"
@@ -42,7 +43,24 @@ Direction StepSolver::bordered_direction(const Compliance& C, const ContactError
   Eigen::CompleteOrthogonalDecomposition<Matrix> cod_g(G), cod_gt(G.transpose());
   cod_g.setThreshold(kRankThreshold);
   cod_gt.setThreshold(kRankThreshold);
-  const Vector dp0 = k ? Vector(-cod_gt.solve(va)) : Vector::Zero(m);
+  // dp0 from the bordered system with no contact error, [C G; G^T 0] [dp0; c] = [0; -v_a]: its
+  // displacement C dp0 = -G c is a rigid motion, which da takes up, so restoring the equilibrium
+  // leaves the rest of the contact error as it was (FETI's natural coarse problem; C alone may be
+  // singular, at a point whose only dof is a pin). The least change of the forces, -(G^T)^+ v_a,
+  // deformed a beam lying free on a flat so much that uzawa's step raised ||v|| for every alpha;
+  // it stays where the bordered system is singular (a motion no active row holds).
+  Vector dp0 = Vector::Zero(m);
+  if (k) {
+    Matrix B = Matrix::Zero(m + k, m + k);
+    B.topLeftCorner(m, m) = Cc;
+    B.topRightCorner(m, k) = G;
+    B.bottomLeftCorner(k, m) = G.transpose();
+    Vector rhs = Vector::Zero(m + k);
+    rhs.tail(k) = -va;
+    const Eigen::FullPivLU<Matrix> lu(B);
+    if (lu.isInvertible()) dp0 = lu.solve(rhs).head(m);
+    if (!lu.isInvertible() || !dp0.allFinite()) dp0 = -cod_gt.solve(va);
+  }
   const Vector w = vc + Cc * dp0;
   Vector dp = dp0;
   dir.ok = true;

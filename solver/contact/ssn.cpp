@@ -47,7 +47,11 @@ class SsnStep : public StepSolver {
     pass_ = out_.passes = 1;
     out_.p = p_previous;
     project_to_cone(problem_, out_.p);
-    if (!fresh_solve(q_guess) || !approach_contact()) return;
+    // A body that no force held yet (its first contact) is brought to touch instead: a
+    // restoring step from one touching point would press it far in (Hertz by a force).
+    bool held = false;
+    for (const Candidate& c : problem_.candidates) held = held || out_.p[c.eta] < 0;
+    if (!fresh_solve(q_guess) || !approach_contact() || (held && !restore_equilibrium())) return;
     Vector q = out_.state.q, p = out_.p;
     augmentations(out_.state);
     const int components = problem_.component_count;
@@ -151,6 +155,31 @@ class SsnStep : public StepSolver {
     }
     out_.converged = true;
     final_check();
+  }
+
+  // A body held by contact starts a step unbalanced: the load grew, the forces are the last
+  // step's, and the pins of the first solve carry the difference as a point reaction that
+  // deforms the body around them. Linearized there, every point of the sheared block slipped, no
+  // row held the slide, and the first Newton step overshot (||dq|| ~ 1e10, 86-174 real solves a
+  // level, each a restart). So Newton starts from one step of the linear model instead: the
+  // bordered system [C G; G^T 0] [dp; da] = [v_c; v_a] on the active components (the
+  // equilibrium rows met, the gaps and slips of the active points closed), put onto the cone,
+  // and solved once (3 real solves a level then).
+  bool restore_equilibrium() {
+    const RigidModes& rigid = problem_.rigid;
+    if (!rigid.count() || error_.norm2 <= tol_) return true;
+    double unbalance = 0.0;
+    for (int k = 0; k < rigid.count(); ++k) unbalance = std::max(unbalance, std::abs(error_.v[rigid.first + k]));
+    if (unbalance <= 0.1 * tol_) return true;
+    const Compliance& C = eq_.compliance(out_.state, relevant_components());
+    if (!C.bordered) return true;
+    const Direction dir = bordered_direction(C, error_, kAccelerationInfinity, 0.0);
+    if (!dir.ok) return true;
+    Vector p = out_.p - dir.d;
+    project_to_cone(problem_, p);
+    const Vector du = eq_.predicted_change(C, p - out_.p);
+    out_.p = p;
+    return fresh_solve(Vector(out_.state.q + du));
   }
 
   // The Alart-Curnier function at (q's pairing, p) and, if asked, its generalized Jacobian

@@ -1,5 +1,6 @@
 #pragma once
 // Loading the shipped example scenes in tests, with edits.
+#include <cmath>
 #include <fstream>
 #include <functional>
 #include <string>
@@ -36,6 +37,39 @@ inline nlohmann::json sheet(int elements, double mu) {
 inline nlohmann::json block_under_shear() {
   nlohmann::json j = example_scene("block-held-by-friction");
   j["stages"].push_back({{"steps", 1}, {"factors", {{"press", 1}, {"shear", 1.05}}}});
+  return j;
+}
+
+// A disc (R = 10, an elliptic grid) between two flats with friction 0.3; the upper flat moves
+// down by `delta`. No supports: only the two contacts hold it (friction its sideways motion and
+// rotation). nu = 0.49 (with the mean-dilatation q4_bbar): friction on a rigid flat narrows the
+// contact of a compressible body below Hertz's width (with nu = 0.3 by 6 % here), which the
+// closed form neglects; the coupling vanishes as nu -> 1/2 (as in cattaneo-mindlin.json).
+inline nlohmann::json disc_between_flats(int n, double delta) {
+  using nlohmann::json;
+  json nodes = json::array(), elements = json::array(), rim = json::array();
+  auto id = [n](int i, int k) { return k * (n + 1) + i; };
+  for (int k = 0; k <= n; ++k)
+    for (int i = 0; i <= n; ++i) {
+      const double u = -1 + 2.0 * i / n, v = -1 + 2.0 * k / n;  // the square mapped onto the disc
+      nodes.push_back({10 * u * std::sqrt(1 - v * v / 2), 10 * v * std::sqrt(1 - u * u / 2)});
+      if (i == 0 || k == 0 || i == n || k == n) rim.push_back(id(i, k));
+    }
+  for (int k = 0; k < n; ++k)
+    for (int i = 0; i < n; ++i) elements.push_back({id(i, k), id(i + 1, k), id(i + 1, k + 1), id(i, k + 1)});
+  json j = {
+      {"body",
+       {{"model", "continuum"}, {"kinematics", "linear"}, {"analysis", "plane_strain"}, {"element", "q4_bbar"},
+        {"thickness", 1}, {"material", {{"young", 200000}, {"poisson", 0.49}}},
+        {"mesh", {{"nodes", nodes}, {"elements", elements}, {"sets", {{"rim", rim}}}}},
+        {"contact_set", "rim"}}},
+      {"obstacles",
+       json::array({{{"name", "lower"}, {"shape", {{"type", "segment"}, {"from", {40, -10}}, {"to", {-40, -10}}}},
+                     {"friction", 0.3}},
+                    {{"name", "upper"}, {"shape", {{"type", "segment"}, {"from", {-40, 10}}, {"to", {40, 10}}}},
+                     {"friction", 0.3}, {"motion", {{"translation", {0, -delta}}}}}})},
+      {"steps", 1},
+      {"solver", {{"contact", {{"method", "cev"}, {"tolerance", 1e-8}, {"reach", 1.0}}}}}};
   return j;
 }
 
