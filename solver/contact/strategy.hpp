@@ -58,6 +58,12 @@ struct ContactParams {
   // linearly, so a step stops nearer the tolerance and may take more real solves (measured
   // in bench/results/scaling.md). Off by default: a fresh G at every real solve.
   bool reuse_compliance = false;
+  // From this many contact unknowns in an iteration on, cev's default loop (and ssn's
+  // augmentation) take the compliance in sparse form (Equilibrium::compliance): no dense C,
+  // G or factor of C's active block, but one sparse solve per product with C and one sparse
+  // LU per set of active rows. Measured on the flat of bench/scaling.py (bench/results/
+  // inner_profile.md): the dense form is faster below about SPARSE_FROM unknowns.
+  int sparse_compliance_from = 1000;
   // penalty: k_n and k_t (force / length); 0 means penalty_factor times the largest diagonal
   // entry of the body's stiffness (k_t defaults to k_n).
   double penalty_normal = 0.0;
