@@ -4,7 +4,6 @@
 // friction bound moves with p_eta, so there are no tau passes. Options: the tau passes of
 // eq. 14 around the same inner loop with eq. 13 on the model (`friction_loop: passes`,
 // ALGORITHM.md section 5), or around the paper's literal loop (`loop: paper`).
-#include <cstdlib>
 #include "solver/contact/acceleration.hpp"
 #include "solver/contact/coulomb_model.hpp"
 #include "solver/contact/step.hpp"
@@ -37,7 +36,7 @@ class CevStep : public StepSolver {
     if (!fresh_solve(q_guess) || !approach_contact()) return;
     while (error_.norm2 > tol_) {
       if (!budget_left()) return;
-      const Compliance& C = eq_.compliance(out_.state, relevant_components(), std::getenv("GRIP_SPARSE_FROM") ? std::atoi(std::getenv("GRIP_SPARSE_FROM")) : params_.sparse_compliance_from);
+      const Compliance& C = eq_.compliance(out_.state, relevant_components(), params_.sparse_compliance_from);
       int inner = 0, halvings = 0;
       const Vector pl = predict_coulomb(C, inner, halvings);
       out_.inner_iterations += inner;

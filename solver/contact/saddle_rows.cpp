@@ -21,7 +21,8 @@ struct RowKind {
 // The saddle-point matrix S (free dofs, then the m rows of C, each unknown scaled by sigma, K's
 // mean diagonal, so that both blocks weigh alike in the pivoting: dx = sigma w) at the kinds
 // `base`, its LU, and the correction S_now = S + E D for the rows `changed` whose kind differs
-// now: S_now^-1 b = z - Z (I + D Z)^-1 D z, z = S^-1 b, Z = S^-1 E.
+// now (E their unit columns, D their rows' change): S_now^-1 b = z - Z (I + D Z)^-1 D z,
+// z = S^-1 b, Z = S^-1 E, whose columns are kept for the next correction on the same LU.
 struct SaddleFactor {
   int nf = 0, m = 0;
   double sigma = 1.0;
@@ -33,6 +34,9 @@ struct SaddleFactor {
   Eigen::SparseMatrix<double> D;
   Matrix Z;
   Eigen::PartialPivLU<Matrix> capacitance;
+  // S^-1 e_(nf + k) for the rows k solved for so far (they depend on S only, not on the kinds).
+  std::vector<int> unit_column;  // row k -> column of `units`, -1 if not yet solved
+  Matrix units;
 };
 
 namespace {
@@ -80,6 +84,8 @@ void factorize(const Compliance& C, SaddleFactor& f, const std::vector<RowKind>&
   f.ok = f.lu.info() == Eigen::Success;
   f.base = f.current = kinds;
   f.changed.clear();
+  f.unit_column.assign(f.m, -1);
+  f.units.resize(f.nf + f.m, 0);
 }
 
 void correct(const Compliance& C, SaddleFactor& f, const std::vector<RowKind>& kinds, NewtonRowStats& stats) {
@@ -87,20 +93,30 @@ void correct(const Compliance& C, SaddleFactor& f, const std::vector<RowKind>& k
   const int n = f.nf + f.m, r = static_cast<int>(f.changed.size());
   Triplets d;
   std::vector<std::pair<int, double>> now, then;
-  Eigen::SparseMatrix<double> E(n, r);
-  Triplets e;
+  std::vector<int> unsolved;
+  for (int k : f.changed)
+    if (f.unit_column[k] < 0) unsolved.push_back(k);
+  if (!unsolved.empty()) {
+    const int old_columns = static_cast<int>(f.units.cols()), u = static_cast<int>(unsolved.size());
+    Matrix rhs = Matrix::Zero(n, u);
+    for (int i = 0; i < u; ++i) {
+      rhs(f.nf + unsolved[i], i) = 1.0;
+      f.unit_column[unsolved[i]] = old_columns + i;
+    }
+    f.units.conservativeResize(n, old_columns + u);
+    f.units.rightCols(u) = f.lu.solve(rhs);
+  }
+  f.Z.resize(n, r);
+  for (int i = 0; i < r; ++i) f.Z.col(i) = f.units.col(f.unit_column[f.changed[i]]);
   for (int i = 0; i < r; ++i) {
     const int k = f.changed[i];
     row_entries(C, f, k, kinds[k], now);
     row_entries(C, f, k, f.base[k], then);
     for (size_t t = 0; t < now.size(); ++t)
       if (now[t].second != then[t].second) d.emplace_back(i, now[t].first, now[t].second - then[t].second);
-    e.emplace_back(f.nf + k, i, 1.0);
   }
   f.D.resize(r, n);
   f.D.setFromTriplets(d.begin(), d.end());
-  E.setFromTriplets(e.begin(), e.end());
-  f.Z = f.lu.solve(Matrix(E));
   f.capacitance.compute(Matrix::Identity(r, r) + f.D * f.Z);
   f.current = kinds;
 }
