@@ -145,7 +145,7 @@ Vector solve_saddle_rows(const Compliance& C, const Vector& F, const Vector& s, 
     f.changed = std::move(changed);
     if (f.changed.empty())  // back at the factorized kinds
       f.current = kinds;
-    else if (static_cast<int>(f.changed.size()) > kSaddleCorrectionRows || !f.ok)
+    else if (f.units.cols() + static_cast<Eigen::Index>(f.changed.size()) > kSaddleCorrectionRows || !f.ok)
       factorize(C, f, kinds, stats);
     else
       correct(C, f, kinds, stats);

@@ -13,9 +13,10 @@ namespace grip {
 //     dx_k = -F_k                          explicit row k (open, no bound)
 //     dx_xi - c dx_eta = -F_xi + c F_eta   slip row xi of normal eta
 // Its pattern is the same for every kind (explicit zeros keep it), so UMFPACK analyses it once
-// per compliance; its LU is kept in C.saddle, and a change of kind of at most
-// kSaddleCorrectionRows rows is a Woodbury correction of the kept LU (that many extra solves)
-// instead of a new LU.
+// per compliance; its LU is kept in C.saddle, and a change of kind of a few rows is a Woodbury
+// correction of the kept LU (one extra solve per row, kept for later corrections) instead of a
+// new LU, while the rows solved for since the LU stay at most kSaddleCorrectionRows (their
+// solves are (free dofs + m) x rows doubles).
 Vector solve_saddle_rows(const Compliance& C, const Vector& F, const Vector& s, const NewtonRows& rows,
                          NewtonRowStats& stats);
 
