@@ -36,7 +36,7 @@ class CevStep : public StepSolver {
     if (!fresh_solve(q_guess) || !approach_contact()) return;
     while (error_.norm2 > tol_) {
       if (!budget_left()) return;
-      const Compliance& C = eq_.compliance(out_.state, relevant_components());
+      const Compliance& C = eq_.compliance(out_.state, relevant_components(), params_.sparse_compliance_from);
       int inner = 0, halvings = 0;
       const Vector pl = predict_coulomb(C, inner, halvings);
       out_.inner_iterations += inner;
@@ -63,17 +63,19 @@ class CevStep : public StepSolver {
     inner = sol.iterations;
     halvings = sol.halvings;
     if (sol.converged) return sol.p;
+    // The tau passes on the model work on C's entries: the dense form, formed here only.
+    const Compliance& dense = C.sparse() ? eq_.compliance(out_.state, relevant_components()) : C;
     Vector pl = sol.p, sl = sol.s;
     for (int pass = 0; pass < params_.max_tau_passes; ++pass) {
       const Vector tau = friction_bounds(problem_, pl);
       int n_used = 0, k = 0, h = 0;
       double alpha_used = 1.0;
-      const Vector next = predict(C, pl, sl, tau, k, h, n_used, alpha_used);
+      const Vector next = predict(dense, pl, sl, tau, k, h, n_used, alpha_used);
       inner += k;
       halvings += h;
       double change = 0.0;
       for (const Candidate& c : problem_.candidates) change = std::max(change, std::abs(next[c.eta] - pl[c.eta]));
-      sl += model_change(C, next - pl);
+      sl += model_change(dense, next - pl);
       pl = next;
       project_to_cone(problem_, pl);
       if (contact_error(problem_, pl, sl, friction_bounds(problem_, pl), out_.state.enabled).norm2 <= mp.target ||

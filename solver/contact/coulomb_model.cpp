@@ -17,8 +17,8 @@ struct Rows {
 class Model {
  public:
   Model(const Problem& problem, const Compliance& C, const Vector& p0, const Vector& s0, double augmentation)
-      : compliance_(C), C_(C.block), p0_full_(p0), s0_full_(s0), problem_(problem) {
-    const int m = static_cast<int>(C.block.rows());
+      : compliance_(C), p0_full_(p0), s0_full_(s0), problem_(problem) {
+    const int m = C.size();
     component_.assign(m, -1);
     for (size_t j = 0; j < C.position.size(); ++j)
       if (C.position[j] >= 0) component_[C.position[j]] = static_cast<int>(j);
@@ -28,15 +28,15 @@ class Model {
       r.xi = c.xi >= 0 ? C.position[c.xi] : -1;
       if (r.eta < 0 && r.xi < 0) continue;
       r.mu = problem.obstacles[c.obstacle].friction;
-      if (r.eta >= 0 && C.block(r.eta, r.eta) > 0) r.r_eta = augmentation / C.block(r.eta, r.eta);
-      if (r.xi >= 0 && C.block(r.xi, r.xi) > 0) r.r_xi = augmentation / C.block(r.xi, r.xi);
+      if (r.eta >= 0 && C.diagonal(r.eta) > 0) r.r_eta = augmentation / C.diagonal(r.eta);
+      if (r.xi >= 0 && C.diagonal(r.xi) > 0) r.r_xi = augmentation / C.diagonal(r.xi);
       rows_.push_back(r);
     }
     // The rigid amplitudes' rows (ALGORITHM.md 7): the body's equilibrium s = 0, an equality,
     // scaled like a contact row by the largest contact compliance.
     double c_max = 0.0;
     for (const Rows& r : rows_)
-      c_max = std::max({c_max, r.eta >= 0 ? C.block(r.eta, r.eta) : 0.0, r.xi >= 0 ? C.block(r.xi, r.xi) : 0.0});
+      c_max = std::max({c_max, r.eta >= 0 ? C.diagonal(r.eta) : 0.0, r.xi >= 0 ? C.diagonal(r.xi) : 0.0});
     for (int k = 0; k < m; ++k)
       if (problem.rigid.is_amplitude(component_[k])) equality_.push_back(k);
     r_equality_ = c_max > 0 ? augmentation / c_max : 1.0;
@@ -49,7 +49,7 @@ class Model {
   }
 
   const Vector& x0() const { return x0_; }
-  Vector s(const Vector& x) const { return s0_ + C_ * (x - x0_); }
+  Vector s(const Vector& x) const { return s0_ + compliance_.apply(x - x0_); }
 
   // The Alart-Curnier function at x (with s = s(x)) and, if asked, the kinds of its
   // generalized Jacobian's rows (NewtonRows).
@@ -105,7 +105,6 @@ class Model {
 
  private:
   const Compliance& compliance_;
-  const Matrix& C_;
   const Vector& p0_full_;
   const Vector& s0_full_;
   const Problem& problem_;

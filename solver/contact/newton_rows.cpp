@@ -1,5 +1,7 @@
 #include "solver/contact/newton_rows.hpp"
 
+#include "solver/contact/saddle_rows.hpp"
+
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
 #include <Eigen/QR>
@@ -115,6 +117,7 @@ void build_capacitance(const Matrix& C, ComplianceFactor& f, const NewtonRows& r
 
 Vector solve_newton_rows(const Compliance& C, const Vector& F, const Vector& s, const NewtonRows& rows,
                          NewtonRowStats& stats) {
+  if (C.sparse()) return solve_saddle_rows(C, F, s, rows, stats);
   const Matrix& Cb = C.block;
   const int m = static_cast<int>(F.size()), n = static_cast<int>(rows.active.size());
   Vector d = -F;

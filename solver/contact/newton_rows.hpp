@@ -26,12 +26,13 @@ struct NewtonRows {
 };
 
 struct NewtonRowStats {
-  int factorizations = 0;  // Cholesky factorizations of C on a set of active rows
+  int factorizations = 0;  // Cholesky factorizations of C on a set of active rows (sparse: LUs)
   int capacitances = 0;    // low-rank corrections to one (rows joined, left, slipping)
   int dense = 0;           // LU factorizations of a whole reduced system
 };
 
-// dx solving J dx = -F at the kinds `rows`, with s = s(x) of the model. Large systems reuse a
+// dx solving J dx = -F at the kinds `rows`, with s = s(x) of the model. A compliance in sparse
+// form: solve_saddle_rows (saddle_rows.hpp). Large systems reuse a
 // Cholesky factorization of C's block on an earlier active set, kept in C.factor while C stays
 // the same, and correct it by a capacitance matrix for the rows that joined or left and for the
 // slip coupling (Woodbury): O(rows^2 x changes) instead of O(rows^3).

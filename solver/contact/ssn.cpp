@@ -273,14 +273,14 @@ class SsnStep : public StepSolver {
   // r_i = augmentation / C_ii, each component's own contact stiffness, from the compliance at
   // the step's first solve (the mean of those where a component was out of reach then).
   void augmentations(const EquilibriumState& state) {
-    const Compliance& C = eq_.compliance(state, relevant_components());
+    const Compliance& C = eq_.compliance(state, relevant_components(), params_.sparse_compliance_from);
     r_ = Vector::Zero(problem_.component_count);
     double sum = 0.0;
     int count = 0;
     for (int k = 0; k < problem_.component_count; ++k) {
       const int a = C.position[k];
-      if (a >= 0 && C.block(a, a) > 0) {
-        r_[k] = params_.augmentation / C.block(a, a);
+      if (a >= 0 && C.diagonal(a) > 0) {
+        r_[k] = params_.augmentation / C.diagonal(a);
         sum += r_[k];
         ++count;
       }

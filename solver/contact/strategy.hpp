@@ -58,6 +58,15 @@ struct ContactParams {
   // linearly, so a step stops nearer the tolerance and may take more real solves (measured
   // in bench/results/scaling.md). Off by default: a fresh G at every real solve.
   bool reuse_compliance = false;
+  // From this many contact unknowns in an iteration on, cev's default loop (and ssn's
+  // augmentation) take the compliance in sparse form (Equilibrium::compliance): no dense C,
+  // G or factor of C's active block, but one sparse solve per product with C and a sparse LU
+  // of a saddle-point system for the inner model's Newton steps (saddle_rows.hpp). Measured on
+  // the flat of bench/scaling.py (bench/results/inner_profile.md, CPU seconds of the whole run,
+  // dense / sparse): 1000 unknowns 0.48-0.66 / 0.57-0.64, 1400 unknowns 1.08-1.13 / 0.78-0.87,
+  // 2000 unknowns 1.53-2.06 / 1.35-1.38. The paper's beam and sheet and Hertz up to a/h 40 (242)
+  // stay dense.
+  int sparse_compliance_from = 1200;
   // penalty: k_n and k_t (force / length); 0 means penalty_factor times the largest diagonal
   // entry of the body's stiffness (k_t defaults to k_n).
   double penalty_normal = 0.0;

@@ -425,9 +425,16 @@ bool same_sparse(const Eigen::SparseMatrix<double>& a, const Eigen::SparseMatrix
 
 }  // namespace
 
-const Compliance& Equilibrium::compliance(const EquilibriumState& state,
-                                          const std::vector<int>& components) {
+const Compliance& Equilibrium::compliance(const EquilibriumState& state, const std::vector<int>& components,
+                                          int sparse_from) {
   const int k = static_cast<int>(components.size());
+  bool tangent_ok = false;
+  if (k > 0) {
+    tangent_ok = compliance_tangent(state);
+    // The border of a body held by contact stays dense (its block is indefinite).
+    if (tangent_ok && k >= sparse_from && problem_.rigid.count() == 0 && body_lu_.symmetric())
+      return sparse_compliance(state, components);
+  }
   std::vector<int> position(problem_.component_count, -1);
   for (int a = 0; a < k; ++a) position[components[a]] = a;
   const bool same_components = position == c_.position;
@@ -439,18 +446,7 @@ const Compliance& Equilibrium::compliance(const EquilibriumState& state,
     c_version_ = -1;
     return c_;
   };
-  if (components.empty()) return empty();
-  if (!constant_tangent_ && !compliance_reuse_) g_valid_ = false;
-  compliance_reused_ = g_valid_ && !constant_tangent_;
-  if (!g_valid_) {  // a new G: from the tangent at this state
-    surface_free_.clear();
-    surface_row_.assign(free_count_, -1);
-    g_.resize(0, 0);
-    if (!factorize_body_tangent(state.q)) return empty();
-    ++counters_.compliance_forms;
-    ++g_version_;
-    g_valid_ = true;
-  }
+  if (components.empty() || !tangent_ok) return empty();
   // The surface dofs of these components that G does not cover yet join it.
   std::vector<int> added;
   std::vector<char> adding(free_count_, 0);
@@ -505,6 +501,65 @@ const Compliance& Equilibrium::compliance(const EquilibriumState& state,
   return c_;
 }
 
+bool Equilibrium::compliance_tangent(const EquilibriumState& state) {
+  if (!constant_tangent_ && !compliance_reuse_) g_valid_ = false;
+  compliance_reused_ = g_valid_ && !constant_tangent_;
+  if (g_valid_) return body_lu_.ok();
+  // A new G: from the tangent at this state.
+  surface_free_.clear();
+  surface_row_.assign(free_count_, -1);
+  g_.resize(0, 0);
+  if (!factorize_body_tangent(state.q)) return false;
+  ++counters_.compliance_forms;
+  ++g_version_;
+  ++tangent_version_;
+  g_valid_ = true;
+  return true;
+}
+
+const Compliance& Equilibrium::sparse_compliance(const EquilibriumState& state,
+                                                 const std::vector<int>& components) {
+  const int k = static_cast<int>(components.size());
+  std::vector<int> position(problem_.component_count, -1);
+  for (int a = 0; a < k; ++a) position[components[a]] = a;
+  const bool same_components = position == sparse_.position;
+  sparse_.position = std::move(position);
+  Triplets ts;
+  for (size_t i = 0; i < problem_.candidates.size(); ++i) {
+    const Candidate& c = problem_.candidates[i];
+    const PairedPoint& pp = state.points[i];
+    const int eta = sparse_.position[c.eta], xi = c.xi >= 0 ? sparse_.position[c.xi] : -1;
+    if (eta < 0 && xi < 0) continue;
+    for (const auto& j : pp.point.jacobian) {
+      const int f = free_index_[j.dof];
+      if (f < 0) continue;
+      if (eta >= 0) ts.emplace_back(f, eta, j.dx.dot(pp.eta));
+      if (xi >= 0) ts.emplace_back(f, xi, j.dx.dot(pp.xi));
+    }
+  }
+  Eigen::SparseMatrix<double> t(free_count_, k);
+  t.setFromTriplets(ts.begin(), ts.end());
+  // The same tangent, components and T (a constant tangent, a pairing that did not move): the
+  // same C, and the inner solver keeps its factorizations.
+  if (same_components && sparse_.body && sparse_version_ == tangent_version_ && same_sparse(t, sparse_.t))
+    return sparse_;
+  sparse_.t = std::move(t);
+  sparse_.normal_of.assign(k, -1);
+  for (const Candidate& c : problem_.candidates)
+    if (c.xi >= 0 && sparse_.position[c.xi] >= 0) sparse_.normal_of[sparse_.position[c.xi]] = sparse_.position[c.eta];
+  sparse_.body = &body_lu_;
+  sparse_.saddle.reset();
+  sparse_version_ = tangent_version_;
+  sparse_.diagonal_entries = body_lu_.quadratic_forms(sparse_.t);
+  return sparse_;
+}
+
+Vector Compliance::apply(const Vector& z) const {
+  if (!sparse()) return block * z;
+  const Vector force = t * z;
+  return t.transpose() * body->solve(force);
+}
+
 // The border G = T^T R of the compliance (ALGORITHM.md 7), times the amplitudes' scale: the
 // rigid motion moves every contact point with it, and the amplitudes' s, the whole body's
 // equilibrium, changes with p by G^T.
@@ -532,6 +587,15 @@ void Equilibrium::add_rigid_border(const EquilibriumState& state) {
 
 Vector Equilibrium::predicted_change(const Compliance& C, const Vector& dp) const {
   Vector du = Vector::Zero(free_index_.size());
+  if (C.sparse()) {  // T on the free dofs; no rigid amplitudes
+    Vector dp_block = Vector::Zero(C.size());
+    for (size_t j = 0; j < C.position.size(); ++j)
+      if (C.position[j] >= 0) dp_block[C.position[j]] = dp[j];
+    const Vector du_free = C.body->solve(Vector(C.t * dp_block));
+    for (size_t i = 0; i < free_index_.size(); ++i)
+      if (free_index_[i] >= 0) du[i] = du_free[free_index_[i]];
+    return du;
+  }
   if (C.block.rows() == 0 || t_surface_.cols() != C.block.rows() || !body_lu_.ok()) return du;
   Vector dp_block = Vector::Zero(C.block.rows());
   for (size_t j = 0; j < C.position.size(); ++j)

@@ -4,6 +4,7 @@
 // d(T(u) p)/du re-evaluated at every iterate. Also the contact compliance C = T^T K^-1 T.
 #include <Eigen/SparseCore>
 #include <Eigen/SparseLU>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -88,17 +89,36 @@ struct PenaltyLaw {
 };
 
 // Factorizations of blocks of a compliance, kept by the inner contact solver (coulomb_model.cpp)
-// for as long as the compliance stays the same.
+// for as long as the compliance stays the same: dense (C's active block) or sparse (the
+// saddle-point systems of the sparse form).
 struct ComplianceFactor;
+struct SaddleFactor;
 
 // The contact compliance C = T^T K^-1 T on a subset of the components (the ones that can
-// take part in this iteration); zero elsewhere.
+// take part in this iteration); zero elsewhere. Dense (`block`) or, for large contact zones,
+// sparse: T on the free dofs and the body's factorization, C z = T^T K^-1 T z by one sparse
+// solve, nothing of size components^2 (Equilibrium::compliance).
 struct Compliance {
-  std::vector<int> position;  // component -> row of `block`, -1 where not computed
-  Matrix block;
+  std::vector<int> position;  // component -> row of `block` (or column of `t`), -1 where not computed
+  Matrix block;               // the dense form; empty in the sparse form
   mutable std::shared_ptr<ComplianceFactor> factor;  // reset whenever `block` changes
   // With the rigid amplitudes' border [C G; G^T 0] (ALGORITHM.md 7): indefinite, no Cholesky.
+  // Dense form only.
   bool bordered = false;
+  // The sparse form: `body` is the body's factorization of K (free dofs), `t` is T on the free
+  // dofs (free dofs x rows), `diagonal` is C's diagonal.
+  const FreeBlockSolver* body = nullptr;
+  Eigen::SparseMatrix<double> t;
+  Vector diagonal_entries;
+  std::vector<int> normal_of;  // row -> the row of its candidate's normal (tangent rows), else -1
+  mutable std::shared_ptr<SaddleFactor> saddle;  // reset whenever `t` or `body` changes
+
+  bool sparse() const { return body != nullptr; }
+  int size() const { return sparse() ? static_cast<int>(t.cols()) : static_cast<int>(block.rows()); }
+  double diagonal(int i) const { return sparse() ? diagonal_entries[i] : block(i, i); }
+  // C z over the rows (one sparse solve in the sparse form).
+  Vector apply(const Vector& z) const;
+  // Dense form only:
   double operator()(int a, int b) const {
     const int i = position[a], j = position[b];
     return i < 0 || j < 0 ? 0.0 : block(i, j);
@@ -106,6 +126,9 @@ struct Compliance {
   // C restricted to the given components, in their order.
   Matrix sub(const std::vector<int>& components) const;
 };
+
+// Never the sparse form (Equilibrium::compliance's `sparse_from`).
+inline constexpr int kDenseCompliance = std::numeric_limits<int>::max();
 
 class Equilibrium {
  public:
@@ -133,7 +156,12 @@ class Equilibrium {
   // or, with reuse on, the G of an earlier state of the same load step (set_step and
   // refresh_compliance() renew it): the inner loop's linear model is then approximate, the
   // real solves still decide. The reference stays valid until the next call.
-  const Compliance& compliance(const EquilibriumState& state, const std::vector<int>& components);
+  // From `sparse_from` components on (and for a body not held by contact, whose tangent is
+  // Cholesky-factorized), the sparse form instead: T on the free dofs, K's factorization and C's
+  // diagonal (t_j^T K^-1 t_j by partial forward solves), no G; its reference is a separate one,
+  // valid until the next sparse call.
+  const Compliance& compliance(const EquilibriumState& state, const std::vector<int>& components,
+                               int sparse_from = kDenseCompliance);
   // Reuse G across a load step's real solves for a changing tangent (default off).
   void set_compliance_reuse(bool on) { compliance_reuse_ = on; }
   // The next compliance() forms G afresh at its state.
@@ -182,6 +210,10 @@ class Equilibrium {
   bool pins_free_ = false;
   // Adds free dofs to G's surface: one solve with the body's factorization per dof.
   void extend_surface_compliance(const std::vector<int>& added);
+  // The body's tangent that G (or the sparse form) comes from: kept, or factorized at state.q
+  // (a changing tangent without reuse). False if it is singular.
+  bool compliance_tangent(const EquilibriumState& state);
+  const Compliance& sparse_compliance(const EquilibriumState& state, const std::vector<int>& components);
 
   const Problem& problem_;
   NewtonParams params_;
@@ -210,6 +242,8 @@ class Equilibrium {
   Eigen::SparseMatrix<double> t_surface_;  // the last compliance's T_s (surface rows x block)
   Compliance c_;
   long g_version_ = 0, c_version_ = -1;  // G's content; the G that c_ was formed from
+  Compliance sparse_;                     // the sparse form
+  long tangent_version_ = 0, sparse_version_ = -1;  // body_lu_'s content; the one sparse_ uses
 };
 
 }  // namespace grip

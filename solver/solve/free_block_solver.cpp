@@ -106,29 +106,79 @@ bool partial_solves_pay(const cholmod_factor* L, const std::vector<int>& rows) {
 
 }  // namespace
 
+namespace {
+
+// A second factorization of the same block in nested-dissection order: short elimination-tree
+// paths where the fill-reducing order of a thin strip is nearly banded.
+void factorize_dissected(CholmodFactor& dissected, const Eigen::SparseMatrix<double>& matrix) {
+  dissected.cholmod().nmethods = 1;
+  dissected.cholmod().method[0].ordering = CHOLMOD_NESDIS;
+  dissected.compute(matrix);
+}
+
+}  // namespace
+
 bool FreeBlockSolver::inverse_block(const std::vector<int>& rows, Matrix& G) {
   if (!ok_ || !symmetric_) return false;
   if (llt_.inverse_block(rows, G)) return true;
   CholmodFactor dissected;
-  dissected.cholmod().nmethods = 1;
-  dissected.cholmod().method[0].ordering = CHOLMOD_NESDIS;
-  dissected.compute(matrix_);
+  factorize_dissected(dissected, matrix_);
   return dissected.info() == Eigen::Success && dissected.inverse_block(rows, G);
+}
+
+bool CholmodFactor::forward_solves(const Eigen::SparseMatrix<double>& columns,
+                                   const std::function<bool(int, const int*, const double*, int)>& use) {
+  if (!m_cholmodFactor) return false;
+  cholmod_common* cc = &cholmod();
+  cholmod_factor* L = cholmod_copy_factor(m_cholmodFactor, cc);  // the partial solve makes it simplicial
+  if (!L) return false;
+  const int n = static_cast<int>(L->n);
+  std::vector<int> position(n);  // row of P b that b's entry f lands in
+  const int* perm = static_cast<const int*>(L->Perm);
+  for (int k = 0; k < n; ++k) position[perm ? perm[k] : k] = k;
+  int most = 1;
+  for (int a = 0; a < columns.outerSize(); ++a)
+    most = std::max(most, static_cast<int>(columns.outerIndexPtr()[a + 1] - columns.outerIndexPtr()[a]));
+  cholmod_dense* B = cholmod_zeros(n, 1, CHOLMOD_REAL, cc);
+  cholmod_sparse* bset = cholmod_allocate_sparse(n, 1, most, true, true, 0, CHOLMOD_PATTERN, cc);
+  cholmod_dense *X = nullptr, *Y = nullptr, *E = nullptr;
+  cholmod_sparse* xset = nullptr;
+  bool ok = B && bset;
+  std::vector<int> pattern;
+  for (int a = 0; ok && a < columns.outerSize(); ++a) {
+    pattern.clear();
+    for (Eigen::SparseMatrix<double>::InnerIterator it(columns, a); it; ++it) {
+      static_cast<double*>(B->x)[position[it.row()]] = it.value();
+      pattern.push_back(position[it.row()]);
+    }
+    std::sort(pattern.begin(), pattern.end());
+    static_cast<int*>(bset->p)[0] = 0;
+    static_cast<int*>(bset->p)[1] = static_cast<int>(pattern.size());
+    std::copy(pattern.begin(), pattern.end(), static_cast<int*>(bset->i));
+    ok = cholmod_solve2(CHOLMOD_L, L, B, bset, &X, &xset, &Y, &E, cc);
+    for (int k : pattern) static_cast<double*>(B->x)[k] = 0.0;
+    if (!ok) break;
+    const int* xi = static_cast<const int*>(xset->i);
+    ok = use(a, xi, static_cast<const double*>(X->x), static_cast<const int*>(xset->p)[1]);
+  }
+  cholmod_free_dense(&B, cc);
+  cholmod_free_dense(&X, cc);
+  cholmod_free_dense(&Y, cc);
+  cholmod_free_dense(&E, cc);
+  cholmod_free_sparse(&bset, cc);
+  cholmod_free_sparse(&xset, cc);
+  cholmod_free_factor(&L, cc);
+  return ok;
 }
 
 bool CholmodFactor::inverse_block(const std::vector<int>& rows, Matrix& G) {
   if (!m_cholmodFactor || !partial_solves_pay(m_cholmodFactor, rows)) return false;
-  cholmod_common* cc = &cholmod();
-  cholmod_factor* L = cholmod_copy_factor(m_cholmodFactor, cc);  // the partial solve makes it simplicial
-  if (!L) return false;
+  const cholmod_factor* L = m_cholmodFactor;
   const int n = static_cast<int>(L->n), s = static_cast<int>(rows.size());
-  std::vector<int> position(n);  // row of P b that b's entry f lands in
-  const int* perm = static_cast<const int*>(L->Perm);
-  for (int k = 0; k < n; ++k) position[perm ? perm[k] : k] = k;
-  cholmod_dense* B = cholmod_zeros(n, 1, CHOLMOD_REAL, cc);
-  cholmod_sparse* bset = cholmod_allocate_sparse(n, 1, 1, true, true, 0, CHOLMOD_PATTERN, cc);
-  cholmod_dense *X = nullptr, *Y = nullptr, *E = nullptr;
-  cholmod_sparse* xset = nullptr;
+  Eigen::SparseMatrix<double> units(n, s);  // the unit columns of the rows
+  std::vector<Eigen::Triplet<double>> ones;
+  for (int a = 0; a < s; ++a) ones.emplace_back(rows[a], a, 1.0);
+  units.setFromTriplets(ones.begin(), ones.end());
   std::vector<std::vector<std::pair<int, double>>> by_row(n);  // W's rows: (column, value)
   // W^T W costs sum |row|^2 <= s^2 x (mean column length) multiply-adds; dense solves would
   // cost 4 nnz(L) per row. Where W is not sparse enough (thin strips: long elimination-tree
@@ -141,44 +191,51 @@ bool CholmodFactor::inverse_block(const std::vector<int>& rows, Matrix& G) {
   const double budget = 2.0 * nnz_l * s;  // half the dense solves' flops
   double pairs = 0.0, reach = 0.0;
   constexpr int kSample = 8;
-  bool ok = B && bset;
-  for (int a = 0; ok && a < s; ++a) {
-    const int k = position[rows[a]];
-    static_cast<double*>(B->x)[k] = 1.0;
-    static_cast<int*>(bset->p)[0] = 0;
-    static_cast<int*>(bset->p)[1] = 1;
-    static_cast<int*>(bset->i)[0] = k;
-    ok = cholmod_solve2(CHOLMOD_L, L, B, bset, &X, &xset, &Y, &E, cc);
-    static_cast<double*>(B->x)[k] = 0.0;
-    if (!ok) break;
-    reach += static_cast<const int*>(xset->p)[1];
-    if (a + 1 == std::min(s, kSample) && static_cast<double>(s) * s * reach / (a + 1) > budget) ok = false;
-    const int* xi = static_cast<const int*>(xset->i);
-    const double* xv = static_cast<const double*>(X->x);
-    for (int t = 0; t < static_cast<const int*>(xset->p)[1]; ++t)
+  const bool ok = forward_solves(units, [&](int a, const int* xi, const double* xv, int count) {
+    reach += count;
+    if (a + 1 == std::min(s, kSample) && static_cast<double>(s) * s * reach / (a + 1) > budget) return false;
+    for (int t = 0; t < count; ++t)
       if (xv[xi[t]] != 0.0) {
         auto& row = by_row[xi[t]];
         pairs += 2.0 * row.size() + 1.0;
         row.emplace_back(a, xv[xi[t]]);
       }
-    ok = ok && pairs < budget;
-  }
-  if (ok) {
-    G.setZero(s, s);
-    for (const auto& row : by_row)
-      for (const auto& [a, va] : row) {
-        double* column = &G(0, a);
-        for (const auto& [b, vb] : row) column[b] += va * vb;
-      }
-  }
-  cholmod_free_dense(&B, cc);
-  cholmod_free_dense(&X, cc);
-  cholmod_free_dense(&Y, cc);
-  cholmod_free_dense(&E, cc);
-  cholmod_free_sparse(&bset, cc);
-  cholmod_free_sparse(&xset, cc);
-  cholmod_free_factor(&L, cc);
-  return ok;
+    return pairs < budget;
+  });
+  if (!ok) return false;
+  G.setZero(s, s);
+  for (const auto& row : by_row)
+    for (const auto& [a, va] : row) {
+      double* column = &G(0, a);
+      for (const auto& [b, vb] : row) column[b] += va * vb;
+    }
+  return true;
+}
+
+bool CholmodFactor::quadratic_forms(const Eigen::SparseMatrix<double>& t, Vector& out, double max_mean_reach) {
+  out.setZero(t.cols());
+  double reach = 0.0;
+  constexpr int kSample = 8;
+  return forward_solves(t, [&](int a, const int* xi, const double* xv, int count) {
+    reach += count;
+    if (max_mean_reach > 0 && a + 1 == std::min(static_cast<int>(t.cols()), kSample) && reach / (a + 1) > max_mean_reach)
+      return false;
+    double sum = 0.0;
+    for (int k = 0; k < count; ++k) sum += xv[xi[k]] * xv[xi[k]];
+    out[a] = sum;
+    return true;
+  });
+}
+
+Vector FreeBlockSolver::quadratic_forms(const Eigen::SparseMatrix<double>& t) {
+  Vector out;
+  if (!ok_ || !symmetric_) return Vector();
+  // A path through more than 1/32 of the rows on average: the nested-dissection order instead.
+  if (llt_.quadratic_forms(t, out, matrix_.rows() / 32.0)) return out;
+  CholmodFactor dissected;
+  factorize_dissected(dissected, matrix_);
+  if (dissected.info() == Eigen::Success && dissected.quadratic_forms(t, out, 0.0)) return out;
+  return Vector();
 }
 
 }  // namespace grip

@@ -8,6 +8,7 @@
 #include <Eigen/CholmodSupport>
 #include <Eigen/SparseCore>
 #include <Eigen/SparseLU>
+#include <functional>
 #include <vector>
 
 #include "solver/core/body.hpp"
@@ -24,6 +25,16 @@ class CholmodFactor : public Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<dou
   // solve, on a simplicial copy of the factor), where a dense solve costs 2 nnz(L) flops per
   // row. False where CHOLMOD fails.
   bool inverse_block(const std::vector<int>& rows, Matrix& G);
+  // t_j^T K^-1 t_j = |L^-1 P t_j|^2 for every column of t (free dofs x columns), by partial
+  // forward solves. False where CHOLMOD fails, or (with `max_mean_reach` > 0) where the first
+  // columns' solves reach more than that many rows on average (long elimination-tree paths).
+  bool quadratic_forms(const Eigen::SparseMatrix<double>& t, Vector& out, double max_mean_reach);
+
+ private:
+  // x = L^-1 P b for each sparse column b of `columns` (free dofs), on a simplicial copy of the
+  // factor: `use(column, rows of x, values of x, count)` sees each; false from it stops.
+  bool forward_solves(const Eigen::SparseMatrix<double>& columns,
+                      const std::function<bool(int, const int*, const double*, int)>& use);
 };
 
 class FreeBlockSolver {
@@ -42,7 +53,15 @@ class FreeBlockSolver {
   // gives the rows long elimination-tree paths (thin strips: a fill-reducing ordering there is
   // nearly banded), a second factorization in nested-dissection order, for G only.
   bool inverse_block(const std::vector<int>& rows, Matrix& G);
+  // t_j^T K^-1 t_j for every column of t (free dofs x columns) where K is Cholesky-factorized
+  // (partial forward solves; on a nested-dissection factorization where the body's own gives
+  // long elimination-tree paths, as for G); an empty vector otherwise.
+  Vector quadratic_forms(const Eigen::SparseMatrix<double>& t);
   bool ok() const { return ok_; }
+  // Factorized by Cholesky (symmetric positive definite).
+  bool symmetric() const { return ok_ && symmetric_; }
+  // The free block as factorized (both triangles).
+  const Eigen::SparseMatrix<double>& matrix() const { return matrix_; }
   // The next factorize() builds its pattern afresh (the free set changed).
   void forget_pattern() {
     rows_.clear();
