@@ -52,12 +52,14 @@ struct ContactParams {
   // Newton's displacement tolerance, as a fraction of the contact tolerance: the contact
   // error has a floor of about ||K^-1|| x the Newton residual (section 9).
   double newton_fraction = 1e-3;
-  // A tangent that changes with the displacement: true lets the compliance's G = K^-1 on the
-  // surface dofs serve a step's real solves while they accept its predictions (Equilibrium::
-  // compliance); the answer agrees to the contact tolerance, but the stale model converges
-  // linearly, so a step stops nearer the tolerance and may take more real solves (measured
-  // in bench/results/scaling.md). Off by default: a fresh G at every real solve.
-  bool reuse_compliance = false;
+  // A tangent that changes with the displacement, cev's inner loops (the default and the tau
+  // passes; the paper's loop always forms G afresh): the compliance's G = K^-1 on the surface
+  // dofs serves later real solves, across load steps too, while its updates accept at the
+  // first trial and lower ||v|| at least 30-fold (cev.cpp); else it is formed afresh. The
+  // answer agrees to the contact tolerance, but the stale model converges linearly, so a step
+  // stops nearer the tolerance (bench/results/coulomb_loop.md). False: a fresh G at every
+  // update.
+  bool reuse_compliance = true;
   // penalty: k_n and k_t (force / length); 0 means penalty_factor times the largest diagonal
   // entry of the body's stiffness (k_t defaults to k_n).
   double penalty_normal = 0.0;
