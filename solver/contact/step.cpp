@@ -36,7 +36,8 @@ StepSolver::StepSolver(Equilibrium& eq, const ContactParams& params, int step,
 StepOutcome StepSolver::run(const Vector& q_guess, const Vector& p_start, const Vector& p_star) {
   couple_newton(eq_.params(), params_.tolerance, params_.newton_fraction,
                 problem_.body->characteristic_length());
-  eq_.set_compliance_reuse(params_.reuse_compliance);
+  eq_.set_compliance_reuse(params_.reuse_compliance && params_.method == ContactMethod::cev &&
+                           params_.loop == ContactLoop::inner);
   const long solves0 = eq_.counters().solves, newton0 = eq_.counters().newton_iterations;
   solves_at_start_ = solves0;
   solve(q_guess, p_start, p_star);

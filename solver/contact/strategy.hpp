@@ -52,11 +52,14 @@ struct ContactParams {
   // Newton's displacement tolerance, as a fraction of the contact tolerance: the contact
   // error has a floor of about ||K^-1|| x the Newton residual (section 9).
   double newton_fraction = 1e-3;
-  // A tangent that changes with the displacement: true lets the compliance's G = K^-1 on the
-  // surface dofs serve a step's real solves while they accept its predictions (Equilibrium::
-  // compliance); the answer agrees to the contact tolerance, but the stale model converges
-  // linearly, so a step stops nearer the tolerance and may take more real solves (measured
-  // in bench/results/scaling.md). Off by default: a fresh G at every real solve.
+  // A tangent that changes with the displacement, cev's inner loops (the default and the tau
+  // passes; the paper's loop always forms G afresh): true lets the compliance's G = K^-1 on
+  // the surface dofs serve later real solves, across load steps too, while its updates accept
+  // at the first trial and lower ||v|| at least 30-fold (cev.cpp); else it is formed afresh.
+  // The answer agrees to the contact tolerance, but the stale model converges linearly, so a
+  // step stops nearer the tolerance (bench/results/coulomb_loop.md: the paper's beam 30 %
+  // fewer instructions; off because the finite-strain patch test's pressure then moves
+  // 4.3e-8 relative against the 1e-9 it asserts). Off by default: a fresh G at every update.
   bool reuse_compliance = false;
   // From this many contact unknowns in an iteration on, cev's default loop (and ssn's
   // augmentation) take the compliance in sparse form (Equilibrium::compliance): no dense C,

@@ -47,7 +47,6 @@ void Equilibrium::set_penalty(std::optional<PenaltyLaw> law) {
 void Equilibrium::set_step(LoadFactors factors, std::vector<double> zeta_previous) {
   factors_ = std::move(factors);
   zeta_previous_ = std::move(zeta_previous);
-  refresh_compliance();  // a changing tangent's G serves one step at most
 }
 
 void Equilibrium::pair(const Vector& q, EquilibriumState& state) const {

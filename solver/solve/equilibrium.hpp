@@ -153,8 +153,8 @@ class Equilibrium {
   // far, one solve per surface dof with one factorization of K, and T_s the rows of T at
   // those dofs (two or three non-zeros per column), so each call costs O(components^2),
   // nothing per free dof. A constant tangent gives one G per run. A changing one gives G at state.q,
-  // or, with reuse on, the G of an earlier state of the same load step (set_step and
-  // refresh_compliance() renew it): the inner loop's linear model is then approximate, the
+  // or, with reuse on, the G of an earlier state, of this load step or an earlier one
+  // (refresh_compliance() renews it): the inner loop's linear model is then approximate, the
   // real solves still decide. The reference stays valid until the next call.
   // From `sparse_from` components on (and for a body not held by contact, whose tangent is
   // Cholesky-factorized), the sparse form instead: T on the free dofs, K's factorization and C's
@@ -162,7 +162,7 @@ class Equilibrium {
   // valid until the next sparse call.
   const Compliance& compliance(const EquilibriumState& state, const std::vector<int>& components,
                                int sparse_from = kDenseCompliance);
-  // Reuse G across a load step's real solves for a changing tangent (default off).
+  // Reuse G across real solves and load steps for a changing tangent.
   void set_compliance_reuse(bool on) { compliance_reuse_ = on; }
   // The next compliance() forms G afresh at its state.
   void refresh_compliance() { g_valid_ = constant_tangent_ && g_valid_; }

@@ -36,7 +36,8 @@ bool FreeBlockSolver::factorize(const Triplets& triplets, const std::vector<int>
         const double* t = &matrix_.coeffRef(it.col(), it.row());
         mirror_[&it.valueRef() - matrix_.valuePtr()] = static_cast<int>(t - matrix_.valuePtr());
       }
-    lu_analysed_ = llt_analysed_ = false;
+    lu_analysed_ = llt_analysed_ = dissected_analysed_ = false;
+    dissected_fails_at_ = 0;
   }
   std::fill(matrix_.valuePtr(), matrix_.valuePtr() + matrix_.nonZeros(), 0.0);
   for (size_t k = 0; k < triplets.size(); ++k)
@@ -110,9 +111,13 @@ namespace {
 
 // A second factorization of the same block in nested-dissection order: short elimination-tree
 // paths where the fill-reducing order of a thin strip is nearly banded.
-void factorize_dissected(CholmodFactor& dissected, const Eigen::SparseMatrix<double>& matrix) {
+void order_by_nested_dissection(CholmodFactor& dissected) {
   dissected.cholmod().nmethods = 1;
   dissected.cholmod().method[0].ordering = CHOLMOD_NESDIS;
+}
+
+void factorize_dissected(CholmodFactor& dissected, const Eigen::SparseMatrix<double>& matrix) {
+  order_by_nested_dissection(dissected);
   dissected.compute(matrix);
 }
 
@@ -121,9 +126,17 @@ void factorize_dissected(CholmodFactor& dissected, const Eigen::SparseMatrix<dou
 bool FreeBlockSolver::inverse_block(const std::vector<int>& rows, Matrix& G) {
   if (!ok_ || !symmetric_) return false;
   if (llt_.inverse_block(rows, G)) return true;
-  CholmodFactor dissected;
-  factorize_dissected(dissected, matrix_);
-  return dissected.info() == Eigen::Success && dissected.inverse_block(rows, G);
+  // More rows only lengthen the partial solves against the same factor's pattern.
+  if (dissected_fails_at_ && rows.size() >= dissected_fails_at_) return false;
+  if (!dissected_analysed_) {
+    order_by_nested_dissection(dissected_);
+    dissected_.analyzePattern(matrix_);
+    dissected_analysed_ = true;
+  }
+  dissected_.factorize(matrix_);
+  if (dissected_.info() == Eigen::Success && dissected_.inverse_block(rows, G)) return true;
+  dissected_fails_at_ = dissected_fails_at_ ? std::min(dissected_fails_at_, rows.size()) : rows.size();
+  return false;
 }
 
 bool CholmodFactor::forward_solves(const Eigen::SparseMatrix<double>& columns,

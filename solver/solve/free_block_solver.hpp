@@ -51,7 +51,9 @@ class FreeBlockSolver {
   // K^-1 on the given rows where K is Cholesky-factorized (CholmodFactor::inverse_block);
   // false otherwise (then solve() for unit right-hand sides). Where the factor's own ordering
   // gives the rows long elimination-tree paths (thin strips: a fill-reducing ordering there is
-  // nearly banded), a second factorization in nested-dissection order, for G only.
+  // nearly banded), a second factorization in nested-dissection order, for G only: analysed
+  // once per pattern, and not tried again for as many rows or more once it did not pay (a
+  // beam's or a membrane's band: its analysis and factorization were 21 % of the beam's time).
   bool inverse_block(const std::vector<int>& rows, Matrix& G);
   // t_j^T K^-1 t_j for every column of t (free dofs x columns) where K is Cholesky-factorized
   // (partial forward solves; on a nested-dissection factorization where the body's own gives
@@ -67,6 +69,8 @@ class FreeBlockSolver {
     rows_.clear();
     cols_.clear();
     ok_ = false;
+    dissected_analysed_ = false;
+    dissected_fails_at_ = 0;
   }
 
  private:
@@ -76,7 +80,9 @@ class FreeBlockSolver {
   std::vector<int> mirror_;        // value index -> index of its transpose entry
   Eigen::SparseLU<Eigen::SparseMatrix<double>> lu_;
   CholmodFactor llt_;
-  bool lu_analysed_ = false, llt_analysed_ = false;
+  CholmodFactor dissected_;  // nested-dissection order, for inverse_block only
+  bool lu_analysed_ = false, llt_analysed_ = false, dissected_analysed_ = false;
+  size_t dissected_fails_at_ = 0;  // the fewest rows for which the dissected factor did not pay; 0: none yet
   bool symmetric_ = false;
   bool ok_ = false;
 };

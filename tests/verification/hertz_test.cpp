@@ -177,8 +177,8 @@ TEST(Hertz, SmallestAcceptedDivisionsMatchTheClosedForm) {
 }
 
 // A tangent that changes (finite kinematics) with friction: the compliance's G reused across
-// a step's real solves changes the path, not the answer (to what the contact tolerance pins
-// it), and forms G fewer times.
+// real solves and steps changes the path, not the answer (to what the contact
+// tolerance pins it), and forms G fewer times than a fresh G at every update.
 TEST(Hertz, ComplianceReuseKeepsTheAnswer) {
   json j = with_pole_elements(example_scene("hertz"), 0.1);
   j["body"]["kinematics"] = "finite";
