@@ -438,7 +438,8 @@ TEST(Service, JobsOverTheIterationOrTimeLimitFailWithThatReason) {
   {
     Server server({"--max-seconds", "0.2"});
     const Api api = server.api();
-    const json doc = api.wait_status(api.submit(beam_scene(40, 400)), {"successful", "failed"});
+    // 4000 steps take about 1.7 s here: well over the limit (400 steps took 0.17 s).
+    const json doc = api.wait_status(api.submit(beam_scene(40, 4000)), {"successful", "failed"});
     EXPECT_EQ(doc["status"], "failed");
     EXPECT_EQ(doc["message"].get<std::string>().rfind("limit: more than 0.2", 0), 0u) << doc;
     EXPECT_EQ(api.get("/v1/health")->status, 200);
