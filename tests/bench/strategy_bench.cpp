@@ -11,6 +11,8 @@
 //   grip_bench [--quick] [--out DIR] [--runs N] [--jobs N] [--budget MINUTES]
 //              [--run-seconds S] [--scenes a,b] [--strategies a,b] [--levels 0,1,2] [--source DIR]
 //              [--label TEXT]
+#include <malloc.h>
+
 #include <algorithm>
 #include <array>
 #include <atomic>
@@ -942,6 +944,9 @@ std::vector<std::string> split(const std::string& s) {
 
 int main(int argc, char** argv) {
   using namespace grip::bench;
+  // The heap settings of `grip` (apps/grip.cpp), so that times do not depend on the heap's history.
+  mallopt(M_MMAP_THRESHOLD, 64 << 20);
+  mallopt(M_TRIM_THRESHOLD, 256 << 20);
   Options opt;
   auto value = [&](int& i) -> std::string {
     if (i + 1 >= argc) throw std::runtime_error(std::string(argv[i]) + " needs a value");
