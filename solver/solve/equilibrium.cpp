@@ -422,6 +422,29 @@ bool same_sparse(const Eigen::SparseMatrix<double>& a, const Eigen::SparseMatrix
          std::equal(a.valuePtr(), a.valuePtr() + a.nonZeros(), b.valuePtr());
 }
 
+// T on the given components (columns at `position`), one row per free dof as `row` numbers it.
+template <class Row>
+Eigen::SparseMatrix<double> contact_map(const Problem& problem, const EquilibriumState& state,
+                                        const std::vector<int>& position, const std::vector<int>& free_index,
+                                        int rows, int cols, Row row) {
+  Triplets ts;
+  for (size_t i = 0; i < problem.candidates.size(); ++i) {
+    const Candidate& c = problem.candidates[i];
+    const PairedPoint& pp = state.points[i];
+    const int eta = position[c.eta], xi = c.xi >= 0 ? position[c.xi] : -1;
+    if (eta < 0 && xi < 0) continue;
+    for (const auto& j : pp.point.jacobian) {
+      const int f = free_index[j.dof];
+      if (f < 0) continue;
+      if (eta >= 0) ts.emplace_back(row(f), eta, j.dx.dot(pp.eta));
+      if (xi >= 0) ts.emplace_back(row(f), xi, j.dx.dot(pp.xi));
+    }
+  }
+  Eigen::SparseMatrix<double> t(rows, cols);
+  t.setFromTriplets(ts.begin(), ts.end());
+  return t;
+}
+
 }  // namespace
 
 const Compliance& Equilibrium::compliance(const EquilibriumState& state, const std::vector<int>& components,
@@ -464,21 +487,8 @@ const Compliance& Equilibrium::compliance(const EquilibriumState& state, const s
     extend_surface_compliance(added);
     ++g_version_;
   }
-  Triplets ts;
-  for (size_t i = 0; i < problem_.candidates.size(); ++i) {
-    const Candidate& c = problem_.candidates[i];
-    const PairedPoint& pp = state.points[i];
-    const int eta = c_.position[c.eta], xi = c.xi >= 0 ? c_.position[c.xi] : -1;
-    if (eta < 0 && xi < 0) continue;
-    for (const auto& j : pp.point.jacobian) {
-      const int f = free_index_[j.dof];
-      if (f < 0) continue;
-      if (eta >= 0) ts.emplace_back(surface_row_[f], eta, j.dx.dot(pp.eta));
-      if (xi >= 0) ts.emplace_back(surface_row_[f], xi, j.dx.dot(pp.xi));
-    }
-  }
-  Eigen::SparseMatrix<double> t_surface(g_.rows(), k);
-  t_surface.setFromTriplets(ts.begin(), ts.end());
+  Eigen::SparseMatrix<double> t_surface = contact_map(problem_, state, c_.position, free_index_, g_.rows(), k,
+                                                      [&](int f) { return surface_row_[f]; });
   // The same G, components and T_s (a constant tangent, a pairing that did not move): the same
   // C, and the inner solver keeps its factorizations.
   if (same_components && c_version_ == g_version_ && same_sparse(t_surface, t_surface_)) return c_;
@@ -523,21 +533,8 @@ const Compliance& Equilibrium::sparse_compliance(const EquilibriumState& state,
   for (int a = 0; a < k; ++a) position[components[a]] = a;
   const bool same_components = position == sparse_.position;
   sparse_.position = std::move(position);
-  Triplets ts;
-  for (size_t i = 0; i < problem_.candidates.size(); ++i) {
-    const Candidate& c = problem_.candidates[i];
-    const PairedPoint& pp = state.points[i];
-    const int eta = sparse_.position[c.eta], xi = c.xi >= 0 ? sparse_.position[c.xi] : -1;
-    if (eta < 0 && xi < 0) continue;
-    for (const auto& j : pp.point.jacobian) {
-      const int f = free_index_[j.dof];
-      if (f < 0) continue;
-      if (eta >= 0) ts.emplace_back(f, eta, j.dx.dot(pp.eta));
-      if (xi >= 0) ts.emplace_back(f, xi, j.dx.dot(pp.xi));
-    }
-  }
-  Eigen::SparseMatrix<double> t(free_count_, k);
-  t.setFromTriplets(ts.begin(), ts.end());
+  Eigen::SparseMatrix<double> t =
+      contact_map(problem_, state, sparse_.position, free_index_, free_count_, k, [](int f) { return f; });
   // The same tangent, components and T (a constant tangent, a pairing that did not move): the
   // same C, and the inner solver keeps its factorizations.
   if (same_components && sparse_.body && sparse_version_ == tangent_version_ && same_sparse(t, sparse_.t))
