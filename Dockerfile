@@ -21,7 +21,7 @@ RUN cmake -S . -B /build -G Ninja -DCMAKE_BUILD_TYPE=Release \
 FROM debian:12-slim
 RUN apt-get update -qq \
  && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
-      libcpp-httplib0.11 libspdlog1.10 libfmt9 libsqlite3-0 libpq5 libcholmod3 \
+      libcpp-httplib0.11 libspdlog1.10 libfmt9 libsqlite3-0 libpq5 libcholmod3 libumfpack5 \
  && rm -rf /var/lib/apt/lists/* \
  && useradd --system --uid 10001 --user-group --home-dir /var/lib/grip --create-home grip
 COPY --from=build /build/apps/grip /usr/local/bin/grip
