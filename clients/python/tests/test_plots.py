@@ -34,19 +34,16 @@ def floats(seq):
 
 @unittest.skipUnless(HAVE_MPL, "matplotlib is not importable by this python "
                                "(use /usr/bin/python3 with python3-matplotlib)")
-class Plots(unittest.TestCase):
+class PlotCase(unittest.TestCase):
+    """A temporary folder and the plots module for the class; `produce` makes what it plots."""
+
     @classmethod
     def setUpClass(cls):
         cls.tmp = tempfile.TemporaryDirectory()
-        cls.out = os.path.join(cls.tmp.name, "paper")
-        cls.proc = support.cli("plot", "--paper", "-o", cls.out, timeout=600)
-        cls.client = support.client()
-        with open(os.path.join(cls.out, "paper-summary.json"), encoding="utf-8") as f:
-            cls.summary = json.load(f)
-        cls.results = {name: cls.client.job(s["job"]).result() for name, s in cls.summary.items()}
         from grip_client import plots
 
         cls.plots = plots
+        cls.produce()
 
     @classmethod
     def tearDownClass(cls):
@@ -54,6 +51,17 @@ class Plots(unittest.TestCase):
 
     def tearDown(self):
         self.plots.pyplot().close("all")
+
+
+class Plots(PlotCase):
+    @classmethod
+    def produce(cls):
+        cls.out = os.path.join(cls.tmp.name, "paper")
+        cls.proc = support.cli("plot", "--paper", "-o", cls.out, timeout=600)
+        cls.client = support.client()
+        with open(os.path.join(cls.out, "paper-summary.json"), encoding="utf-8") as f:
+            cls.summary = json.load(f)
+        cls.results = {name: cls.client.job(s["job"]).result() for name, s in cls.summary.items()}
 
     def assert_png(self, path):
         with open(path, "rb") as f:
@@ -191,34 +199,21 @@ class Plots(unittest.TestCase):
         self.assertEqual(p.returncode, 2)
 
 
-@unittest.skipUnless(HAVE_MPL, "matplotlib is not importable by this python "
-                               "(use /usr/bin/python3 with python3-matplotlib)")
-class TwoBodyPlots(unittest.TestCase):
+class TwoBodyPlots(PlotCase):
     """A scene of several bodies (schemas/examples/two-cylinders.json, solved by `grip solve`):
     each body is its own line, named, with exactly its rows of `nodes`, and the contact stress
     is drawn per contact pair."""
 
     @classmethod
-    def setUpClass(cls):
+    def produce(cls):
         import subprocess
 
-        cls.tmp = tempfile.TemporaryDirectory()
         out = os.path.join(cls.tmp.name, "result.json")
         scene = os.path.join(support.EXAMPLES, "two-cylinders.json")
         subprocess.run([support.grip_binary(), "solve", scene, "--out", out], check=True,
                        capture_output=True, timeout=120)
         with open(out, encoding="utf-8") as f:
             cls.result = json.load(f)
-        from grip_client import plots
-
-        cls.plots = plots
-
-    @classmethod
-    def tearDownClass(cls):
-        cls.tmp.cleanup()
-
-    def tearDown(self):
-        self.plots.pyplot().close("all")
 
     def test_each_body_is_its_own_line(self):
         fig, data = self.plots.shapes(self.result)
