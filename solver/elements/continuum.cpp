@@ -16,7 +16,7 @@ ContinuumBody::ContinuumBody(PlaneMesh mesh, const std::vector<int>& contact_set
   if (options_.element == ContinuumElement::q4_bbar && options_.kinematics == ContinuumKinematics::finite)
     throw std::invalid_argument("q4_bbar is implemented for linear kinematics (use q9 for finite strain)");
   if (!(options_.thickness > 0)) throw std::invalid_argument("thickness must be positive");
-  const std::vector<MeshIssue> issues = options_.mesh_checked ? std::vector<MeshIssue>{} : check_mesh(mesh_, shape_);
+  const std::vector<MeshIssue> issues = check_mesh(mesh_, shape_);
   if (!issues.empty())
     throw std::invalid_argument((issues[0].element >= 0 ? "element " + std::to_string(issues[0].element)
                                                         : "node " + std::to_string(issues[0].node)) +

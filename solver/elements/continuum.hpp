@@ -31,9 +31,6 @@ struct ContinuumOptions {
   ContinuumKinematics kinematics = ContinuumKinematics::finite;
   PlaneAnalysis analysis = PlaneAnalysis::plane_strain;
   double thickness = 1.0;  // out-of-plane depth (plane strain: the length the results are per)
-  // The caller ran check_mesh on the mesh and found nothing (the scene reader, which names each
-  // issue's JSON pointer): the constructor does not run it again.
-  bool mesh_checked = false;
 };
 
 QuadShape quad_shape(ContinuumElement element);

@@ -32,22 +32,33 @@ int digit_count(uint64_t s) {
   return n + (s >= kPowersOf10[n]);
 }
 
-// The n decimal digits of s at out[0, n): the low eight in 32-bit arithmetic, two at a time.
+// Four digits of v < 10000 at out[0, 4).
+void write_four(char* out, uint32_t v) {
+  std::memcpy(out, kDigitPairs + 2 * (v / 100), 2);
+  std::memcpy(out + 2, kDigitPairs + 2 * (v % 100), 2);
+}
+
+// The n decimal digits of s at out[0, n): four at a time, in 32-bit arithmetic below 10^8.
 void write_digits(char* out, uint64_t s, int n) {
   char* end = out + n;
   if (n > 8) {
-    uint32_t low = static_cast<uint32_t>(s % 100000000);
+    const uint32_t low = static_cast<uint32_t>(s % 100000000);
     s /= 100000000;
-    for (int k = 0; k < 4; ++k, low /= 100) {
-      end -= 2;
-      std::memcpy(end, kDigitPairs + 2 * (low % 100), 2);
-    }
+    write_four(end - 4, low % 10000);
+    write_four(end - 8, low / 10000);
+    end -= 8;
     n -= 8;
   }
   uint32_t high = static_cast<uint32_t>(s);
-  for (; n >= 2; n -= 2, high /= 100) {
+  for (; n >= 4; n -= 4, high /= 10000) {
+    end -= 4;
+    write_four(end, high % 10000);
+  }
+  if (n >= 2) {
     end -= 2;
     std::memcpy(end, kDigitPairs + 2 * (high % 100), 2);
+    high /= 100;
+    n -= 2;
   }
   if (n) *--end = static_cast<char>('0' + high);
 }

@@ -321,7 +321,6 @@ void read_continuum(Reader& r, json& body, Problem& problem, const std::string& 
     r.error(ptr + "/contact_set", show(cs) + " names no node set (sets: " + Reader::list(names) + ")");
     return;
   }
-  options.mesh_checked = true;  // read_explicit_mesh and read_generated_mesh return checked meshes only
   try {
     problem.body = std::make_unique<ContinuumBody>(*mesh, mesh->sets.at(cs.get<std::string>()), material, options);
   } catch (const std::invalid_argument& e) {
