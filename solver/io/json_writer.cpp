@@ -5,119 +5,21 @@
 #include <cmath>
 #include <cstring>
 
-// fmt comes with spdlog (Debian's libspdlog-dev is built on libfmt-dev). Its Dragonbox gives the
-// shortest decimal significand and exponent that read back as the double in about a third of
-// std::to_chars's instructions (libstdc++ 12: ~530 per double, most of a refined result's writing).
-#include <fmt/format.h>
-
 namespace grip {
 
-namespace {
-
-// "00".."99": two digits per division.
-constexpr char kDigitPairs[] =
-    "00010203040506070809101112131415161718192021222324252627282930313233343536373839"
-    "40414243444546474849505152535455565758596061626364656667686970717273747576777879"
-    "8081828384858687888990919293949596979899";
-
-constexpr uint64_t kPowersOf10[20] = {1ull, 10ull, 100ull, 1000ull, 10000ull, 100000ull, 1000000ull,
-                                      10000000ull, 100000000ull, 1000000000ull, 10000000000ull,
-                                      100000000000ull, 1000000000000ull, 10000000000000ull,
-                                      100000000000000ull, 1000000000000000ull, 10000000000000000ull,
-                                      100000000000000000ull, 1000000000000000000ull,
-                                      10000000000000000000ull};
-
-int digit_count(uint64_t s) {
-  const int n = ((64 - __builtin_clzll(s | 1)) * 1233) >> 12;  // log10(2) ~ 1233 / 4096
-  return n + (s >= kPowersOf10[n]);
-}
-
-// Four digits of v < 10000 at out[0, 4).
-void write_four(char* out, uint32_t v) {
-  std::memcpy(out, kDigitPairs + 2 * (v / 100), 2);
-  std::memcpy(out + 2, kDigitPairs + 2 * (v % 100), 2);
-}
-
-// The n decimal digits of s at out[0, n): four at a time, in 32-bit arithmetic below 10^8.
-void write_digits(char* out, uint64_t s, int n) {
-  char* end = out + n;
-  if (n > 8) {
-    const uint32_t low = static_cast<uint32_t>(s % 100000000);
-    s /= 100000000;
-    write_four(end - 4, low % 10000);
-    write_four(end - 8, low / 10000);
-    end -= 8;
-    n -= 8;
-  }
-  uint32_t high = static_cast<uint32_t>(s);
-  for (; n >= 4; n -= 4, high /= 10000) {
-    end -= 4;
-    write_four(end, high % 10000);
-  }
-  if (n >= 2) {
-    end -= 2;
-    std::memcpy(end, kDigitPairs + 2 * (high % 100), 2);
-    high /= 100;
-    n -= 2;
-  }
-  if (n) *--end = static_cast<char>('0' + high);
-}
-
-}  // namespace
-
-// The copies below are of fixed sizes (the compiler makes them a few moves, no library call):
-// they may write scratch beyond the number's end, within kMaxNumberChars.
+// std::to_chars writes the shortest decimal that reads back as the double, "%g" style (fmt's compiled "{}"
+// took 20 % longer here; its faster Dragonbox entry is not public API).
 char* write_number(char* out, double v) {
   if (!std::isfinite(v)) {
     std::memcpy(out, "null", 4);
     return out + 4;
   }
-  if (std::signbit(v)) {
-    *out++ = '-';
-    v = -v;
+  char* end = std::to_chars(out, out + kMaxNumberChars, v, std::chars_format::general).ptr;
+  if (std::none_of(out, end, [](char c) { return c == '.' || c == 'e'; })) {  // "100" reads back as an integer
+    std::memcpy(end, ".0", 2);
+    end += 2;
   }
-  if (v == 0) {
-    std::memcpy(out, "0.0", 3);
-    return out + 3;
-  }
-  const auto dec = fmt::detail::dragonbox::to_decimal(v);  // v = significand x 10^exponent, shortest
-  const int n = digit_count(dec.significand);  // at most 17
-  const int point = n + dec.exponent;          // v = 0.d1 d2 ... dn x 10^point
-  if (point > 0 && point <= 17) {              // fixed: ddd.ddd or ddd000.0
-    if (point >= n) {
-      write_digits(out, dec.significand, n);
-      std::memset(out + n, '0', 17);
-      out += point;
-      std::memcpy(out, ".0", 2);
-      return out + 2;
-    }
-    char digits[40] = {};
-    write_digits(digits, dec.significand, n);
-    std::memcpy(out, digits, 17);
-    out[point] = '.';
-    std::memcpy(out + point + 1, digits + point, 16);
-    return out + n + 1;
-  }
-  if (point <= 0 && point > -5) {  // fixed: 0.000ddd
-    std::memcpy(out, "0.00000", 8);
-    write_digits(out + 2 - point, dec.significand, n);
-    return out + 2 - point + n;
-  }
-  // scientific: d.ddde-07, de+22 (two exponent digits at least, as printf and to_chars write)
-  write_digits(out + 1, dec.significand, n);
-  out[0] = out[1];
-  out[1] = '.';
-  out += n > 1 ? n + 1 : 1;
-  int e = point - 1;
-  *out++ = 'e';
-  *out++ = e < 0 ? '-' : '+';
-  if (e < 0) e = -e;
-  if (e >= 100) {
-    *out++ = static_cast<char>('0' + e / 100);
-    e %= 100;
-  }
-  std::memcpy(out, kDigitPairs + 2 * e, 2);
-  return out + 2;
+  return end;
 }
 
 JsonWriter::JsonWriter(std::ostream& out) : out_(out), buffer_(1 << 16) {}

@@ -12,8 +12,7 @@
 
 namespace grip {
 
-// The room write_number needs: its longest number is 24 characters ("-2.2250738585072014e-308"),
-// and it may write scratch beyond the number's end within this room.
+// The room write_number needs: its longest number is 24 characters ("-2.2250738585072014e-308").
 constexpr int kMaxNumberChars = 40;
 // v at `out` (kMaxNumberChars free); returns the number's end.
 char* write_number(char* out, double v);

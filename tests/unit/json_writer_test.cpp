@@ -68,10 +68,10 @@ TEST(JsonNumbers, EdgeValuesAndTheirForms) {
   EXPECT_EQ(written(100.0), "100.0");
   EXPECT_EQ(written(0.1), "0.1");
   EXPECT_EQ(written(-2.5), "-2.5");
-  EXPECT_EQ(written(1e-5), "0.00001");
+  EXPECT_EQ(written(1e-5), "1e-05");
   EXPECT_EQ(written(1e-6), "1e-06");
   EXPECT_EQ(written(0.000123), "0.000123");
-  EXPECT_EQ(written(1e16), "10000000000000000.0");
+  EXPECT_EQ(written(1e16), "1e+16");
   EXPECT_EQ(written(1e17), "1e+17");
   EXPECT_EQ(written(1.5e300), "1.5e+300");
   EXPECT_EQ(written(std::numeric_limits<double>::quiet_NaN()), "null");
