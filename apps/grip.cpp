@@ -6,6 +6,7 @@
 #include <malloc.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <chrono>
 #include <ctime>
 #include <fstream>
@@ -106,7 +107,11 @@ int solve(int argc, char** argv) {
               read.second - start.second, solved.first - read.first, solved.second - read.second,
               written.first - solved.first, written.second - solved.second);
   if (!run.completed) std::fprintf(stderr, "%s\n", run.reason.c_str());
-  return run.completed ? 0 : 1;
+  // The process ends here and its memory goes with it: std::exit skips freeing the scene and the
+  // run block by block (their destructors took 2 % of a refined Hertz run: 11,520 elements'
+  // fields of 10 steps). The event file is closed first; exit flushes stdout.
+  events.close();
+  std::exit(run.completed ? 0 : 1);
 }
 
 int serve(int argc, char** argv) {

@@ -6,8 +6,12 @@ Both codes: the half-disc of schemas/examples/hertz.json, its diameter lowered 0
 same graded mesh (grip's half-disc with elements of `size` within 0.8 mm of the pole and the
 fewest graded divisions beyond that it accepts; GetFEM reads it from grip's result). Accuracy: a and p0 of a semi-ellipse fitted to the nodal contact pressures,
 against the closed form at each code's own load P. Time: the whole process (start-up,
-meshing, solving, reading the answer), one run each. Writes bench/results/peers.md.
+meshing, solving, writing the answer), one run each, grip with its default output (every field
+of every step, as a user gets it). Prints each row with its GetFEM/grip time ratio as it is
+measured and writes the table to bench/results/peers.md (the run before it moves under
+"Earlier runs"). Usage: compare.py [GRIP] [--sizes 10,20,40] [--table PATH]
 """
+import argparse
 import json
 import math
 import os
@@ -23,7 +27,7 @@ from scaling import hertz_scene  # noqa: E402  the scenes of the scaling benchma
 
 E, NU, R = 200000.0, 0.3, 10.0
 ES = E / (1 - NU * NU)
-SIZES = {10: 0.05, 20: 0.0265}
+SIZES = {10: 0.05, 20: 0.0265, 40: 0.01325}  # as bench/scaling.py's hertz_scene
 
 
 def fit(xs, sigma):
@@ -40,10 +44,7 @@ def grip_run(grip, a_over_h, mu, mesh_path):
     """grip on the scene, timed; writes its mesh (reference positions, cells) to mesh_path."""
     with tempfile.TemporaryDirectory() as tmp:
         scene = Path(tmp) / "scene.json"
-        j = hertz_scene(a_over_h, mu)
-        # What is read below, as GetFEM's script computes only what it prints.
-        j["output"] = {"steps": "last", "fields": ["nodes", "contact_points"]}
-        scene.write_text(json.dumps(j))
+        scene.write_text(json.dumps(hertz_scene(a_over_h, mu)))  # grip's default output
         start = time.monotonic()
         subprocess.run([grip, "solve", str(scene), "--out", str(Path(tmp) / "out.json")], check=True,
                        capture_output=True)
@@ -79,17 +80,23 @@ def getfem_run(a_over_h, mu, mesh_path):
 
 
 def main():
-    grip = sys.argv[1] if len(sys.argv) > 1 else str(ROOT / "build/apps/grip")
+    ap = argparse.ArgumentParser()
+    ap.add_argument("grip", nargs="?", default=str(ROOT / "build/apps/grip"))
+    ap.add_argument("--sizes", default="10,20,40", help="a/h values, from " + ",".join(map(str, SIZES)))
+    ap.add_argument("--table", default=str(ROOT / "bench/results/peers.md"))
+    args = ap.parse_args()
     load = os.getloadavg()
     rows = []
-    for a_over_h in (10, 20):
+    for a_over_h in (int(v) for v in args.sizes.split(",")):
         for mu in (0.0, 0.3):
             with tempfile.TemporaryDirectory() as tmp:
                 mesh_path = Path(tmp) / "mesh.json"
-                g = grip_run(grip, a_over_h, mu, mesh_path)
+                g = grip_run(args.grip, a_over_h, mu, mesh_path)
                 f = getfem_run(a_over_h, mu, mesh_path)
             rows.append((a_over_h, mu, g, f))
-            print(a_over_h, mu, json.dumps(g), json.dumps(f), flush=True)
+            print(f"a/h {a_over_h} mu {mu}: grip {g['seconds']:.2f} s, GetFEM {f['seconds']:.2f} s, "
+                  f"GetFEM/grip {f['seconds'] / g['seconds']:.1f}x (load {os.getloadavg()[0]:.1f})",
+                  json.dumps(g), json.dumps(f), flush=True)
     commit = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"], capture_output=True,
                             text=True).stdout.strip()
     pct = lambda v: f"{100 * v:+.2f} %"
@@ -106,8 +113,8 @@ def main():
         "abscissae (GetFEM's multiplier at its reference nodes; grip's x - ux). With friction 0.3 the "
         "frictionless closed form is not the answer (the coupling of normal and tangential tractions "
         "narrows the zone and raises the peak, Spence): there the two codes are compared with each "
-        "other. Time: the whole process, one run each, grip asked for the last step's nodes and contact points "
-        "only (what is read).",
+        "other. Time: the whole process, one run each; grip with its default output (every field of every "
+        "step written: 28 MB at a/h 40).",
         "",
         "| a/h | friction | grip P N/mm | grip a err | grip p0 err | grip s | GetFEM P N/mm | GetFEM a err | "
         "GetFEM p0 err | GetFEM s | time ratio |",
@@ -118,8 +125,14 @@ def main():
                      f"{g['seconds']:.2f} | {f['P']:.0f} | {pct(f['a_error'])} | {pct(f['p0_error'])} | "
                      f"{f['seconds']:.2f} | {f['seconds'] / g['seconds']:.0f}x |")
     lines.append("")
-    (ROOT / "bench/results/peers.md").write_text("\n".join(lines))
-    print("\n".join(lines))
+    table = Path(args.table)
+    if table.exists():  # the previous run moves under "Earlier runs"
+        old = table.read_text()
+        top, _, earlier = old.partition("## Earlier runs")
+        top = top.replace("# grip and GetFEM on the same Hertz geometry (bench/peers/run.sh)\n", "").strip()
+        lines += ["## Earlier runs", "", top, "", earlier.strip(), ""]
+    table.write_text("\n".join(lines))
+    print("\n".join(lines[:len(rows) + 6]))
 
 
 if __name__ == "__main__":

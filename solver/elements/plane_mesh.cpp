@@ -167,7 +167,17 @@ void reverse_element(std::vector<int>& element, QuadShape shape) {
 std::vector<MeshIssue> check_mesh(const PlaneMesh& mesh, QuadShape shape) {
   std::vector<MeshIssue> issues;
   const int n = quad_node_count(shape), nodes = static_cast<int>(mesh.nodes.size());
+  // det J at the element's nodes and Gauss points, from the shape functions' natural
+  // derivatives there (the same for every element: computed once, not per element).
+  std::vector<Vec2> checks;
+  for (int a = 0; a < n; ++a) checks.push_back(quad_node_natural(shape, a));
+  for (const GaussPoint& g : quad_gauss_rule(shape)) checks.push_back({g.xi, g.eta});
+  std::vector<ShapeGradients> dN_nat(checks.size());
+  Vector N;
+  for (size_t c = 0; c < checks.size(); ++c) quad_shape_functions(shape, checks[c].x(), checks[c].y(), N, dN_nat[c]);
   std::vector<char> used(mesh.nodes.size(), 0);
+  ShapeGradients X(n, 2);
+  std::vector<int> sorted(n);
   for (int e = 0; e < static_cast<int>(mesh.elements.size()); ++e) {
     const auto& el = mesh.elements[e];
     if (static_cast<int>(el.size()) != n) {
@@ -184,22 +194,20 @@ std::vector<MeshIssue> check_mesh(const PlaneMesh& mesh, QuadShape shape) {
         used[a] = 1;  // even in a faulty element: one fault, one message
       }
     if (!ids_ok) continue;
-    if (std::set<int>(el.begin(), el.end()).size() != el.size()) {
+    std::copy(el.begin(), el.end(), sorted.begin());
+    std::sort(sorted.begin(), sorted.end());
+    if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) {
       issues.push_back({e, -1, "names a node twice"});
       continue;
     }
-    ShapeGradients X(n, 2);
     for (int a = 0; a < n; ++a) X.row(a) = mesh.nodes[el[a]].transpose();
     const double size2 = (X.colwise().maxCoeff() - X.colwise().minCoeff()).squaredNorm();
-    std::vector<Vec2> checks;
-    for (int a = 0; a < n; ++a) checks.push_back(quad_node_natural(shape, a));
-    for (const GaussPoint& g : quad_gauss_rule(shape)) checks.push_back({g.xi, g.eta});
-    for (const Vec2& c : checks) {
-      const double det = quad_point(shape, X, c.x(), c.y(), 1.0).detJ;
+    for (size_t c = 0; c < checks.size(); ++c) {
+      const double det = Mat2(X.transpose() * dN_nat[c]).determinant();  // as quad_point's detJ
       if (!(det > 1e-12 * size2)) {
         issues.push_back({e, -1, std::string(det < 0 ? "is inverted or its nodes are not counter-clockwise"
                                                      : "has zero area") +
-                                     " (det J = " + std::to_string(det) + " at xi, eta = " + point_text(c) + ")"});
+                                     " (det J = " + std::to_string(det) + " at xi, eta = " + point_text(checks[c]) + ")"});
         break;
       }
     }

@@ -1,8 +1,8 @@
 #include "solver/io/result.hpp"
 
+#include "solver/io/json_writer.hpp"
+
 #include <algorithm>
-#include <charconv>
-#include <cmath>
 #include <functional>
 
 #include "solver/contact/contact_error.hpp"
@@ -185,11 +185,10 @@ json effects_json(const Scene& scene, const RunResult& run) {
 
 namespace {
 
-// Everything but the steps.
+// Everything but the steps and the mesh.
 json result_head(const Scene& scene, const RunResult& run) {
   json head = {{"scene", scene.effective},
           {"effects", effects_json(scene, run)},
-          {"mesh", {{"cells", scene.problem.body->cells()}}},
           {"summary",
            {{"completed", run.completed}, {"reason", run.reason}, {"steps", run.steps.size()},
             {"contact_iterations", run.counters.solves},
@@ -210,83 +209,80 @@ json result_head(const Scene& scene, const RunResult& run) {
   return head;
 }
 
-// A double as JSON reads it back exactly (shortest round trip), with a point or an exponent
-// as nlohmann writes floating-point numbers; null where not finite, as nlohmann does.
-void append_number(std::string& out, double v) {
-  if (!std::isfinite(v)) {
-    out += "null";
-    return;
-  }
-  char buf[32];
-  char* end = std::to_chars(buf, buf + sizeof buf, v).ptr;
-  out.append(buf, end);
-  if (std::none_of(buf, end, [](char c) { return c == '.' || c == 'e'; })) out += ".0";
-}
-
-// table_json's rows, written as they are made (in chunks): no document of the table's size in
-// memory, and no stream call per number.
-void write_table(std::ostream& out, const FieldTable& t, const std::string& index_name) {
+// table_json's rows, written as they are made: no document of the table's size in memory.
+void write_table(JsonWriter& w, const FieldTable& t, const std::string& index_name) {
   std::vector<std::pair<std::string, int>> keys{{index_name, -1}};  // -1: the row index
   for (size_t c = 0; c < t.names.size(); ++c)
     if (t.names[c] != index_name) keys.emplace_back(t.names[c], static_cast<int>(c));
   std::sort(keys.begin(), keys.end());  // an object's keys in nlohmann's order
   std::vector<std::string> quoted;
-  for (const auto& k : keys) quoted.push_back(json(k.first).dump() + ":");
-  std::string chunk = "[";
+  for (size_t k = 0; k < keys.size(); ++k) quoted.push_back((k ? "," : "{") + json(keys[k].first).dump() + ":");
+  w.put('[');
   for (size_t i = 0; i < t.rows.size(); ++i) {
-    chunk += i ? ",\n{" : "\n{";
+    w.raw(i ? ",\n" : "\n");
     for (size_t k = 0; k < keys.size(); ++k) {
-      if (k) chunk += ',';
-      chunk += quoted[k];
+      w.raw(quoted[k]);
       if (keys[k].second < 0)
-        chunk += std::to_string(i);
+        w.integer(static_cast<long long>(i));
       else
-        append_number(chunk, t.rows[i][keys[k].second]);
+        w.number(t.rows[i][keys[k].second]);
     }
-    chunk += '}';
-    if (chunk.size() > (1 << 16)) {
-      out.write(chunk.data(), static_cast<std::streamsize>(chunk.size()));
-      chunk.clear();
-    }
+    w.put('}');
   }
-  chunk += ']';
-  out.write(chunk.data(), static_cast<std::streamsize>(chunk.size()));
+  w.put(']');
 }
 
 using Streamed = std::vector<std::pair<std::string, std::function<void()>>>;
 
 // The object `small` with the members `streamed` (written by their functions) among its keys.
-void write_object(std::ostream& out, const json& small, Streamed streamed) {
+void write_object(JsonWriter& w, const json& small, Streamed streamed) {
   std::sort(streamed.begin(), streamed.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
   auto it = small.begin();
   auto st = streamed.begin();
-  out << '{';
+  w.put('{');
   for (bool first = true; it != small.end() || st != streamed.end(); first = false) {
-    if (!first) out << ',';
+    if (!first) w.put(',');
     if (st == streamed.end() || (it != small.end() && it.key() < st->first)) {
-      out << json(it.key()).dump() << ':' << it.value().dump();
+      w.string(it.key());
+      w.put(':');
+      w.value(it.value());
       ++it;
     } else {
-      out << json(st->first).dump() << ':';
+      w.string(st->first);
+      w.put(':');
       st->second();
       ++st;
     }
   }
-  out << '}';
+  w.put('}');
 }
 
-void write_step(std::ostream& out, const Problem& problem, const StepRecord& rec, const OutputOptions& output) {
+void write_step(JsonWriter& w, const Problem& problem, const StepRecord& rec, const OutputOptions& output) {
   OutputOptions summary = output;
   summary.fields.erase(std::remove_if(summary.fields.begin(), summary.fields.end(),
                                       [](const std::string& f) { return f == "nodes" || f == "elements"; }),
                        summary.fields.end());
   Streamed tables;
   if (rec.state.q.size() != 0 && !rec.site_fields.rows.empty()) {  // as step_json decides
-    if (output.wants("nodes")) tables.emplace_back("nodes", [&] { write_table(out, rec.site_fields, "node"); });
+    if (output.wants("nodes")) tables.emplace_back("nodes", [&] { write_table(w, rec.site_fields, "node"); });
     if (output.wants("elements"))
-      tables.emplace_back("elements", [&] { write_table(out, rec.element_fields, "element"); });
+      tables.emplace_back("elements", [&] { write_table(w, rec.element_fields, "element"); });
   }
-  write_object(out, step_json(problem, rec, summary), std::move(tables));
+  write_object(w, step_json(problem, rec, summary), std::move(tables));
+}
+
+// mesh.cells, one cell a line.
+void write_cells(JsonWriter& w, const std::vector<std::vector<int>>& cells) {
+  w.raw("{\"cells\":[");
+  for (size_t e = 0; e < cells.size(); ++e) {
+    w.raw(e ? ",\n[" : "\n[");
+    for (size_t a = 0; a < cells[e].size(); ++a) {
+      if (a) w.put(',');
+      w.integer(cells[e][a]);
+    }
+    w.put(']');
+  }
+  w.raw("]}");
 }
 
 }  // namespace
@@ -295,20 +291,24 @@ json result_json(const Scene& scene, const RunResult& run) {
   json steps = json::array();
   for (const auto& rec : run.steps) steps.push_back(step_json(scene.problem, rec, scene.output));
   json r = result_head(scene, run);
+  r["mesh"] = {{"cells", scene.problem.body->cells()}};
   r["steps"] = std::move(steps);
   return r;
 }
 
 void write_result(std::ostream& out, const Scene& scene, const RunResult& run) {
-  write_object(out, result_head(scene, run), {{"steps", [&] {
-                                                 out << '[';
-                                                 for (size_t k = 0; k < run.steps.size(); ++k) {
-                                                   out << (k ? ",\n" : "\n");
-                                                   write_step(out, scene.problem, run.steps[k], scene.output);
-                                                 }
-                                                 out << ']';
-                                               }}});
-  out << '\n';
+  JsonWriter w(out);
+  write_object(w, result_head(scene, run),
+               {{"mesh", [&] { write_cells(w, scene.problem.body->cells()); }},
+                {"steps", [&] {
+                   w.put('[');
+                   for (size_t k = 0; k < run.steps.size(); ++k) {
+                     w.raw(k ? ",\n" : "\n");
+                     write_step(w, scene.problem, run.steps[k], scene.output);
+                   }
+                   w.put(']');
+                 }}});
+  w.put('\n');
 }
 
 }  // namespace grip
