@@ -4,9 +4,6 @@
 // penalty springs: its rigid amplitudes are solved with the deformation (Equilibrium with the
 // pins free), first with springs of 1e-2, 1e-4, 1e-6 x the largest stiffness on its pins,
 // each solve from the last, then without them.
-#include <Eigen/LU>
-#include <Eigen/SparseCore>
-
 #include "solver/contact/step.hpp"
 
 namespace grip {
@@ -34,7 +31,6 @@ class PenaltyStep : public StepSolver {
       for (double spring = kPinSpring; spring > 1e-7 && s.converged; spring *= 1e-2) {
         law.pin_spring = spring * eq_.stiffness_scale(q_guess);
         eq_.set_penalty(law);
-        if (spring == kPinSpring) balance_rigidly(q0);
         s = eq_.solve(q0, p_start);
         if (s.converged) q0 = s.q;
         ++solves;
@@ -72,42 +68,6 @@ class PenaltyStep : public StepSolver {
     Vector dq;
     if (approach_motion(dq)) q += dq;
   }
-
-  // Moves q along the free rigid motions to where the law's forces (and the pin springs)
-  // balance the load on them: Newton on the amplitudes a, R^T r(q + R a) = 0, Jacobian R^T K R,
-  // each step halved until |R^T r| falls. Without it, a body that one obstacle enters by a
-  // whole increment (the disc's upper flat, 0.5 mm at once) is pushed by that point alone
-  // against the soft pin springs, through its other contacts, which were only touching and
-  // had no stiffness yet: Newton's first iterates swing the body between the obstacles.
-  void balance_rigidly(Vector& q) const {
-    const Matrix& R = problem_.rigid.modes;
-    const int n = static_cast<int>(q.size());
-    const Vector none = Vector::Zero(problem_.component_count);
-    auto unbalance = [&](const Vector& at, Matrix* J) {
-      Triplets triplets;
-      const Vector r = eq_.residual(at, none, J ? &triplets : nullptr);
-      if (J) {
-        Eigen::SparseMatrix<double> K(n, n);
-        K.setFromTriplets(triplets.begin(), triplets.end());
-        *J = R.transpose() * (K * R);
-      }
-      return Vector(R.transpose() * r);
-    };
-    for (int it = 0; it < kBalanceIterations; ++it) {
-      Matrix J;
-      const Vector g = unbalance(q, &J);
-      const Vector dq = R * J.fullPivLu().solve(-g);
-      if (!dq.allFinite()) return;
-      bool decreased = false;
-      for (double f = 1.0; f > 1e-6 && !decreased; f *= 0.5)
-        if (unbalance(q + f * dq, nullptr).norm() < g.norm()) {
-          q += f * dq;
-          decreased = true;
-        }
-      if (!decreased || dq.cwiseAbs().maxCoeff() <= tol_) return;
-    }
-  }
-  static constexpr int kBalanceIterations = 30;
 
   // The first solve's pin springs, times the largest diagonal stiffness: stiff enough to keep
   // Newton's iterates bounded while points switch between stick and slip (a free slide is
