@@ -197,8 +197,12 @@ class Equilibrium {
   // force units (the scale Newton's residual test is relative to).
   Vector residual(const Vector& q, const EquilibriumState& paired, const Vector& p,
                   Triplets* tangent, double* force_scale = nullptr) const;
-  // p(q) of the penalty law at a paired state, and (if asked) its stiffness triplets.
-  Vector penalty_forces(const EquilibriumState& paired, Triplets* tangent) const;
+  // p(q) of the penalty law at a paired state, and (if asked) its stiffness triplets. With an
+  // increment dq (all dofs), p(q) + (dp/dq) dq: the law linearized at q.
+  Vector penalty_forces(const EquilibriumState& paired, Triplets* tangent, const Vector* increment = nullptr) const;
+  // The penalty law's answer at a converged iterate q (paired): one more Newton correction dq,
+  // and the forces p(q) + (dp/dq) dq at q + dq.
+  EquilibriumState& finish_penalty(EquilibriumState& state);
   // Step length along the Newton correction dq at q: the natural monotonicity test with the
   // factorization `solver` of the step's tangent; at most the body's trust-region fraction.
   double line_search(const Vector& q, const Vector& dq, const Vector& p, const FreeBlockSolver& solver) const;

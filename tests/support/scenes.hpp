@@ -73,6 +73,30 @@ inline nlohmann::json disc_between_flats(int n, double delta) {
   return j;
 }
 
+// A Timoshenko beam (20 elements) lying on a flat (mu 0.3) with no supports, pressed by nodal
+// forces (N = 200), then pushed along x at its end through Q / (mu N) = 0.28, 0.56, 0.83 and
+// 1.17 (load cases press and push). von Karman kinematics hold theta at the middle node (a
+// finite rotation is no null mode of a stressed beam): only the translations are free.
+inline nlohmann::json beam_lying_on_a_flat(const std::string& kinematics) {
+  using nlohmann::json;
+  json loads = json::array();
+  for (int n = 0; n <= 20; ++n)
+    loads.push_back({{"node", n}, {"force", {0.0, n == 0 || n == 20 ? -5.0 : -10.0}}, {"case", "press"}});
+  loads.push_back({{"node", 0}, {"force", {20.0, 0.0}}, {"case", "push"}});
+  json j = {{"body",
+             {{"model", "timoshenko_beam"}, {"kinematics", kinematics}, {"material", {{"young", 210000}, {"poisson", 0.3}}},
+              {"section", {{"width", 2}, {"depth", 2}}}, {"mesh", {{"origin", {0, 0}}, {"length", 20}, {"elements", 20}}},
+              {"loads", loads}}},
+            {"obstacles", json::array({{{"name", "flat"}, {"shape", {{"type", "segment"}, {"from", {100, -1}}, {"to", {-100, -1}}}},
+                                        {"friction", 0.3}}})},
+            {"stages", json::array({{{"steps", 1}, {"factors", {{"press", 1}}}},
+                                    {{"steps", 3}, {"factors", {{"press", 1}, {"push", 2.5}}}},
+                                    {{"steps", 1}, {"factors", {{"press", 1}, {"push", 3.5}}}}})},
+            {"solver", {{"contact", {{"method", "cev"}, {"tolerance", 1e-8}}}}}};
+  if (kinematics == "von_karman") j["body"]["supports"] = json::array({{{"node", 10}, {"fix", {"theta"}}}});
+  return j;
+}
+
 inline Solved solve_scene(const nlohmann::json& j) {
   Solved s{read_scene(j), {}};
   s.run = run_load_steps(s.scene.problem, s.scene.steps, s.scene.params);

@@ -36,10 +36,10 @@ double free_motion_unbalance(const Problem& problem, const StepRecord& rec) {
   return worst / scale;
 }
 
-// The balance of load and contact forces that every converged step meets: 1e-9 where the
-// amplitudes are contact unknowns; with the penalty law the amplitudes are Newton unknowns of a
-// system 1e3 times stiffer than the body, which Newton balances only to its residual test.
-double balance(const Scene& scene) { return scene.params.contact.method == ContactMethod::penalty ? 1e-7 : 1e-9; }
+// The balance of load and contact forces that every converged step meets (issue 16): 1e-9
+// of the load, with every strategy (penalty: its forces are the law linearized over Newton's
+// last correction, Equilibrium::finish_penalty).
+double balance(const Scene&) { return 1e-9; }
 
 // Every converged step is sound and balances the load on its free motions to balance().
 // A strategy that ends each tau pass at ||v|| <= tol (a finite n, uzawa) settles p* only to
@@ -115,15 +115,14 @@ const char* const kUzawaSlow =
     "uzawa's fixed alpha needs thousands of real solves a level on the beam's compliance (5022, 8494, 1741, "
     "3375 measured), far over the 500 of a step; the disc runs in tests/hard";
 
-// Penalty's own Newton (pins free, springs 1e3 x the body's stiffness): on the disc the upper flat's
-// 0.5 mm enters at once, each iteration closes about two more points and Newton stops after 40
-// at a residual of 0.26 of the load (the first pin-spring solve already; the same would hold
-// a supported disc); on the beam the law's springs turn the rounding of a position (eps |x|,
-// |x| up to 20) into forces of ~4e-6 N a point, and Newton stops at its round-off floor with the
-// push balanced to 1e-6 of the load, over the 1e-9 asserted here.
+// Penalty's own Newton (pins free, springs 1e3 x the body's stiffness) on the disc: the first step
+// fails, and so do its 5 cuts of the increment down to 0.5 / 32 mm, Newton stopping at 40 iterations
+// (300 s of solving: too slow for this suite either way). Probed (bench/results/held_by_contact.md):
+// moving the disc rigidly first to where the law's forces balance the load gets the first pin-spring
+// level through, but the next (springs 100 x softer) fails with a free residual of 0.6-1.0.
 const char* const kPenaltyNewton =
-    "penalty: Newton does not converge in the disc's first step (0.5 mm of overlap at once, points close two "
-    "an iteration), and balances the beam's load only to 1e-6 (its springs turn position rounding into force)";
+    "penalty: Newton does not converge in the disc's first step, nor in its 5 cuts of the increment (40 "
+    "iterations), nor from the rigid position where the law balances (the second pin-spring level fails)";
 
 const Strategy kStrategies[] = {
     {"cev", json::object()},
@@ -131,7 +130,7 @@ const Strategy kStrategies[] = {
     {"cev_paper", {{"loop", "paper"}}, {"beam"}, kPaperBeam},
     {"cev_paper_n3", {{"loop", "paper"}, {"acceleration", {{"n", 3}}}}, {"beam"}, kPaperBeam},
     {"uzawa", {{"method", "uzawa"}}, {"disc", "beam"}, kUzawaSlow},
-    {"penalty", {{"method", "penalty"}}, {"disc", "beam"}, kPenaltyNewton},
+    {"penalty", {{"method", "penalty"}}, {"disc"}, kPenaltyNewton},
     {"ssn", {{"method", "ssn"}}},
 };
 
@@ -333,31 +332,13 @@ TEST_P(HeldByContactStrategy, BlockPushedOntoAWallByAForce) {
 namespace grip {
 namespace {
 
-// A Timoshenko beam (20 elements) lying on a flat (mu 0.3) with no supports, pressed by nodal
-// forces (N = 200), then pushed along x at its end through Q / (mu N) = 0.28, 0.56, 0.83, and
-// 1.17: the flat's reaction is the push until the last, which fails with the reason. Linear
-// kinematics: contact holds all three motions; von Karman: the translations (its rotation held
-// by theta at the middle node, since a finite rotation is no null mode).
+// The beam lying on a flat (tests/support/scenes.hpp): the flat's reaction is the push until
+// the last level, which fails with the reason. Linear kinematics: contact holds all three
+// motions; von Karman: the translations.
 TEST_P(HeldByContactStrategy, BeamOnAFlatPushedAlongIt) {
   if (!runs_on("beam")) GTEST_SKIP() << GetParam().why_not;
-  json loads = json::array();
-  for (int n = 0; n <= 20; ++n)
-    loads.push_back({{"node", n}, {"force", {0.0, n == 0 || n == 20 ? -5.0 : -10.0}}, {"case", "press"}});
-  loads.push_back({{"node", 0}, {"force", {20.0, 0.0}}, {"case", "push"}});
-  json j = {{"body",
-             {{"model", "timoshenko_beam"}, {"kinematics", "linear"}, {"material", {{"young", 210000}, {"poisson", 0.3}}},
-              {"section", {{"width", 2}, {"depth", 2}}}, {"mesh", {{"origin", {0, 0}}, {"length", 20}, {"elements", 20}}},
-              {"loads", loads}}},
-            {"obstacles", json::array({{{"name", "flat"}, {"shape", {{"type", "segment"}, {"from", {100, -1}}, {"to", {-100, -1}}}},
-                                        {"friction", 0.3}}})},
-            {"stages", json::array({{{"steps", 1}, {"factors", {{"press", 1}}}},
-                                    {{"steps", 3}, {"factors", {{"press", 1}, {"push", 2.5}}}},
-                                    {{"steps", 1}, {"factors", {{"press", 1}, {"push", 3.5}}}}})},
-            {"solver", {{"contact", {{"method", "cev"}, {"tolerance", 1e-8}}}}}};
   for (const char* kinematics : {"linear", "von_karman"}) {
-    j["body"]["kinematics"] = kinematics;
-    if (std::string(kinematics) == "von_karman") j["body"]["supports"] = json::array({{{"node", 10}, {"fix", {"theta"}}}});
-    const Solved s = solve_scene(with(j));
+    const Solved s = solve_scene(with(beam_lying_on_a_flat(kinematics)));
     expect_held(s);
     EXPECT_EQ(s.scene.problem.rigid.count(), std::string(kinematics) == "linear" ? 3 : 2);
     ASSERT_EQ(s.run.steps.size(), 5u) << s.run.reason;
