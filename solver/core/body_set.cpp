@@ -1,6 +1,7 @@
 #include "solver/core/body_set.hpp"
 
 #include <algorithm>
+#include <limits>
 
 namespace grip {
 
@@ -133,10 +134,21 @@ std::vector<std::vector<int>> BodySet::cells() const {
 
 FieldTable BodySet::stacked(FieldTable (Body::*fields)(const Vector&) const, const Vector& q) const {
   FieldTable all;
+  std::vector<FieldTable> tables;
   for (int b = 0; b < count(); ++b) {
-    FieldTable t = (parts_[b].get()->*fields)(part_q(q, b));
-    if (b == 0) all.names = t.names;
-    for (auto& row : t.rows) all.rows.push_back(std::move(row));
+    tables.push_back((parts_[b].get()->*fields)(part_q(q, b)));
+    for (const std::string& name : tables.back().names)
+      if (std::find(all.names.begin(), all.names.end(), name) == all.names.end()) all.names.push_back(name);
+  }
+  for (FieldTable& t : tables) {
+    std::vector<size_t> column;
+    for (const std::string& name : t.names)
+      column.push_back(std::find(all.names.begin(), all.names.end(), name) - all.names.begin());
+    for (const auto& row : t.rows) {
+      std::vector<double> wide(all.names.size(), std::numeric_limits<double>::quiet_NaN());
+      for (size_t c = 0; c < row.size(); ++c) wide[column[c]] = row[c];
+      all.rows.push_back(std::move(wide));
+    }
   }
   return all;
 }

@@ -53,7 +53,9 @@ class BodySet final : public Body {
   void commit(const Vector& q) override;
 
  private:
-  // The parts' tables of `fields` one below the other (the names of the first part).
+  // The parts' tables of `fields` one below the other, with every part's columns; a column
+  // that a part lacks (a beam's theta on a continuum's rows) is NaN there, which the result
+  // leaves out of that row.
   FieldTable stacked(FieldTable (Body::*fields)(const Vector&) const, const Vector& q) const;
   std::vector<std::unique_ptr<Body>> parts_;
   std::vector<std::string> names_;

@@ -46,8 +46,10 @@ void add_candidates(Problem& problem, const std::vector<LoadStep>& path, double 
           nearest = std::min(nearest, std::abs(obstacle.shape->project(x - obstacle.offset(f)).gap));
         if (nearest > reach) continue;
       }
-      // The side whose outward surface normal (+y or -y) points toward the obstacle.
-      const int side = (proj.point - x).y() >= 0 ? +1 : -1;
+      // The side whose outward surface normal (+y or -y) points toward the obstacle; a pair's
+      // slave surface names its side (a beam's upper or lower surface).
+      const int named = master ? obstacle.master->slave_side : 0;
+      const int side = named ? named : (proj.point - x).y() >= 0 ? +1 : -1;
       Candidate c{site, side, o, next++};
       if (obstacle.frictional || obstacle.friction > 0) c.xi = next++;
       problem.candidates.push_back(c);

@@ -78,10 +78,13 @@ struct StartUp {
 // equilibrium of the whole body is the component's s. In p an amplitude is stored divided by
 // `scale` (length per force: 1 / the largest stiffness), and its s multiplied by it, so the
 // compliance with its border [C, G; G^T, 0] stays symmetric and the error vector in length.
+// In a scene of several bodies each mode moves one body (zero on the others' dofs): its s is that
+// body's equilibrium, with the forces of its pairs on it (the mortar Jacobian moves both sides).
 struct RigidModes {
   Matrix modes;                    // dof x count, column k is 1 at pins[k] and 0 at the other pins
   std::vector<int> pins;
-  std::vector<std::string> names;  // "translate along x", ...
+  std::vector<std::string> names;  // "translate along x", ...; "BODY: ..." in a scene of several bodies
+  std::vector<int> body;           // the body each mode moves (index into the scene's bodies; 0 for one body)
   int first = 0;
   double scale = 1.0;
   int count() const { return static_cast<int>(pins.size()); }

@@ -42,7 +42,8 @@ json table_json(const FieldTable& t, const char* index_name) {
   json rows = json::array();
   for (size_t i = 0; i < t.rows.size(); ++i) {
     json row = {{index_name, i}};
-    for (size_t c = 0; c < t.names.size(); ++c) row[t.names[c]] = t.rows[i][c];
+    for (size_t c = 0; c < t.names.size(); ++c)
+      if (!std::isnan(t.rows[i][c])) row[t.names[c]] = t.rows[i][c];  // NaN: a column the row's body lacks
     rows.push_back(row);
   }
   return rows;
@@ -61,10 +62,26 @@ json step_json(const Problem& problem, const StepRecord& rec, const OutputOption
                         {"at_round_off_floor", rec.state.at_floor}};
   if (!rec.epsilon_used.empty()) j["epsilon"] = rec.epsilon_used;
   if (problem.rigid.count() && rec.converged) {
-    // The rigid motion fitted to the displacement (translation of the point at the origin).
-    const Vector a = rigid_amplitudes(body, rec.state.q);
-    j["rigid_motion"] = {{"translation", {a[0], a[1]}}};
-    if (a.size() > 2) j["rigid_motion"]["rotation"] = a[2];
+    // The rigid motion fitted to the displacement (translation of the point at the origin);
+    // in a scene of several bodies, of each body with motions held by contact.
+    auto motion = [](const Body& b, const Vector& q) {
+      const Vector a = rigid_amplitudes(b, q);
+      json m = {{"translation", {a[0], a[1]}}};
+      if (a.size() > 2) m["rotation"] = a[2];
+      return m;
+    };
+    if (const auto* all = dynamic_cast<const BodySet*>(&body)) {
+      json motions = json::array();
+      for (int b = 0; b < all->count(); ++b) {
+        if (std::find(problem.rigid.body.begin(), problem.rigid.body.end(), b) == problem.rigid.body.end()) continue;
+        json m = motion(all->part(b), all->part_q(rec.state.q, b));
+        m["body"] = all->name(b);
+        motions.push_back(m);
+      }
+      j["rigid_motions"] = motions;
+    } else {
+      j["rigid_motion"] = motion(body, rec.state.q);
+    }
   }
   if (output.wants("history")) {
     json history = json::array();
@@ -160,9 +177,12 @@ json effects_json(const Scene& scene, const RunResult& run) {
     json bodies = json::array(), pairs = json::array();
     for (int b = 0; b < all->count(); ++b) {
       const Body::Traits t = all->part(b).traits();
+      json held = json::array();  // its motions held by contact, without the "BODY: " of the scene's list
+      for (int k = 0; k < problem.rigid.count(); ++k)
+        if (problem.rigid.body[k] == b) held.push_back(problem.rigid.names[k].substr(all->name(b).size() + 2));
       bodies.push_back({{"name", all->name(b)}, {"geometric_nonlinearity", t.geometric_nonlinearity},
                         {"plasticity", t.plasticity}, {"constant_tangent", t.constant_tangent},
-                        {"dofs", all->part(b).dof_count()}});
+                        {"dofs", all->part(b).dof_count()}, {"held_by_contact", held}});
     }
     for (size_t o = 0; o < problem.obstacles.size(); ++o) {
       const ObstacleInstance& pair = problem.obstacles[o];
@@ -216,11 +236,15 @@ void write_table(JsonWriter& w, const FieldTable& t, const std::string& index_na
     if (t.names[c] != index_name) keys.emplace_back(t.names[c], static_cast<int>(c));
   std::sort(keys.begin(), keys.end());  // an object's keys in nlohmann's order
   std::vector<std::string> quoted;
-  for (size_t k = 0; k < keys.size(); ++k) quoted.push_back((k ? "," : "{") + json(keys[k].first).dump() + ":");
+  for (const auto& k : keys) quoted.push_back(json(k.first).dump() + ":");
   w.put('[');
   for (size_t i = 0; i < t.rows.size(); ++i) {
-    w.raw(i ? ",\n" : "\n");
+    w.raw(i ? ",\n{" : "\n{");
+    bool first = true;
     for (size_t k = 0; k < keys.size(); ++k) {
+      if (keys[k].second >= 0 && std::isnan(t.rows[i][keys[k].second])) continue;  // as table_json
+      if (!first) w.put(',');
+      first = false;
       w.raw(quoted[k]);
       if (keys[k].second < 0)
         w.integer(static_cast<long long>(i));

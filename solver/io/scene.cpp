@@ -9,6 +9,7 @@
 #include <optional>
 #include <sstream>
 
+#include "solver/core/body_set.hpp"
 #include "solver/io/json_depth.hpp"
 #include "solver/io/scene_reader.hpp"
 #include "solver/io/schema_validation.hpp"
@@ -150,10 +151,8 @@ std::string motion_name(const Vector& coefficients, double L) {
 }  // namespace
 
 // The rigid motions the supports leave free, as coefficients of body_modes() (columns).
-Matrix scene_io::free_motions(const Problem& problem) {
-  const std::vector<Vector> modes = body_modes(*problem.body);
-  std::vector<int> fixed;
-  for (const Constraint& c : problem.constraints) fixed.push_back(c.dof);
+Matrix scene_io::free_motions(const Body& body, const std::vector<int>& fixed) {
+  const std::vector<Vector> modes = body_modes(body);
   Matrix R = Matrix::Zero(std::max<size_t>(fixed.size(), 1), modes.size());
   for (size_t i = 0; i < fixed.size(); ++i)
     for (size_t m = 0; m < modes.size(); ++m) R(i, m) = modes[m][fixed[i]];
@@ -192,57 +191,108 @@ std::vector<Vector> motion_basis(const Matrix& free) {
   return basis;
 }
 
+// The bodies of a scene whose rigid motions are their own: the one body, or each body of a
+// scene of several, with the dof it starts at and the pointer of its supports.
+struct BodyPart {
+  const Body* body;
+  int offset;
+  std::string supports;  // the pointer of its supports
+  std::string prefix;    // "NAME: " before its motions' names in a scene of several bodies
+};
+
+std::vector<BodyPart> body_parts(const Problem& problem) {
+  const auto* all = dynamic_cast<const BodySet*>(problem.body.get());
+  if (!all) return {{problem.body.get(), 0, "/body/supports", ""}};
+  std::vector<BodyPart> parts;
+  for (int b = 0; b < all->count(); ++b)
+    parts.push_back({&all->part(b), all->dof_offset(b), "/bodies/" + std::to_string(b) + "/supports", all->name(b) + ": "});
+  return parts;
+}
+
+// A motion of the whole problem (dofs) in words, per body it moves: "translate along x", or
+// "upper: translate along x; lower: translate along x" where it moves several bodies; and the
+// first body it moves.
+std::pair<std::string, int> motion_words(const std::vector<BodyPart>& parts, const Vector& d) {
+  std::string words;
+  int first = -1, moved = 0;
+  for (size_t b = 0; b < parts.size(); ++b) {
+    const Body& body = *parts[b].body;
+    const Vector part = d.segment(parts[b].offset, body.dof_count());
+    if (part.norm() <= 1e-9 * d.norm()) continue;
+    const std::vector<Vector> modes = body_modes(body);
+    Matrix B(part.size(), modes.size());
+    for (size_t m = 0; m < modes.size(); ++m) B.col(m) = modes[m];
+    const Vector c = B.colPivHouseholderQr().solve(part);
+    if (first < 0) first = static_cast<int>(b);
+    words += (moved++ ? "; " : "") + parts[b].prefix + motion_name(c, body.characteristic_length());
+  }
+  if (moved == 1 && !parts[first].prefix.empty()) words = words.substr(parts[first].prefix.size());
+  return {moved > 1 ? "move together (" + words + ")" : words, std::max(first, 0)};
+}
+
 // Free rigid motions are held by contact (ALGORITHM.md section 7) where the model allows it:
 // translations always (internal forces are self-equilibrated at any state), rotations where
 // the tangent is constant (linear kinematics: an infinitesimal rotation is a null mode of K);
-// a membrane (no reference stiffness) never. Records them in problem.rigid (pins come later).
+// a membrane (no reference stiffness) never. Records them in problem.rigid (pins come later);
+// in a scene of several bodies each body's motions on its own dofs.
 void check_rigid_modes(Reader& r, Problem& problem) {
-  const Body& body = *problem.body;
-  const double L = body.characteristic_length();
-  const std::vector<Vector> free = motion_basis(scene_io::free_motions(problem));
-  const std::vector<Vector> modes = body_modes(body);
-  for (const Vector& c : free) {
-    const bool rotates = c.size() > 2 && std::abs(c[2]) > 1e-9;
-    std::string why;
-    if (problem.start)
-      why = "a membrane has no stiffness of its own to carry a load to its contacts";
-    else if (rotates && !body.traits().constant_tangent)
-      why = "a free rotation is held by contact only with linear kinematics (its infinitesimal rotation is a "
-            "null mode of the stiffness; a finite one is not)";
-    if (!why.empty()) {
-      r.error("/body/supports", "leave the body free to " + motion_name(c, L) + ": " + why +
-                                    "; fix a component that this motion moves, or drive the body by a "
-                                    "prescribed displacement");
-      continue;
+  const std::vector<BodyPart> parts = body_parts(problem);
+  for (size_t b = 0; b < parts.size(); ++b) {
+    const Body& body = *parts[b].body;
+    const int o = parts[b].offset, n = body.dof_count();
+    std::vector<int> fixed;
+    for (const Constraint& c : problem.constraints)
+      if (c.dof >= o && c.dof < o + n) fixed.push_back(c.dof - o);
+    const double L = body.characteristic_length();
+    const std::vector<Vector> free = motion_basis(scene_io::free_motions(body, fixed));
+    const std::vector<Vector> modes = body_modes(body);
+    for (const Vector& c : free) {
+      const bool rotates = c.size() > 2 && std::abs(c[2]) > 1e-9;
+      std::string why;
+      if (problem.start)
+        why = "a membrane has no stiffness of its own to carry a load to its contacts";
+      else if (rotates && !body.traits().constant_tangent)
+        why = "a free rotation is held by contact only with linear kinematics (its infinitesimal rotation is a "
+              "null mode of the stiffness; a finite one is not)";
+      if (!why.empty()) {
+        r.error(parts[b].supports, "leave the body free to " + motion_name(c, L) + ": " + why +
+                                       "; fix a component that this motion moves, or drive the body by a "
+                                       "prescribed displacement");
+        continue;
+      }
+      Vector mode = Vector::Zero(problem.body->dof_count());
+      for (int m = 0; m < c.size(); ++m) mode.segment(o, n) += c[m] * modes[m];
+      problem.rigid.names.push_back(parts[b].prefix + motion_name(c, L));
+      problem.rigid.body.push_back(static_cast<int>(b));
+      problem.rigid.modes.conservativeResize(mode.size(), problem.rigid.modes.cols() + 1);
+      problem.rigid.modes.col(problem.rigid.modes.cols() - 1) = mode;
     }
-    Vector mode = Vector::Zero(body.dof_count());
-    for (int m = 0; m < c.size(); ++m) mode += c[m] * modes[m];
-    problem.rigid.names.push_back(motion_name(c, L));
-    problem.rigid.modes.conservativeResize(body.dof_count(), problem.rigid.modes.cols() + 1);
-    problem.rigid.modes.col(problem.rigid.modes.cols() - 1) = mode;
   }
 }
 
 // With the candidates known: every free motion must move some contact point toward or along
-// (with friction) an obstacle, else nothing can stop it; and each mode gets its pin, a dof
-// that no support and no contact point uses, with the modes normalized to 1 at their own pin.
+// (with friction) an obstacle or the other body of its pair, else nothing can stop it; and each
+// mode gets its pin, a dof that no support and no contact point uses, with the modes
+// normalized to 1 at their own pin.
 void hold_rigid_modes(Reader& r, Problem& problem) {
   RigidModes& rigid = problem.rigid;
   const Body& body = *problem.body;
   const int count = static_cast<int>(rigid.modes.cols());
   if (count == 0) return;
-  const Vector q0 = Vector::Zero(body.dof_count());
+  const std::vector<BodyPart> parts = body_parts(problem);
+  // The contact points in the reference configuration; a pair's Jacobian moves both its bodies.
+  const EquilibriumState paired = Equilibrium(problem, NewtonParams{}).evaluate(Vector::Zero(body.dof_count()));
   Matrix G = Matrix::Zero(problem.component_count, count);
   std::vector<char> supported(body.dof_count(), 0), on_contact(body.dof_count(), 0);
   for (const Constraint& c : problem.constraints) supported[c.dof] = 1;
-  for (const Candidate& c : problem.candidates) {
-    const SurfacePoint sp = body.surface_point(q0, c.site, c.side);
-    const Projection proj = problem.obstacles[c.obstacle].shape->project(sp.x);
-    for (const auto& j : sp.jacobian) {
+  for (size_t i = 0; i < problem.candidates.size(); ++i) {
+    const Candidate& c = problem.candidates[i];
+    const PairedPoint& pp = paired.points[i];
+    for (const auto& j : pp.point.jacobian) {
       on_contact[j.dof] = 1;
       for (int k = 0; k < count; ++k) {
-        G(c.eta, k) -= j.dx.dot(proj.normal) * rigid.modes(j.dof, k);
-        if (c.xi >= 0) G(c.xi, k) += j.dx.dot(proj.tangent) * rigid.modes(j.dof, k);
+        G(c.eta, k) += j.dx.dot(pp.eta) * rigid.modes(j.dof, k);
+        if (c.xi >= 0) G(c.xi, k) += j.dx.dot(pp.xi) * rigid.modes(j.dof, k);
       }
     }
   }
@@ -251,21 +301,21 @@ void hold_rigid_modes(Reader& r, Problem& problem) {
       "friction, along it): fix a component that this motion moves, give the obstacle friction, or drive the body "
       "by a prescribed displacement";
   if (problem.candidates.empty()) {
-    for (const std::string& name : rigid.names) r.error("/body/supports", "leave the body free to " + name + unstoppable);
+    for (int k = 0; k < count; ++k) {
+      const BodyPart& part = parts[rigid.body[k]];
+      r.error(part.supports, "leave the body free to " + rigid.names[k].substr(part.prefix.size()) + unstoppable);
+    }
     return;
   }
   const Eigen::JacobiSVD<Matrix> svd(G, Eigen::ComputeFullV);
   const double largest = std::max(1.0, svd.singularValues().size() ? svd.singularValues()[0] : 0.0);
   for (int k = 0; k < count; ++k) {
     if (k < svd.singularValues().size() && svd.singularValues()[k] > 1e-6 * largest) continue;
-    // The motion that no contact point resists, in words: its coefficients of the body's modes.
-    const Vector v = svd.matrixV().col(k);
-    const Vector d = rigid.modes * v;
-    const std::vector<Vector> modes = body_modes(body);
-    Matrix B(d.size(), modes.size());
-    for (size_t m = 0; m < modes.size(); ++m) B.col(m) = modes[m];
-    const Vector c = B.colPivHouseholderQr().solve(d);
-    r.error("/body/supports", "leave the body free to " + motion_name(c, body.characteristic_length()) + unstoppable);
+    // The motion that no contact point resists, in words, at the first body it moves.
+    const auto [words, b] = motion_words(parts, Vector(rigid.modes * svd.matrixV().col(k)));
+    r.error(parts[b].supports, std::string(words.rfind("move together", 0) == 0 ? "leave the bodies free to "
+                                                                                 : "leave the body free to ") +
+                                   words + unstoppable);
   }
   if (!r.issues.empty()) return;
   // Pins: the dofs that pin the modes best (column-pivoted QR of the modes' rows), off the
@@ -286,7 +336,8 @@ void hold_rigid_modes(Reader& r, Problem& problem) {
   rigid.pins = best_pins(true);
   if (rigid.pins.empty()) rigid.pins = best_pins(false);
   if (rigid.pins.empty()) {
-    r.error("/body/supports", "leave the body free to " + rigid.names.front() + ", and no free dof can hold it in the solves");
+    r.error(parts[rigid.body.front()].supports,
+            "leave the body free to " + rigid.names.front() + ", and no free dof can hold it in the solves");
     return;
   }
   Matrix at_pins(count, count);
@@ -561,7 +612,7 @@ Scene read_checked_scene(const nlohmann::json& input) {
     for (size_t k = 0; k < r.cases.size(); ++k) scene_io::case_load(scene.problem, static_cast<int>(k));
   read_solver(r, e, scene.params);
   read_output(r, e, scene);
-  if (r.issues.empty() && scene.problem.body && !several) check_rigid_modes(r, scene.problem);
+  if (r.issues.empty() && scene.problem.body) check_rigid_modes(r, scene.problem);
   if (r.issues.empty()) read_start(r, e, scene.problem);
   if (!r.issues.empty()) throw SceneErrors(std::move(r.issues));
   const double reach = scene.params.contact_reach > 0 ? scene.params.contact_reach

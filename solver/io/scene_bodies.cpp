@@ -5,6 +5,7 @@
 
 #include "solver/core/body_set.hpp"
 #include "solver/elements/continuum.hpp"
+#include "solver/elements/timoshenko_beam.hpp"
 #include "solver/io/scene_reader.hpp"
 
 namespace grip::scene_io {
@@ -47,16 +48,15 @@ void read_bodies(Reader& r, json& bodies, Problem& problem) {
     for (const std::string& other : names)
       if (other == name) r.error(bp + "/name", show(name) + " names another body already");
     if (body.value("model", "") == "rigid_plastic_membrane")
-      r.error(bp + "/model", "a rigid_plastic_membrane starts from a prescribed depth against an obstacle: it is for "
-                             "one-body scenes (body) so far");
+      r.error(bp + "/model",
+              "a rigid_plastic_membrane has no stiffness in its flat reference state: its first step starts from a "
+              "prescribed depth of one node pressed by a rigid obstacle (solver.start), whose reaction is the first "
+              "contact force (ALGORITHM.md 9); against a deformable body that depth would be shared with the other "
+              "body's compliance, which gives no starting force, so a membrane is for one-body scenes (body)");
     if (!r.issues.empty()) continue;
     Problem part;
     read_body(r, body, part, bp);
     if (!r.issues.empty() || !part.body) continue;
-    // Contact holds the free rigid motions of one body only (ALGORITHM.md 7), not yet of one of several.
-    if (free_motions(part).cols() > 0)
-      r.error(bp + "/supports", "leave the body free to move rigidly: in a scene of several bodies each body must be "
-                                "held by its own supports (fix a component, or prescribe a displacement) so far");
     names.push_back(name.get<std::string>());
     parts.push_back(std::move(part));
   }
@@ -78,10 +78,15 @@ void read_bodies(Reader& r, json& bodies, Problem& problem) {
 
 namespace {
 
-// "BODY.SET" of a continuum body: the body's index and the set's nodes; nullopt after an error.
+// "BODY.SET": the body's index, its sites in the set and the set's surface pieces; nullopt after
+// an error. A continuum names a node set of its mesh (its contact_set's nodes in it, the
+// boundary sides between them); a beam names its surface "upper" or "lower": its axis offset by
+// half the depth toward +y or -y (Body::surface_point's side), through every node.
 struct SetRef {
   int body = -1;
-  std::vector<int> sites;  // sites of the BodySet whose nodes are in the set
+  std::vector<int> sites;                      // sites of the BodySet
+  std::vector<std::array<int, 2>> segments;    // its surface pieces, body on the left of a -> b
+  int side = 0;                                // a beam's surface side; 0 for a continuum
 };
 
 std::optional<SetRef> find_set(Reader& r, const BodySet& all, const std::string& text, const std::string& ptr) {
@@ -89,9 +94,22 @@ std::optional<SetRef> find_set(Reader& r, const BodySet& all, const std::string&
   const std::string body = text.substr(0, dot), set = dot == std::string::npos ? "" : text.substr(dot + 1);
   for (int b = 0; b < all.count(); ++b) {
     if (all.name(b) != body) continue;
+    const int first = all.site_offset(b), count = all.part(b).site_count();
+    if (dynamic_cast<const TimoshenkoBeam*>(&all.part(b))) {
+      if (set != "upper" && set != "lower") {
+        r.error(ptr, "\"" + set + "\" names no surface of the beam \"" + body + "\" (surfaces: upper, lower: its axis "
+                     "offset by half the depth toward +y or -y)");
+        return std::nullopt;
+      }
+      SetRef ref{b, {}, {}, set == "upper" ? +1 : -1};
+      for (int s = first; s < first + count; ++s) ref.sites.push_back(s);
+      for (int s = first; s + 1 < first + count; ++s)  // the beam on the left: lower toward +x, upper toward -x
+        ref.segments.push_back(ref.side < 0 ? std::array<int, 2>{s, s + 1} : std::array<int, 2>{s + 1, s});
+      return ref;
+    }
     const auto* continuum = dynamic_cast<const ContinuumBody*>(&all.part(b));
     if (!continuum) {
-      r.error(ptr, "body \"" + body + "\" is not a continuum: contact pairs between bodies are for continuum bodies so far");
+      r.error(ptr, "body \"" + body + "\" has no surface that pairs with another body's (continuum and beam bodies do)");
       return std::nullopt;
     }
     const auto& sets = continuum->mesh().sets;
@@ -102,13 +120,17 @@ std::optional<SetRef> find_set(Reader& r, const BodySet& all, const std::string&
       return std::nullopt;
     }
     const std::set<int> nodes(sets.at(set).begin(), sets.at(set).end());
-    SetRef ref{b, {}};
-    for (int s = 0; s < all.part(b).site_count(); ++s)
-      if (nodes.count(all.part(b).site_node(s))) ref.sites.push_back(all.site_offset(b) + s);
+    SetRef ref{b, {}, {}, 0};
+    for (int s = 0; s < count; ++s)
+      if (nodes.count(all.part(b).site_node(s))) ref.sites.push_back(first + s);
     if (ref.sites.empty()) {
       r.error(ptr, "set \"" + set + "\" shares no node with the contact_set of body \"" + body + "\"");
       return std::nullopt;
     }
+    // The contact sides of its body with both ends in the set.
+    const std::set<int> in_set(ref.sites.begin(), ref.sites.end());
+    for (const auto& side : all.surface_segments())
+      if (in_set.count(side[0]) && in_set.count(side[1])) ref.segments.push_back(side);
     return ref;
   }
   std::vector<std::string> names;
@@ -152,16 +174,7 @@ void read_contacts(Reader& r, json& scene, Problem& problem) {
       r.error(cp + "/master", "is on the slave's own body: self-contact is not supported");
       continue;
     }
-    // Each side's segments: the contact sides of its body with both ends in its set.
-    auto sides_in = [&](const std::vector<int>& sites) {
-      const std::set<int> in_set(sites.begin(), sites.end());
-      std::vector<std::array<int, 2>> segments;
-      for (const auto& s : all.surface_segments())
-        if (in_set.count(s[0]) && in_set.count(s[1])) segments.push_back(s);
-      return segments;
-    };
-    const std::vector<std::array<int, 2>> segments = sides_in(master_set->sites);
-    if (segments.empty()) {
+    if (master_set->segments.empty()) {
       r.error(cp + "/master", "set " + show(master) + " spans no side of its body's contact surface");
       continue;
     }
@@ -174,7 +187,8 @@ void read_contacts(Reader& r, json& scene, Problem& problem) {
     pair.friction = r.number(c, cp, "friction", 0.0);
     if (pair.friction < 0) r.error(cp + "/friction", show(c["friction"]) + " is negative");
     pair.frictional = pair.friction > 0;
-    pair.master = make_master_surface(all, master_set->body, segments, sides_in(slave->sites));
+    pair.master = make_master_surface(all, master_set->body, master_set->segments, slave->segments, master_set->side,
+                                      slave->side);
     pair.slaves = slave->sites;
     pair.slave_body = slave->body;
     problem.obstacles.push_back(std::move(pair));

@@ -223,13 +223,15 @@ void read_continuum(Reader& r, json& body, Problem& problem, const std::string& 
 void read_body(Reader& r, json& body, Problem& problem, const std::string& ptr);
 
 // scene["bodies"]: every body read on its own, then joined into one BodySet (dofs, sites and
-// load vectors at each body's offsets); each body must be held by its own supports.
+// load vectors at each body's offsets); a body's free rigid motions are held by contact as in
+// a one-body scene (scene.cpp).
 void read_bodies(Reader& r, json& bodies, Problem& problem);
 // scene["contacts"]: [{slave: "BODY.SET", master: "BODY.SET" | "OBSTACLE", friction, name}]
 // (after the obstacles): a pair with a body master joins problem.obstacles (no shape); one with
 // an obstacle master restricts that obstacle to the slave sets that name it.
 void read_contacts(Reader& r, json& scene, Problem& problem);
-// The rigid motions (coefficients of translation x, y and rotation) the supports leave free.
-Matrix free_motions(const Problem& problem);
+// The rigid motions of `body` (coefficients of translation x, y and rotation) that supports on
+// the dofs `fixed` leave free.
+Matrix free_motions(const Body& body, const std::vector<int>& fixed);
 
 }  // namespace grip::scene_io

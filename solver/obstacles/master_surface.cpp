@@ -38,9 +38,11 @@ std::vector<std::vector<int>> chains_of(const std::vector<std::array<int, 2>>& s
 }  // namespace
 
 MasterSurface make_master_surface(const Body& body, int body_index, const std::vector<std::array<int, 2>>& segments,
-                                  const std::vector<std::array<int, 2>>& slave_segments) {
+                                  const std::vector<std::array<int, 2>>& slave_segments, int side, int slave_side) {
   MasterSurface m;
   m.body = body_index;
+  m.side = side;
+  m.slave_side = slave_side;
   m.chains = chains_of(segments);
   m.slave_chains = chains_of(slave_segments);
   double zeta = 0.0;
@@ -60,7 +62,7 @@ DeformedMaster::DeformedMaster(const Body& body, const Vector& q, const MasterSu
     std::vector<ProfilePiece> pieces;
     chain.zeta.push_back(0.0);
     for (int site : surface.chains[c]) {
-      chain.points.push_back(body.surface_point(q, site, 0));
+      chain.points.push_back(body.surface_point(q, site, surface.side));
       const size_t n = chain.points.size();
       if (n < 2) continue;
       const Vec2 a = chain.points[n - 2].x, b = chain.points[n - 1].x;
@@ -106,7 +108,7 @@ void DeformedMaster::integrate_mortar(const Body& body, const Vector& q, const M
   const double gauss = 1.0 / std::sqrt(3.0);
   for (const std::vector<int>& slave : surface.slave_chains) {
     std::vector<Vec2> x;
-    for (int site : slave) x.push_back(body.surface_point(q, site, 0).x);
+    for (int site : slave) x.push_back(body.surface_point(q, site, surface.slave_side).x);
     for (size_t e = 0; e + 1 < slave.size(); ++e) {
       const Vec2 a = x[e], b = x[e + 1];
       const double length = (b - a).norm();

@@ -37,13 +37,17 @@ struct MasterSurface {
   std::vector<std::vector<int>> chains;  // sites of the problem's body along each run, body on the left
   std::vector<std::vector<double>> reference_zeta;  // per chain and site: reference arc length
   std::vector<std::vector<int>> slave_chains;       // the slave surface's runs (sites, body on the left)
+  // The sides (Body::surface_point) of the master's and the slave's sites: 0 for a continuum's
+  // boundary nodes; +1 (upper) or -1 (lower) for a beam's surface, its axis offset by half its depth.
+  int side = 0, slave_side = 0;
 };
 
 // The chains through the given segments ([a, b], body on the left of a -> b), each followed
 // from a segment that no other segment ends at (or any, for a closed loop); zeta from 0 along
 // the master's chains in the reference configuration, continuing from one chain to the next.
 MasterSurface make_master_surface(const Body& body, int body_index, const std::vector<std::array<int, 2>>& segments,
-                                  const std::vector<std::array<int, 2>>& slave_segments);
+                                  const std::vector<std::array<int, 2>>& slave_segments, int side = 0,
+                                  int slave_side = 0);
 
 struct MasterPoint {
   Projection projection;  // zeta: the master's reference arc length (material, for slips)

@@ -55,9 +55,27 @@ TEST(TwoBodiesScene, ErrorsNameThePointerOfTheValue) {
   j = ok;
   j["bodies"][1].erase("name");
   EXPECT_TRUE(has_error(j, "/bodies/1/name"));
-  j = ok;
-  j["bodies"][1]["supports"][0]["fix"] = {"y"};  // free to slide along x
-  EXPECT_TRUE(has_error(j, "/bodies/1/supports"));
+  // Free motions that contact cannot stop are refused at the supports of the body they move: the
+  // block free in x on a frictionless flat interface; both bodies free in y together.
+  const json block = example_scene("block-on-foundation");
+  j = block;
+  j["bodies"][0]["supports"] = json::array({{{"set", "top"}, {"fix", {"y"}}}});
+  EXPECT_TRUE(has_error(j, "/bodies/0/supports"));
+  EXPECT_NE(error_pointers(j).front().find("leave the body free to translate along x"), std::string::npos)
+      << error_pointers(j).front();
+  j = block;
+  j["bodies"][0]["supports"] = json::array({{{"set", "left"}, {"fix", {"x"}}}});
+  j["bodies"][1]["supports"] = json::array({{{"set", "left"}, {"fix", {"x"}}}});
+  EXPECT_TRUE(has_error(j, "/bodies/0/supports"));
+  EXPECT_NE(error_pointers(j).front().find("leave the bodies free to move together (block: translate along y; "
+                                           "foundation: translate along y)"),
+            std::string::npos)
+      << error_pointers(j).front();
+  // Held by contact: the block free in y on the supported foundation.
+  j = block;
+  j["bodies"][0]["supports"] = json::array({{{"set", "left"}, {"fix", {"x"}}}});
+  EXPECT_TRUE(error_pointers(j).empty());
+  EXPECT_EQ(read_scene(j).problem.rigid.names, std::vector<std::string>{"block: translate along y"});
   j = ok;
   j["body"] = ok["bodies"][0];
   EXPECT_TRUE(has_error(j, "/body"));

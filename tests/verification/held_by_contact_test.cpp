@@ -11,66 +11,13 @@
 
 #include "solver/elements/continuum.hpp"
 #include "tests/support/contact_profile.hpp"
-#include "tests/support/result_checks.hpp"
+#include "tests/support/held.hpp"
 
 namespace grip {
 namespace {
 
 using nlohmann::json;
 using namespace grip::testing;
-
-// The applied load and the contact forces on the body's free rigid motions, relative to the
-// load's size: the whole body's equilibrium, which no support helps with.
-double free_motion_unbalance(const Problem& problem, const StepRecord& rec) {
-  Vector f = problem.load(rec.factors);
-  double scale = f.cwiseAbs().sum();
-  for (size_t i = 0; i < problem.candidates.size(); ++i) {
-    const Candidate& c = problem.candidates[i];
-    const PairedPoint& pp = rec.state.points[i];
-    const Vec2 force = rec.p[c.eta] * pp.eta + (c.xi >= 0 ? rec.p[c.xi] : 0.0) * pp.xi;
-    for (const auto& j : pp.point.jacobian) f[j.dof] += j.dx.dot(force);
-    scale += force.norm();
-  }
-  double worst = 0.0;
-  for (int k = 0; k < problem.rigid.count(); ++k) worst = std::max(worst, std::abs(problem.rigid.modes.col(k).dot(f)));
-  return worst / scale;
-}
-
-// The balance of load and contact forces that every converged step meets (issue 16): 1e-9
-// of the load, with every strategy (penalty: its forces are the law linearized over Newton's
-// last correction, Equilibrium::finish_penalty).
-double balance(const Scene&) { return 1e-9; }
-
-// Every converged step is sound and balances the load on its free motions to balance().
-// A strategy that ends each tau pass at ||v|| <= tol (a finite n, uzawa) settles p* only to
-// about C^-1 v (here up to 3e-4 of the largest normal force): its cone holds to that.
-void expect_held(const Solved& s) {
-  EXPECT_TRUE(result_is_finite(s));
-  ASSERT_GT(s.scene.problem.rigid.count(), 0);
-  const json effects = effects_json(s.scene, s.run);
-  EXPECT_EQ(effects["held_by_contact"].size(), static_cast<size_t>(s.scene.problem.rigid.count()));
-  const bool penalty = s.scene.params.contact.method == ContactMethod::penalty;
-  EXPECT_EQ(effects["held_by_contact_by"].get<std::string>().find(penalty ? "penalty springs" : "no regularization") !=
-                std::string::npos,
-            true);
-  InvariantTolerances tolerances = tolerances_of(s.scene);
-  const ContactParams& c = s.scene.params.contact;
-  if (c.method == ContactMethod::uzawa || c.acceleration != kAccelerationInfinity) tolerances.tau_relative = 1e-3;
-  for (const StepRecord& rec : s.run.steps) {
-    if (!rec.converged) continue;
-    // The penalty law p = k s: gaps and sticking slips are |p| / k, k = factor x the largest
-    // stiffness (1 / rigid.scale), not the contact tolerance.
-    if (c.method == ContactMethod::penalty)
-      tolerances.length = (1 + 1e-6) * rec.p.head(s.scene.problem.rigid.first).cwiseAbs().maxCoeff() *
-                          s.scene.problem.rigid.scale / c.penalty_factor;
-    EXPECT_TRUE(step_invariants(s.scene.problem, rec, tolerances));
-    // ssn's events report its Newton iterates, which no ||v|| test accepts.
-    if (c.method != ContactMethod::ssn) EXPECT_TRUE(monotone_contact_error(rec));
-    EXPECT_LT(free_motion_unbalance(s.scene.problem, rec), balance(s.scene)) << "step " << rec.index;
-    const json step = step_json(s.scene.problem, rec, s.scene.output);
-    EXPECT_TRUE(step.contains("rigid_motion")) << "step " << rec.index;
-  }
-}
 
 Vec2 contact_resultant(const Problem& problem, const StepRecord& rec, int obstacle) {
   Vec2 total = Vec2::Zero();
@@ -92,17 +39,6 @@ int node_at(const json& scene, const Vec2& x) {
   ADD_FAILURE() << "no node at (" << x.x() << ", " << x.y() << ")";
   return 0;
 }
-
-// The strategies that hold a body by contact, each a solver.contact block over the defaults.
-// `not_for`: the cases a strategy is not run on, and why (measured, in the README).
-struct Strategy {
-  const char* name;
-  json contact;
-  std::vector<std::string> not_for = {};
-  const char* why_not = "";
-};
-// ctest and gtest name the parameter by its strategy, not by its bytes.
-void PrintTo(const Strategy& s, std::ostream* os) { *os << s.name; }
 
 const char* const kPaperBeam =
     "the paper's literal loop on the beam lying on a flat: alpha halved 40 times without a decrease of the "
@@ -133,11 +69,6 @@ const Strategy kStrategies[] = {
     {"penalty", {{"method", "penalty"}}, {"disc"}, kPenaltyNewton},
     {"ssn", {{"method", "ssn"}}},
 };
-
-json with_strategy(json j, const Strategy& strategy) {
-  for (const auto& [key, value] : strategy.contact.items()) j["solver"]["contact"][key] = value;
-  return j;
-}
 
 class HeldByContactStrategy : public ::testing::TestWithParam<Strategy> {
  protected:
