@@ -38,7 +38,6 @@ bool FreeBlockSolver::factorize(const Triplets& triplets, const std::vector<int>
       }
     lu_analysed_ = llt_analysed_ = dissected_analysed_ = false;
     dissected_fails_at_ = 0;
-    band_width_ = band_.analyse(matrix_);
   }
   std::fill(matrix_.valuePtr(), matrix_.valuePtr() + matrix_.nonZeros(), 0.0);
   for (size_t k = 0; k < triplets.size(); ++k)
@@ -54,13 +53,6 @@ bool FreeBlockSolver::factorize(const Triplets& triplets, const std::vector<int>
     double* w = matrix_.valuePtr();
     for (int k = 0; k < matrix_.nonZeros(); ++k)
       if (mirror_[k] > k) w[k] = w[mirror_[k]] = 0.5 * (w[k] + w[mirror_[k]]);
-  }
-  banded_ = false;
-  if (symmetric_ && band_width_ >= 0 && band_width_ <= kMaxBand) {
-    // Not positive definite, or a pivot at round-off: LU, as below.
-    banded_ = ok_ = band_.factorize(matrix_) && band_.rcond() > 1e-14;
-    if (ok_) return true;
-    symmetric_ = false;
   }
   if (symmetric_) {
     if (!llt_analysed_) {  // the ordering: once per pattern
@@ -132,7 +124,7 @@ void factorize_dissected(CholmodFactor& dissected, const Eigen::SparseMatrix<dou
 }  // namespace
 
 bool FreeBlockSolver::inverse_block(const std::vector<int>& rows, Matrix& G) {
-  if (!ok_ || !symmetric_ || banded_) return false;
+  if (!ok_ || !symmetric_) return false;
   if (llt_.inverse_block(rows, G)) return true;
   // More rows only lengthen the partial solves against the same factor's pattern.
   if (dissected_fails_at_ && rows.size() >= dissected_fails_at_) return false;
@@ -251,7 +243,6 @@ bool CholmodFactor::quadratic_forms(const Eigen::SparseMatrix<double>& t, Vector
 Vector FreeBlockSolver::quadratic_forms(const Eigen::SparseMatrix<double>& t) {
   Vector out;
   if (!ok_ || !symmetric_) return Vector();
-  if (banded_) return band_.quadratic_forms(t);
   // A path through more than 1/32 of the rows on average: the nested-dissection order instead.
   if (llt_.quadratic_forms(t, out, matrix_.rows() / 32.0)) return out;
   CholmodFactor dissected;

@@ -12,7 +12,6 @@
 #include <vector>
 
 #include "solver/core/body.hpp"
-#include "solver/solve/band_cholesky.hpp"
 
 namespace grip {
 
@@ -47,14 +46,10 @@ class FreeBlockSolver {
   // residual stays exact, so Newton still converges, and LDL^T serves).
   bool factorize(const Triplets& triplets, const std::vector<int>& free_index, int free_count,
                  double near_symmetric_tolerance = 0.0);
-  Vector solve(const Vector& b) const {
-    return !symmetric_ ? Vector(lu_.solve(b)) : banded_ ? band_.solve(b) : Vector(llt_.solve(b));
-  }
-  Matrix solve(const Matrix& b) const {
-    return !symmetric_ ? Matrix(lu_.solve(b)) : banded_ ? band_.solve(b) : Matrix(llt_.solve(b));
-  }
-  // K^-1 on the given rows where K is Cholesky-factorized by CHOLMOD (CholmodFactor::inverse_block);
-  // false otherwise (then solve() for unit right-hand sides: a band's solves are cheap). Where the factor's own ordering
+  Vector solve(const Vector& b) const { return symmetric_ ? Vector(llt_.solve(b)) : Vector(lu_.solve(b)); }
+  Matrix solve(const Matrix& b) const { return symmetric_ ? Matrix(llt_.solve(b)) : Matrix(lu_.solve(b)); }
+  // K^-1 on the given rows where K is Cholesky-factorized (CholmodFactor::inverse_block);
+  // false otherwise (then solve() for unit right-hand sides). Where the factor's own ordering
   // gives the rows long elimination-tree paths (thin strips: a fill-reducing ordering there is
   // nearly banded), a second factorization in nested-dissection order, for G only: analysed
   // once per pattern, and not tried again for as many rows or more once it did not pay (a
@@ -76,12 +71,7 @@ class FreeBlockSolver {
     ok_ = false;
     dissected_analysed_ = false;
     dissected_fails_at_ = 0;
-    band_width_ = -1;
   }
-  // A symmetric block whose half-bandwidth (in the reverse Cuthill-McKee order) is at most
-  // this is factorized on its band (band_cholesky.hpp), else by CHOLMOD. The band's n b^2 is
-  // then about a sparse factorization's flops on a 2D mesh's strip of that width.
-  static constexpr int kMaxBand = 16;
 
  private:
   Eigen::SparseMatrix<double> matrix_;
@@ -91,9 +81,6 @@ class FreeBlockSolver {
   Eigen::SparseLU<Eigen::SparseMatrix<double>> lu_;
   CholmodFactor llt_;
   CholmodFactor dissected_;  // nested-dissection order, for inverse_block only
-  BandCholesky band_;
-  int band_width_ = -1;  // of the pattern; -1: not measured yet
-  bool banded_ = false;  // the symmetric factor is band_
   bool lu_analysed_ = false, llt_analysed_ = false, dissected_analysed_ = false;
   size_t dissected_fails_at_ = 0;  // the fewest rows for which the dissected factor did not pay; 0: none yet
   bool symmetric_ = false;
