@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 
 namespace grip {
 
@@ -15,6 +16,7 @@ Equilibrium::Equilibrium(const Problem& problem, NewtonParams params, std::vecto
   index_free_dofs();
   length_scales_ = problem.body->dof_length_scales();
   constant_tangent_ = problem.body->traits().constant_tangent;
+  for (const ObstacleInstance& o : problem.obstacles) has_pairs_ = has_pairs_ || o.master.has_value();
   zeta_previous_.assign(problem.candidates.size(), 0.0);
 }
 
@@ -56,9 +58,11 @@ void Equilibrium::pair(const Vector& q, EquilibriumState& state) const {
   state.enabled.assign(problem_.component_count, 0);
   for (int k = 0; k < problem_.rigid.count(); ++k) state.enabled[problem_.rigid.first + k] = 1;
   // Deformable masters in their current configuration (mortar, segment-to-segment).
-  std::vector<std::optional<DeformedMaster>> masters(problem_.obstacles.size());
+  auto& masters = state.masters;
+  masters.assign(problem_.obstacles.size(), nullptr);
   for (size_t o = 0; o < masters.size(); ++o)
-    if (problem_.obstacles[o].master) masters[o].emplace(*problem_.body, q, *problem_.obstacles[o].master);
+    if (problem_.obstacles[o].master)
+      masters[o] = std::make_shared<const DeformedMaster>(*problem_.body, q, *problem_.obstacles[o].master);
   for (size_t i = 0; i < cands.size(); ++i) {
     const Candidate& c = cands[i];
     const ObstacleInstance& obstacle = problem_.obstacles[c.obstacle];
@@ -152,10 +156,10 @@ double Equilibrium::stiffness_scale(const Vector& q) const {
 }
 
 Vector Equilibrium::residual(const Vector& q, const EquilibriumState& paired, const Vector& p_given,
-                             Triplets* tangent, double* force_scale) const {
+                             Triplets* tangent, double* force_scale, bool body_tangent) const {
   const Vector p = penalty_ ? penalty_forces(paired, tangent) : p_given;
   Vector r = Vector::Zero(q.size());
-  problem_.body->internal_force(q, r, tangent);
+  problem_.body->internal_force(q, r, body_tangent ? tangent : nullptr);
   const Vector external = problem_.load(factors_);
   Vector contact = Vector::Zero(q.size());
   for (size_t i = 0; i < problem_.candidates.size(); ++i) {
@@ -173,6 +177,12 @@ Vector Equilibrium::residual(const Vector& q, const EquilibriumState& paired, co
     for (const auto& a : pp.point.jacobian)
       for (const auto& b : pp.point.jacobian)
         tangent->emplace_back(a.dof, b.dof, -a.dx.dot(df_dx * b.dx));
+    if (const auto& master = paired.masters[c.obstacle]) {  // the pair's stiffness, both bodies
+      const size_t first = tangent->size();
+      master->force_derivative(problem_.body->surface_point(q, c.site, c.side), c.site, p_eta, p_xi, *tangent);
+      for (size_t k = first; k < tangent->size(); ++k)
+        (*tangent)[k] = {(*tangent)[k].row(), (*tangent)[k].col(), -(*tangent)[k].value()};
+    }
   }
   if (force_scale) {
     auto largest = [&](const Vector& v) { return (v.array() / length_scales_.array()).abs().maxCoeff(); };
@@ -240,13 +250,16 @@ EquilibriumState Equilibrium::solve(const Vector& q_guess, const Vector& p) {
   constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
   // The penalty law adds stiffness that changes with the contact state: no reuse then.
   const bool reuse = constant_tangent_ && !penalty_;
+  // A pair of bodies adds its stiffness, which moves with the pairing, on a few surface dofs:
+  // kept as a low-rank correction of the constant body tangent (low_rank_step).
+  const bool low_rank = reuse && has_pairs_;
   Triplets triplets;
   double last_step = 0.0;
   for (int it = 1; it <= params_.max_iterations + 1; ++it) {
     pair(state.q, state);
     triplets.clear();
     double force_scale = 0.0;
-    const Vector r = residual(state.q, state, p, reuse ? nullptr : &triplets, &force_scale);
+    const Vector r = residual(state.q, state, p, reuse && !low_rank ? nullptr : &triplets, &force_scale, !low_rank);
     const double r_max = scaled_free_max(r);
     state.relative_residual = force_scale > 0 ? r_max / force_scale : 0.0;
     if (!std::isfinite(r_max)) {
@@ -284,7 +297,9 @@ EquilibriumState Equilibrium::solve(const Vector& q_guess, const Vector& p) {
     Vector r_free(free_count_);
     for (int i = 0; i < r.size(); ++i)
       if (free_index_[i] >= 0) r_free[free_index_[i]] = r[i];
-    const Vector dq_free = reuse ? body_lu_.solve(Vector(-r_free)) : lu_.solve(Vector(-r_free));
+    const Vector dq_free = low_rank ? low_rank_step(triplets, Vector(-r_free))
+                           : reuse  ? body_lu_.solve(Vector(-r_free))
+                                    : lu_.solve(Vector(-r_free));
     state.newton_iterations = it;
     ++counters_.newton_iterations;
     Vector dq = Vector::Zero(state.q.size());
@@ -312,6 +327,42 @@ EquilibriumState Equilibrium::solve(const Vector& q_guess, const Vector& p) {
                  " iterations (free residual " + std::to_string(state.relative_residual) +
                  " of the force scale)";
   return state;
+}
+
+Vector Equilibrium::low_rank_step(const Triplets& contact, const Vector& rhs) {
+  // (K + P A P^T)^-1 b = z - K^-1 P A (I + G A)^-1 P^T z, z = K^-1 b, G = P^T K^-1 P: two
+  // solves with the body's factorization and a dense system of the pair's free surface dofs.
+  std::map<int, int> slot;  // free index -> row of A
+  std::vector<int> rows;
+  for (const auto& t : contact)
+    for (int dof : {t.row(), t.col()})
+      if (free_index_[dof] >= 0 && slot.emplace(free_index_[dof], static_cast<int>(rows.size())).second)
+        rows.push_back(free_index_[dof]);
+  const Vector z = body_lu_.solve(rhs);
+  const int m = static_cast<int>(rows.size());
+  if (m == 0) return z;
+  Matrix A = Matrix::Zero(m, m);
+  for (const auto& t : contact) {
+    const int i = free_index_[t.row()], j = free_index_[t.col()];
+    if (i >= 0 && j >= 0) A(slot[i], slot[j]) += t.value();
+  }
+  if (rows != low_rank_rows_) {  // G on these dofs (K is constant: kept while they stay)
+    low_rank_rows_ = rows;
+    if (!body_lu_.inverse_block(rows, low_rank_g_)) {
+      Matrix unit = Matrix::Zero(free_count_, m);
+      for (int k = 0; k < m; ++k) unit(rows[k], k) = 1.0;
+      const Matrix x = body_lu_.solve(unit);
+      low_rank_g_.resize(m, m);
+      for (int k = 0; k < m; ++k) low_rank_g_.row(k) = x.row(rows[k]);
+    }
+  }
+  Vector zs(m);
+  for (int k = 0; k < m; ++k) zs[k] = z[rows[k]];
+  const Matrix coupled = Matrix::Identity(m, m) + low_rank_g_ * A;
+  const Vector y = A * coupled.partialPivLu().solve(zs);
+  Vector py = Vector::Zero(free_count_);
+  for (int k = 0; k < m; ++k) py[rows[k]] = y[k];
+  return z - body_lu_.solve(py);
 }
 
 EquilibriumState& Equilibrium::finish(EquilibriumState& state, const Vector& p) const {

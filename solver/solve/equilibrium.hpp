@@ -57,6 +57,9 @@ struct EquilibriumState {
   Vector p;                   // the contact forces in equilibrium (given, or from the penalty law)
   Vector s;                   // (s_eta, s_xi) per component
   std::vector<PairedPoint> points;
+  // Per obstacle: the master surface of a pair of bodies in this state's configuration (null
+  // for a rigid obstacle); its force_derivative() is the pair's stiffness.
+  std::vector<std::shared_ptr<const DeformedMaster>> masters;
   std::vector<char> enabled;  // component has a non-zero column of T on the free dofs
   int newton_iterations = 0;
   bool converged = false;
@@ -195,8 +198,14 @@ class Equilibrium {
   // R = A(q) - lambda F - T p on all dofs; tangent of R (with the contact load stiffness).
   // force_scale (if asked): the largest of |A(q)|, |lambda F| and |T p| over all dofs, in
   // force units (the scale Newton's residual test is relative to).
+  // body_tangent false: only the contact terms go into `tangent`.
   Vector residual(const Vector& q, const EquilibriumState& paired, const Vector& p,
-                  Triplets* tangent, double* force_scale = nullptr) const;
+                  Triplets* tangent, double* force_scale = nullptr, bool body_tangent = true) const;
+  // Newton's step for the constant body tangent (factorized) plus the contact terms
+  // `contact` (a pair of bodies' stiffness, on a few surface dofs), by the Woodbury identity.
+  Vector low_rank_step(const Triplets& contact, const Vector& rhs);
+  std::vector<int> low_rank_rows_;  // the free dofs of low_rank_g_
+  Matrix low_rank_g_;               // K^-1 on them
   // p(q) of the penalty law at a paired state, and (if asked) its stiffness triplets.
   Vector penalty_forces(const EquilibriumState& paired, Triplets* tangent) const;
   // Step length along the Newton correction dq at q: the natural monotonicity test with the
@@ -230,6 +239,7 @@ class Equilibrium {
   // Newton is a modified Newton on it and the compliance reuses it.
   bool factorize_body_tangent(const Vector& q);
   bool constant_tangent_ = false;
+  bool has_pairs_ = false;  // a contact pair of two bodies (a deformable master)
   bool body_factorized_ = false;
   FreeBlockSolver body_lu_;  // the body's own tangent (compliance, constant tangents)
   FreeBlockSolver lu_;       // Newton's tangent, with the contact terms
