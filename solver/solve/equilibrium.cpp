@@ -156,10 +156,10 @@ double Equilibrium::stiffness_scale(const Vector& q) const {
 }
 
 Vector Equilibrium::residual(const Vector& q, const EquilibriumState& paired, const Vector& p_given,
-                             Triplets* tangent, double* force_scale, bool body_tangent) const {
+                             Triplets* tangent, double* force_scale) const {
   const Vector p = penalty_ ? penalty_forces(paired, tangent) : p_given;
   Vector r = Vector::Zero(q.size());
-  problem_.body->internal_force(q, r, body_tangent ? tangent : nullptr);
+  problem_.body->internal_force(q, r, tangent);
   const Vector external = problem_.load(factors_);
   Vector contact = Vector::Zero(q.size());
   for (size_t i = 0; i < problem_.candidates.size(); ++i) {
@@ -234,6 +234,45 @@ double free_row_sum_norm(const Triplets& triplets, const std::vector<int>& free_
   return free_count ? rows.maxCoeff() : 0.0;
 }
 
+// Newton's step for the constant body tangent K (factorized in `body`) plus the contact terms
+// of `tangent` from `first` on (a pair of bodies' stiffness, on a few surface dofs), by the
+// Woodbury identity: (K + P A P^T)^-1 b = z - K^-1 P A (I + G A)^-1 P^T z, z = K^-1 b,
+// G = P^T K^-1 P: two solves with the body's factorization, G by partial solves, and a dense
+// system of the pair's free surface dofs.
+Vector low_rank_step(FreeBlockSolver& body, const std::vector<int>& free_index, int free_count,
+                     const Triplets& tangent, size_t first, const Vector& rhs) {
+  const Triplets contact(tangent.begin() + static_cast<long>(first), tangent.end());
+  std::map<int, int> slot;  // free index -> row of A
+  std::vector<int> rows;
+  for (const auto& t : contact)
+    for (int dof : {t.row(), t.col()})
+      if (free_index[dof] >= 0 && slot.emplace(free_index[dof], static_cast<int>(rows.size())).second)
+        rows.push_back(free_index[dof]);
+  const Vector z = body.solve(rhs);
+  const int m = static_cast<int>(rows.size());
+  if (m == 0) return z;
+  Matrix A = Matrix::Zero(m, m);
+  for (const auto& t : contact) {
+    const int i = free_index[t.row()], j = free_index[t.col()];
+    if (i >= 0 && j >= 0) A(slot[i], slot[j]) += t.value();
+  }
+  Matrix g;  // K^-1 on the pair's dofs
+  if (!body.inverse_block(rows, g)) {
+    Matrix unit = Matrix::Zero(free_count, m);
+    for (int k = 0; k < m; ++k) unit(rows[k], k) = 1.0;
+    const Matrix x = body.solve(unit);
+    g.resize(m, m);
+    for (int k = 0; k < m; ++k) g.row(k) = x.row(rows[k]);
+  }
+  Vector zs(m);
+  for (int k = 0; k < m; ++k) zs[k] = z[rows[k]];
+  const Matrix coupled = Matrix::Identity(m, m) + g * A;
+  const Vector y = A * coupled.partialPivLu().solve(zs);
+  Vector py = Vector::Zero(free_count);
+  for (int k = 0; k < m; ++k) py[rows[k]] = y[k];
+  return z - body.solve(py);
+}
+
 }  // namespace
 
 EquilibriumState Equilibrium::solve(const Vector& q_guess, const Vector& p) {
@@ -254,12 +293,19 @@ EquilibriumState Equilibrium::solve(const Vector& q_guess, const Vector& p) {
   // kept as a low-rank correction of the constant body tangent (low_rank_step).
   const bool low_rank = reuse && has_pairs_;
   Triplets triplets;
+  size_t body_triplets = 0;  // how many of the tangent's triplets are the body's (low_rank)
+  if (low_rank) {
+    Triplets body;
+    Vector force = Vector::Zero(state.q.size());
+    problem_.body->internal_force(state.q, force, &body);
+    body_triplets = body.size();
+  }
   double last_step = 0.0;
   for (int it = 1; it <= params_.max_iterations + 1; ++it) {
     pair(state.q, state);
     triplets.clear();
     double force_scale = 0.0;
-    const Vector r = residual(state.q, state, p, reuse && !low_rank ? nullptr : &triplets, &force_scale, !low_rank);
+    const Vector r = residual(state.q, state, p, reuse && !low_rank ? nullptr : &triplets, &force_scale);
     const double r_max = scaled_free_max(r);
     state.relative_residual = force_scale > 0 ? r_max / force_scale : 0.0;
     if (!std::isfinite(r_max)) {
@@ -297,7 +343,8 @@ EquilibriumState Equilibrium::solve(const Vector& q_guess, const Vector& p) {
     Vector r_free(free_count_);
     for (int i = 0; i < r.size(); ++i)
       if (free_index_[i] >= 0) r_free[free_index_[i]] = r[i];
-    const Vector dq_free = low_rank ? low_rank_step(triplets, Vector(-r_free))
+    // The body's triplets come first (residual()); the pair's follow.
+    const Vector dq_free = low_rank ? low_rank_step(body_lu_, free_index_, free_count_, triplets, body_triplets, Vector(-r_free))
                            : reuse  ? body_lu_.solve(Vector(-r_free))
                                     : lu_.solve(Vector(-r_free));
     state.newton_iterations = it;
@@ -327,42 +374,6 @@ EquilibriumState Equilibrium::solve(const Vector& q_guess, const Vector& p) {
                  " iterations (free residual " + std::to_string(state.relative_residual) +
                  " of the force scale)";
   return state;
-}
-
-Vector Equilibrium::low_rank_step(const Triplets& contact, const Vector& rhs) {
-  // (K + P A P^T)^-1 b = z - K^-1 P A (I + G A)^-1 P^T z, z = K^-1 b, G = P^T K^-1 P: two
-  // solves with the body's factorization and a dense system of the pair's free surface dofs.
-  std::map<int, int> slot;  // free index -> row of A
-  std::vector<int> rows;
-  for (const auto& t : contact)
-    for (int dof : {t.row(), t.col()})
-      if (free_index_[dof] >= 0 && slot.emplace(free_index_[dof], static_cast<int>(rows.size())).second)
-        rows.push_back(free_index_[dof]);
-  const Vector z = body_lu_.solve(rhs);
-  const int m = static_cast<int>(rows.size());
-  if (m == 0) return z;
-  Matrix A = Matrix::Zero(m, m);
-  for (const auto& t : contact) {
-    const int i = free_index_[t.row()], j = free_index_[t.col()];
-    if (i >= 0 && j >= 0) A(slot[i], slot[j]) += t.value();
-  }
-  if (rows != low_rank_rows_) {  // G on these dofs (K is constant: kept while they stay)
-    low_rank_rows_ = rows;
-    if (!body_lu_.inverse_block(rows, low_rank_g_)) {
-      Matrix unit = Matrix::Zero(free_count_, m);
-      for (int k = 0; k < m; ++k) unit(rows[k], k) = 1.0;
-      const Matrix x = body_lu_.solve(unit);
-      low_rank_g_.resize(m, m);
-      for (int k = 0; k < m; ++k) low_rank_g_.row(k) = x.row(rows[k]);
-    }
-  }
-  Vector zs(m);
-  for (int k = 0; k < m; ++k) zs[k] = z[rows[k]];
-  const Matrix coupled = Matrix::Identity(m, m) + low_rank_g_ * A;
-  const Vector y = A * coupled.partialPivLu().solve(zs);
-  Vector py = Vector::Zero(free_count_);
-  for (int k = 0; k < m; ++k) py[rows[k]] = y[k];
-  return z - body_lu_.solve(py);
 }
 
 EquilibriumState& Equilibrium::finish(EquilibriumState& state, const Vector& p) const {

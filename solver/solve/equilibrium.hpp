@@ -198,14 +198,8 @@ class Equilibrium {
   // R = A(q) - lambda F - T p on all dofs; tangent of R (with the contact load stiffness).
   // force_scale (if asked): the largest of |A(q)|, |lambda F| and |T p| over all dofs, in
   // force units (the scale Newton's residual test is relative to).
-  // body_tangent false: only the contact terms go into `tangent`.
   Vector residual(const Vector& q, const EquilibriumState& paired, const Vector& p,
-                  Triplets* tangent, double* force_scale = nullptr, bool body_tangent = true) const;
-  // Newton's step for the constant body tangent (factorized) plus the contact terms
-  // `contact` (a pair of bodies' stiffness, on a few surface dofs), by the Woodbury identity.
-  Vector low_rank_step(const Triplets& contact, const Vector& rhs);
-  std::vector<int> low_rank_rows_;  // the free dofs of low_rank_g_
-  Matrix low_rank_g_;               // K^-1 on them
+                  Triplets* tangent, double* force_scale = nullptr) const;
   // p(q) of the penalty law at a paired state, and (if asked) its stiffness triplets.
   Vector penalty_forces(const EquilibriumState& paired, Triplets* tangent) const;
   // Step length along the Newton correction dq at q: the natural monotonicity test with the
