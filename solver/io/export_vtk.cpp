@@ -27,6 +27,8 @@ struct Grid {
   std::vector<Array> cell_data;
   double load_factor = 0.0;
   int step = 0;
+  // The bodies' rows: first point, points, first cell, cells (one piece over all for one body).
+  std::vector<std::array<size_t, 4>> pieces;
 };
 
 int cell_type(size_t sites) {
@@ -114,7 +116,18 @@ Grid grid_of(const json& result, size_t k) {
       for (size_t c = first; c < first + count && c < g.cells.size(); ++c) body.values[c] = static_cast<double>(b);
     }
     g.cell_data.push_back(std::move(body));
+    for (const json& entry : result["bodies"])
+      g.pieces.push_back({entry.value("first_node", size_t{0}), entry.value("nodes", size_t{0}),
+                          entry.value("first_element", size_t{0}), entry.value("elements", size_t{0})});
   }
+  // A piece must hold its rows and its cells' points.
+  bool whole = true;
+  for (const auto& [first_point, points, first_cell, cells] : g.pieces) {
+    whole = whole && first_point + points <= g.points.size() && first_cell + cells <= g.cells.size();
+    for (size_t c = first_cell; whole && c < first_cell + cells; ++c)
+      for (int s : g.cells[c]) whole = whole && s >= static_cast<int>(first_point) && s < static_cast<int>(first_point + points);
+  }
+  if (g.pieces.empty() || !whole) g.pieces = {{0, g.points.size(), 0, g.cells.size()}};
   return g;
 }
 
@@ -192,33 +205,37 @@ std::string step_vtu(const json& result, std::size_t k) {
      << "<UnstructuredGrid>\n"
      << "<FieldData><DataArray type=\"Float64\" Name=\"TimeValue\" NumberOfTuples=\"1\" "
         "format=\"ascii\">"
-     << number(g.load_factor) << "</DataArray></FieldData>\n"
-     << "<Piece NumberOfPoints=\"" << g.points.size() << "\" NumberOfCells=\"" << g.cells.size()
-     << "\">\n";
-  auto arrays = [&](const char* tag, const std::vector<Array>& list) {
-    os << '<' << tag << ">\n";
-    for (const Array& a : list) {
-      os << "<DataArray type=\"Float64\" Name=\"" << xml_escape(vtk_name(a.name))
-         << "\" format=\"ascii\">\n";
-      for (double v : a.values) os << number(v) << ' ';
-      os << "\n</DataArray>\n";
-    }
-    os << "</" << tag << ">\n";
-  };
-  arrays("PointData", g.point_data);
-  arrays("CellData", g.cell_data);
-  os << "<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
-  for (const auto& p : g.points) os << number(p[0]) << ' ' << number(p[1]) << " 0\n";
-  os << "</DataArray>\n</Points>\n<Cells>\n"
-     << "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
-  for (const auto& c : g.cells)
-    for (int s : c) os << s << ' ';
-  os << "\n</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
-  size_t offset = 0;
-  for (const auto& c : g.cells) os << (offset += c.size()) << ' ';
-  os << "\n</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n";
-  for (const auto& c : g.cells) os << cell_type(c.size()) << ' ';
-  os << "\n</DataArray>\n</Cells>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
+     << number(g.load_factor) << "</DataArray></FieldData>\n";
+  // One piece per body: its points, its cells (numbered within the piece) and its rows of the
+  // arrays.
+  for (const auto& [first_point, points, first_cell, cells] : g.pieces) {
+    os << "<Piece NumberOfPoints=\"" << points << "\" NumberOfCells=\"" << cells << "\">\n";
+    auto arrays = [&](const char* tag, const std::vector<Array>& list, size_t first, size_t count) {
+      os << '<' << tag << ">\n";
+      for (const Array& a : list) {
+        os << "<DataArray type=\"Float64\" Name=\"" << xml_escape(vtk_name(a.name)) << "\" format=\"ascii\">\n";
+        for (size_t i = first; i < first + count; ++i) os << number(a.values[i]) << ' ';
+        os << "\n</DataArray>\n";
+      }
+      os << "</" << tag << ">\n";
+    };
+    arrays("PointData", g.point_data, first_point, points);
+    arrays("CellData", g.cell_data, first_cell, cells);
+    os << "<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
+    for (size_t i = first_point; i < first_point + points; ++i)
+      os << number(g.points[i][0]) << ' ' << number(g.points[i][1]) << " 0\n";
+    os << "</DataArray>\n</Points>\n<Cells>\n"
+       << "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
+    for (size_t c = first_cell; c < first_cell + cells; ++c)
+      for (int s : g.cells[c]) os << s - static_cast<int>(first_point) << ' ';
+    os << "\n</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
+    size_t offset = 0;
+    for (size_t c = first_cell; c < first_cell + cells; ++c) os << (offset += g.cells[c].size()) << ' ';
+    os << "\n</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n";
+    for (size_t c = first_cell; c < first_cell + cells; ++c) os << cell_type(g.cells[c].size()) << ' ';
+    os << "\n</DataArray>\n</Cells>\n</Piece>\n";
+  }
+  os << "</UnstructuredGrid>\n</VTKFile>\n";
   return os.str();
 }
 

@@ -6,8 +6,10 @@
 // field is a point array, every numeric element field a cell array (when there is one row per
 // cell), and the contact points' p_n, p_t, sigma_n, sigma_t, gap, slip and state (-1 none,
 // 0 open, 1 stick, 2 slip) are point arrays at their node (named `<obstacle>.<field>` when
-// the scene has several obstacles). Several bodies make one grid with a cell array `body`
-// (the index in the result's bodies[]). Steps without node fields (a failed step) are skipped.
+// the scene has several obstacles). Several bodies: the .vtu holds one <Piece> per body (its
+// points, cells and array rows; result.bodies[] gives the rows), and both formats carry a cell
+// array `body` (the index in bodies[]); the legacy .vtk is one grid. Steps without node fields
+// (a failed step) are skipped.
 #include <nlohmann/json.hpp>
 #include <string>
 #include <utility>

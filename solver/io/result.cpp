@@ -6,6 +6,7 @@
 #include <functional>
 
 #include "solver/contact/contact_error.hpp"
+#include "solver/contact/master_reading.hpp"
 #include "solver/core/body_set.hpp"
 #include "solver/solve/rigid_equilibrium.hpp"
 
@@ -131,6 +132,22 @@ json step_json(const Problem& problem, const StepRecord& rec, const OutputOption
     points.push_back(std::move(point));
   }
   j["contact_points"] = points;
+  if (const auto* all = dynamic_cast<const BodySet*>(&body)) {  // each pair's field read on its master
+    json readings = json::array();
+    for (size_t o = 0; o < problem.obstacles.size(); ++o) {
+      const ObstacleInstance& pair = problem.obstacles[o];
+      if (!pair.master) continue;
+      for (const MasterReading& r : master_readings(problem, rec.state.q, rec.p, rec.tau, static_cast<int>(o))) {
+        const double area = body.tributary_area(r.site);
+        const Vec2 x = body.surface_point(rec.state.q, r.site, 0).x;
+        readings.push_back({{"node", body.site_node(r.site)}, {"obstacle", pair.name},
+                            {"body", all->name(pair.master->body)}, {"x", x.x()}, {"y", x.y()},
+                            {"p_n", r.sigma_n * area}, {"p_t", r.sigma_t * area},
+                            {"sigma_n", r.sigma_n}, {"sigma_t", r.sigma_t}});
+      }
+    }
+    j["master_points"] = readings;
+  }
   return j;
 }
 

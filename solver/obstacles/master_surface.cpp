@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "solver/obstacles/dual.hpp"
+
 namespace grip {
 
 namespace {
@@ -33,6 +35,57 @@ std::vector<std::vector<int>> chains_of(const std::vector<std::array<int, 2>>& s
   for (size_t k = 0; k < segments.size(); ++k)
     if (!used[k]) follow(k);
   return chains;
+}
+
+// The outward normal of the side a -> b (the body on its left: to the right of the travel).
+template <class S>
+P2<S> side_normal(const P2<S>& a, const P2<S>& b) {
+  const P2<S> e = unit(b - a);
+  return {e.y, -e.x};
+}
+
+// The outward normal at site k of a chain of n sites (`at(k)` its position): the mean of its
+// sides' normals.
+template <class S, class At>
+P2<S> site_normal(const At& at, int n, int k) {
+  P2<S> sum{S(0.0), S(0.0)};
+  if (k > 0) sum = sum + side_normal<S>(at(k - 1), at(k));
+  if (k + 1 < n) sum = sum + side_normal<S>(at(k), at(k + 1));
+  return unit(sum);
+}
+
+// The normal at `along` (in [0, 1]) of segment k: interpolated between its sites' normals.
+template <class S, class At>
+P2<S> smoothed_normal(const At& at, int n, int k, const S& along) {
+  return unit((S(1.0) - along) * site_normal<S>(at, n, k) + along * site_normal<S>(at, n, k + 1));
+}
+
+// The mortar integrals of the slave segment a -> b against the master segments k_first..k_last
+// of a chain (`at(k)` the master sites): add(end, k, int psi_end N_k) for end 0 (a) and 1 (b).
+// Each master segment is cut to the part of the slave segment its ends project onto (along
+// the slave's normal); on each piece the integrand is quadratic, and two Gauss points make it
+// exact.
+template <class S, class At, class Add>
+void segment_mortar(const P2<S>& a, const P2<S>& b, const At& at, int k_first, int k_last, const Add& add) {
+  const double gauss = 1.0 / std::sqrt(3.0);
+  const S length = grip::length(b - a);
+  const P2<S> along = (S(1.0) / length) * (b - a);
+  for (int k = k_first; k <= k_last; ++k) {
+    const S xp = dot(at(k) - a, along) / length, xq = dot(at(k + 1) - a, along) / length;
+    const S& low = value(xp) <= value(xq) ? xp : xq;
+    const S& high = value(xp) <= value(xq) ? xq : xp;
+    const S lo = value(low) > 0.0 ? low : S(0.0), hi = value(high) < 1.0 ? high : S(1.0);
+    if (!(value(hi) > value(lo)) || std::abs(value(xq) - value(xp)) < 1e-12) continue;
+    for (double g : {-gauss, gauss}) {
+      const S xi = S(0.5) * (lo + hi) + S(0.5 * g) * (hi - lo), weight = S(0.5) * (hi - lo) * length;
+      const S t = (xi - xp) / (xq - xp);
+      const S psi_a = S(2.0) - S(3.0) * xi, psi_b = S(3.0) * xi - S(1.0);  // the dual basis on the segment
+      add(0, k, psi_a * (S(1.0) - t) * weight);
+      add(0, k + 1, psi_a * t * weight);
+      add(1, k, psi_b * (S(1.0) - t) * weight);
+      add(1, k + 1, psi_b * t * weight);
+    }
+  }
 }
 
 }  // namespace
@@ -69,14 +122,6 @@ DeformedMaster::DeformedMaster(const Body& body, const Vector& q, const MasterSu
       pieces.push_back(SegmentPiece{a, b});
       chain.zeta.push_back(chain.zeta.back() + (b - a).norm());
     }
-    const size_t n = chain.points.size();
-    chain.normal.assign(n, Vec2::Zero());
-    for (size_t k = 0; k + 1 < n; ++k) {  // outward: to the right of the direction of travel
-      const Vec2 side = -rot90((chain.points[k + 1].x - chain.points[k].x).normalized());
-      chain.normal[k] += side;
-      chain.normal[k + 1] += side;
-    }
-    for (Vec2& normal : chain.normal) normal.normalize();
     chain.profile = make_profile(std::move(pieces));
     chains_.push_back(std::move(chain));
   }
@@ -103,41 +148,25 @@ DeformedMaster::Closest DeformedMaster::closest(const Vec2& x) const {
 }
 
 void DeformedMaster::integrate_mortar(const Body& body, const Vector& q, const MasterSurface& surface) {
+  surface_ = &surface;
   std::map<int, double> tributary;                          // D_j
   std::map<int, std::map<std::array<int, 2>, double>> m;  // M_jk, k as (chain, index)
-  const double gauss = 1.0 / std::sqrt(3.0);
+  for (const std::vector<int>& slave : surface.slave_chains)
+    for (int site : slave) slave_points_[site] = body.surface_point(q, site, surface.slave_side);
   for (const std::vector<int>& slave : surface.slave_chains) {
-    std::vector<Vec2> x;
-    for (int site : slave) x.push_back(body.surface_point(q, site, surface.slave_side).x);
     for (size_t e = 0; e + 1 < slave.size(); ++e) {
-      const Vec2 a = x[e], b = x[e + 1];
+      const Vec2 a = slave_points_[slave[e]].x, b = slave_points_[slave[e + 1]].x;
       const double length = (b - a).norm();
       if (!(length > 0)) continue;
-      const Vec2 along = (b - a) / length;
       tributary[slave[e]] += 0.5 * length;
       tributary[slave[e + 1]] += 0.5 * length;
-      const Closest from = closest(a), to = closest(b);
-      if (from.chain != to.chain) continue;
-      const Chain& chain = chains_[from.chain];
-      const int last = static_cast<int>(chain.points.size()) - 2;
-      // The master segments between the ends' closest points, and one more on either side:
-      // each is cut to the part of the slave segment its ends project onto (along its normal).
-      for (int k = std::max(0, std::min(from.segment, to.segment) - 1);
-           k <= std::min(last, std::max(from.segment, to.segment) + 1); ++k) {
-        const double xp = (chain.points[k].x - a).dot(along) / length;
-        const double xq = (chain.points[k + 1].x - a).dot(along) / length;
-        const double lo = std::max(0.0, std::min(xp, xq)), hi = std::min(1.0, std::max(xp, xq));
-        if (!(hi > lo) || std::abs(xq - xp) < 1e-12) continue;
-        for (double g : {-gauss, gauss}) {
-          const double xi = 0.5 * (lo + hi) + 0.5 * g * (hi - lo), weight = 0.5 * (hi - lo) * length;
-          const double t = (xi - xp) / (xq - xp);
-          const double psi_a = 2 - 3 * xi, psi_b = 3 * xi - 1;  // the dual basis on the segment
-          m[slave[e]][{from.chain, k}] += psi_a * (1 - t) * weight;
-          m[slave[e]][{from.chain, k + 1}] += psi_a * t * weight;
-          m[slave[e + 1]][{from.chain, k}] += psi_b * (1 - t) * weight;
-          m[slave[e + 1]][{from.chain, k + 1}] += psi_b * t * weight;
-        }
-      }
+      const auto range = mortar_range(a, b);
+      if (!range) continue;
+      const int chain = (*range)[0];
+      const auto at = [&](int k) { return p2(chains_[chain].points[k].x); };
+      const std::array<int, 2> ends{slave[e], slave[e + 1]};
+      segment_mortar(p2(a), p2(b), at, (*range)[1], (*range)[2],
+                     [&](int end, int k, double v) { m[ends[end]][{chain, k}] += v; });
     }
   }
   for (const auto& [site, row] : m) {
@@ -149,18 +178,27 @@ void DeformedMaster::integrate_mortar(const Body& body, const Vector& q, const M
   }
 }
 
+std::optional<std::array<int, 3>> DeformedMaster::mortar_range(const Vec2& a, const Vec2& b) const {
+  const Closest from = closest(a), to = closest(b);
+  if (from.chain != to.chain) return std::nullopt;
+  // The master segments between the ends' closest points, and one more on either side.
+  const int last = static_cast<int>(chains_[from.chain].points.size()) - 2;
+  return std::array<int, 3>{from.chain, std::max(0, std::min(from.segment, to.segment) - 1),
+                            std::min(last, std::max(from.segment, to.segment) + 1)};
+}
+
 MasterPoint DeformedMaster::project(const Vec2& x, int slave_site) const {
   const Closest c = closest(x);
   const Chain& on = chains_[c.chain];
-  const size_t k = c.segment;
+  const int k = c.segment, n = static_cast<int>(on.points.size());
   const double t = c.t, along = std::clamp(t, 0.0, 1.0), length = on.zeta[k + 1] - on.zeta[k];
   const std::vector<double>& ref = *on.reference;
   MasterPoint best;
   Projection& p = best.projection;
   p = c.projection;
-  p.normal = ((1 - along) * on.normal[k] + along * on.normal[k + 1]).normalized();
+  p.normal = vec2(smoothed_normal<double>([&](int i) { return p2(on.points[i].x); }, n, k, along));
   p.tangent = rot90(p.normal);
-  p.dnormal_dx = Mat2::Zero();
+  p.dnormal_dx = Mat2::Zero();  // the normal's turn is in force_derivative()
   p.zeta_rate *= (ref[k + 1] - ref[k]) / length;
   const auto mortar = mortar_.find(slave_site);
   if (mortar != mortar_.end()) {  // the mortar point sum_k w_k x_k
@@ -179,6 +217,98 @@ MasterPoint DeformedMaster::project(const Vec2& x, int slave_site) const {
   }
   p.gap = (x - p.point).dot(p.normal);
   return best;
+}
+
+void DeformedMaster::force_derivative(const SurfacePoint& slave, int slave_site, double p_eta, double p_xi,
+                                      Triplets& out) const {
+  // The variables: the positions of the slave point, then of the master sites and the slave
+  // surface's sites that the pairing reads (two coordinates each, in this order).
+  std::vector<const SurfacePoint*> vars{&slave};
+  std::map<std::array<int, 2>, int> master_slot;  // (chain, index) -> variable
+  std::map<int, int> slave_slot;                  // slave site -> variable
+  const auto use_master = [&](int chain, int k) {
+    if (master_slot.emplace(std::array<int, 2>{chain, k}, static_cast<int>(vars.size())).second)
+      vars.push_back(&chains_[chain].points[k]);
+  };
+  const Closest c = closest(slave.x);
+  const int n = static_cast<int>(chains_[c.chain].points.size());
+  for (int k = std::max(0, c.segment - 1); k <= std::min(n - 1, c.segment + 2); ++k) use_master(c.chain, k);
+  struct Piece {
+    int a, b;
+    std::array<int, 3> range;
+  };
+  std::vector<Piece> pieces;  // the slave segments at the site, where it has mortar weights
+  const bool mortar = mortar_.count(slave_site) > 0;
+  if (mortar)
+    for (const std::vector<int>& chain : surface_->slave_chains)
+      for (size_t e = 0; e + 1 < chain.size(); ++e) {
+        if (chain[e] != slave_site && chain[e + 1] != slave_site) continue;
+        const Vec2 a = slave_points_.at(chain[e]).x, b = slave_points_.at(chain[e + 1]).x;
+        if (!((b - a).norm() > 0)) continue;
+        const auto range = mortar_range(a, b);
+        if (!range) continue;
+        pieces.push_back({chain[e], chain[e + 1], *range});
+        for (int k = (*range)[1]; k <= (*range)[2] + 1; ++k) use_master((*range)[0], k);
+        for (int site : {chain[e], chain[e + 1]})
+          if (slave_slot.emplace(site, static_cast<int>(vars.size())).second) vars.push_back(&slave_points_.at(site));
+      }
+  const int count = 2 * static_cast<int>(vars.size());
+  const auto seeded = [&](int slot) {
+    const Vec2& x = vars[slot]->x;
+    return P2<Dual>{Dual(x.x(), Vector::Unit(count, 2 * slot)), Dual(x.y(), Vector::Unit(count, 2 * slot + 1))};
+  };
+  const auto master_at = [&](int chain) {
+    return [&, chain](int k) {
+      const auto it = master_slot.find({chain, k});
+      if (it != master_slot.end()) return seeded(it->second);
+      const Vec2& x = chains_[chain].points[k].x;
+      return P2<Dual>{Dual(x.x()), Dual(x.y())};
+    };
+  };
+  const P2<Dual> x = seeded(0);
+  // t along the segment: on the segment's line (inside it, or on the extension beyond a chain's
+  // end) it moves with x and the segment; at a corner's vertex (t = 0) it stays.
+  const auto on = master_at(c.chain);
+  const P2<Dual> from = on(c.segment), segment = on(c.segment + 1) - from;
+  const Dual t = c.t != 0.0 ? dot(x - from, segment) / dot(segment, segment) : Dual(0.0);
+  const Dual along = c.t > 0.0 && c.t < 1.0 ? t : Dual(std::clamp(c.t, 0.0, 1.0));
+  const P2<Dual> normal = smoothed_normal<Dual>(on, n, c.segment, along);
+  const P2<Dual> f = Dual(-p_eta) * normal + Dual(p_xi) * rot90(normal);
+  // The forces at the variables' points: f on the slave, -w_k f on master site k.
+  std::vector<std::pair<const SurfacePoint*, P2<Dual>>> forces{{&slave, f}};
+  if (mortar) {
+    std::map<std::array<int, 2>, Dual> m;  // M_jk as in integrate_mortar, with derivatives
+    for (const Piece& piece : pieces) {
+      const int chain = piece.range[0];
+      const int end = piece.a == slave_site ? 0 : 1;
+      segment_mortar(seeded(slave_slot.at(piece.a)), seeded(slave_slot.at(piece.b)), master_at(chain),
+                     piece.range[1], piece.range[2], [&](int e, int k, const Dual& v) {
+                       if (e == end) m[{chain, k}] += v;
+                     });
+    }
+    Dual covered(0.0);
+    for (const auto& entry : m) covered += entry.second;
+    for (const auto& [k, value] : m)
+      forces.push_back({&chains_[k[0]].points[k[1]], (Dual(-1.0) * value / covered) * f});
+  } else {
+    forces.push_back({&chains_[c.chain].points[c.segment], (t - Dual(1.0)) * f});
+    forces.push_back({&chains_[c.chain].points[c.segment + 1], (Dual(0.0) - t) * f});
+  }
+  // Chain rule: d(J_row . force)/dq_col = sum over variables of d(force)/dx_var dx_var/dq_col
+  // (the points' Jacobians are constant: continuum sites).
+  for (const auto& [point, force] : forces) {
+    if (!force.x.d.size() && !force.y.d.size()) continue;
+    const Vector dfx = force.x.d.size() ? force.x.d : Vector::Zero(count);
+    const Vector dfy = force.y.d.size() ? force.y.d : Vector::Zero(count);
+    for (const auto& row : point->jacobian) {
+      const Vector d = row.dx.x() * dfx + row.dx.y() * dfy;
+      for (size_t v = 0; v < vars.size(); ++v)
+        for (const auto& col : vars[v]->jacobian) {
+          out.emplace_back(row.dof, col.dof, d[2 * v] * col.dx.x() + d[2 * v + 1] * col.dx.y());
+          out.emplace_back(col.dof, row.dof, 0.0);  // a tangent's pattern is symmetric
+        }
+    }
+  }
 }
 
 }  // namespace grip

@@ -22,9 +22,16 @@
 // NaN), shared by (1 - t, t).
 // The normal is smoothed: interpolated along each segment between the sites' mean normals
 // (so it is continuous across the sites; the polyline's own corner normal turns with a
-// stiffness of force / gap, unbounded as the gap closes); its turn is left out of dnormal_dx.
+// stiffness of force / gap, unbounded as the gap closes).
+// The pair's forces depend on both bodies' positions through the normal (its turn with the
+// slave point's place along the segment and with the master's sites) and through the mortar
+// weights (the slave's force redistributed over the master as the surfaces move along each
+// other): force_derivative() gives that stiffness, by forward-mode differentiation of the
+// same pairing code.
+#include <array>
 #include <map>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "solver/core/body.hpp"
@@ -60,13 +67,18 @@ class DeformedMaster {
   // The pairing of slave point x; `slave_site` (a site of a slave chain, or -1) selects its
   // mortar weights where it has them.
   MasterPoint project(const Vec2& x, int slave_site = -1) const;
+  // d(T p)/dq of the pair's generalized forces at the slave point `slave` (of `slave_site`)
+  // for given (p_eta, p_xi): the slave takes J^T f, f = p_eta eta + p_xi xi, master site k
+  // -w_k J_k^T f, and f and w move with the normal and the weights. Triplets (row, col,
+  // d force_row / d q_col) for the pair alone (continuum sites: constant point Jacobians),
+  // each with its transpose's place (a zero): the pattern stays symmetric.
+  void force_derivative(const SurfacePoint& slave, int slave_site, double p_eta, double p_xi, Triplets& out) const;
 
  private:
   struct Chain {
     std::unique_ptr<Obstacle> profile;
     std::vector<SurfacePoint> points;
     std::vector<double> zeta;            // current arc length at each site
-    std::vector<Vec2> normal;            // outward normal at each site: the mean of its sides' normals
     const std::vector<double>* reference;
   };
   struct Closest {
@@ -76,7 +88,12 @@ class DeformedMaster {
   };
   Closest closest(const Vec2& x) const;
   void integrate_mortar(const Body& body, const Vector& q, const MasterSurface& surface);
+  // The master chain and segments (first, last) that slave segment a -> b integrates against;
+  // none where its ends are closest to different chains.
+  std::optional<std::array<int, 3>> mortar_range(const Vec2& a, const Vec2& b) const;
   std::vector<Chain> chains_;
+  const MasterSurface* surface_ = nullptr;
+  std::map<int, SurfacePoint> slave_points_;  // the slave surface's sites (their surface points)
   // Per slave site: (chain, index) of master sites and the weights w_jk.
   std::map<int, std::vector<std::pair<std::array<int, 2>, double>>> mortar_;
 };

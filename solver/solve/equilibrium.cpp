@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 
 namespace grip {
 
@@ -15,6 +16,7 @@ Equilibrium::Equilibrium(const Problem& problem, NewtonParams params, std::vecto
   index_free_dofs();
   length_scales_ = problem.body->dof_length_scales();
   constant_tangent_ = problem.body->traits().constant_tangent;
+  for (const ObstacleInstance& o : problem.obstacles) has_pairs_ = has_pairs_ || o.master.has_value();
   zeta_previous_.assign(problem.candidates.size(), 0.0);
 }
 
@@ -56,9 +58,11 @@ void Equilibrium::pair(const Vector& q, EquilibriumState& state) const {
   state.enabled.assign(problem_.component_count, 0);
   for (int k = 0; k < problem_.rigid.count(); ++k) state.enabled[problem_.rigid.first + k] = 1;
   // Deformable masters in their current configuration (mortar, segment-to-segment).
-  std::vector<std::optional<DeformedMaster>> masters(problem_.obstacles.size());
+  auto& masters = state.masters;
+  masters.assign(problem_.obstacles.size(), nullptr);
   for (size_t o = 0; o < masters.size(); ++o)
-    if (problem_.obstacles[o].master) masters[o].emplace(*problem_.body, q, *problem_.obstacles[o].master);
+    if (problem_.obstacles[o].master)
+      masters[o] = std::make_shared<const DeformedMaster>(*problem_.body, q, *problem_.obstacles[o].master);
   for (size_t i = 0; i < cands.size(); ++i) {
     const Candidate& c = cands[i];
     const ObstacleInstance& obstacle = problem_.obstacles[c.obstacle];
@@ -179,6 +183,12 @@ Vector Equilibrium::residual(const Vector& q, const EquilibriumState& paired, co
     for (const auto& a : pp.point.jacobian)
       for (const auto& b : pp.point.jacobian)
         tangent->emplace_back(a.dof, b.dof, -a.dx.dot(df_dx * b.dx));
+    if (const auto& master = paired.masters[c.obstacle]) {  // the pair's stiffness, both bodies
+      const size_t first = tangent->size();
+      master->force_derivative(problem_.body->surface_point(q, c.site, c.side), c.site, p_eta, p_xi, *tangent);
+      for (size_t k = first; k < tangent->size(); ++k)
+        (*tangent)[k] = {(*tangent)[k].row(), (*tangent)[k].col(), -(*tangent)[k].value()};
+    }
   }
   if (force_scale) {
     auto largest = [&](const Vector& v) { return (v.array() / length_scales_.array()).abs().maxCoeff(); };
@@ -230,6 +240,45 @@ double free_row_sum_norm(const Triplets& triplets, const std::vector<int>& free_
   return free_count ? rows.maxCoeff() : 0.0;
 }
 
+// Newton's step for the constant body tangent K (factorized in `body`) plus the contact terms
+// of `tangent` from `first` on (a pair of bodies' stiffness, on a few surface dofs), by the
+// Woodbury identity: (K + P A P^T)^-1 b = z - K^-1 P A (I + G A)^-1 P^T z, z = K^-1 b,
+// G = P^T K^-1 P: two solves with the body's factorization, G by partial solves, and a dense
+// system of the pair's free surface dofs.
+Vector low_rank_step(FreeBlockSolver& body, const std::vector<int>& free_index, int free_count,
+                     const Triplets& tangent, size_t first, const Vector& rhs) {
+  const Triplets contact(tangent.begin() + static_cast<long>(first), tangent.end());
+  std::map<int, int> slot;  // free index -> row of A
+  std::vector<int> rows;
+  for (const auto& t : contact)
+    for (int dof : {t.row(), t.col()})
+      if (free_index[dof] >= 0 && slot.emplace(free_index[dof], static_cast<int>(rows.size())).second)
+        rows.push_back(free_index[dof]);
+  const Vector z = body.solve(rhs);
+  const int m = static_cast<int>(rows.size());
+  if (m == 0) return z;
+  Matrix A = Matrix::Zero(m, m);
+  for (const auto& t : contact) {
+    const int i = free_index[t.row()], j = free_index[t.col()];
+    if (i >= 0 && j >= 0) A(slot[i], slot[j]) += t.value();
+  }
+  Matrix g;  // K^-1 on the pair's dofs
+  if (!body.inverse_block(rows, g)) {
+    Matrix unit = Matrix::Zero(free_count, m);
+    for (int k = 0; k < m; ++k) unit(rows[k], k) = 1.0;
+    const Matrix x = body.solve(unit);
+    g.resize(m, m);
+    for (int k = 0; k < m; ++k) g.row(k) = x.row(rows[k]);
+  }
+  Vector zs(m);
+  for (int k = 0; k < m; ++k) zs[k] = z[rows[k]];
+  const Matrix coupled = Matrix::Identity(m, m) + g * A;
+  const Vector y = A * coupled.partialPivLu().solve(zs);
+  Vector py = Vector::Zero(free_count);
+  for (int k = 0; k < m; ++k) py[rows[k]] = y[k];
+  return z - body.solve(py);
+}
+
 }  // namespace
 
 EquilibriumState Equilibrium::solve(const Vector& q_guess, const Vector& p) {
@@ -246,13 +295,23 @@ EquilibriumState Equilibrium::solve(const Vector& q_guess, const Vector& p) {
   constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
   // The penalty law adds stiffness that changes with the contact state: no reuse then.
   const bool reuse = constant_tangent_ && !penalty_;
+  // A pair of bodies adds its stiffness, which moves with the pairing, on a few surface dofs:
+  // kept as a low-rank correction of the constant body tangent (low_rank_step).
+  const bool low_rank = reuse && has_pairs_;
   Triplets triplets;
+  size_t body_triplets = 0;  // how many of the tangent's triplets are the body's (low_rank)
+  if (low_rank) {
+    Triplets body;
+    Vector force = Vector::Zero(state.q.size());
+    problem_.body->internal_force(state.q, force, &body);
+    body_triplets = body.size();
+  }
   double last_step = 0.0;
   for (int it = 1; it <= params_.max_iterations + 1; ++it) {
     pair(state.q, state);
     triplets.clear();
     double force_scale = 0.0;
-    const Vector r = residual(state.q, state, p, reuse ? nullptr : &triplets, &force_scale);
+    const Vector r = residual(state.q, state, p, reuse && !low_rank ? nullptr : &triplets, &force_scale);
     const double r_max = scaled_free_max(r);
     state.relative_residual = force_scale > 0 ? r_max / force_scale : 0.0;
     if (!std::isfinite(r_max)) {
@@ -290,7 +349,10 @@ EquilibriumState Equilibrium::solve(const Vector& q_guess, const Vector& p) {
     Vector r_free(free_count_);
     for (int i = 0; i < r.size(); ++i)
       if (free_index_[i] >= 0) r_free[free_index_[i]] = r[i];
-    const Vector dq_free = reuse ? body_lu_.solve(Vector(-r_free)) : lu_.solve(Vector(-r_free));
+    // The body's triplets come first (residual()); the pair's follow.
+    const Vector dq_free = low_rank ? low_rank_step(body_lu_, free_index_, free_count_, triplets, body_triplets, Vector(-r_free))
+                           : reuse  ? body_lu_.solve(Vector(-r_free))
+                                    : lu_.solve(Vector(-r_free));
     state.newton_iterations = it;
     ++counters_.newton_iterations;
     Vector dq = Vector::Zero(state.q.size());

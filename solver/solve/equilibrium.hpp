@@ -57,6 +57,9 @@ struct EquilibriumState {
   Vector p;                   // the contact forces in equilibrium (given, or from the penalty law)
   Vector s;                   // (s_eta, s_xi) per component
   std::vector<PairedPoint> points;
+  // Per obstacle: the master surface of a pair of bodies in this state's configuration (null
+  // for a rigid obstacle); its force_derivative() is the pair's stiffness.
+  std::vector<std::shared_ptr<const DeformedMaster>> masters;
   std::vector<char> enabled;  // component has a non-zero column of T on the free dofs
   int newton_iterations = 0;
   bool converged = false;
@@ -234,6 +237,7 @@ class Equilibrium {
   // Newton is a modified Newton on it and the compliance reuses it.
   bool factorize_body_tangent(const Vector& q);
   bool constant_tangent_ = false;
+  bool has_pairs_ = false;  // a contact pair of two bodies (a deformable master)
   bool body_factorized_ = false;
   FreeBlockSolver body_lu_;  // the body's own tangent (compliance, constant tangents)
   FreeBlockSolver lu_;       // Newton's tangent, with the contact terms

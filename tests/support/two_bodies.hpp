@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "solver/contact/master_reading.hpp"
 #include "solver/core/body_set.hpp"
 #include "tests/support/contact_profile.hpp"
 #include "tests/support/scenes.hpp"
@@ -111,48 +112,17 @@ inline void expect_pairs_balanced(const Solved& s, const StepRecord& rec) {
   EXPECT_LT(total.norm(), 1e-12 * scale) << "step " << rec.index;
 }
 
-// The contact stresses on the master body b of the pair on `obstacle`, read from the slave's
-// traction field: the slave's nodal stresses (p / tributary length, the slave's readings),
-// interpolated linearly along the slave surface to where each master site meets it (the
-// closest point on the slave polyline, current configuration). The interface carries one
-// traction field, whichever body it is read from (what a mortar method's multiplier field
-// is); the master's nodal forces are instead its consistent loads, smeared by one slave
-// element at a contact edge. A master site presses where every slave node of its slave
-// segment with a weight above 1e-6 presses: the zone read from the master is the slave's.
-// Positions are the master's reference x; p_n is the stress times the master's tributary length.
+// The contact stresses on the master body of the pair on `obstacle`, read from the slave's
+// traction field (master_readings, the result's master_points). Positions are the master's
+// reference x; p_n is the stress times the master's tributary length.
 inline std::vector<ContactNode> master_field_profile(const Problem& problem, const StepRecord& rec, int obstacle) {
-  const BodySet& all = body_set(problem);
-  const ObstacleInstance& pair = problem.obstacles[obstacle];
-  std::map<int, std::array<double, 3>> slave;  // site -> sigma_n, sigma_t, pressing
-  for (size_t i = 0; i < problem.candidates.size(); ++i) {
-    const Candidate& c = problem.candidates[i];
-    if (c.obstacle != obstacle) continue;
-    const double area = problem.body->tributary_area(c.site);
-    slave[c.site] = {rec.p[c.eta] / area, c.xi >= 0 ? rec.p[c.xi] / area : 0.0,
-                     contact_state(problem, i, rec.p, rec.tau) != ContactState::open ? 1.0 : 0.0};
-  }
-  auto at = [&](int site) { return problem.body->surface_point(rec.state.q, site, 0).x; };
   std::vector<ContactNode> nodes;
-  const int b = pair.master->body;
-  for (int s = all.site_offset(b); s < all.site_offset(b + 1); ++s) {
-    const Vec2 y = at(s);
-    double best = std::numeric_limits<double>::infinity();
+  for (const MasterReading& r : master_readings(problem, rec.state.q, rec.p, rec.tau, obstacle)) {
     ContactNode n;
-    n.x = problem.body->site_reference(s).x();
-    for (const std::vector<int>& chain : pair.master->slave_chains)
-      for (size_t e = 0; e + 1 < chain.size(); ++e) {
-        const Vec2 a = at(chain[e]), d = at(chain[e + 1]) - a;
-        const double t = std::clamp((y - a).dot(d) / d.squaredNorm(), 0.0, 1.0);
-        const double distance = (a + t * d - y).norm();
-        if (distance >= best) continue;
-        best = distance;
-        const auto sa = slave.count(chain[e]) ? slave[chain[e]] : std::array<double, 3>{0, 0, 0};
-        const auto sb = slave.count(chain[e + 1]) ? slave[chain[e + 1]] : std::array<double, 3>{0, 0, 0};
-        const bool pressing = (t > 1 - 1e-6 || sa[2] > 0) && (t < 1e-6 || sb[2] > 0);
-        n.sigma_n = pressing ? (1 - t) * sa[0] + t * sb[0] : 0.0;
-        n.sigma_t = pressing ? (1 - t) * sa[1] + t * sb[1] : 0.0;
-      }
-    const double area = problem.body->tributary_area(s);
+    n.x = problem.body->site_reference(r.site).x();
+    n.sigma_n = r.sigma_n;
+    n.sigma_t = r.sigma_t;
+    const double area = problem.body->tributary_area(r.site);
     n.p_n = n.sigma_n * area;
     n.p_t = n.sigma_t * area;
     n.state = n.p_n < 0 ? ContactState::slip : ContactState::open;

@@ -6,10 +6,16 @@
 // - slave forces that are a uniform traction's consistent loads (its tributary lengths) put
 //   on the master exactly that traction's consistent loads (the master's tributary lengths):
 //   what carries a uniform pressure across non-matching meshes (the patch test);
-// - the pair's Jacobian puts f on the slave site and -f in all on the master.
+// - the pair's Jacobian puts f on the slave site and -f in all on the master;
+// - the pair's stiffness (the normal's turn and the mortar weights' redistribution with both
+//   bodies' positions, DeformedMaster::force_derivative) is the derivative of its forces T p:
+//   against central differences on a curved, sliding interface, with friction.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "solver/core/body_set.hpp"
+#include "solver/solve/equilibrium.hpp"
 #include "tests/support/scenes.hpp"
 
 namespace grip {
@@ -60,6 +66,71 @@ TEST(Mortar, TheCoarserSlaveHandsTheMasterConsistentLoads) {
   json j = example_scene("block-on-foundation");
   j["contacts"][0] = {{"slave", "block.bottom"}, {"master", "foundation.top"}};
   expect_consistent_loads(j);
+}
+
+// The contact forces T(q) p on every dof (no loads are set: F = 0).
+Vector pair_forces(const Equilibrium& eq, const Vector& q, const Vector& p) {
+  return eq.applied_forces(eq.evaluate(q), p);
+}
+
+void expect_stiffness_is_the_derivative(json scene) {
+  scene["contacts"][0]["friction"] = 0.3;
+  const Scene s = read_scene(scene);
+  const Problem& problem = s.problem;
+  const auto& all = dynamic_cast<const BodySet&>(*problem.body);
+  const int n = all.dof_count();
+  // Both surfaces curved and the block slid 0.13 mm along the foundation (element sides
+  // 0.5 and 1.43 mm): the weights, the normals and the node-to-segment ends all move.
+  Vector q = Vector::Zero(n);
+  const Vector q0 = Vector::Zero(n);
+  for (int site = 0; site < all.site_count(); ++site) {
+    const SurfacePoint sp = all.surface_point(q0, site, 0);
+    const double x = sp.x.x();
+    const Vec2 u = all.body_of_site(site) == 0 ? Vec2(0.13 + 0.02 * std::sin(x), -0.01 + 0.03 * std::cos(0.4 * x))
+                                               : Vec2(0.01 * std::cos(x), 0.02 * std::cos(0.4 * x) + 0.005 * std::sin(2 * x));
+    for (const auto& j : sp.jacobian) q[j.dof] = j.dx.dot(u);
+  }
+  Equilibrium eq(problem, NewtonParams{});
+  Vector p = Vector::Zero(problem.component_count);
+  for (size_t i = 0; i < problem.candidates.size(); ++i) {
+    const Candidate& c = problem.candidates[i];
+    p[c.eta] = -(1.0 + 0.1 * i);
+    ASSERT_GE(c.xi, 0);
+    p[c.xi] = i % 2 ? 0.3 : -0.2;
+  }
+  Triplets triplets, internal;  // the residual's tangent holds -d(T p)/dq beside the body's
+  eq.residual(q, p, &triplets);
+  Vector ignored = Vector::Zero(n);
+  all.internal_force(q, ignored, &internal);
+  Eigen::SparseMatrix<double> tangent(n, n), body(n, n);
+  tangent.setFromTriplets(triplets.begin(), triplets.end());
+  body.setFromTriplets(internal.begin(), internal.end());
+  const Matrix analytic = -Matrix(tangent - body);  // d(T p)/dq
+  // Central differences: the forces are smooth in q away from the pairing's switches (a
+  // master site's projection crossing a slave segment's end), which a step of 1e-7 mm misses;
+  // truncation (h / element)^2 ~ 1e-13 and round-off eps |T p| / h ~ 1e-9 of the entries.
+  const double h = 1e-7;
+  Matrix numeric = Matrix::Zero(n, n);
+  for (int k = 0; k < n; ++k) {
+    Vector plus = q, minus = q;
+    plus[k] += h;
+    minus[k] -= h;
+    numeric.col(k) = (pair_forces(eq, plus, p) - pair_forces(eq, minus, p)) / (2 * h);
+  }
+  const double scale = numeric.cwiseAbs().maxCoeff();
+  // The pair's stiffness is that of forces ~1 N turning and moving over element sides ~1 mm.
+  EXPECT_GT(scale, 0.1);
+  EXPECT_LT((analytic - numeric).cwiseAbs().maxCoeff(), 1e-6 * scale);
+}
+
+TEST(Mortar, TheStiffnessOfAFinerSlaveIsTheDerivativeOfItsForces) {
+  expect_stiffness_is_the_derivative(example_scene("block-on-foundation"));
+}
+
+TEST(Mortar, TheStiffnessOfACoarserSlaveIsTheDerivativeOfItsForces) {
+  json j = example_scene("block-on-foundation");
+  j["contacts"][0] = {{"slave", "block.bottom"}, {"master", "foundation.top"}};
+  expect_stiffness_is_the_derivative(j);
 }
 
 }  // namespace

@@ -4,6 +4,9 @@
 // the VTK cells carry it.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <sstream>
+
 #include "solver/io/export_csv.hpp"
 #include "solver/io/export_vtk.hpp"
 #include "solver/io/result.hpp"
@@ -102,12 +105,66 @@ TEST(TwoBodiesScene, ResultValidatesAndNamesTheBodies) {
     EXPECT_EQ(p["master"], "lower");
   }
   EXPECT_EQ(r["effects"]["contacts"][0]["contact_candidates"], r["effects"]["contact_candidates"]);
+  // The pressure read on the master: the slave's stresses interpolated along the slave surface,
+  // so each lies between the slave's extremes (a convex combination of two slave nodes').
+  double slave_min = 0.0, master_min = 0.0;
+  for (const json& p : r["steps"][0]["contact_points"]) slave_min = std::min(slave_min, p["sigma_n"].get<double>());
+  const json& readings = r["steps"][0]["master_points"];
+  ASSERT_FALSE(readings.empty());
+  const int lower_first = r["bodies"][1]["first_node"];
+  for (const json& m : readings) {
+    EXPECT_EQ(m["body"], "lower");
+    EXPECT_GE(m["node"].get<int>(), lower_first);
+    EXPECT_GE(m["sigma_n"].get<double>(), slave_min);
+    EXPECT_LE(m["sigma_n"].get<double>(), 0.0);
+    master_min = std::min(master_min, m["sigma_n"].get<double>());
+  }
+  EXPECT_LT(master_min, 0.5 * slave_min);  // the contact zone is read from the master too
   const std::string csv = result_csv(r, "nodes");
   EXPECT_EQ(csv.substr(0, csv.find('\n')).find("step,load_factor,body,node"), 0u) << csv.substr(0, 80);
   EXPECT_NE(csv.find(",lower,"), std::string::npos);
-  // VTK: one grid, each cell with its body's index.
+  // VTK: one piece per body, each with its body's points (the rows of its nodes), its cells
+  // numbered within the piece, and the cell array `body`.
   const std::string vtu = step_vtu(r, 0);
   EXPECT_NE(vtu.find("Name=\"body\""), std::string::npos);
+  // The text between `open` (from `from` on) and the next `close`; `from` moves past it.
+  auto between = [&](size_t& from, const std::string& open, const std::string& close) {
+    const size_t a = vtu.find(open, from);
+    if (a == std::string::npos) return std::string();
+    const size_t b = vtu.find(close, a + open.size());
+    from = b + close.size();
+    return vtu.substr(a + open.size(), b - a - open.size());
+  };
+  auto numbers = [](const std::string& text) {
+    std::istringstream in(text);
+    std::vector<double> v;
+    for (double x; in >> x;) v.push_back(x);
+    return v;
+  };
+  size_t at = 0;
+  for (size_t b = 0; b < 2; ++b) {
+    SCOPED_TRACE("body " + std::to_string(b));
+    const json& body = r["bodies"][b];
+    const int first = body["first_node"], count = body["nodes"], cells = body["elements"];
+    const std::string piece = between(at, "<Piece ", ">");
+    EXPECT_EQ(piece, "NumberOfPoints=\"" + std::to_string(count) + "\" NumberOfCells=\"" + std::to_string(cells) + "\"");
+    const std::vector<double> body_index = numbers(between(at, "Name=\"body\" format=\"ascii\">", "</DataArray>"));
+    ASSERT_EQ(body_index.size(), static_cast<size_t>(cells));
+    for (double v : body_index) EXPECT_EQ(v, static_cast<double>(b));
+    const std::vector<double> xyz = numbers(between(at, "NumberOfComponents=\"3\" format=\"ascii\">", "</DataArray>"));
+    ASSERT_EQ(xyz.size(), 3u * count);
+    for (int n = 0; n < count; ++n) {
+      EXPECT_EQ(xyz[3 * n], r["steps"][0]["nodes"][first + n]["x"].get<double>());
+      EXPECT_EQ(xyz[3 * n + 1], r["steps"][0]["nodes"][first + n]["y"].get<double>());
+    }
+    const std::vector<double> connectivity = numbers(between(at, "Name=\"connectivity\" format=\"ascii\">", "</DataArray>"));
+    ASSERT_FALSE(connectivity.empty());
+    EXPECT_EQ(*std::min_element(connectivity.begin(), connectivity.end()), 0.0);
+    EXPECT_EQ(*std::max_element(connectivity.begin(), connectivity.end()), count - 1.0);
+    const int first_cell = body["first_element"];
+    EXPECT_EQ(connectivity[0], r["mesh"]["cells"][first_cell][0].get<double>() - first);
+  }
+  EXPECT_EQ(vtu.find("<Piece ", at), std::string::npos);  // two pieces, no more
 }
 
 // A pair whose surfaces lie beyond the contact reach (the set's length by default) has no
