@@ -97,7 +97,7 @@ std::vector<json> step_rows(const json& result) {
 
 const std::vector<std::string>& result_csv_tables() {
   static const std::vector<std::string> names = {"steps", "nodes", "elements", "contact_points",
-                                                 "history"};
+                                                 "master_points", "history"};
   return names;
 }
 
@@ -106,6 +106,7 @@ std::string result_csv(const json& result, std::string_view table) {
   if (table == "nodes") return objects_csv(per_step_items(result, "nodes", true));
   if (table == "elements") return objects_csv(per_step_items(result, "elements", true));
   if (table == "contact_points") return objects_csv(per_step_items(result, "contact_points", true));
+  if (table == "master_points") return objects_csv(per_step_items(result, "master_points", true));
   if (table == "history") return objects_csv(per_step_items(result, "history", false));
   throw std::invalid_argument("unknown table '" + std::string(table) + "'");
 }

@@ -39,6 +39,24 @@ TEST(ExportCsv, LongTablesWithIdentifyingColumnsFirst) {
   EXPECT_THROW(result_csv(r, "nope"), std::invalid_argument);
 }
 
+// Scenes of several bodies: each step's readings on the master bodies are a table of their own;
+// a result without them gives an empty one (the client then writes no file).
+TEST(ExportCsv, MasterPointsTable) {
+  json r = two_quads();
+  EXPECT_EQ(result_csv(r, "master_points"), "\n");
+  r["steps"][0]["master_points"] = {
+      {{"node", 4}, {"body", "lower"}, {"obstacle", "pair"}, {"x", 1.0}, {"y", 0.0}, {"p_n", -1.5}, {"p_t", 0.0},
+       {"sigma_n", -3.0}, {"sigma_t", 0.25}},
+      {{"node", 5}, {"body", "lower"}, {"obstacle", "pair"}, {"x", 2.0}, {"y", 0.0}, {"p_n", 0.0}, {"p_t", 0.0},
+       {"sigma_n", 0.0}, {"sigma_t", 0.0}}};
+  const std::string points = result_csv(r, "master_points");
+  const std::string header = points.substr(0, points.find('\n'));
+  EXPECT_EQ(header.substr(0, std::string("step,load_factor,body,node").size()), "step,load_factor,body,node");
+  for (const char* column : {"body", "obstacle", "sigma_n", "sigma_t"}) EXPECT_NE(header.find(column), std::string::npos);
+  EXPECT_EQ(std::count(points.begin(), points.end(), '\n'), 3);
+  EXPECT_NE(points.find("-3"), std::string::npos);
+}
+
 TEST(ExportVtk, QuadrilateralsWithPointAndCellArrays) {
   const json r = two_quads();
   const std::string vtk = step_legacy_vtk(r, 0);

@@ -301,7 +301,7 @@ def _safe_extract(data: bytes, dest: str) -> List[str]:
     return names
 
 
-CSV_TABLES = ("steps", "nodes", "elements", "contact_points", "history")
+CSV_TABLES = ("steps", "nodes", "elements", "contact_points", "master_points", "history")
 
 
 def cmd_result(client: Client, args, out: TextIO) -> int:
