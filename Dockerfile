@@ -16,7 +16,7 @@ RUN bash scripts/setup.sh --service && rm -rf /var/lib/apt/lists/*
 COPY . .
 RUN cmake -S . -B /build -G Ninja -DCMAKE_BUILD_TYPE=Release \
  && cmake --build /build --target grip \
- && strip /build/apps/grip
+ && strip /build/apps/grip /build/apps/grip-server
 
 FROM debian:12-slim
 RUN apt-get update -qq \
@@ -24,7 +24,8 @@ RUN apt-get update -qq \
       libcpp-httplib0.11 libspdlog1.10 libfmt9 libsqlite3-0 libpq5 libcholmod3 libumfpack5 \
  && rm -rf /var/lib/apt/lists/* \
  && useradd --system --uid 10001 --user-group --home-dir /var/lib/grip --create-home grip
-COPY --from=build /build/apps/grip /usr/local/bin/grip
+# grip serve and grip healthcheck run grip-server from grip's directory (apps/CMakeLists.txt).
+COPY --from=build /build/apps/grip /build/apps/grip-server /usr/local/bin/
 COPY --from=build /src/schemas /usr/local/share/grip/schemas
 ENV GRIP_HOST=0.0.0.0 \
     GRIP_PORT=8080 \

@@ -2,11 +2,16 @@
 //   grip solve SCENE.json [--out RESULT.json] [--events EVENTS.ndjson]
 //   grip serve [options]        the HTTP/JSON service (grip serve --help)
 //   grip healthcheck [--host H] [--port P]
+// serve and healthcheck run grip-server (apps/grip_server.cpp) from grip's own directory, so
+// that solving does not load the service's libraries.
 // Exit codes of solve: 0 solved, 1 a step failed, 2 usage or scene error.
-#include <malloc.h>
+#include <unistd.h>
 
+#include <cerrno>
+#include <climits>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <chrono>
 #include <ctime>
 #include <fstream>
@@ -14,7 +19,7 @@
 #include <string>
 #include <vector>
 
-#include "server/serve.hpp"
+#include "apps/heap_tuning.hpp"
 #include "solver/io/result.hpp"
 
 namespace {
@@ -114,35 +119,25 @@ int solve(int argc, char** argv) {
   std::exit(run.completed ? 0 : 1);
 }
 
-int serve(int argc, char** argv) {
-  const std::vector<std::string> args(argv + 2, argv + argc);
-  if (!args.empty() && (args[0] == "--help" || args[0] == "-h")) {
-    std::fputs(grip::server::serve_usage().c_str(), stdout);
-    return 0;
-  }
-  grip::server::ServeConfig config;
-  try {
-    config = grip::server::read_serve_config(args);
-  } catch (const std::invalid_argument& e) {
-    std::fprintf(stderr, "grip serve: %s\n%s", e.what(), grip::server::serve_usage().c_str());
-    return 2;
-  }
-  return grip::server::serve(config);
+// serve and healthcheck: grip-server next to this executable, with the same arguments.
+int run_server(char** argv) {
+  char self[PATH_MAX];
+  const ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1);
+  std::string path = n > 0 ? std::string(self, n) : std::string(argv[0]);
+  path = path.substr(0, path.find_last_of('/') + 1) + "grip-server";
+  argv[0] = path.data();
+  execv(path.c_str(), argv);
+  std::fprintf(stderr, "grip %s: cannot run %s: %s\n", argv[1], path.c_str(), std::strerror(errno));
+  return 2;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  // glibc's default 128 KiB thresholds hand each compliance's and factor's buffers back to the
-  // kernel when freed and fault them in again at the next real solve (on the paper's beam most
-  // of the CPU time went to brk and page faults). Freed heap up to 256 MiB stays with the process.
-  mallopt(M_MMAP_THRESHOLD, 64 << 20);
-  mallopt(M_TRIM_THRESHOLD, 256 << 20);
+  grip::tune_heap();
   if (argc < 2) return usage();
   const std::string command = argv[1];
   if (command == "solve") return solve(argc, argv);
-  if (command == "serve") return serve(argc, argv);
-  if (command == "healthcheck")
-    return grip::server::healthcheck(std::vector<std::string>(argv + 2, argv + argc));
+  if (command == "serve" || command == "healthcheck") return run_server(argv);
   return usage();
 }
