@@ -16,10 +16,12 @@
 #include <ctime>
 #include <fstream>
 #include <iostream>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "apps/heap_tuning.hpp"
+#include "apps/step_writer.hpp"
 #include "solver/io/result.hpp"
 
 namespace {
@@ -77,11 +79,15 @@ int solve(int argc, char** argv) {
   };
   std::printf("%5s %12s %6s %6s %6s %12s %7s %6s %6s %9s  %s\n", "step", "load_factor", "iters",
               "passes", "newton", "||v||_2", "contact", "stick", "slip", "ms", "status");
+  // With --out, each finished step is written on a thread of its own while the next one solves.
+  std::optional<grip::StepWriter> writer;
+  if (!out_path.empty()) writer.emplace();
   grip::SteppingObserver observer;
   observer.step_started = [&](int step, double lf) { emit(grip::step_started_event(step, lf)); };
   observer.iteration = [&](const grip::IterationEvent& ev) { emit(grip::iteration_event(ev)); };
   observer.step_finished = [&](const grip::StepRecord& rec) {
     emit(grip::step_finished_event(rec));
+    if (writer) writer->add(grip::step_output(scene.problem, rec, scene.output));
     const auto& last = rec.history.empty() ? grip::IterationEvent{} : rec.history.back();
     std::printf("%5d %12.6g %6d %6d %6d %12.3e %7d %6d %6d %9.2f  %s\n", rec.index,
                 rec.load_factor, rec.solves, rec.passes, rec.newton_iterations, last.v2,
@@ -101,7 +107,7 @@ int solve(int argc, char** argv) {
               run.seconds);
   if (!out_path.empty()) {
     std::ofstream out(out_path);
-    grip::write_result(out, scene, run);
+    grip::write_result(out, scene, run, writer->finish());
     if (!out) {
       std::fprintf(stderr, "cannot write %s\n", out_path.c_str());
       return 2;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <functional>
+#include <stdexcept>
 
 #include "solver/contact/contact_error.hpp"
 #include "solver/contact/master_reading.hpp"
@@ -247,30 +248,42 @@ json result_head(const Scene& scene, const RunResult& run) {
 }
 
 // table_json's rows, written as they are made: no document of the table's size in memory.
-void write_table(JsonWriter& w, const FieldTable& t, const std::string& index_name) {
+void write_table(JsonWriter& w, const FlatTable& t, const std::string& index_name) {
   std::vector<std::pair<std::string, int>> keys{{index_name, -1}};  // -1: the row index
   for (size_t c = 0; c < t.names.size(); ++c)
     if (t.names[c] != index_name) keys.emplace_back(t.names[c], static_cast<int>(c));
   std::sort(keys.begin(), keys.end());  // an object's keys in nlohmann's order
   std::vector<std::string> quoted;
   for (const auto& k : keys) quoted.push_back(json(k.first).dump() + ":");
+  const size_t width = t.names.size();
   w.put('[');
-  for (size_t i = 0; i < t.rows.size(); ++i) {
+  for (size_t i = 0; i < t.rows; ++i) {
+    const double* row = t.values.data() + i * width;
     w.raw(i ? ",\n{" : "\n{");
     bool first = true;
     for (size_t k = 0; k < keys.size(); ++k) {
-      if (keys[k].second >= 0 && std::isnan(t.rows[i][keys[k].second])) continue;  // as table_json
+      if (keys[k].second >= 0 && std::isnan(row[keys[k].second])) continue;  // as table_json
       if (!first) w.put(',');
       first = false;
       w.raw(quoted[k]);
       if (keys[k].second < 0)
         w.integer(static_cast<long long>(i));
       else
-        w.number(t.rows[i][keys[k].second]);
+        w.number(row[keys[k].second]);
     }
     w.put('}');
   }
   w.put(']');
+}
+
+FlatTable flat_table(const FieldTable& t) {
+  FlatTable f{t.names, t.rows.size(), {}};
+  f.values.reserve(t.rows.size() * t.names.size());
+  for (const auto& row : t.rows) {
+    if (row.size() != t.names.size()) throw std::logic_error("a field table's row is not as wide as its names");
+    f.values.insert(f.values.end(), row.begin(), row.end());
+  }
+  return f;
 }
 
 using Streamed = std::vector<std::pair<std::string, std::function<void()>>>;
@@ -298,18 +311,11 @@ void write_object(JsonWriter& w, const json& small, Streamed streamed) {
   w.put('}');
 }
 
-void write_step(JsonWriter& w, const Problem& problem, const StepRecord& rec, const OutputOptions& output) {
-  OutputOptions summary = output;
-  summary.fields.erase(std::remove_if(summary.fields.begin(), summary.fields.end(),
-                                      [](const std::string& f) { return f == "nodes" || f == "elements"; }),
-                       summary.fields.end());
+void write_step(JsonWriter& w, const StepOutput& step) {
   Streamed tables;
-  if (rec.state.q.size() != 0 && !rec.site_fields.rows.empty()) {  // as step_json decides
-    if (output.wants("nodes")) tables.emplace_back("nodes", [&] { write_table(w, rec.site_fields, "node"); });
-    if (output.wants("elements"))
-      tables.emplace_back("elements", [&] { write_table(w, rec.element_fields, "element"); });
-  }
-  write_object(w, step_json(problem, rec, summary), std::move(tables));
+  if (step.nodes) tables.emplace_back("nodes", [&] { write_table(w, *step.nodes, "node"); });
+  if (step.elements) tables.emplace_back("elements", [&] { write_table(w, *step.elements, "element"); });
+  write_object(w, step.summary, std::move(tables));
 }
 
 // mesh.cells, one cell a line.
@@ -337,7 +343,29 @@ json result_json(const Scene& scene, const RunResult& run) {
   return r;
 }
 
-void write_result(std::ostream& out, const Scene& scene, const RunResult& run) {
+StepOutput step_output(const Problem& problem, const StepRecord& rec, const OutputOptions& output) {
+  OutputOptions summary = output;
+  summary.fields.erase(std::remove_if(summary.fields.begin(), summary.fields.end(),
+                                      [](const std::string& f) { return f == "nodes" || f == "elements"; }),
+                       summary.fields.end());
+  StepOutput step{step_json(problem, rec, summary), {}, {}};
+  if (rec.state.q.size() != 0 && !rec.site_fields.rows.empty()) {  // as step_json decides
+    if (output.wants("nodes")) step.nodes = flat_table(rec.site_fields);
+    if (output.wants("elements")) step.elements = flat_table(rec.element_fields);
+  }
+  return step;
+}
+
+void write_step(std::ostream& out, const StepOutput& step) {
+  JsonWriter w(out);
+  write_step(w, step);
+}
+
+namespace {
+
+// The result with each step written by write_step(k).
+void write_result(std::ostream& out, const Scene& scene, const RunResult& run,
+                  const std::function<void(JsonWriter&, size_t)>& write_step) {
   JsonWriter w(out);
   write_object(w, result_head(scene, run),
                {{"mesh", [&] { write_cells(w, scene.problem.body->cells()); }},
@@ -345,11 +373,27 @@ void write_result(std::ostream& out, const Scene& scene, const RunResult& run) {
                    w.put('[');
                    for (size_t k = 0; k < run.steps.size(); ++k) {
                      w.raw(k ? ",\n" : "\n");
-                     write_step(w, scene.problem, run.steps[k], scene.output);
+                     write_step(w, k);
                    }
                    w.put(']');
                  }}});
   w.put('\n');
+}
+
+}  // namespace
+
+void write_result(std::ostream& out, const Scene& scene, const RunResult& run) {
+  write_result(out, scene, run, [&](JsonWriter& w, size_t k) {
+    write_step(w, step_output(scene.problem, run.steps[k], scene.output));
+  });
+}
+
+void write_result(std::ostream& out, const Scene& scene, const RunResult& run,
+                  const std::vector<std::string_view>& step_texts) {
+  if (step_texts.size() != run.steps.size())
+    throw std::logic_error("write_result: " + std::to_string(step_texts.size()) + " step texts for " +
+                           std::to_string(run.steps.size()) + " steps");
+  write_result(out, scene, run, [&](JsonWriter& w, size_t k) { w.raw(step_texts[k]); });
 }
 
 }  // namespace grip

@@ -2,7 +2,11 @@
 // Results and events as JSON (DESIGN.md vocabulary). Events are the same objects whether
 // written to an NDJSON file by `grip solve --events` or streamed by the service.
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <ostream>
+#include <string>
+#include <string_view>
+#include <vector>
 
 #include "solver/io/scene.hpp"
 
@@ -23,5 +27,27 @@ nlohmann::json result_json(const Scene& scene, const RunResult& run);
 // The same document written as it is made (the step tables row by row, never held as JSON):
 // for large meshes, where building the document took more time and memory than the solve.
 void write_result(std::ostream& out, const Scene& scene, const RunResult& run);
+
+// A FieldTable's rows in one block (row after row), as a step's output keeps them.
+struct FlatTable {
+  std::vector<std::string> names;
+  size_t rows = 0;
+  std::vector<double> values;  // rows x names.size()
+};
+// One step of the result as write_result writes it, taken from the record when the step
+// finishes: its small members as JSON, its tables copied. Writing it reads neither the problem
+// nor the record, so `grip solve` writes each step on a thread of its own while the next step
+// solves (the solver itself stays single-threaded).
+struct StepOutput {
+  nlohmann::json summary;                // step_json without the tables
+  std::optional<FlatTable> nodes, elements;  // where recorded and wanted
+};
+StepOutput step_output(const Problem& problem, const StepRecord& rec, const OutputOptions& output);
+// The step's text in the result's "steps" array.
+void write_step(std::ostream& out, const StepOutput& step);
+// write_result with the steps already written: step_texts[k] is write_step's text of
+// run.steps[k]. The same bytes as write_result.
+void write_result(std::ostream& out, const Scene& scene, const RunResult& run,
+                  const std::vector<std::string_view>& step_texts);
 
 }  // namespace grip

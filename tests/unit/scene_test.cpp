@@ -4,6 +4,7 @@
 
 #include <sstream>
 
+#include "apps/step_writer.hpp"
 #include "solver/io/result.hpp"
 #include "tests/support/scenes.hpp"
 
@@ -231,6 +232,32 @@ TEST(SceneEffects, StreamedResultReadsBackAsTheBuiltOne) {
             ASSERT_EQ(read["steps"][k][key][i][table->names[c]].get<double>(), table->rows[i][c])
                 << key << " row " << i << " " << table->names[c];
     }
+}
+
+// grip solve writes each step on a thread while the next one solves (apps/step_writer.hpp,
+// step_output taken in the solver's observer); the file must be write_result's to the byte,
+// for a single body with every field and for two bodies (master points, several tables).
+TEST(SceneEffects, StepsWrittenWhileSolvingAreTheStreamedResultByteForByte) {
+  json hertz = testing::example_scene("hertz");
+  hertz["steps"] = 3;
+  json two = testing::example_scene("two-cylinders");
+  for (const json& j : {hertz, two}) {
+    Scene scene = read_scene(j);
+    StepWriter writer;
+    SteppingObserver observer;
+    observer.step_finished = [&](const StepRecord& rec) { writer.add(step_output(scene.problem, rec, scene.output)); };
+    const RunResult run = run_load_steps(scene.problem, scene.steps, scene.params, observer);
+    ASSERT_TRUE(run.completed);
+    std::ostringstream concurrent, streamed;
+    write_result(concurrent, scene, run, writer.finish());
+    write_result(streamed, scene, run);
+    ASSERT_GT(streamed.str().size(), 10000u);
+    EXPECT_TRUE(concurrent.str() == streamed.str()) << j["description"];
+    // The texts must be the steps of this run: one too few is an error, not a shorter file.
+    std::vector<std::string_view> missing(run.steps.size() - 1);
+    std::ostringstream ignored;
+    EXPECT_THROW(write_result(ignored, scene, run, missing), std::logic_error);
+  }
 }
 
 }  // namespace
