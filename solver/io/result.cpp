@@ -53,7 +53,56 @@ json table_json(const FieldTable& t, const char* index_name) {
 
 }  // namespace
 
-json step_json(const Problem& problem, const StepRecord& rec, const OutputOptions& output) {
+// The contact points' numbers, read from the problem and the record.
+std::vector<ContactPointRow> contact_point_rows(const Problem& problem, const StepRecord& rec) {
+  const Body& body = *problem.body;
+  const auto* all = dynamic_cast<const BodySet*>(&body);
+  std::vector<ContactPointRow> rows;
+  rows.reserve(problem.candidates.size());
+  for (size_t i = 0; i < problem.candidates.size(); ++i) {
+    const Candidate& c = problem.candidates[i];
+    const PairedPoint& pp = rec.state.points[i];
+    const double area = body.tributary_area(c.site);
+    const double p_n = rec.p[c.eta], p_t = c.xi >= 0 ? rec.p[c.xi] : 0.0;
+    ContactPointRow r{body.site_node(c.site), problem.obstacles[c.obstacle].name,
+                      to_string(contact_state(problem, i, rec.p, rec.tau)), {}, {},
+                      pp.point.x, pp.projection.point, pp.projection.normal,
+                      p_n, p_t, p_n / area, p_t / area, pp.projection.gap,
+                      c.xi >= 0 ? rec.state.s[c.xi] : 0.0};
+    if (all) {  // several bodies: who touches whom
+      const ObstacleInstance& o = problem.obstacles[c.obstacle];
+      r.body = all->name(all->body_of_site(c.site));
+      r.master = o.master ? all->name(o.master->body) : o.name;
+      r.several_bodies = true;
+    }
+    rows.push_back(std::move(r));
+  }
+  return rows;
+}
+
+json contact_points_json(const std::vector<ContactPointRow>& rows) {
+  json points = json::array();
+  for (const ContactPointRow& r : rows) {
+    json point = {{"node", r.node}, {"obstacle", r.obstacle},
+                  {"x", r.x.x()}, {"y", r.x.y()},
+                  {"pair", {r.pair.x(), r.pair.y()}},
+                  {"normal", {r.normal.x(), r.normal.y()}},
+                  {"p_n", r.p_n}, {"p_t", r.p_t}, {"sigma_n", r.sigma_n}, {"sigma_t", r.sigma_t},
+                  {"gap", r.gap}, {"slip", r.slip}, {"state", r.state}};
+    if (r.several_bodies) {
+      point["body"] = r.body;
+      point["master"] = r.master;
+    }
+    points.push_back(std::move(point));
+  }
+  return points;
+}
+
+namespace {
+
+// step_json; with `rows`, the contact points are left out of the document and put there.
+json step_json(const Problem& problem, const StepRecord& rec, const OutputOptions& output,
+               std::optional<std::vector<ContactPointRow>>* rows) {
   const Body& body = *problem.body;
   json j = step_finished_event(rec);
   j.erase("type");
@@ -112,27 +161,9 @@ json step_json(const Problem& problem, const StepRecord& rec, const OutputOption
     j["reactions"] = reactions;
   }
   if (!output.wants("contact_points")) return j;
-  json points = json::array();
-  for (size_t i = 0; i < problem.candidates.size(); ++i) {
-    const Candidate& c = problem.candidates[i];
-    const PairedPoint& pp = rec.state.points[i];
-    const double area = body.tributary_area(c.site);
-    const double p_n = rec.p[c.eta], p_t = c.xi >= 0 ? rec.p[c.xi] : 0.0;
-    json point = {{"node", body.site_node(c.site)}, {"obstacle", problem.obstacles[c.obstacle].name},
-                      {"x", pp.point.x.x()}, {"y", pp.point.x.y()},
-                      {"pair", {pp.projection.point.x(), pp.projection.point.y()}},
-                      {"normal", {pp.projection.normal.x(), pp.projection.normal.y()}},
-                      {"p_n", p_n}, {"p_t", p_t}, {"sigma_n", p_n / area}, {"sigma_t", p_t / area},
-                      {"gap", pp.projection.gap}, {"slip", c.xi >= 0 ? rec.state.s[c.xi] : 0.0},
-                      {"state", to_string(contact_state(problem, i, rec.p, rec.tau))}};
-    if (const auto* all = dynamic_cast<const BodySet*>(&body)) {  // several bodies: who touches whom
-      const ObstacleInstance& o = problem.obstacles[c.obstacle];
-      point["body"] = all->name(all->body_of_site(c.site));
-      point["master"] = o.master ? all->name(o.master->body) : o.name;
-    }
-    points.push_back(std::move(point));
-  }
-  j["contact_points"] = points;
+  std::vector<ContactPointRow> points = contact_point_rows(problem, rec);
+  if (rows) *rows = std::move(points);
+  else j["contact_points"] = contact_points_json(points);
   if (const auto* all = dynamic_cast<const BodySet*>(&body)) {  // each pair's field read on its master
     json readings = json::array();
     for (size_t o = 0; o < problem.obstacles.size(); ++o) {
@@ -150,6 +181,12 @@ json step_json(const Problem& problem, const StepRecord& rec, const OutputOption
     j["master_points"] = readings;
   }
   return j;
+}
+
+}  // namespace
+
+json step_json(const Problem& problem, const StepRecord& rec, const OutputOptions& output) {
+  return step_json(problem, rec, output, nullptr);
 }
 
 json effects_json(const Scene& scene, const RunResult& run) {
@@ -315,6 +352,8 @@ void write_step(JsonWriter& w, const StepOutput& step) {
   Streamed tables;
   if (step.nodes) tables.emplace_back("nodes", [&] { write_table(w, *step.nodes, "node"); });
   if (step.elements) tables.emplace_back("elements", [&] { write_table(w, *step.elements, "element"); });
+  if (step.contact_points)
+    tables.emplace_back("contact_points", [&] { w.value(contact_points_json(*step.contact_points)); });
   write_object(w, step.summary, std::move(tables));
 }
 
@@ -348,7 +387,8 @@ StepOutput step_output(const Problem& problem, const StepRecord& rec, const Outp
   summary.fields.erase(std::remove_if(summary.fields.begin(), summary.fields.end(),
                                       [](const std::string& f) { return f == "nodes" || f == "elements"; }),
                        summary.fields.end());
-  StepOutput step{step_json(problem, rec, summary), {}, {}};
+  StepOutput step;
+  step.summary = step_json(problem, rec, summary, &step.contact_points);
   if (rec.state.q.size() != 0 && !rec.site_fields.rows.empty()) {  // as step_json decides
     if (output.wants("nodes")) step.nodes = flat_table(rec.site_fields);
     if (output.wants("elements")) step.elements = flat_table(rec.element_fields);

@@ -38,9 +38,20 @@ struct FlatTable {
 // finishes: its small members as JSON, its tables copied. Writing it reads neither the problem
 // nor the record, so `grip solve` writes each step on a thread of its own while the next step
 // solves (the solver itself stays single-threaded).
+// A contact point of a step's "contact_points" (body and master: several bodies only).
+struct ContactPointRow {
+  int node = 0;
+  std::string obstacle, state, body, master;
+  Vec2 x, pair, normal;
+  double p_n = 0, p_t = 0, sigma_n = 0, sigma_t = 0, gap = 0, slip = 0;
+  bool several_bodies = false;
+};
+std::vector<ContactPointRow> contact_point_rows(const Problem& problem, const StepRecord& rec);
+nlohmann::json contact_points_json(const std::vector<ContactPointRow>& rows);
 struct StepOutput {
-  nlohmann::json summary;                // step_json without the tables
+  nlohmann::json summary;  // step_json without the tables and the contact points
   std::optional<FlatTable> nodes, elements;  // where recorded and wanted
+  std::optional<std::vector<ContactPointRow>> contact_points;  // as JSON on the writer's thread
 };
 StepOutput step_output(const Problem& problem, const StepRecord& rec, const OutputOptions& output);
 // The step's text in the result's "steps" array.
