@@ -197,9 +197,13 @@ class Equilibrium {
   EquilibriumState& finish(EquilibriumState& state, const Vector& p) const;
   // R = A(q) - lambda F - T p on all dofs; tangent of R (with the contact load stiffness).
   // force_scale (if asked): the largest of |A(q)|, |lambda F| and |T p| over all dofs, in
-  // force units (the scale Newton's residual test is relative to).
+  // force units (the scale Newton's residual test is relative to). Without body_tangent, the
+  // tangent's contact terms only.
   Vector residual(const Vector& q, const EquilibriumState& paired, const Vector& p,
-                  Triplets* tangent, double* force_scale = nullptr) const;
+                  Triplets* tangent, double* force_scale = nullptr, bool body_tangent = true) const;
+  // Newton's step -K_t^-1 r for the constant body tangent plus the pair's stiffness (the
+  // `contact` triplets), as a low-rank correction on G.
+  Vector low_rank_step(const EquilibriumState& state, const Triplets& contact, const Vector& rhs);
   // p(q) of the penalty law at a paired state, and (if asked) its stiffness triplets. With an
   // increment dq (all dofs), p(q) + (dp/dq) dq: the law linearized at q.
   Vector penalty_forces(const EquilibriumState& paired, Triplets* tangent, const Vector* increment = nullptr) const;
