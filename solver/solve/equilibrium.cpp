@@ -6,6 +6,8 @@
 #include <limits>
 #include <map>
 
+#include "solver/core/body_set.hpp"
+
 namespace grip {
 
 Equilibrium::Equilibrium(const Problem& problem, NewtonParams params, std::vector<Constraint> extra)
@@ -30,6 +32,18 @@ void Equilibrium::index_free_dofs() {
     for (int pin : problem_.rigid.pins) free_index_[pin] = -1;
   for (int i = 0; i < n; ++i)
     if (free_index_[i] == 0) free_index_[i] = free_count_++;
+  // Several bodies: each body's free rows follow one another (its dofs do), so its own tangent
+  // is a diagonal block of the free block, factorized on its own (FreeBlockSolver::set_blocks).
+  if (const auto* set = dynamic_cast<const BodySet*>(problem_.body.get())) {
+    std::vector<int> starts;
+    for (int b = 0; b <= set->count(); ++b) {
+      const int end = set->dof_offset(b);
+      starts.push_back(static_cast<int>(
+          std::count_if(free_index_.begin(), free_index_.begin() + end, [](int f) { return f >= 0; })));
+    }
+    body_lu_.set_blocks(starts, params_.parallel);
+    lu_.set_blocks(std::move(starts), params_.parallel);
+  }
 }
 
 void Equilibrium::set_penalty(std::optional<PenaltyLaw> law) {

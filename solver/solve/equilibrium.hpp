@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "solver/core/parallel.hpp"
 #include "solver/core/problem.hpp"
 #include "solver/solve/free_block_solver.hpp"
 
@@ -35,6 +36,9 @@ struct NewtonParams {
   double divergence_lengths = 10.0;
   // Steps of the line search along a Newton correction.
   int max_backtracks = 8;
+  // Runs the bodies' own factorizations and solves of a scene of several bodies (the solver
+  // starts no threads of its own); empty: one after another.
+  ParallelFor parallel;
 };
 
 // Newton's tests as a fraction of the contact tolerance (relative to `length`, the body's
