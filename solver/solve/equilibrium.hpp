@@ -248,7 +248,11 @@ class Equilibrium {
   bool has_pairs_ = false;  // a contact pair of two bodies (a deformable master)
   bool body_factorized_ = false;
   FreeBlockSolver body_lu_;  // the body's own tangent (compliance, constant tangents)
-  FreeBlockSolver lu_;       // Newton's tangent, with the contact terms
+  // Newton's tangent, with the contact terms. For a changing tangent (finite kinematics) the
+  // pair's stiffness is among its entries and couples the bodies: one factorization of the
+  // whole, since a low-rank correction of the bodies' own factors would need G on the pair's
+  // dofs afresh at every iterate (13 such G's cost 6x one factorization, two cylinders).
+  FreeBlockSolver lu_;
   double body_tangent_norm_ = 0.0;  // |K|_inf of the constant body tangent (round-off scale)
   std::vector<int> surface_free_;  // surface row of G -> free index
   std::vector<int> surface_row_;   // free index -> surface row of G, -1 off the surface
