@@ -1,5 +1,5 @@
 // grip: command line entry point.
-//   grip solve SCENE.json [--out RESULT.json] [--events EVENTS.ndjson]
+//   grip solve SCENE.json [--out RESULT.json] [--events EVENTS.ndjson] [--threads N]
 //   grip serve [options]        the HTTP/JSON service (grip serve --help)
 //   grip healthcheck [--host H] [--port P]
 // serve and healthcheck run grip-server (apps/grip_server.cpp) from grip's own directory, so
@@ -7,6 +7,8 @@
 // Exit codes of solve: 0 solved, 1 a step failed, 2 usage or scene error.
 #include <unistd.h>
 
+#include <algorithm>
+#include <atomic>
 #include <cerrno>
 #include <climits>
 #include <cstdio>
@@ -16,8 +18,10 @@
 #include <ctime>
 #include <fstream>
 #include <iostream>
+#include <exception>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "apps/heap_tuning.hpp"
@@ -28,17 +32,43 @@ namespace {
 
 int usage() {
   std::fprintf(stderr,
-               "usage: grip solve SCENE.json [--out RESULT.json] [--events EVENTS.ndjson]\n"
+               "usage: grip solve SCENE.json [--out RESULT.json] [--events EVENTS.ndjson] [--threads N]\n"
                "       grip serve [options]   (grip serve --help)\n"
                "       grip healthcheck [--host H] [--port P]\n");
   return 2;
 }
 
+// The solver's independent tasks (the bodies' own factorizations and solves) on up to `threads`
+// threads: the solver starts none of its own. Empty (one after another) for one thread.
+grip::ParallelFor on_threads(int threads) {
+  if (threads <= 1) return {};
+  return [threads](int count, const std::function<void(int)>& task) {
+    std::atomic<int> next{0};
+    std::exception_ptr failure;
+    std::atomic<bool> failed{false};
+    auto work = [&] {
+      for (int k; (k = next++) < count;) try {
+          task(k);
+        } catch (...) {
+          if (!failed.exchange(true)) failure = std::current_exception();
+        }
+    };
+    std::vector<std::thread> helpers;
+    for (int t = 1; t < std::min(threads, count); ++t) helpers.emplace_back(work);
+    work();
+    for (auto& h : helpers) h.join();
+    if (failure) std::rethrow_exception(failure);
+  };
+}
+
 int solve(int argc, char** argv) {
   std::string scene_path, out_path, events_path;
+  int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   for (int i = 2; i < argc; ++i) {
     const std::string a = argv[i];
-    if ((a == "--out" || a == "--events") && i + 1 < argc)
+    if (a == "--threads" && i + 1 < argc && std::atoi(argv[i + 1]) >= 1)
+      threads = std::atoi(argv[++i]);
+    else if ((a == "--out" || a == "--events") && i + 1 < argc)
       (a == "--out" ? out_path : events_path) = argv[++i];
     else if (!a.empty() && a[0] != '-' && scene_path.empty())
       scene_path = a;
@@ -96,6 +126,7 @@ int solve(int argc, char** argv) {
                               : rec.reason.c_str());
     std::fflush(stdout);
   };
+  scene.params.newton.parallel = on_threads(threads);
   const auto read = now();
   const grip::RunResult run =
       grip::run_load_steps(scene.problem, scene.steps, scene.params, observer);

@@ -6,6 +6,8 @@
 #include <limits>
 #include <map>
 
+#include "solver/core/body_set.hpp"
+
 namespace grip {
 
 Equilibrium::Equilibrium(const Problem& problem, NewtonParams params, std::vector<Constraint> extra)
@@ -30,6 +32,18 @@ void Equilibrium::index_free_dofs() {
     for (int pin : problem_.rigid.pins) free_index_[pin] = -1;
   for (int i = 0; i < n; ++i)
     if (free_index_[i] == 0) free_index_[i] = free_count_++;
+  // Several bodies: each body's free rows follow one another (its dofs do), so its own tangent
+  // is a diagonal block of the free block, factorized on its own (FreeBlockSolver::set_blocks).
+  if (const auto* set = dynamic_cast<const BodySet*>(problem_.body.get())) {
+    std::vector<int> starts;
+    for (int b = 0; b <= set->count(); ++b) {
+      const int end = set->dof_offset(b);
+      starts.push_back(static_cast<int>(
+          std::count_if(free_index_.begin(), free_index_.begin() + end, [](int f) { return f >= 0; })));
+    }
+    body_lu_.set_blocks(starts, params_.parallel);
+    lu_.set_blocks(std::move(starts), params_.parallel);
+  }
 }
 
 void Equilibrium::set_penalty(std::optional<PenaltyLaw> law) {
@@ -162,10 +176,10 @@ double Equilibrium::stiffness_scale(const Vector& q) const {
 }
 
 Vector Equilibrium::residual(const Vector& q, const EquilibriumState& paired, const Vector& p_given,
-                             Triplets* tangent, double* force_scale) const {
+                             Triplets* tangent, double* force_scale, bool body_tangent) const {
   const Vector p = penalty_ ? penalty_forces(paired, tangent) : p_given;
   Vector r = Vector::Zero(q.size());
-  problem_.body->internal_force(q, r, tangent);
+  problem_.body->internal_force(q, r, body_tangent ? tangent : nullptr);
   const Vector external = problem_.load(factors_);
   Vector contact = Vector::Zero(q.size());
   for (size_t i = 0; i < problem_.candidates.size(); ++i) {
@@ -175,6 +189,9 @@ Vector Equilibrium::residual(const Vector& q, const EquilibriumState& paired, co
     const Vec2 f = p_eta * pp.eta + p_xi * pp.xi;
     for (const auto& j : pp.point.jacobian) contact[j.dof] += j.dx.dot(f);
     if (!tangent) continue;
+    // Without the body's tangent (a low-rank correction: no factorization pattern to keep), a
+    // point that carries no force adds nothing.
+    if (!body_tangent && p_eta == 0.0 && p_xi == 0.0) continue;
     // f = -p_eta n + p_xi rot90(n): df/dx = (-p_eta I + p_xi R) dn/dx. Emitted even when zero,
     // so that the tangent's pattern stays the same from one iterate to the next.
     Mat2 R;
@@ -243,46 +260,48 @@ double free_row_sum_norm(const Triplets& triplets, const std::vector<int>& free_
   return free_count ? rows.maxCoeff() : 0.0;
 }
 
-// Newton's step for the constant body tangent K (factorized in `body`) plus the contact terms
-// of `tangent` from `first` on (a pair of bodies' stiffness, on a few surface dofs), by the
-// Woodbury identity: (K + P A P^T)^-1 b = z - K^-1 P A (I + G A)^-1 P^T z, z = K^-1 b,
-// G = P^T K^-1 P: two solves with the body's factorization, G by partial solves, and a dense
-// system of the pair's free surface dofs.
-Vector low_rank_step(FreeBlockSolver& body, const std::vector<int>& free_index, int free_count,
-                     const Triplets& tangent, size_t first, const Vector& rhs) {
-  const Triplets contact(tangent.begin() + static_cast<long>(first), tangent.end());
+}  // namespace
+
+// Newton's step for the constant body tangent K plus the pair's stiffness A (the `contact`
+// triplets, on a few surface dofs), by the Woodbury identity:
+// (K + P A P^T)^-1 b = z - K^-1 P A (I + G A)^-1 P^T z, z = K^-1 b, G = P^T K^-1 P on the dofs
+// where A is not zero (the pressing points' and their master segments'). G is read from the
+// compliance's G (K^-1 on the surface dofs, the same constant K), extended by the dofs it does
+// not cover yet: formed once a run, where forming it at every iterate was half the run's time.
+Vector Equilibrium::low_rank_step(const EquilibriumState& state, const Triplets& contact, const Vector& rhs) {
+  const Vector z = body_lu_.solve(rhs);
   std::map<int, int> slot;  // free index -> row of A
   std::vector<int> rows;
-  for (const auto& t : contact)
-    for (int dof : {t.row(), t.col()})
-      if (free_index[dof] >= 0 && slot.emplace(free_index[dof], static_cast<int>(rows.size())).second)
-        rows.push_back(free_index[dof]);
-  const Vector z = body.solve(rhs);
-  const int m = static_cast<int>(rows.size());
-  if (m == 0) return z;
-  Matrix A = Matrix::Zero(m, m);
   for (const auto& t : contact) {
-    const int i = free_index[t.row()], j = free_index[t.col()];
-    if (i >= 0 && j >= 0) A(slot[i], slot[j]) += t.value();
+    const int i = free_index_[t.row()], j = free_index_[t.col()];
+    if (i < 0 || j < 0 || t.value() == 0.0) continue;
+    for (int f : {i, j})
+      if (slot.emplace(f, static_cast<int>(rows.size())).second) rows.push_back(f);
   }
-  Matrix g;  // K^-1 on the pair's dofs
-  if (!body.inverse_block(rows, g)) {
-    Matrix unit = Matrix::Zero(free_count, m);
-    for (int k = 0; k < m; ++k) unit(rows[k], k) = 1.0;
-    const Matrix x = body.solve(unit);
-    g.resize(m, m);
-    for (int k = 0; k < m; ++k) g.row(k) = x.row(rows[k]);
+  const int m = static_cast<int>(rows.size());
+  if (m == 0 || !compliance_tangent(state)) return z;
+  std::vector<int> added;
+  for (int f : rows)
+    if (surface_row_[f] < 0) added.push_back(f);
+  if (!added.empty()) {
+    extend_surface_compliance(added);
+    ++g_version_;
   }
+  Matrix A = Matrix::Zero(m, m), g(m, m);
+  for (const auto& t : contact) {
+    const int i = free_index_[t.row()], j = free_index_[t.col()];
+    if (i >= 0 && j >= 0 && t.value() != 0.0) A(slot[i], slot[j]) += t.value();
+  }
+  for (int a = 0; a < m; ++a)
+    for (int b = 0; b < m; ++b) g(a, b) = g_(surface_row_[rows[a]], surface_row_[rows[b]]);
   Vector zs(m);
   for (int k = 0; k < m; ++k) zs[k] = z[rows[k]];
   const Matrix coupled = Matrix::Identity(m, m) + g * A;
   const Vector y = A * coupled.partialPivLu().solve(zs);
-  Vector py = Vector::Zero(free_count);
+  Vector py = Vector::Zero(free_count_);
   for (int k = 0; k < m; ++k) py[rows[k]] = y[k];
-  return z - body.solve(py);
+  return z - body_lu_.solve(py);
 }
-
-}  // namespace
 
 EquilibriumState Equilibrium::solve(const Vector& q_guess, const Vector& p) {
   ++counters_.solves;
@@ -302,19 +321,13 @@ EquilibriumState Equilibrium::solve(const Vector& q_guess, const Vector& p) {
   // kept as a low-rank correction of the constant body tangent (low_rank_step).
   const bool low_rank = reuse && has_pairs_;
   Triplets triplets;
-  size_t body_triplets = 0;  // how many of the tangent's triplets are the body's (low_rank)
-  if (low_rank) {
-    Triplets body;
-    Vector force = Vector::Zero(state.q.size());
-    problem_.body->internal_force(state.q, force, &body);
-    body_triplets = body.size();
-  }
   double last_step = 0.0;
   for (int it = 1; it <= params_.max_iterations + 1; ++it) {
     pair(state.q, state);
     triplets.clear();
     double force_scale = 0.0;
-    const Vector r = residual(state.q, state, p, reuse && !low_rank ? nullptr : &triplets, &force_scale);
+    // low_rank: the contact terms only (the body's are in its kept factorization).
+    const Vector r = residual(state.q, state, p, reuse && !low_rank ? nullptr : &triplets, &force_scale, !low_rank);
     const double r_max = scaled_free_max(r);
     state.relative_residual = force_scale > 0 ? r_max / force_scale : 0.0;
     if (!std::isfinite(r_max)) {
@@ -352,8 +365,7 @@ EquilibriumState Equilibrium::solve(const Vector& q_guess, const Vector& p) {
     Vector r_free(free_count_);
     for (int i = 0; i < r.size(); ++i)
       if (free_index_[i] >= 0) r_free[free_index_[i]] = r[i];
-    // The body's triplets come first (residual()); the pair's follow.
-    const Vector dq_free = low_rank ? low_rank_step(body_lu_, free_index_, free_count_, triplets, body_triplets, Vector(-r_free))
+    const Vector dq_free = low_rank ? low_rank_step(state, triplets, Vector(-r_free))
                            : reuse  ? body_lu_.solve(Vector(-r_free))
                                     : lu_.solve(Vector(-r_free));
     state.newton_iterations = it;

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "solver/core/parallel.hpp"
 #include "solver/core/problem.hpp"
 #include "solver/solve/free_block_solver.hpp"
 
@@ -35,6 +36,9 @@ struct NewtonParams {
   double divergence_lengths = 10.0;
   // Steps of the line search along a Newton correction.
   int max_backtracks = 8;
+  // Runs the bodies' own factorizations and solves of a scene of several bodies (the solver
+  // starts no threads of its own); empty: one after another.
+  ParallelFor parallel;
 };
 
 // Newton's tests as a fraction of the contact tolerance (relative to `length`, the body's
@@ -197,9 +201,13 @@ class Equilibrium {
   EquilibriumState& finish(EquilibriumState& state, const Vector& p) const;
   // R = A(q) - lambda F - T p on all dofs; tangent of R (with the contact load stiffness).
   // force_scale (if asked): the largest of |A(q)|, |lambda F| and |T p| over all dofs, in
-  // force units (the scale Newton's residual test is relative to).
+  // force units (the scale Newton's residual test is relative to). Without body_tangent, the
+  // tangent's contact terms only.
   Vector residual(const Vector& q, const EquilibriumState& paired, const Vector& p,
-                  Triplets* tangent, double* force_scale = nullptr) const;
+                  Triplets* tangent, double* force_scale = nullptr, bool body_tangent = true) const;
+  // Newton's step -K_t^-1 r for the constant body tangent plus the pair's stiffness (the
+  // `contact` triplets), as a low-rank correction on G.
+  Vector low_rank_step(const EquilibriumState& state, const Triplets& contact, const Vector& rhs);
   // p(q) of the penalty law at a paired state, and (if asked) its stiffness triplets. With an
   // increment dq (all dofs), p(q) + (dp/dq) dq: the law linearized at q.
   Vector penalty_forces(const EquilibriumState& paired, Triplets* tangent, const Vector* increment = nullptr) const;
@@ -240,7 +248,11 @@ class Equilibrium {
   bool has_pairs_ = false;  // a contact pair of two bodies (a deformable master)
   bool body_factorized_ = false;
   FreeBlockSolver body_lu_;  // the body's own tangent (compliance, constant tangents)
-  FreeBlockSolver lu_;       // Newton's tangent, with the contact terms
+  // Newton's tangent, with the contact terms. For a changing tangent (finite kinematics) the
+  // pair's stiffness is among its entries and couples the bodies: one factorization of the
+  // whole, since a low-rank correction of the bodies' own factors would need G on the pair's
+  // dofs afresh at every iterate (13 such G's cost 6x one factorization, two cylinders).
+  FreeBlockSolver lu_;
   double body_tangent_norm_ = 0.0;  // |K|_inf of the constant body tangent (round-off scale)
   std::vector<int> surface_free_;  // surface row of G -> free index
   std::vector<int> surface_row_;   // free index -> surface row of G, -1 off the surface

@@ -38,6 +38,10 @@ bool FreeBlockSolver::factorize(const Triplets& triplets, const std::vector<int>
       }
     lu_analysed_ = llt_analysed_ = dissected_analysed_ = false;
     dissected_fails_at_ = 0;
+    coupled_ = starts_.size() < 3;  // one body
+    for (int col = 0; !coupled_ && col < matrix_.outerSize(); ++col)
+      for (Eigen::SparseMatrix<double>::InnerIterator it(matrix_, col); it; ++it)
+        if (block_of(static_cast<int>(it.row())) != block_of(col)) coupled_ = true;
   }
   std::fill(matrix_.valuePtr(), matrix_.valuePtr() + matrix_.nonZeros(), 0.0);
   for (size_t k = 0; k < triplets.size(); ++k)
@@ -54,6 +58,8 @@ bool FreeBlockSolver::factorize(const Triplets& triplets, const std::vector<int>
     for (int k = 0; k < matrix_.nonZeros(); ++k)
       if (mirror_[k] > k) w[k] = w[mirror_[k]] = 0.5 * (w[k] + w[mirror_[k]]);
   }
+  split_ = !coupled_;
+  if (split_) return factorize_parts(near_symmetric_tolerance);
   if (symmetric_) {
     if (!llt_analysed_) {  // the ordering: once per pattern
       // CHOLMOD's own choice: supernodal where dense blocks pay (2D continua), simplicial for
@@ -125,6 +131,25 @@ void factorize_dissected(CholmodFactor& dissected, const Eigen::SparseMatrix<dou
 
 bool FreeBlockSolver::inverse_block(const std::vector<int>& rows, Matrix& G) {
   if (!ok_ || !symmetric_) return false;
+  if (split_) {  // K^-1 is block diagonal: each body's rows from its own factor
+    std::vector<std::vector<int>> local(parts_.size()), at(parts_.size());
+    for (size_t a = 0; a < rows.size(); ++a) {
+      const int b = block_of(rows[a]);
+      local[b].push_back(rows[a] - starts_[b]);
+      at[b].push_back(static_cast<int>(a));
+    }
+    std::vector<Matrix> blocks(parts_.size());
+    std::vector<char> ok(parts_.size(), 1);
+    for_each_part([&](int b) {
+      if (!local[b].empty()) ok[b] = parts_[b]->inverse_block(local[b], blocks[b]);
+    });
+    if (!std::all_of(ok.begin(), ok.end(), [](char c) { return c != 0; })) return false;
+    G.setZero(static_cast<int>(rows.size()), static_cast<int>(rows.size()));
+    for (size_t b = 0; b < parts_.size(); ++b)
+      for (size_t i = 0; i < at[b].size(); ++i)
+        for (size_t j = 0; j < at[b].size(); ++j) G(at[b][i], at[b][j]) = blocks[b](i, j);
+    return true;
+  }
   if (llt_.inverse_block(rows, G)) return true;
   // More rows only lengthen the partial solves against the same factor's pattern.
   if (dissected_fails_at_ && rows.size() >= dissected_fails_at_) return false;
@@ -163,6 +188,10 @@ bool CholmodFactor::forward_solves(const Eigen::SparseMatrix<double>& columns,
     for (Eigen::SparseMatrix<double>::InnerIterator it(columns, a); it; ++it) {
       static_cast<double*>(B->x)[position[it.row()]] = it.value();
       pattern.push_back(position[it.row()]);
+    }
+    if (pattern.empty()) {  // a column without entries in this block: x = 0
+      ok = use(a, nullptr, nullptr, 0);
+      continue;
     }
     std::sort(pattern.begin(), pattern.end());
     static_cast<int*>(bset->p)[0] = 0;
@@ -243,12 +272,91 @@ bool CholmodFactor::quadratic_forms(const Eigen::SparseMatrix<double>& t, Vector
 Vector FreeBlockSolver::quadratic_forms(const Eigen::SparseMatrix<double>& t) {
   Vector out;
   if (!ok_ || !symmetric_) return Vector();
+  if (split_) {  // t^T K^-1 t summed over the bodies, each with its rows of t
+    std::vector<Triplets> local(parts_.size());
+    for (int col = 0; col < t.outerSize(); ++col)
+      for (Eigen::SparseMatrix<double>::InnerIterator it(t, col); it; ++it) {
+        const int b = block_of(static_cast<int>(it.row()));
+        local[b].emplace_back(static_cast<int>(it.row()) - starts_[b], col, it.value());
+      }
+    std::vector<Vector> forms(parts_.size());
+    for_each_part([&](int b) {
+      Eigen::SparseMatrix<double> tb(starts_[b + 1] - starts_[b], t.cols());
+      tb.setFromTriplets(local[b].begin(), local[b].end());
+      forms[b] = parts_[b]->quadratic_forms(tb);
+    });
+    out.setZero(t.cols());
+    for (const Vector& f : forms) {
+      if (f.size() != t.cols()) return Vector();
+      out += f;
+    }
+    return out;
+  }
   // A path through more than 1/32 of the rows on average: the nested-dissection order instead.
   if (llt_.quadratic_forms(t, out, matrix_.rows() / 32.0)) return out;
   CholmodFactor dissected;
   factorize_dissected(dissected, matrix_);
   if (dissected.info() == Eigen::Success && dissected.quadratic_forms(t, out, 0.0)) return out;
   return Vector();
+}
+
+void FreeBlockSolver::set_blocks(std::vector<int> starts, ParallelFor parallel) {
+  starts_ = std::move(starts);
+  parallel_ = std::move(parallel);
+  parts_.clear();
+  for (size_t b = 0; b + 1 < starts_.size(); ++b) parts_.push_back(std::make_unique<FreeBlockSolver>());
+  forget_pattern();
+}
+
+int FreeBlockSolver::block_of(int row) const {
+  return static_cast<int>(std::upper_bound(starts_.begin(), starts_.end(), row) - starts_.begin()) - 1;
+}
+
+void FreeBlockSolver::for_each_part(const std::function<void(int)>& task) const {
+  const int count = static_cast<int>(parts_.size());
+  run_each(matrix_.rows() >= kParallelRows ? parallel_ : ParallelFor(), count, task);
+}
+
+bool FreeBlockSolver::factorize_parts(double near_symmetric_tolerance) {
+  std::vector<Triplets> local(parts_.size());
+  for (int col = 0; col < matrix_.outerSize(); ++col) {
+    const int b = block_of(col);
+    for (Eigen::SparseMatrix<double>::InnerIterator it(matrix_, col); it; ++it)
+      local[b].emplace_back(static_cast<int>(it.row()) - starts_[b], col - starts_[b], it.value());
+  }
+  const int largest = static_cast<int>(matrix_.rows());
+  if (static_cast<int>(identity_.size()) < largest) {
+    identity_.resize(largest);
+    for (int k = 0; k < largest; ++k) identity_[k] = k;
+  }
+  std::vector<char> ok(parts_.size(), 0);
+  for_each_part([&](int b) {
+    ok[b] = parts_[b]->factorize(local[b], identity_, starts_[b + 1] - starts_[b], near_symmetric_tolerance);
+  });
+  ok_ = std::all_of(ok.begin(), ok.end(), [](char c) { return c != 0; });
+  symmetric_ = ok_;
+  for (const auto& part : parts_) symmetric_ = symmetric_ && part->symmetric();
+  return ok_;
+}
+
+Vector FreeBlockSolver::solve(const Vector& b) const {
+  if (!split_) return symmetric_ ? Vector(llt_.solve(b)) : Vector(lu_.solve(b));
+  Vector x(b.size());
+  for_each_part([&](int k) {
+    const int s = starts_[k], n = starts_[k + 1] - s;
+    x.segment(s, n) = parts_[k]->solve(Vector(b.segment(s, n)));
+  });
+  return x;
+}
+
+Matrix FreeBlockSolver::solve(const Matrix& b) const {
+  if (!split_) return symmetric_ ? Matrix(llt_.solve(b)) : Matrix(lu_.solve(b));
+  Matrix x(b.rows(), b.cols());
+  for_each_part([&](int k) {
+    const int s = starts_[k], n = starts_[k + 1] - s;
+    x.middleRows(s, n) = parts_[k]->solve(Matrix(b.middleRows(s, n)));
+  });
+  return x;
 }
 
 }  // namespace grip

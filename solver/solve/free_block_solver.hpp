@@ -9,9 +9,11 @@
 #include <Eigen/SparseCore>
 #include <Eigen/SparseLU>
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include "solver/core/body.hpp"
+#include "solver/core/parallel.hpp"
 
 namespace grip {
 
@@ -46,8 +48,14 @@ class FreeBlockSolver {
   // residual stays exact, so Newton still converges, and LDL^T serves).
   bool factorize(const Triplets& triplets, const std::vector<int>& free_index, int free_count,
                  double near_symmetric_tolerance = 0.0);
-  Vector solve(const Vector& b) const { return symmetric_ ? Vector(llt_.solve(b)) : Vector(lu_.solve(b)); }
-  Matrix solve(const Matrix& b) const { return symmetric_ ? Matrix(llt_.solve(b)) : Matrix(lu_.solve(b)); }
+  // Several bodies: free rows [starts[b], starts[b + 1]) are body b's (starts ends with the free
+  // count). Where the block has no entry between two bodies (the bodies' own tangent; Newton's
+  // where bodies meet rigid tools only, or where a pair's stiffness enters as a low-rank
+  // correction), each body's block is factorized and solved on its own, the bodies' tasks run
+  // through `parallel` (the solver starts no threads). Else one factorization of the whole.
+  void set_blocks(std::vector<int> starts, ParallelFor parallel);
+  Vector solve(const Vector& b) const;
+  Matrix solve(const Matrix& b) const;
   // K^-1 on the given rows where K is Cholesky-factorized (CholmodFactor::inverse_block);
   // false otherwise (then solve() for unit right-hand sides). Where the factor's own ordering
   // gives the rows long elimination-tree paths (thin strips: a fill-reducing ordering there is
@@ -60,6 +68,8 @@ class FreeBlockSolver {
   // long elimination-tree paths, as for G); an empty vector otherwise.
   Vector quadratic_forms(const Eigen::SparseMatrix<double>& t);
   bool ok() const { return ok_; }
+  // Factorized body by body (set_blocks).
+  bool split() const { return split_; }
   // Factorized by Cholesky (symmetric positive definite).
   bool symmetric() const { return ok_ && symmetric_; }
   // The free block as factorized (both triangles).
@@ -71,9 +81,24 @@ class FreeBlockSolver {
     ok_ = false;
     dissected_analysed_ = false;
     dissected_fails_at_ = 0;
+    for (auto& part : parts_) part->forget_pattern();
   }
 
  private:
+  // The bodies' blocks: factorizes each diagonal block of matrix_ on its own (split_), or
+  // leaves split_ false where an entry couples two bodies.
+  bool factorize_parts(double near_symmetric_tolerance);
+  int block_of(int row) const;
+  // The bodies' tasks: through parallel_ where a thread's start (tens of microseconds) is
+  // small beside the work (kParallelRows free rows or more), else one after another.
+  void for_each_part(const std::function<void(int)>& task) const;
+  static constexpr int kParallelRows = 2000;
+  std::vector<int> starts_;  // body b's free rows begin at starts_[b]; empty: one body
+  ParallelFor parallel_;
+  std::vector<std::unique_ptr<FreeBlockSolver>> parts_;
+  std::vector<int> identity_;  // dof -> row for the parts (their triplets are in local rows)
+  bool coupled_ = true;        // the pattern has entries between bodies
+  bool split_ = false;
   Eigen::SparseMatrix<double> matrix_;
   std::vector<int> rows_, cols_;  // the triplet sequence the pattern was built from
   std::vector<int> slot_;         // triplet k -> index in matrix_.valuePtr(), -1 if dropped
