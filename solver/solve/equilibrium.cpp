@@ -286,6 +286,16 @@ Vector low_rank_step(FreeBlockSolver& body, const std::vector<int>& free_index, 
 
 EquilibriumState Equilibrium::solve(const Vector& q_guess, const Vector& p) {
   ++counters_.solves;
+  return newton(q_guess, p);
+}
+
+void Equilibrium::continue_solve(EquilibriumState& state, const Vector& p) {
+  const int before = state.newton_iterations;
+  state = newton(state.q, p);
+  state.newton_iterations += before;
+}
+
+EquilibriumState Equilibrium::newton(const Vector& q_guess, const Vector& p) {
   EquilibriumState state;
   state.q = q_guess;
   for (const Constraint& c : problem_.constraints)
