@@ -63,7 +63,7 @@ class StepSolver {
   // with a smaller ||v|| is accepted. du is the linear model's displacement change for pl - p
   // (Newton starts from it). `trials` counts the real solves.
   bool line_search(const Vector& pl, const Vector& du, int& trials);
-  // Inexact real solves (ContactParams::inexact_newton): Newton's correction test for a trial
+  // Inexact real solves (kInexactNewton, step.cpp): Newton's correction test for a trial
   // whose contact error starts at v_ref, loosened to that fraction of v_ref (true if looser
   // than the full precision); and back to the full precision.
   bool loosen_newton(double v_ref);

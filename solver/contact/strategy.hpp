@@ -52,18 +52,6 @@ struct ContactParams {
   // Newton's displacement tolerance, as a fraction of the contact tolerance: the contact
   // error has a floor of about ||K^-1|| x the Newton residual (section 9).
   double newton_fraction = 1e-3;
-  // Inexact real solves in cev's inner loops (an Eisenstat-Walker forcing term): a
-  // line-search trial from a contact error v0 ends Newton once its correction is below this
-  // fraction of v0. Newton's residual test stays at the full precision: loosened too, it let
-  // the membrane sheet through at states whose error K^-1 r exceeded the contact error (the
-  // line search then found no decrease). A trial that ends the step is finished at the full
-  // precision: the step ends on the same tests as with exact solves (the answers agree to
-  // what the contact tolerance pins them to). Newton iterations, paper's
-  // beam / sheet / sheet of 60 elements (bench/results/inexact_newton.md): exact 124 / 256 /
-  // 271; 0.01: 124 / 227 / 239; 0.05: 115 / 193 / 198; 0.1: 110 / 189 / 191, but the beam's
-  // kept G was renewed 9 times instead of 6 and its run cost more instructions than exact
-  // solves. 0: every solve at full precision.
-  double inexact_newton = 0.05;
   // A tangent that changes with the displacement, cev's inner loops (the default and the tau
   // passes; the paper's loop always forms G afresh): true lets the compliance's G = K^-1 on
   // the surface dofs serve later real solves, across load steps too, while its updates accept
