@@ -63,6 +63,11 @@ class StepSolver {
   // with a smaller ||v|| is accepted. du is the linear model's displacement change for pl - p
   // (Newton starts from it). `trials` counts the real solves.
   bool line_search(const Vector& pl, const Vector& du, int& trials);
+  // Inexact real solves (kInexactNewton, step.cpp): Newton's correction test for a trial
+  // whose contact error starts at v_ref, loosened to that fraction of v_ref (true if looser
+  // than the full precision); and back to the full precision.
+  bool loosen_newton(double v_ref);
+  void tighten_newton();
 
   // Direction of eq. 13 for the active block of v: n = infinity solves with C'_EE; a finite n
   // uses the polynomial accelerator (normalized, section 8); level 1 with alpha_fixed > 0 is
@@ -103,6 +108,7 @@ class StepSolver {
   const StopRequest& stop_;
   std::chrono::steady_clock::time_point start_;
   double tol_ = 0.0;
+  NewtonParams newton_base_;  // Newton's tests at the contact tolerance (couple_newton)
   int pass_ = 0, m_ = 0;
   long solves_at_start_ = 0;
   long newton_emitted_ = 0;  // the Newton counter at the last event

@@ -305,6 +305,16 @@ Vector Equilibrium::low_rank_step(const EquilibriumState& state, const Triplets&
 
 EquilibriumState Equilibrium::solve(const Vector& q_guess, const Vector& p) {
   ++counters_.solves;
+  return newton(q_guess, p);
+}
+
+void Equilibrium::continue_solve(EquilibriumState& state, const Vector& p) {
+  const int before = state.newton_iterations;
+  state = newton(state.q, p);
+  state.newton_iterations += before;
+}
+
+EquilibriumState Equilibrium::newton(const Vector& q_guess, const Vector& p) {
   EquilibriumState state;
   state.q = q_guess;
   for (const Constraint& c : problem_.constraints)

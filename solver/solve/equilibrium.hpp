@@ -148,6 +148,9 @@ class Equilibrium {
   const LoadFactors& factors() const { return factors_; }
 
   EquilibriumState solve(const Vector& q_guess, const Vector& p);
+  // Newton continued from a converged state at the current tests (tightened since): the same
+  // real solve finished more precisely, not counted as another.
+  void continue_solve(EquilibriumState& state, const Vector& p);
   // With a penalty law set, solve() ignores its p and finds p(q) from the law.
   // A body held by contact then has its pins free (PenaltyLaw::pin_spring).
   void set_penalty(std::optional<PenaltyLaw> law);
@@ -197,6 +200,7 @@ class Equilibrium {
 
  private:
   void pair(const Vector& q, EquilibriumState& state) const;
+  EquilibriumState newton(const Vector& q_guess, const Vector& p);
   // A converged iterate: admissibility and the forces in equilibrium (penalty law).
   EquilibriumState& finish(EquilibriumState& state, const Vector& p) const;
   // R = A(q) - lambda F - T p on all dofs; tangent of R (with the contact load stiffness).
