@@ -140,7 +140,7 @@ Vector Equilibrium::penalty_forces(const EquilibriumState& paired, Triplets* tan
       const double start = law.previous.size() ? law.previous[c.xi] : 0.0;
       const double trial = start - law.tangential * paired.s[c.xi];
       const double bound = mu * std::abs(p[c.eta]);
-      if (std::abs(trial) <= bound) {
+      if (std::abs(trial) <= bound || (!stick_branch_.empty() && stick_branch_[i])) {
         p[c.xi] = trial;
         dpt = -law.tangential * pp.projection.zeta_rate * pp.xi.transpose();
       } else {  // slip: the return to the cone
@@ -163,6 +163,18 @@ Vector Equilibrium::penalty_forces(const EquilibriumState& paired, Triplets* tan
         tangent->emplace_back(a.dof, b.dof, -a.dx.dot(df_dx * b.dx));
   }
   return p;
+}
+
+std::vector<signed char> Equilibrium::trial_signs(const EquilibriumState& paired) const {
+  const PenaltyLaw& law = *penalty_;
+  std::vector<signed char> signs(problem_.candidates.size(), 0);
+  for (size_t i = 0; i < problem_.candidates.size(); ++i) {
+    const Candidate& c = problem_.candidates[i];
+    if (c.xi < 0 || !paired.enabled[c.eta] || !paired.enabled[c.xi] || paired.s[c.eta] <= 0) continue;
+    const double trial = (law.previous.size() ? law.previous[c.xi] : 0.0) - law.tangential * paired.s[c.xi];
+    signs[i] = trial > 0 ? 1 : trial < 0 ? -1 : 0;
+  }
+  return signs;
 }
 
 double Equilibrium::stiffness_scale(const Vector& q) const {
@@ -332,9 +344,27 @@ EquilibriumState Equilibrium::newton(const Vector& q_guess, const Vector& p) {
   const bool low_rank = reuse && has_pairs_;
   Triplets triplets;
   double last_step = 0.0;
+  std::vector<signed char> signs;  // the penalty law's trial signs at the last iterate
   for (int it = 1; it <= params_.max_iterations + 1; ++it) {
     pair(state.q, state);
     triplets.clear();
+    // A penalty point whose trial tangential force changed sign since the last iterate has
+    // crossed the cone's interior, its stick band (width 2 mu |p_eta| / k_t, a few 1e-6 of the
+    // body when k_t is 1e3 x its stiffness): Newton from either slip branch predicts the other
+    // one (no tangential stiffness there), so it cycles between them. The step is taken on the
+    // stick branch instead (trial force and spring), which puts such a point in its band; the
+    // stopping tests always use the law itself.
+    std::vector<char> branch;
+    stick_branch_.clear();
+    if (penalty_) {
+      std::vector<signed char> now = trial_signs(state);
+      for (size_t i = 0; i < signs.size(); ++i)
+        if (now[i] * signs[i] < 0) {
+          branch.resize(now.size(), 0);
+          branch[i] = 1;
+        }
+      signs = std::move(now);
+    }
     double force_scale = 0.0;
     // low_rank: the contact terms only (the body's are in its kept factorization).
     const Vector r = residual(state.q, state, p, reuse && !low_rank ? nullptr : &triplets, &force_scale, !low_rank);
@@ -360,6 +390,13 @@ EquilibriumState Equilibrium::newton(const Vector& q_guess, const Vector& p) {
       return penalty_ ? finish_penalty(state) : finish(state, p);
     }
     if (it > params_.max_iterations) break;
+    Vector r_step;
+    if (!branch.empty()) {
+      stick_branch_ = std::move(branch);
+      triplets.clear();
+      r_step = residual(state.q, state, p, reuse && !low_rank ? nullptr : &triplets, nullptr, !low_rank);
+    }
+    const Vector& r_newton = stick_branch_.empty() ? r : r_step;
     if (reuse) {
       if (!factorize_body_tangent(state.q)) {
         state.reason = "singular stiffness: the supports do not hold the body";
@@ -374,7 +411,7 @@ EquilibriumState Equilibrium::newton(const Vector& q_guess, const Vector& p) {
     }
     Vector r_free(free_count_);
     for (int i = 0; i < r.size(); ++i)
-      if (free_index_[i] >= 0) r_free[free_index_[i]] = r[i];
+      if (free_index_[i] >= 0) r_free[free_index_[i]] = r_newton[i];
     const Vector dq_free = low_rank ? low_rank_step(state, triplets, Vector(-r_free))
                            : reuse  ? body_lu_.solve(Vector(-r_free))
                                     : lu_.solve(Vector(-r_free));
@@ -393,12 +430,13 @@ EquilibriumState Equilibrium::newton(const Vector& q_guess, const Vector& p) {
       return state;
     }
     last_step = step;
-    if (step <= params_.displacement_tolerance) {
+    if (step <= params_.displacement_tolerance && stick_branch_.empty()) {
       state.q += dq;
       pair(state.q, state);
       return penalty_ ? finish_penalty(state) : finish(state, p);
     }
     state.q += line_search(state.q, dq, p, reuse ? body_lu_ : lu_) * dq;
+    stick_branch_.clear();
   }
   pair(state.q, state);
   state.reason = "Newton did not converge in " + std::to_string(params_.max_iterations) +

@@ -227,6 +227,12 @@ class Equilibrium {
   // free_index_ from the supports, the start-up's dofs and (unless pins_free_) the pins.
   void index_free_dofs();
   bool pins_free_ = false;
+  // The penalty law's trial tangential force at each candidate: its sign (0 off contact or
+  // without friction), at a paired state.
+  std::vector<signed char> trial_signs(const EquilibriumState& paired) const;
+  // Candidates that penalty_forces() takes on the stick branch of the law whatever their
+  // trial (Newton's iterates only; empty otherwise): see solve().
+  std::vector<char> stick_branch_;
   // Adds free dofs to G's surface: one solve with the body's factorization per dof.
   void extend_surface_compliance(const std::vector<int>& added);
   // The body's tangent that G (or the sparse form) comes from: kept, or factorized at state.q
