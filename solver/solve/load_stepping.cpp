@@ -113,7 +113,15 @@ RunResult run_load_steps(Problem& problem, const std::vector<LoadStep>& steps,
       const Vector guess = start_q ? *start_q : Vector(q + (q - q_before) * ratio);
       // The contact forces start from the same extrapolation (the strategies bring it back
       // into the cone): a step then starts near its answer, not a whole increment away.
-      const Vector p_guess = from_previous_force || !extrapolate_forces ? p : Vector(p + (p - p_before) * ratio);
+      Vector p_guess = from_previous_force || !extrapolate_forces ? p : Vector(p + (p - p_before) * ratio);
+      const bool extrapolated = p_guess != p;
+      // Rigid amplitudes not extrapolated follow the supports: a pin left where it was turns a
+      // held body about its moving supports (two cylinders under displacement control: the upper
+      // one by delta / L at the start, a turn of the pairing that the linear model leaves out;
+      // cev stalled at ||v|| = 2e-3).
+      if (!extrapolated && problem.rigid.count())
+        p_guess.segment(problem.rigid.first, problem.rigid.count()) +=
+            amplitudes_following_supports(problem, current, target);
       eq.set_step(target, zeta);
       // A load that no static equilibrium can carry: no cut of the increment can help.
       if (std::string why = unreachable_equilibrium(problem, eq.evaluate(guess), target); !why.empty()) {
@@ -132,7 +140,7 @@ RunResult run_load_steps(Problem& problem, const std::vector<LoadStep>& steps,
         if (out.stopped) result.stopped = true;
         // A poor extrapolation (after the start-up step, or where contact changes) is retried
         // from the previous force before the increment is cut: a cut changes the load path.
-        if (!out.stopped && !from_previous_force && p_guess != p) {
+        if (!out.stopped && !from_previous_force && extrapolated) {
           from_previous_force = true;
           ++rec.restarts;
           continue;

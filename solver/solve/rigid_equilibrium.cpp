@@ -1,8 +1,11 @@
 #include "solver/solve/rigid_equilibrium.hpp"
 
+#include <Eigen/LU>
 #include <Eigen/QR>
 #include <cmath>
 #include <cstdio>
+
+#include "solver/core/body_set.hpp"
 
 namespace grip {
 namespace {
@@ -64,6 +67,58 @@ std::string unreachable_equilibrium(const Problem& problem, const EquilibriumSta
            ", mu = " + std::to_string(mu) + "); no static equilibrium exists";
   }
   return "";
+}
+
+Vector amplitudes_following_supports(const Problem& problem, const LoadFactors& from, const LoadFactors& to) {
+  const RigidModes& rigid = problem.rigid;
+  Vector change = Vector::Zero(rigid.count());
+  if (rigid.count() == 0 || rigid.scale <= 0) return change;
+  const Body& whole = *problem.body;
+  const auto* set = dynamic_cast<const BodySet*>(&whole);
+  const int n = whole.dof_count();
+  auto factor = [](const LoadFactors& f, int c) { return c < static_cast<int>(f.size()) ? f[c] : 0.0; };
+  std::vector<char> done(rigid.count(), 0);
+  for (int k = 0; k < rigid.count(); ++k) {
+    if (done[k]) continue;
+    const int b = rigid.body[k];
+    const Body& body = set ? set->part(b) : whole;
+    const int offset = set ? set->dof_offset(b) : 0, m = body.dof_count();
+    // The body's rigid motions (translations x, y, rotation) on the whole problem's dofs.
+    std::vector<Vector> modes = {body.rigid_translation(Vec2::UnitX()), body.rigid_translation(Vec2::UnitY())};
+    if (const Vector rot = body.rigid_rotation(); rot.size()) modes.push_back(rot / body.characteristic_length());
+    Matrix B = Matrix::Zero(n, modes.size());
+    for (size_t c = 0; c < modes.size(); ++c) B.block(offset, c, m, 1) = modes[c];
+    std::vector<int> rows;
+    std::vector<double> values;
+    for (const Constraint& c : problem.constraints)
+      if (c.dof >= offset && c.dof < offset + m) {
+        rows.push_back(c.dof);
+        values.push_back(c.value * (factor(to, c.load_case) - factor(from, c.load_case)));
+      }
+    Matrix Bc(rows.size(), modes.size());
+    Vector d(rows.size());
+    for (size_t r = 0; r < rows.size(); ++r) {
+      Bc.row(r) = B.row(rows[r]);
+      d[r] = values[r];
+    }
+    for (int j = k; j < rigid.count(); ++j) done[j] = done[j] || rigid.body[j] == b;
+    if (rows.empty() || d.lpNorm<Eigen::Infinity>() == 0.0) continue;
+    // c = c0 + N a: c0 fits the prescribed change, N spans the motions it leaves free; a makes
+    // the motion B c the shortest over all dofs.
+    const Vector c0 = Bc.completeOrthogonalDecomposition().solve(d);
+    Eigen::FullPivLU<Matrix> lu(Bc);
+    lu.setThreshold(1e-9);
+    Vector c = c0;
+    if (lu.rank() < Bc.cols()) {
+      const Matrix N = lu.kernel();
+      const Matrix BN = B * N;
+      c -= N * (BN.transpose() * BN).ldlt().solve(BN.transpose() * (B * c0));
+    }
+    const Vector motion = B * c;
+    for (int j = 0; j < rigid.count(); ++j)
+      if (rigid.body[j] == b) change[j] = motion[rigid.pins[j]] / rigid.scale;
+  }
+  return change;
 }
 
 Vector rigid_amplitudes(const Body& body, const Vector& q) {

@@ -17,6 +17,13 @@ namespace grip {
 std::string unreachable_equilibrium(const Problem& problem, const EquilibriumState& paired,
                                     const LoadFactors& factors);
 
+// The change of the rigid amplitudes (problem.rigid, in their unit) that follows the supports
+// from load factors `from` to `to`: for each body with free rigid motions, the rigid motion that
+// fits the change of its prescribed values by least squares and has the least norm over its dofs
+// (no part along the motions the supports leave free), read at its pins. A step then starts
+// with a held body where its supports take it, not turned about them.
+Vector amplitudes_following_supports(const Problem& problem, const LoadFactors& from, const LoadFactors& to);
+
 // The rigid motion fitted to q by least squares over the body's translations and rotation
 // (about the origin): (x, y, rotation in radians; no rotation for a body without one).
 Vector rigid_amplitudes(const Body& body, const Vector& q);

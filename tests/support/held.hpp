@@ -12,6 +12,7 @@
 #include "solver/core/body_set.hpp"
 #include "tests/support/contact_profile.hpp"
 #include "tests/support/result_checks.hpp"
+#include "tests/support/two_bodies.hpp"
 
 namespace grip::testing {
 
@@ -83,6 +84,20 @@ inline void expect_held(const Solved& s) {
     EXPECT_TRUE(step.contains(problem_is_one_body(s.scene.problem) ? "rigid_motion" : "rigid_motions"))
         << "step " << rec.index;
   }
+}
+
+// A scene of several bodies that contact alone holds on its free motions `names`: held and sound
+// (expect_held), completed, the pair's forces cancel on the last step (expect_pairs_balanced),
+// and the contact forces on body b add up to `load_y` along y (to balance(); x is held by a
+// support), no support of the held body helping.
+inline void expect_carried_by_contact(const Solved& s, const std::vector<std::string>& names, int b, double load_y) {
+  expect_held(s);
+  ASSERT_TRUE(s.run.completed) << s.run.reason;
+  EXPECT_EQ(s.scene.problem.rigid.names, names);
+  const StepRecord& rec = s.run.steps.back();
+  expect_pairs_balanced(s, rec);
+  const Vec2 on_body = body_resultant(s.scene.problem, b, contact_forces(s.scene.problem, rec));
+  EXPECT_NEAR(on_body.y(), load_y, balance(s.scene) * std::abs(load_y));
 }
 
 // The strategies that hold a body by contact, each a solver.contact block over the defaults.

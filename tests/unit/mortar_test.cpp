@@ -133,5 +133,32 @@ TEST(Mortar, TheStiffnessOfACoarserSlaveIsTheDerivativeOfItsForces) {
   expect_stiffness_is_the_derivative(j);
 }
 
+// A beam's lower surface as the master (its sites: the axis offset by half the depth, moved by
+// the rotation dof too) over a q4 foundation's top as the slave. The beam's surface point is
+// linear in q (x + u + z theta, y + z + w: Body::surface_point), so its Jacobian is constant and
+// the pair's stiffness needs no curvature term of its own: the derivative test holds as for two
+// continua.
+TEST(Mortar, TheStiffnessOfABeamMasterIsTheDerivativeOfItsForces) {
+  const json beam = {{"name", "beam"},
+                     {"model", "timoshenko_beam"},
+                     {"kinematics", "linear"},
+                     {"material", {{"young", 200000}, {"poisson", 0.3}}},
+                     {"section", {{"width", 1}, {"depth", 1}}},
+                     {"mesh", {{"origin", {-5, 0.5}}, {"length", 10}, {"elements", 20}}},
+                     {"supports", {{{"node", 10}, {"fix", {"u", "w"}}}}}};
+  const json foundation = {{"name", "foundation"},
+                           {"model", "continuum"},
+                           {"kinematics", "linear"},
+                           {"analysis", "plane_strain"},
+                           {"element", "q4"},
+                           {"material", {{"young", 70000}, {"poisson", 0.33}}},
+                           {"mesh", {{"rectangle", {{"origin", {-5, -4}}, {"size", {10, 4}}, {"divisions", {13, 4}}}}}},
+                           {"contact_set", "top"},
+                           {"supports", {{{"set", "left"}, {"fix", {"x"}}}, {{"set", "bottom"}, {"fix", {"y"}}}}}};
+  expect_stiffness_is_the_derivative({{"bodies", {beam, foundation}},
+                                      {"contacts", {{{"slave", "foundation.top"}, {"master", "beam.lower"}}}},
+                                      {"steps", 1}});
+}
+
 }  // namespace
 }  // namespace grip

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <optional>
 
 #include "solver/elements/continuum.hpp"
 #include "tests/support/held.hpp"
@@ -30,11 +31,21 @@ int node_at(const json& scene, int b, const Vec2& x) {
   return std::max(best, 0);
 }
 
+// The node of body b's mesh on the line x = 0 nearest to y.
+int node_on_axis(const json& scene, int b, double y) {
+  const Scene s = read_scene(scene);
+  const auto& mesh = dynamic_cast<const ContinuumBody&>(body_set(s.problem).part(b)).mesh();
+  int best = -1;
+  for (size_t i = 0; i < mesh.nodes.size(); ++i)
+    if (std::abs(mesh.nodes[i].x()) < 1e-9 &&
+        (best < 0 || std::abs(mesh.nodes[i].y() - y) < std::abs(mesh.nodes[best].y() - y)))
+      best = static_cast<int>(i);
+  if (best < 0) ADD_FAILURE() << "no node on x = 0";
+  return std::max(best, 0);
+}
+
 // The shipped two cylinders with equal materials (steel), the upper one held in x on its
-// diameter only and pressed by a force P at the diameter's centre. (The same state by
-// displacement control, the centre and the node near (5, 10) held where the force put them,
-// did not converge: cev stalled at ||v|| = 1.4e-3 after 5 cuts, 466 s; with the centre alone
-// held, at 1e-6 on the rotation left to contact. Not asserted here; see the report.)
+// diameter only and pressed by a force P at the diameter's centre.
 json cylinders_by_force(double P) {
   json j = example_scene("two-cylinders");
   j["bodies"][1]["material"] = j["bodies"][0]["material"];
@@ -42,6 +53,23 @@ json cylinders_by_force(double P) {
   json& upper = j["bodies"][0];
   upper["supports"] = json::array({{{"set", "diameter"}, {"fix", {"x"}}}});
   upper["loads"] = json::array({{{"node", node_at(j, 0, Vec2(0, 10))}, {"force", {0.0, -P}}}});
+  return j;
+}
+
+// The same, with the upper cylinder's rotation held too, by x at the node at (0, 5) on its axis
+// of symmetry; or, with `prescribed`, the force replaced by the centre node's displacement (no
+// motion left to contact). Left free, that rotation is neutral: frictionless circles pressed
+// together carry no moment about the upper one's centre (the pairing turns with the slave, so
+// the forces' moment about it vanishes), and the stopping test pins it only to 3e-7 rad, which
+// moves every nodal force by 5e-5 of the largest (measured).
+json cylinders_held_on_their_axis(double P, std::optional<double> prescribed = std::nullopt) {
+  json j = cylinders_by_force(P);
+  json& upper = j["bodies"][0];
+  upper["supports"].push_back({{"node", node_on_axis(j, 0, 5.0)}, {"fix", {"x"}}});
+  if (prescribed) {
+    upper.erase("loads");
+    upper["supports"].push_back({{"node", node_at(j, 0, Vec2(0, 10))}, {"fix", {"y"}}, {"values", {{"y", *prescribed}}}});
+  }
   return j;
 }
 
@@ -70,19 +98,21 @@ class TwoBodiesHeld : public ::testing::TestWithParam<Strategy> {
  protected:
   json with(json j) const { return with_strategy(std::move(j), GetParam()); }
   const char* name() const { return GetParam().name; }
+  // Whether each linear model is solved to rounding (n = infinity), not to the tolerance.
+  bool exact_model() const {
+    const json& c = GetParam().contact;
+    return c.value("method", "cev") == "cev" && !c.contains("acceleration");
+  }
 };
 
 TEST_P(TwoBodiesHeld, CylindersUnderAForceMatchHertz) {
   const double P = 5000.0;  // N / mm: a = 0.54 mm, about 11 elements of 0.05 mm
   const Solved f = solve_scene(with(cylinders_by_force(P)));
-  expect_held(f);
-  ASSERT_TRUE(f.run.completed) << f.run.reason;
-  EXPECT_EQ(f.scene.problem.rigid.names, (std::vector<std::string>{"upper: translate along y", "upper: rotate about (0, 10)"}));
-  const StepRecord& rec = f.run.steps.back();
-  expect_pairs_balanced(f, rec);
   // The lower body carries the whole force through the pair: no support of the upper one helps.
+  expect_carried_by_contact(f, {"upper: translate along y", "upper: rotate about (0, 10)"}, 1, -P);
+  if (!f.run.completed) return;
+  const StepRecord& rec = f.run.steps.back();
   const Vec2 on_lower = body_resultant(f.scene.problem, 1, contact_forces(f.scene.problem, rec));
-  EXPECT_NEAR(-on_lower.y(), P, balance(f.scene) * P);
   const HertzContact closed = combined_hertz(f.scene.effective, P);
   const EllipseFit fit = fit_semi_ellipse(contact_profile(f.scene.problem, rec));
   std::printf("%s: force P = %.0f N/mm: a = %.4f mm (fit %+.3f %%), p0 = %.1f MPa (fit %+.3f %%), lower body carries "
@@ -101,6 +131,55 @@ TEST_P(TwoBodiesHeld, CylindersUnderAForceMatchHertz) {
   // No rotation by symmetry, to what the stopping test pins a soft mode to: measured 3e-8 to
   // 3.4e-7 rad, at the 10 mm lever 4e-5 of the descent at most.
   EXPECT_LT(std::abs(step["rigid_motions"][0]["rotation"].get<double>()) * 10.0, 1e-4 * std::abs(down));
+
+}
+
+// The state of a force P, held by contact, and the state of the displacement that P gave its
+// node, held by the support: the same fields (as for one body, held_by_contact_test.cpp).
+TEST_P(TwoBodiesHeld, CylindersUnderAForceOrItsDisplacementGiveTheSameFields) {
+  // Penalty: with the rotation held on the axis, its Newton (pins free, the pair's stiffness left
+  // out) stops at a free residual of 1.1e-5 of the force scale after 40 iterations (measured);
+  // not run until the pair's stiffness serves the penalty law (see the report of issue 19).
+  if (GetParam().contact.value("method", "") == "penalty") GTEST_SKIP() << "penalty: Newton does not converge here";
+  const double P = 5000.0;  // N / mm
+  // Between two bodies the pairing moves with the state, so no real solve reproduces the linear
+  // model to rounding: every strategy stops at ||v|| <= tol, which pins the forces to about
+  // C^-1 v (at the shipped 1e-8: 3.4e-6 of the largest, cev). 1e-10 brings that below 1e-6 where
+  // n = infinity; a finite n or uzawa keep the shipped tolerance and the one-body bound.
+  const auto scene = [&](std::optional<double> prescribed) {
+    json j = with(cylinders_held_on_their_axis(P, prescribed));
+    if (exact_model()) j["solver"]["contact"]["tolerance"] = 1e-10;
+    return j;
+  };
+  const Solved f = solve_scene(scene(std::nullopt));
+  expect_held(f);
+  ASSERT_TRUE(f.run.completed) << f.run.reason;
+  EXPECT_EQ(f.scene.problem.rigid.names, std::vector<std::string>{"upper: translate along y"});
+  const StepRecord& rec = f.run.steps.back();
+  expect_pairs_balanced(f, rec);
+  const int centre = node_at(f.scene.effective, 0, Vec2(0, 10));
+  const double delta = rec.state.q[body_set(f.scene.problem).dof_offset(0) + 2 * centre + 1];
+  const Solved d = solve_scene(scene(delta));
+  ASSERT_TRUE(d.run.completed) << d.run.reason;
+  EXPECT_EQ(d.scene.problem.rigid.count(), 0);
+  const StepRecord& drec = d.run.steps.back();
+  expect_pairs_balanced(d, drec);
+  double p_max = 0.0, p_diff = 0.0;
+  for (const Candidate& c : f.scene.problem.candidates) {
+    p_max = std::max(p_max, std::abs(rec.p[c.eta]));
+    p_diff = std::max(p_diff, std::abs(rec.p[c.eta] - drec.p[c.eta]));
+  }
+  const double q_diff = (rec.state.q - drec.state.q).lpNorm<Eigen::Infinity>();
+  const double q_max = rec.state.q.lpNorm<Eigen::Infinity>();
+  const double carried = -body_resultant(d.scene.problem, 0, drec.reactions).y();
+  std::printf("%s: force %d real solves, %d Newton; displacement control (delta = %.6g mm) %d real solves, %d Newton, "
+              "support carries %.12g; forces differ by %.2e, displacements by %.2e (relative)\n",
+              name(), rec.solves, rec.newton_iterations, delta, drec.solves, drec.newton_iterations, carried,
+              p_diff / p_max, q_diff / q_max);
+  const double agree = exact_model() ? 1e-6 : 2e-4;
+  EXPECT_LT(p_diff, agree * p_max);
+  EXPECT_LT(q_diff, agree * q_max);
+  EXPECT_NEAR(carried, P, agree * P);
 }
 
 // Exact: a uniform compression sigma through both bodies (q4 carries it exactly), so the
