@@ -41,16 +41,27 @@ struct ReversedCounter {
   }
 };
 
-TEST(BodyBlocks, EachBodyOnItsOwnGivesTheWholeFactorizationsAnswers) {
-  const Triplets t = two_grids(false);
-  const int n = 45 * 45 + 40 * 40;
-  std::vector<int> identity(n);
-  for (int k = 0; k < n; ++k) identity[k] = k;
+// The two grids factorized whole and with the bodies' blocks declared (tasks counted).
+struct BothWays {
+  static constexpr int n = 45 * 45 + 40 * 40;
   FreeBlockSolver whole, parts;
   ReversedCounter counter;
-  parts.set_blocks({0, 45 * 45, n}, counter);
-  ASSERT_TRUE(whole.factorize(t, identity, n));
-  ASSERT_TRUE(parts.factorize(t, identity, n));
+  explicit BothWays(const Triplets& t) {
+    std::vector<int> identity(n);
+    for (int k = 0; k < n; ++k) identity[k] = k;
+    parts.set_blocks({0, 45 * 45, n}, counter);
+    factorized = whole.factorize(t, identity, n) && parts.factorize(t, identity, n);
+  }
+  bool factorized = false;
+};
+
+TEST(BodyBlocks, EachBodyOnItsOwnGivesTheWholeFactorizationsAnswers) {
+  const Triplets t = two_grids(false);
+  BothWays both(t);
+  ASSERT_TRUE(both.factorized);
+  const int n = both.n;
+  FreeBlockSolver &whole = both.whole, &parts = both.parts;
+  const ReversedCounter& counter = both.counter;
   EXPECT_FALSE(whole.split());
   EXPECT_TRUE(parts.split());
   EXPECT_TRUE(parts.symmetric());
@@ -78,14 +89,11 @@ TEST(BodyBlocks, EachBodyOnItsOwnGivesTheWholeFactorizationsAnswers) {
 
 TEST(BodyBlocks, AnEntryBetweenBodiesKeepsOneFactorization) {
   const Triplets t = two_grids(true);
-  const int n = 45 * 45 + 40 * 40;
-  std::vector<int> identity(n);
-  for (int k = 0; k < n; ++k) identity[k] = k;
-  FreeBlockSolver whole, parts;
-  ReversedCounter counter;
-  parts.set_blocks({0, 45 * 45, n}, counter);
-  ASSERT_TRUE(whole.factorize(t, identity, n));
-  ASSERT_TRUE(parts.factorize(t, identity, n));
+  BothWays both(t);
+  ASSERT_TRUE(both.factorized);
+  const int n = both.n;
+  FreeBlockSolver &whole = both.whole, &parts = both.parts;
+  const ReversedCounter& counter = both.counter;
   EXPECT_FALSE(parts.split());
   EXPECT_EQ(*counter.tasks, 0);
   const Vector b = Vector::LinSpaced(n, -1.0, 2.0);
