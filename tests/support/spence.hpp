@@ -47,8 +47,9 @@ inline double spence_stick_ratio(double beta_over_mu) {
 // Spence's setting: an elastic half-plane pressed by a rigid cylinder. A block 2 depth wide
 // and depth deep (E = 200 GPa, nu = 0.3, plane strain, q4), its bottom held, under a rigid
 // circle R = 100 mm moved down 0.035 mm in `steps` equal steps: a = 1.03 mm at the end, so
-// R / a = 100 and, at the default depth of 300 mm, depth / a = 300 (with depth / a = 30, the
-// block's far field raises c/a by about 0.03: tests/hard/spence_slow_test.cpp). Elements of
+// R / a = 100 and, at the default depth of 300 mm, depth / a = 300 (a block 30 mm deep lets
+// c/a grow over the loading, 0.71 to 0.76 over steps 6-10: tests/hard/spence_slow_test.cpp;
+// 1000 mm deep gives what 300 does). Elements of
 // `size` within 1.5 mm of the first touch, growing 1.3-fold from one to the next beyond it.
 inline nlohmann::json spence_block(double size, int steps, double mu, double depth = 300) {
   const double extent = 1.5, R = 100;
