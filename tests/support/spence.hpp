@@ -20,9 +20,9 @@
 // The exact (coupled) problem, the one Spence solved, is computed by the half-plane
 // boundary-element model of tests/support/spence_halfplane.hpp: without the coupling it gives
 // the relation (stick set 0.750 at a/h 40 and 80, 0.744 at 160), with it c/a = 0.692 at a/h 40
-// and 80, 0.684 and 0.680 at a/h 120 and 160 (the peak pressure 8 % over Hertz's p0, a 2.5 %
-// short of Hertz's): the coupling lowers c/a by 0.05-0.06. That model, not the first-order
-// relation, is what the finite element scene is held to.
+// and 80, 0.684 at 120, 0.680-0.686 at 160 (20 or 40 increments); the peak pressure 8 % over
+// Hertz's p0, a 2.5 % short of Hertz's: the coupling lowers c/a by 0.05-0.06. That model, not
+// the first-order relation, is what the finite element scene is held to.
 #include <algorithm>
 #include <cmath>
 
