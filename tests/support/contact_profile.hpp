@@ -49,14 +49,15 @@ inline nlohmann::json with_pole_elements(nlohmann::json scene, double size) {
   return scene;
 }
 
-// Hertz's line contact of the half-disc of an effective scene's body (plane strain) under a
-// load P per unit thickness: half-width a = sqrt(4 P R / (pi E*)), peak p0 = 2 P / (pi a).
+// Hertz's line contact of an effective scene's body (plane strain) under a load P per unit
+// thickness: half-width a = sqrt(4 P R / (pi E*)), peak p0 = 2 P / (pi a); R the body's
+// half-disc radius, or `radius` when given (a rigid cylinder pressed onto the body).
 struct HertzContact {
   double P = 0.0, a = 0.0, p0 = 0.0;
 };
-inline HertzContact hertz_contact(const nlohmann::json& body, double P) {
+inline HertzContact hertz_contact(const nlohmann::json& body, double P, double radius = 0) {
   const double E = body["material"]["young"], nu = body["material"]["poisson"];
-  const double R = body["mesh"]["half_disc"]["radius"];
+  const double R = radius > 0 ? radius : body["mesh"]["half_disc"]["radius"].get<double>();
   const double a = std::sqrt(4 * P * R * (1 - nu * nu) / (std::numbers::pi * E));
   return {P, a, 2 * P / (std::numbers::pi * a)};
 }
