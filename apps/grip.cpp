@@ -24,7 +24,7 @@
 #include <thread>
 #include <vector>
 
-#include "apps/heap_tuning.hpp"
+#include "apps/process_tuning.hpp"
 #include "apps/step_writer.hpp"
 #include "solver/io/result.hpp"
 
@@ -171,10 +171,13 @@ int run_server(char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  grip::tune_heap();
+  grip::tune_process();
   if (argc < 2) return usage();
   const std::string command = argv[1];
-  if (command == "solve") return solve(argc, argv);
+  if (command == "solve") {
+    grip::heap_on_huge_pages();
+    return solve(argc, argv);
+  }
   if (command == "serve" || command == "healthcheck") return run_server(argv);
   return usage();
 }
