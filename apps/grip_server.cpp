@@ -10,7 +10,7 @@
 #include <string>
 #include <vector>
 
-#include "apps/heap_tuning.hpp"
+#include "apps/process_tuning.hpp"
 #include "server/serve.hpp"
 
 namespace {
@@ -33,7 +33,7 @@ int serve(const std::vector<std::string>& args) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  grip::tune_heap();
+  grip::tune_process();
   const std::string command = argc > 1 ? argv[1] : "";
   const std::vector<std::string> args(argv + std::min(argc, 2), argv + argc);
   if (command == "serve") return serve(args);

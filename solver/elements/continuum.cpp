@@ -16,11 +16,8 @@ ContinuumBody::ContinuumBody(PlaneMesh mesh, const std::vector<int>& contact_set
   if (options_.element == ContinuumElement::q4_bbar && options_.kinematics == ContinuumKinematics::finite)
     throw std::invalid_argument("q4_bbar is implemented for linear kinematics (use q9 for finite strain)");
   if (!(options_.thickness > 0)) throw std::invalid_argument("thickness must be positive");
-  const std::vector<MeshIssue> issues = check_mesh(mesh_, shape_);
-  if (!issues.empty())
-    throw std::invalid_argument((issues[0].element >= 0 ? "element " + std::to_string(issues[0].element)
-                                                        : "node " + std::to_string(issues[0].node)) +
-                                " " + issues[0].detail);
+  // The only check of the mesh: the scene reader reads the issues off the exception.
+  if (std::vector<MeshIssue> issues = check_mesh(mesh_, shape_); !issues.empty()) throw InvalidMesh(std::move(issues));
   contact_ = boundary_part(mesh_, shape_, contact_set);
   Vec2 lo = mesh_.nodes.front(), hi = lo;
   for (const Vec2& x : mesh_.nodes) {

@@ -37,8 +37,9 @@ QuadShape quad_shape(ContinuumElement element);
 
 class ContinuumBody final : public Body {
  public:
-  // The mesh must pass check_mesh; contact_set is a node set on the boundary (boundary_part).
-  // Throws std::invalid_argument otherwise, or for q4_bbar with finite kinematics.
+  // The mesh must pass check_mesh (InvalidMesh otherwise); contact_set is a node set on the
+  // boundary (boundary_part). Throws std::invalid_argument otherwise, or for q4_bbar with
+  // finite kinematics.
   ContinuumBody(PlaneMesh mesh, const std::vector<int>& contact_set,
                 std::shared_ptr<const PlaneMaterial> material, ContinuumOptions options);
 

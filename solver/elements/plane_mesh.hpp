@@ -5,6 +5,7 @@
 // sentence; the scene reader adds the JSON pointer.
 #include <map>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -27,6 +28,12 @@ struct MeshIssue {
   std::string detail;
 };
 std::vector<MeshIssue> check_mesh(const PlaneMesh& mesh, QuadShape shape);
+// What a body that takes a mesh (ContinuumBody) throws when check_mesh finds issues: all of
+// them (the scene reader names each one's JSON pointer); what() is the first in words.
+struct InvalidMesh : std::invalid_argument {
+  explicit InvalidMesh(std::vector<MeshIssue> issues);
+  std::vector<MeshIssue> issues;
+};
 
 // Element sides on the boundary (used by exactly one element), each with its 2 (q4) or 3
 // (q9, corner - mid - corner) nodes in the element's counter-clockwise order: the body lies

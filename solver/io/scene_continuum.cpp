@@ -52,7 +52,7 @@ std::optional<Refinement> read_refinement(Reader& r, json& gen, const std::strin
   return out;
 }
 
-std::optional<PlaneMesh> read_explicit_mesh(Reader& r, json& mesh, const std::string& ptr, QuadShape shape) {
+std::optional<PlaneMesh> read_explicit_mesh(Reader& r, json& mesh, const std::string& ptr) {
   PlaneMesh m;
   json* nodes = r.array(mesh, ptr, "nodes", true);
   json* elements = r.array(mesh, ptr, "elements", true);
@@ -88,14 +88,11 @@ std::optional<PlaneMesh> read_explicit_mesh(Reader& r, json& mesh, const std::st
       m.sets[name] = ids;
     }
   if (r.issues.size() > before) return std::nullopt;
-  if (m.elements.empty()) r.error(ptr + "/elements", "needs at least one element");
-  for (const MeshIssue& issue : check_mesh(m, shape))
-    r.error(issue.element >= 0 ? ptr + "/elements/" + std::to_string(issue.element)
-                               : ptr + "/nodes/" + std::to_string(issue.node),
-            (issue.element >= 0 ? "element " + std::to_string(issue.element) : "node " + std::to_string(issue.node)) +
-                " " + issue.detail);
-  if (r.issues.size() > before) return std::nullopt;
-  return m;
+  if (m.elements.empty()) {
+    r.error(ptr + "/elements", "needs at least one element");
+    return std::nullopt;
+  }
+  return m;  // checked by the body's constructor (report_mesh_issues)
 }
 
 std::optional<PlaneMesh> read_generated_mesh(Reader& r, json& mesh, const std::string& ptr, QuadShape shape,
@@ -136,13 +133,23 @@ std::optional<PlaneMesh> read_generated_mesh(Reader& r, json& mesh, const std::s
     r.error(gp + "/divisions", e.what());
     return std::nullopt;
   }
-  for (const MeshIssue& issue : check_mesh(m, shape)) {
-    r.error(gp, "generated element " + std::to_string(issue.element) + " " + issue.detail +
-                    ": soften the refinement or change the divisions");
-    break;
+  return m;  // checked by the body's constructor (report_mesh_issues)
+}
+
+// The issues check_mesh found (through the body's constructor), each at its JSON pointer: an
+// explicit mesh's elements and nodes, or the generator's object (`kind`) with its first.
+void report_mesh_issues(Reader& r, const std::vector<MeshIssue>& issues, const std::string& ptr,
+                        const std::string& kind) {
+  if (kind != "nodes") {
+    r.error(ptr + "/" + kind, "generated element " + std::to_string(issues.at(0).element) + " " + issues[0].detail +
+                                  ": soften the refinement or change the divisions");
+    return;
   }
-  if (r.issues.size() > before) return std::nullopt;
-  return m;
+  for (const MeshIssue& issue : issues)
+    r.error(issue.element >= 0 ? ptr + "/elements/" + std::to_string(issue.element)
+                               : ptr + "/nodes/" + std::to_string(issue.node),
+            (issue.element >= 0 ? "element " + std::to_string(issue.element) : "node " + std::to_string(issue.node)) +
+                " " + issue.detail);
 }
 
 // The nodes named by {"set": name} or {"node": id}; nullopt after an error.
@@ -289,20 +296,20 @@ void read_continuum(Reader& r, json& body, Problem& problem, const std::string& 
   }
 
   std::optional<PlaneMesh> mesh;
-  std::string default_contact;
+  std::string kind, default_contact;  // kind: "nodes", "rectangle" or "half_disc"
+  const std::string mp = ptr + "/mesh";
   if (json* m = r.object(body, ptr, "mesh", true)) {
-    const std::string mp = ptr + "/mesh";
     std::vector<std::string> kinds;
     for (const char* k : {"nodes", "rectangle", "half_disc"})
       if (m->contains(k)) kinds.push_back(k);
     if (kinds.size() != 1) {
       r.error(mp, "needs exactly one of \"nodes\" (with \"elements\"), \"rectangle\" and \"half_disc\"");
-    } else if (kinds[0] == "nodes") {
-      mesh = read_explicit_mesh(r, *m, mp, shape);
+    } else if ((kind = kinds[0]) == "nodes") {
+      mesh = read_explicit_mesh(r, *m, mp);
     } else {
-      if (m->contains("sets")) r.error(mp + "/sets", "are generated for a " + kinds[0]);
-      mesh = read_generated_mesh(r, *m, mp, shape, kinds[0]);
-      default_contact = kinds[0] == "rectangle" ? "bottom" : "arc";
+      if (m->contains("sets")) r.error(mp + "/sets", "are generated for a " + kind);
+      mesh = read_generated_mesh(r, *m, mp, shape, kind);
+      default_contact = kind == "rectangle" ? "bottom" : "arc";
     }
   }
   if (!mesh || !r.issues.empty()) return;
@@ -321,21 +328,28 @@ void read_continuum(Reader& r, json& body, Problem& problem, const std::string& 
     r.error(ptr + "/contact_set", show(cs) + " names no node set (sets: " + Reader::list(names) + ")");
     return;
   }
+  const std::vector<int> contact_set = mesh->sets.at(cs.get<std::string>());
+  std::unique_ptr<ContinuumBody> continuum;
   try {
-    problem.body = std::make_unique<ContinuumBody>(*mesh, mesh->sets.at(cs.get<std::string>()), material, options);
+    continuum = std::make_unique<ContinuumBody>(std::move(*mesh), contact_set, material, options);
+  } catch (const InvalidMesh& e) {
+    report_mesh_issues(r, e.issues, mp, kind);
+    return;
   } catch (const std::invalid_argument& e) {
     r.error(ptr + "/contact_set", e.what());
     return;
   }
+  const PlaneMesh& checked = continuum->mesh();
+  problem.body = std::move(continuum);
 
-  read_continuum_supports(r, body, ptr, *mesh, problem);
-  read_continuum_loads(r, body, ptr, *mesh, shape, problem, options.thickness);
+  read_continuum_supports(r, body, ptr, checked, problem);
+  read_continuum_loads(r, body, ptr, checked, shape, problem, options.thickness);
   if (!r.issues.empty()) return;
   // ALGORITHM.md section 7: contact holds the free rigid motions of one connected body
   // (scene.cpp); a mesh of several parts must have each part held by its supports.
   std::vector<char> fixed(problem.body->dof_count(), 0);
   for (const Constraint& c : problem.constraints) fixed[c.dof] = 1;
-  const std::string free = free_rigid_motion(*mesh, fixed);
+  const std::string free = free_rigid_motion(checked, fixed);
   if (free.rfind("the part containing", 0) == 0)
     r.error(ptr + "/supports",
             "leave " + free +

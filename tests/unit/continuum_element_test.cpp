@@ -360,5 +360,29 @@ TEST(ContinuumLocking, MeanDilatationAndNineNodesDoNotLock) {
   EXPECT_NEAR(q9, expected, 0.08 * expected);
 }
 
+// The body's constructor is where a mesh is checked (the scene reader reads the issues off
+// its exception): every issue check_mesh finds, the first in what().
+TEST(ContinuumBodyMesh, RejectsAFaultyMeshWithAllItsIssues) {
+  PlaneMesh mesh = distorted_patch(QuadShape::q4);
+  const std::vector<int> bottom = mesh.sets.at("bottom");
+  mesh.elements[0][2] = 999;                  // a node that does not exist
+  std::swap(mesh.elements[1][1], mesh.elements[1][3]);  // clockwise
+  mesh.nodes.push_back({9, 9});               // in no element
+  const std::vector<MeshIssue> expected = check_mesh(mesh, QuadShape::q4);
+  ASSERT_EQ(expected.size(), 3u);
+  try {
+    ContinuumBody(mesh, bottom, material(PlaneAnalysis::plane_strain), ContinuumOptions{});
+    FAIL() << "a faulty mesh was accepted";
+  } catch (const InvalidMesh& e) {
+    ASSERT_EQ(e.issues.size(), expected.size());
+    for (size_t k = 0; k < expected.size(); ++k) {
+      EXPECT_EQ(e.issues[k].element, expected[k].element);
+      EXPECT_EQ(e.issues[k].node, expected[k].node);
+      EXPECT_EQ(e.issues[k].detail, expected[k].detail);
+    }
+    EXPECT_EQ(std::string(e.what()), "element 0 " + expected[0].detail);
+  }
+}
+
 }  // namespace
 }  // namespace grip
