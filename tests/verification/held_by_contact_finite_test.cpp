@@ -257,5 +257,25 @@ TEST(HeldByContactFinite, RotationNoContactResistsIsRejected) {
   EXPECT_EQ(read_scene(j).problem.rigid.count(), 3);
 }
 
+// The Hertz half-disc with its diameter held in x and finite kinematics: a rotation about a
+// point of the diameter is free to first order only (a finite one moves the diameter in x),
+// which contact cannot hold: refused before solving, the rotation named.
+TEST(HeldByContactFinite, RotationFreeToFirstOrderOnlyIsRejected) {
+  json j = example_scene("hertz");
+  j["body"]["kinematics"] = "finite";
+  j["body"]["supports"] = json::array({{{"set", "diameter"}, {"fix", {"x"}}}});
+  j["body"]["loads"] = json::array({{{"node", 0}, {"force", {0.0, -100.0}}}});
+  std::string issues;
+  try {
+    read_scene(j);
+  } catch (const SceneErrors& e) {
+    for (const auto& i : e.issues()) issues += i.pointer + ": " + i.detail + "\n";
+  }
+  EXPECT_NE(issues.find("/body/supports: leave the body free to rotate about (0, 0): with finite kinematics a "
+                        "rotation is free only about a single supported node"),
+            std::string::npos)
+      << issues;
+}
+
 }  // namespace
 }  // namespace grip
