@@ -39,7 +39,7 @@ class CevStep : public StepSolver {
     out_.p = p_start;
     project_to_cone(problem_, out_.p);
     if (!fresh_solve(q_guess) || !approach_contact()) return;
-    while (error_.norm2 > tol_) {
+    while (!error_met(error_)) {
       if (!budget_left()) return;
       const Compliance& C = eq_.compliance(out_.state, relevant_components(), params_.sparse_compliance_from);
       int inner = 0, halvings = 0;
@@ -125,7 +125,7 @@ class CevStep : public StepSolver {
 
   // Inner iterations on the linear model, then one real solve and its line search.
   bool inner_pass() {
-    while (error_.norm2 > tol_) {
+    while (!error_met(error_)) {
       if (!budget_left()) return false;
       const Compliance& C = eq_.compliance(out_.state, relevant_components());
       int inner = 0, halvings = 0, n_used = 0;

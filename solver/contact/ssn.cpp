@@ -57,7 +57,7 @@ class SsnStep : public StepSolver {
     const int components = problem_.component_count;
     int restarts = 0;
     // Only a state from the oracle ends the loop: the step is judged on a real solve.
-    for (int it = 1; error_.norm2 > tol_; ++it) {
+    for (int it = 1; !error_met(error_); ++it) {
       if (!budget_left()) return;
       if (it > params_.max_iterations)
         return void(fail("semismooth Newton did not converge in " + std::to_string(params_.max_iterations) +

@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "solver/contact/acceleration.hpp"
+#include "solver/solve/rigid_equilibrium.hpp"
 
 namespace grip {
 namespace {
@@ -41,6 +42,7 @@ StepSolver::StepSolver(Equilibrium& eq, const ContactParams& params, int step,
     : eq_(eq), problem_(eq.problem()), params_(params), step_(step), observer_(obs), stop_(stop),
       start_(Clock::now()), newton_emitted_(eq.counters().newton_iterations) {
   tol_ = params.tolerance * problem_.body->characteristic_length();
+  strict_balance_ = rigid_modes_follow_state(problem_);
   is_normal_.assign(problem_.component_count, 0);
   for (const Candidate& c : problem_.candidates) is_normal_[c.eta] = 1;
 }
@@ -59,6 +61,13 @@ StepOutcome StepSolver::run(const Vector& q_guess, const Vector& p_start, const 
       static_cast<int>(eq_.counters().newton_iterations - newton0 + own_newton_iterations_);
   out_.v2 = error_.norm2;
   return std::move(out_);
+}
+
+double StepSolver::unbalance(const ContactError& e) const {
+  if (!strict_balance_) return 0.0;
+  double largest = 0.0;
+  for (int k = 0; k < problem_.rigid.count(); ++k) largest = std::max(largest, std::abs(e.v[problem_.rigid.first + k]));
+  return largest;
 }
 
 bool StepSolver::frictionless() const {
@@ -176,6 +185,14 @@ void StepSolver::accept(EquilibriumState s, const Vector& p) {
   out_.p = p;
   if (coulomb_) out_.tau = friction_bounds(problem_, p);
   error_ = error_at(out_.p, out_.state.s, out_.state.enabled);
+  if (strict_balance_) {
+    // Newton's share of the tolerance of the size of the forces (the sum of the load's and the
+    // contact forces' magnitudes), in the amplitudes' unit (s = scale R^T (F + T p)).
+    double size = problem_.load(eq_.factors()).cwiseAbs().sum();
+    for (const Candidate& c : problem_.candidates)
+      size += std::hypot(p[c.eta], c.xi >= 0 ? p[c.xi] : 0.0);
+    balance_tol_ = problem_.rigid.scale * params_.newton_fraction * params_.tolerance * size;
+  }
 }
 
 bool StepSolver::fail(std::string reason) {
@@ -210,12 +227,12 @@ bool StepSolver::line_search(const Vector& pl, const Vector& du, int& trials) {
     ContactError e = error_at(pt, trial.s, trial.enabled);
     // A loose trial that ends the step is finished at the full precision (no solve counted:
     // the same solve continued), and judged there.
-    if (loose && e.norm2 < v0 && e.norm2 <= tol_) {
+    if (loose && improves(e, v0) && e.norm2 <= tol_) {
       eq_.continue_solve(trial, pt);
       if (!trial.converged) continue;
       e = error_at(pt, trial.s, trial.enabled);
     }
-    if (e.norm2 < v0) {
+    if (improves(e, v0)) {
       accept(std::move(trial), pt);
       return true;
     }
@@ -282,7 +299,7 @@ Direction StepSolver::direction(const Compliance& C, const ContactError& err, in
 }
 
 bool StepSolver::literal_pass(int first_level, double alpha_fixed) {
-  while (error_.norm2 > tol_) {
+  while (!error_met(error_)) {
     if (!budget_left()) return false;
     int level = first_level;  // each update starts at the chosen n
     const Compliance& C = eq_.compliance(out_.state, relevant_components());
@@ -299,7 +316,7 @@ bool StepSolver::literal_pass(int first_level, double alpha_fixed) {
       EquilibriumState trial = eq_.solve(out_.state.q, pt);
       if (trial.converged) {
         const ContactError et = error_at(pt, trial.s, trial.enabled);
-        if (et.norm2 < v0) {
+        if (improves(et, v0)) {
           accept(std::move(trial), pt);
           ++m_;
           emit(trials, 0, halvings, dir.n, dir.alpha * a);
@@ -363,6 +380,11 @@ double StepSolver::force_precision() {
 void StepSolver::final_check() {
   if (error_.norm2 > tol_) {
     fail("contact error above tolerance at the end of the step");
+    return;
+  }
+  if (!error_met(error_)) {
+    fail("the load and the contact forces do not balance on the body's free motions to the tolerance at the end of "
+         "the step");
     return;
   }
   // A free motion that no pressing point resists has no determined amplitude (ALGORITHM.md 7).

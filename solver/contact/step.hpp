@@ -94,6 +94,20 @@ class StepSolver {
   void emit(int trials, int inner, int halvings, int n, double alpha, int own_newton = 0);
 
   bool frictionless() const;
+  // The step's stopping test: ||v|| <= tol, and where the body's free motions follow its state
+  // (rigid_modes_at: finite kinematics, a free rotation) its amplitudes' rows, the residuals at
+  // its pins, to Newton's residual tolerance (newton_fraction x tolerance) relative to the size
+  // of the forces, as every other residual: the linear model is not exact there, so ||v|| <= tol
+  // alone left the moment unbalanced by up to 3e-7 of the forces (a disc turned between two
+  // flats), where elsewhere the model's rows hold to rounding.
+  bool error_met(const ContactError& e) const { return e.norm2 <= tol_ && unbalance(e) <= balance_tol_; }
+  // A trial is better than the accepted state with error v0: a smaller ||v||, or, within the
+  // tolerance, a smaller unbalance on the free motions (error_met's second test).
+  bool improves(const ContactError& e, double v0) const {
+    return e.norm2 < v0 || (e.norm2 <= tol_ && unbalance(e) < unbalance(error_));
+  }
+  // The largest amplitude row of e where error_met tests it, else 0.
+  double unbalance(const ContactError& e) const;
   // The contact error at (p, s): with the bounds out_.tau of the pass, or with Coulomb's
   // bounds mu |p_eta| of p itself.
   ContactError error_at(const Vector& p, const Vector& s, const std::vector<char>& enabled) const {
@@ -108,6 +122,8 @@ class StepSolver {
   const StopRequest& stop_;
   std::chrono::steady_clock::time_point start_;
   double tol_ = 0.0;
+  bool strict_balance_ = false;  // error_met tests the amplitudes' rows
+  double balance_tol_ = 0.0;     // their bound, at the accepted state (accept)
   NewtonParams newton_base_;  // Newton's tests at the contact tolerance (couple_newton)
   int pass_ = 0, m_ = 0;
   long solves_at_start_ = 0;

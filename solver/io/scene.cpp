@@ -13,6 +13,7 @@
 #include "solver/io/json_depth.hpp"
 #include "solver/io/scene_reader.hpp"
 #include "solver/io/schema_validation.hpp"
+#include "solver/solve/rigid_equilibrium.hpp"
 
 namespace grip {
 namespace {
@@ -232,8 +233,10 @@ std::pair<std::string, int> motion_words(const std::vector<BodyPart>& parts, con
 
 // Free rigid motions are held by contact (ALGORITHM.md section 7) where the model allows it:
 // translations always (internal forces are self-equilibrated at any state), rotations where
-// the tangent is constant (linear kinematics: an infinitesimal rotation is a null mode of K);
-// a membrane (no reference stiffness) never. Records them in problem.rigid (pins come later);
+// the tangent is constant (linear kinematics: an infinitesimal rotation is a null mode of K) or
+// where a finite rotation leaves the body's strain unchanged (the continuum with finite
+// kinematics, about at most one supported node: its motions then follow its current shape,
+// rigid_modes_at); a membrane (no reference stiffness) never. Records them in problem.rigid (pins come later);
 // in a scene of several bodies each body's motions on its own dofs.
 void check_rigid_modes(Reader& r, Problem& problem) {
   const std::vector<BodyPart> parts = body_parts(problem);
@@ -252,8 +255,7 @@ void check_rigid_modes(Reader& r, Problem& problem) {
       if (problem.start)
         why = "a membrane has no stiffness of its own to carry a load to its contacts";
       else if (rotates && !body.traits().constant_tangent)
-        why = "a free rotation is held by contact only with linear kinematics (its infinitesimal rotation is a "
-              "null mode of the stiffness; a finite one is not)";
+        why = finite_rotation_refusal(body, fixed);
       if (!why.empty()) {
         r.error(parts[b].supports, "leave the body free to " + motion_name(c, L) + ": " + why +
                                        "; fix a component that this motion moves, or drive the body by a "

@@ -7,6 +7,7 @@
 #include <map>
 
 #include "solver/core/body_set.hpp"
+#include "solver/solve/rigid_equilibrium.hpp"
 
 namespace grip {
 
@@ -479,8 +480,8 @@ EquilibriumState& Equilibrium::finish(EquilibriumState& state, const Vector& p) 
     for (int k = 0; k < rigid.count(); ++k) state.p[rigid.first + k] = state.q[rigid.pins[k]] / rigid.scale;
   if (rigid.count()) {
     const Vector applied = applied_forces(state, state.p);
-    for (int k = 0; k < rigid.count(); ++k)
-      state.s[rigid.first + k] = rigid.scale * rigid.modes.col(k).dot(applied);
+    const Matrix modes = rigid_modes_at(problem_, state.q);
+    for (int k = 0; k < rigid.count(); ++k) state.s[rigid.first + k] = rigid.scale * modes.col(k).dot(applied);
   }
   return state;
 }
@@ -714,10 +715,15 @@ Vector Compliance::apply(const Vector& z) const {
 
 // The border G = T^T R of the compliance (ALGORITHM.md 7), times the amplitudes' scale: the
 // rigid motion moves every contact point with it, and the amplitudes' s, the whole body's
-// equilibrium, changes with p by G^T.
+// equilibrium, changes with p by G^T. R at the state (rigid_modes_at): for a deformed body free
+// to rotate with finite kinematics, about its current shape, where K R = 0 holds only up to
+// terms in its stresses (K R is the load's own turn); the model is then approximate there and
+// the real solves decide, as for any changing tangent.
 void Equilibrium::add_rigid_border(const EquilibriumState& state) {
   const RigidModes& rigid = problem_.rigid;
   c_.bordered = false;
+  if (rigid.count() == 0) return;
+  const Matrix modes = rigid_modes_at(problem_, state.q);
   for (int k = 0; k < rigid.count(); ++k) {
     const int col = c_.position[rigid.first + k];
     if (col < 0) continue;
@@ -728,8 +734,8 @@ void Equilibrium::add_rigid_border(const EquilibriumState& state) {
       const int eta = c_.position[c.eta], xi = c.xi >= 0 ? c_.position[c.xi] : -1;
       double g_eta = 0.0, g_xi = 0.0;
       for (const auto& j : pp.point.jacobian) {
-        g_eta += j.dx.dot(pp.eta) * rigid.modes(j.dof, k);
-        g_xi += j.dx.dot(pp.xi) * rigid.modes(j.dof, k);
+        g_eta += j.dx.dot(pp.eta) * modes(j.dof, k);
+        g_xi += j.dx.dot(pp.xi) * modes(j.dof, k);
       }
       if (eta >= 0) c_.block(eta, col) = c_.block(col, eta) = rigid.scale * g_eta;
       if (xi >= 0) c_.block(xi, col) = c_.block(col, xi) = rigid.scale * g_xi;

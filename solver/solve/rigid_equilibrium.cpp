@@ -32,7 +32,103 @@ std::string factors_text(const Problem& problem, const LoadFactors& factors) {
   return (shown > 1 ? "at load factors " : "at load factor ") + (shown ? text : std::string("0"));
 }
 
+// Every dof a translation, x and y of one node one after the other (the continuum): a model whose
+// rigid rotations are finite ones of its nodes.
+bool translation_pairs(const Body& body) {
+  const Vector tx = body.rigid_translation(Vec2::UnitX()), ty = body.rigid_translation(Vec2::UnitY());
+  if (tx.size() % 2 || body.rigid_rotation().size() != tx.size()) return false;
+  for (int d = 0; d < tx.size(); d += 2)
+    if (tx[d] != 1.0 || tx[d + 1] != 0.0 || ty[d] != 0.0 || ty[d + 1] != 1.0) return false;
+  return true;
+}
+
 }  // namespace
+
+std::string finite_rotation_refusal(const Body& body, const std::vector<int>& fixed) {
+  if (!translation_pairs(body))
+    return "a free rotation is held by contact only with linear kinematics or a model with finite rigid rotations "
+           "(the continuum): a von Karman beam's axial strain u' + w'^2 / 2 changes under a finite rotation, so only "
+           "an infinitesimal one is a null mode of its stiffness";
+  for (int d : fixed)
+    if (d / 2 != fixed.front() / 2)
+      return "with finite kinematics a rotation is free only about a single supported node: supports at several "
+             "nodes leave it free to first order and stop it at any finite angle";
+  return "";
+}
+
+namespace {
+
+// Calls f(body, offset, own) for each body whose free motions turn it and follow its state (finite
+// kinematics and a free rotation: rigid_modes_at), `own` its modes, at `offset` its first dof.
+template <class F>
+void for_each_turning_body(const Problem& problem, F f) {
+  const RigidModes& rigid = problem.rigid;
+  const Body& whole = *problem.body;
+  const auto* set = dynamic_cast<const BodySet*>(&whole);
+  std::vector<char> done(rigid.count(), 0);
+  for (int k = 0; k < rigid.count(); ++k) {
+    if (done[k]) continue;
+    const int b = rigid.body[k];
+    std::vector<int> own;
+    for (int j = k; j < rigid.count(); ++j)
+      if (rigid.body[j] == b) {
+        own.push_back(j);
+        done[j] = 1;
+      }
+    const Body& body = set ? set->part(b) : whole;
+    if (body.traits().constant_tangent || !translation_pairs(body)) continue;
+    const int offset = set ? set->dof_offset(b) : 0, m = body.dof_count();
+    // Translations only (the supports hold the rotation): the same motions at every state.
+    Matrix T(m, 2);
+    T << body.rigid_translation(Vec2::UnitX()), body.rigid_translation(Vec2::UnitY());
+    bool turns = false;
+    for (int j : own) {
+      const Vector r = rigid.modes.col(j).segment(offset, m);
+      const Vector fit = T * (T.transpose() * r / (m / 2));  // tx, ty orthogonal, |t|^2 = m / 2
+      turns = turns || (r - fit).norm() > 1e-9 * r.norm();
+    }
+    if (turns) f(body, offset, own);
+  }
+}
+
+}  // namespace
+
+bool rigid_modes_follow_state(const Problem& problem) {
+  bool any = false;
+  for_each_turning_body(problem, [&](const Body&, int, const std::vector<int>&) { any = true; });
+  return any;
+}
+
+Matrix rigid_modes_at(const Problem& problem, const Vector& q) {
+  const RigidModes& rigid = problem.rigid;
+  Matrix modes = rigid.modes;
+  for_each_turning_body(problem, [&](const Body& body, int offset, const std::vector<int>& own) {
+    const int m = body.dof_count();
+    Matrix B(m, 3);
+    B.col(0) = body.rigid_translation(Vec2::UnitX());
+    B.col(1) = body.rigid_translation(Vec2::UnitY());
+    // The rotation about the deformed positions X + u: (-y, x) at each node.
+    Vector rot = body.rigid_rotation();
+    for (int d = 0; d < m; d += 2) {
+      rot[d] -= q[offset + d + 1];
+      rot[d + 1] += q[offset + d];
+    }
+    B.col(2) = rot / body.characteristic_length();
+    // The combinations of B that vanish at the body's supports (at most one node:
+    // finite_rotation_refusal) and are the identity at its pins: a square system.
+    std::vector<int> rows;
+    for (const Constraint& c : problem.constraints)
+      if (c.dof >= offset && c.dof < offset + m) rows.push_back(c.dof - offset);
+    const int supports = static_cast<int>(rows.size());
+    for (int j : own) rows.push_back(rigid.pins[j] - offset);
+    Matrix A(rows.size(), 3), rhs = Matrix::Zero(rows.size(), own.size());
+    for (size_t r = 0; r < rows.size(); ++r) A.row(r) = B.row(rows[r]);
+    for (size_t j = 0; j < own.size(); ++j) rhs(supports + j, j) = 1.0;
+    const Matrix X = A.colPivHouseholderQr().solve(rhs);
+    for (size_t j = 0; j < own.size(); ++j) modes.col(own[j]).segment(offset, m) = B * X.col(j);
+  });
+  return modes;
+}
 
 std::string unreachable_equilibrium(const Problem& problem, const EquilibriumState& paired,
                                     const LoadFactors& factors) {

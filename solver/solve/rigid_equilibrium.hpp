@@ -4,6 +4,7 @@
 // Coulomb's cone. Checked before a step is solved, so that a load no static equilibrium can
 // carry fails its step with the reason in words instead of a drifting solve.
 #include <string>
+#include <vector>
 
 #include "solver/solve/equilibrium.hpp"
 
@@ -23,6 +24,23 @@ std::string unreachable_equilibrium(const Problem& problem, const EquilibriumSta
 // (no part along the motions the supports leave free), read at its pins. A step then starts
 // with a held body where its supports take it, not turned about them.
 Vector amplitudes_following_supports(const Problem& problem, const LoadFactors& from, const LoadFactors& to);
+
+// Why a free rotation of `body` cannot be held by contact with finite kinematics ("" where it
+// can), its supported dofs `fixed` (the body's own numbering): the model must have finite rigid
+// rotations (every dof a translation: the continuum; a von Karman beam's strain changes under a
+// finite rotation), and the supports may hold at most one node, about which the rotation then
+// turns at any angle (supports at several nodes leave it free to first order only).
+std::string finite_rotation_refusal(const Body& body, const std::vector<int>& fixed);
+
+// The free rigid motions of problem.rigid at the state q, 1 at their own pin and 0 at the other
+// pins. For a body with finite kinematics left free to rotate: the translations and the rotation
+// about its current shape, zero at its supports (ALGORITHM.md 7): the internal forces of a
+// deformed body balance about its deformed positions, so that is where the contact forces and
+// the load must balance too. Elsewhere problem.rigid.modes itself (a constant tangent, or
+// translations only: the same at every state).
+Matrix rigid_modes_at(const Problem& problem, const Vector& q);
+// Whether rigid_modes_at changes with the state for some body of the problem.
+bool rigid_modes_follow_state(const Problem& problem);
 
 // The rigid motion fitted to q by least squares over the body's translations and rotation
 // (about the origin): (x, y, rotation in radians; no rotation for a body without one).

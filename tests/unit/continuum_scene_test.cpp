@@ -144,10 +144,20 @@ TEST(ContinuumScene, FreeMotionThatNoObstacleStopsIsRejected) {
   EXPECT_DOUBLE_EQ(s.problem.rigid.modes(s.problem.rigid.pins[0], 0), 1.0);
   EXPECT_EQ(s.problem.rigid.pins[0] % 2, 0);
   EXPECT_GE(s.problem.rigid.pins[0] / 2, 5);
-  // No supports: finite kinematics cannot hold a free rotation by contact.
+  // No supports, finite kinematics: the rotation is held too, about the block's current shape
+  // (rigid_modes_at; a finite rotation leaves the continuum's strain unchanged).
   j["body"].erase("supports");
+  EXPECT_EQ(read_scene(j).problem.rigid.count(), 3);
+  // The top held in x: free to turn about a point of the top to first order only (a finite turn
+  // moves the top in x), which finite kinematics cannot hold by contact.
+  j["body"]["supports"] = json::parse(R"([{"set": "top", "fix": ["x"]}])");
   EXPECT_TRUE(has_issue(issues_of(j), "/body/supports",
-                        "a free rotation is held by contact only with linear kinematics"));
+                        "rotate about (0, 1): with finite kinematics a rotation is free only about a single supported "
+                        "node"));
+  // One node held: the rotation about it is free at any angle.
+  j["body"]["supports"] = json::parse(R"([{"node": 0, "fix": ["x", "y"]}])");
+  EXPECT_EQ(read_scene(j).problem.rigid.names, std::vector<std::string>{"rotate about (0, 0)"});
+  j["body"].erase("supports");
   // Linear kinematics: all three motions are held (the flat resists the rotation, friction the slide).
   j["body"]["kinematics"] = "linear";
   s = read_scene(j);

@@ -1,0 +1,281 @@
+// A body held only by contact with finite kinematics and its rotation left free (ALGORITHM.md
+// section 7): the rotation of a deformed body is taken about its current shape
+// (rigid_modes_at), where its internal forces balance, so the load and the contact forces must
+// balance there too. A disc (finite strain, neo-Hookean, q4) squeezed between two flats and
+// turned by a couple: contact alone holds its three motions. Invariants: the force and the
+// moment balance about any point with the deformed positions, at every converged step; the
+// small-strain answer at small load; the same state by displacement control.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "solver/elements/continuum.hpp"
+#include "tests/support/contact_profile.hpp"
+#include "tests/support/held.hpp"
+
+namespace grip {
+namespace {
+
+using nlohmann::json;
+using namespace grip::testing;
+
+constexpr int kGrid = 32;      // the disc's grid: (kGrid + 1)^2 nodes
+constexpr double kRadius = 10.0;
+
+int grid_node(int i, int k) { return k * (kGrid + 1) + i; }
+const int kCentre = grid_node(kGrid / 2, kGrid / 2), kRight = grid_node(kGrid, kGrid / 2),
+          kLeft = grid_node(0, kGrid / 2), kAbove = grid_node(kGrid / 2, 3 * kGrid / 4);
+
+// The disc between two flats (tests/support/scenes.hpp) with `kinematics`, nu = 0.3 and q4
+// (q4_bbar is linear only), the upper flat moved down by `delta`, and a couple M = 2 R F
+// (counter-clockwise) from two opposite vertical forces F at the ends of its horizontal diameter,
+// both raised over `steps` equal steps.
+json turned_disc(const char* kinematics, double delta, double F, int steps) {
+  json j = disc_between_flats(kGrid, delta);
+  j["body"]["kinematics"] = kinematics;
+  j["body"]["element"] = "q4";
+  j["body"]["material"]["poisson"] = 0.3;
+  j["body"]["loads"] = json::array({{{"node", kRight}, {"force", {0.0, F}}}, {{"node", kLeft}, {"force", {0.0, -F}}}});
+  j["steps"] = steps;
+  return j;
+}
+
+// The resultant force and the moment about `o` of the load and the contact forces on the disc,
+// at the deformed positions X + u of the nodes they act on; and the size they are measured
+// against: the sum of the forces' magnitudes (times R for the moment).
+struct Balance {
+  Vec2 force = Vec2::Zero();
+  double moment = 0.0;
+  double force_size = 0.0;
+};
+
+Balance balance_about(const Problem& problem, const StepRecord& rec, const Vec2& o) {
+  const auto& mesh = dynamic_cast<const ContinuumBody&>(*problem.body).mesh();
+  Vector f = problem.load(rec.factors);
+  Balance b;
+  b.force_size = f.cwiseAbs().sum();
+  for (size_t i = 0; i < problem.candidates.size(); ++i) {
+    const Candidate& c = problem.candidates[i];
+    const PairedPoint& pp = rec.state.points[i];
+    const Vec2 force = rec.p[c.eta] * pp.eta + (c.xi >= 0 ? rec.p[c.xi] : 0.0) * pp.xi;
+    for (const auto& j : pp.point.jacobian) f[j.dof] += j.dx.dot(force);
+    b.force_size += force.norm();
+  }
+  for (size_t n = 0; n < mesh.nodes.size(); ++n) {
+    const Vec2 x = mesh.nodes[n] + rec.state.q.segment<2>(2 * n) - o, fn = f.segment<2>(2 * n);
+    b.force += fn;
+    b.moment += x.x() * fn.y() - x.y() * fn.x();
+  }
+  return b;
+}
+
+// Each flat's resultant on the disc.
+Vec2 flat_resultant(const Problem& problem, const StepRecord& rec, int obstacle) {
+  Vec2 total = Vec2::Zero();
+  for (size_t i = 0; i < problem.candidates.size(); ++i) {
+    const Candidate& c = problem.candidates[i];
+    if (c.obstacle == obstacle)
+      total += rec.p[c.eta] * rec.state.points[i].eta + (c.xi >= 0 ? rec.p[c.xi] : 0.0) * rec.state.points[i].xi;
+  }
+  return total;
+}
+
+// Every converged step: held and sound (expect_held: the balance on the motions about the
+// current shape to 1e-9), and the force and the moment about two points balance to 1e-9 of the
+// forces' size (times R), measured here from the positions themselves.
+void expect_balanced(const Solved& s) {
+  expect_held(s);
+  for (const StepRecord& rec : s.run.steps) {
+    if (!rec.converged) continue;
+    for (const Vec2& o : {Vec2(0, 0), Vec2(3, -7)}) {
+      const Balance b = balance_about(s.scene.problem, rec, o);
+      EXPECT_LT(b.force.norm(), 1e-9 * b.force_size) << "step " << rec.index;
+      EXPECT_LT(std::abs(b.moment), 1e-9 * b.force_size * kRadius) << "step " << rec.index << " about (" << o.x()
+                                                                      << ", " << o.y() << ")";
+      std::printf("step %d: force unbalance %.2e, moment unbalance about (%g, %g) %.2e (of the forces' size)\n",
+                  rec.index, b.force.norm() / b.force_size, o.x(), o.y(), std::abs(b.moment) / (b.force_size * kRadius));
+    }
+  }
+}
+
+TEST(HeldByContactFinite, TurnedDiscBalancesAboutItsDeformedShape) {
+  const Solved s = solve_scene(turned_disc("finite", 0.1, 100.0, 3));
+  ASSERT_TRUE(s.run.completed) << s.run.reason;
+  EXPECT_EQ(s.scene.problem.rigid.count(), 3);
+  expect_balanced(s);
+  for (const StepRecord& rec : s.run.steps) {
+    const Vec2 lower = flat_resultant(s.scene.problem, rec, 0), upper = flat_resultant(s.scene.problem, rec, 1);
+    const json step = step_json(s.scene.problem, rec, s.scene.output);
+    std::printf("finite disc, step %d: P = %.4f, Q lower %.6f upper %.6f N/mm, rotation %.3e; %d real solves, %d Newton\n",
+                rec.index, lower.y(), lower.x(), upper.x(), step["rigid_motion"]["rotation"].get<double>(), rec.solves,
+                rec.newton_iterations);
+    // The couple turns the disc counter-clockwise, its bottom along +x and its top along -x;
+    // the flats' friction resists: the lower flat pushes along -x, the upper along +x.
+    EXPECT_GT(step["rigid_motion"]["rotation"].get<double>(), 0.0);
+    EXPECT_LT(lower.x(), 0.0);
+    EXPECT_GT(upper.x(), 0.0);
+  }
+  print_work("finite disc turned between two flats", s);
+}
+
+// The largest displacement gradient |du/dX| along the element edges: the size of the terms in
+// which finite and small strain differ (the Green strain's (grad u)^T grad u / 2, the rotation of
+// the stress), relative to the linear ones.
+double largest_gradient(const Problem& problem, const Vector& q) {
+  const auto& body = dynamic_cast<const ContinuumBody&>(*problem.body);
+  double largest = 0.0;
+  for (const auto& cell : body.cells())
+    for (size_t a = 0; a < cell.size(); ++a) {
+      const int m = cell[a], n = cell[(a + 1) % cell.size()];
+      const Vec2 du = q.segment<2>(2 * n) - q.segment<2>(2 * m);
+      largest = std::max(largest, du.norm() / (body.mesh().nodes[n] - body.mesh().nodes[m]).norm());
+    }
+  return largest;
+}
+
+// At a small load the finite-strain answer is the small-strain one up to terms of the order of
+// the displacement gradient: the squeeze force and the friction that holds the couple.
+TEST(HeldByContactFinite, SmallLoadAgreesWithSmallStrain) {
+  const Solved f = solve_scene(turned_disc("finite", 0.02, 20.0, 1));
+  const Solved l = solve_scene(turned_disc("linear", 0.02, 20.0, 1));
+  ASSERT_TRUE(f.run.completed) << f.run.reason;
+  ASSERT_TRUE(l.run.completed) << l.run.reason;
+  expect_balanced(f);
+  const StepRecord &fr = f.run.steps.back(), &lr = l.run.steps.back();
+  const Vec2 pf = flat_resultant(f.scene.problem, fr, 0), pl = flat_resultant(l.scene.problem, lr, 0);
+  const double gradient = largest_gradient(l.scene.problem, lr.state.q);
+  std::printf("small load: P finite %.6f, linear %.6f (%+.3e), Q finite %.6f, linear %.6f (%+.3e); largest "
+              "gradient %.3e; real solves finite %d, linear %d\n",
+              pf.y(), pl.y(), pf.y() / pl.y() - 1, pf.x(), pl.x(), pf.x() / pl.x() - 1, gradient, fr.solves, lr.solves);
+  EXPECT_LT(std::abs(pf.y() / pl.y() - 1), gradient);
+  EXPECT_LT(std::abs(pf.x() / pl.x() - 1), gradient);
+}
+
+// The same state by displacement control: the centre held where the forces put it, and the
+// node above it held in x (which fixes the turn). Nothing is free then; the supports carry
+// nothing (the free run is in equilibrium), and the fields agree.
+TEST(HeldByContactFinite, TurnedDiscByForceMatchesDisplacementControl) {
+  const json scene = turned_disc("finite", 0.1, 100.0, 1);
+  const Solved f = solve_scene(scene);
+  ASSERT_TRUE(f.run.completed) << f.run.reason;
+  expect_balanced(f);
+  const StepRecord& fr = f.run.steps.back();
+  json held = scene;
+  const Vector& q = fr.state.q;
+  held["body"]["supports"] = json::array(
+      {{{"node", kCentre}, {"fix", {"x", "y"}}, {"values", {{"x", q[2 * kCentre]}, {"y", q[2 * kCentre + 1]}}}},
+       {{"node", kAbove}, {"fix", {"x"}}, {"values", {{"x", q[2 * kAbove]}}}}});
+  const Solved d = solve_scene(held);
+  ASSERT_TRUE(d.run.completed) << d.run.reason;
+  EXPECT_EQ(d.scene.problem.rigid.count(), 0);
+  const StepRecord& dr = d.run.steps.back();
+  double p_max = 0.0, p_diff = 0.0;
+  for (const Candidate& c : f.scene.problem.candidates) {
+    p_max = std::max(p_max, std::abs(fr.p[c.eta]));
+    p_diff = std::max(p_diff, std::abs(fr.p[c.eta] - dr.p[c.eta]));
+  }
+  const double q_diff = (q - dr.state.q).lpNorm<Eigen::Infinity>(), q_max = q.lpNorm<Eigen::Infinity>();
+  const Vec2 reaction = reaction_resultant(d.scene.problem, dr);
+  const double P = flat_resultant(f.scene.problem, fr, 0).y();
+  std::printf("by force: %d real solves, %d Newton; by displacement: %d real solves, %d Newton; forces differ by "
+              "%.2e, displacements by %.2e (relative), support reaction %.2e of P\n",
+              fr.solves, fr.newton_iterations, dr.solves, dr.newton_iterations, p_diff / p_max, q_diff / q_max,
+              reaction.norm() / P);
+  EXPECT_LT(p_diff, 1e-6 * p_max);
+  EXPECT_LT(q_diff, 1e-6 * q_max);
+  EXPECT_LT(reaction.norm(), 1e-6 * P);
+}
+
+// The strategies that hold the turned disc, with the same balance. Not here, measured: the tau
+// passes (friction_loop passes) stall in step 1 at ||v|| = 1e-6, five times tol, after 5 cuts
+// ("no decrease of the contact error along the predicted force change"); the paper's literal
+// loop and uzawa fail too, after 220 and 240 s.
+class HeldByContactFiniteStrategy : public ::testing::TestWithParam<Strategy> {};
+
+TEST_P(HeldByContactFiniteStrategy, TurnedDiscBalances) {
+  const Solved s = solve_scene(with_strategy(turned_disc("finite", 0.1, 100.0, 3), GetParam()));
+  ASSERT_TRUE(s.run.completed) << s.run.reason;
+  expect_balanced(s);
+  std::string solves;
+  for (const StepRecord& rec : s.run.steps) solves += std::to_string(rec.solves) + " ";
+  std::printf("%s: real solves a step %s, %ld Newton in all\n", GetParam().name, solves.c_str(),
+              s.run.counters.newton_iterations);
+}
+
+const Strategy kFiniteStrategies[] = {
+    {"cev", json::object()},
+    {"penalty", {{"method", "penalty"}}},
+    {"ssn", {{"method", "ssn"}}},
+};
+
+INSTANTIATE_TEST_SUITE_P(Strategies, HeldByContactFiniteStrategy, ::testing::ValuesIn(kFiniteStrategies),
+                         [](const ::testing::TestParamInfo<Strategy>& info) { return std::string(info.param.name); });
+
+// A ring (radii 5 and 8, finite strain, no supports) around a frictionless shaft of radius
+// 4.99: the shaft holds both translations, but turning the ring about the shaft's axis moves
+// every inner point along the shaft's surface, which nothing resists: rejected before solving,
+// with the motion named.
+TEST(HeldByContactFinite, RotationNoContactResistsIsRejected) {
+  const int around = 32, across = 3;
+  json nodes = json::array(), elements = json::array(), inner = json::array();
+  for (int k = 0; k <= across; ++k)
+    for (int i = 0; i < around; ++i) {
+      const double r = 5.0 + 3.0 * k / across, t = 2 * M_PI * i / around;
+      nodes.push_back({r * std::cos(t), r * std::sin(t)});
+      if (k == 0) inner.push_back(i);
+    }
+  for (int k = 0; k < across; ++k)
+    for (int i = 0; i < around; ++i) {
+      const int a = k * around + i, b = k * around + (i + 1) % around;
+      elements.push_back({a, a + around, b + around, b});  // counter-clockwise: out, along, in
+    }
+  json j = {{"body",
+             {{"model", "continuum"}, {"kinematics", "finite"}, {"analysis", "plane_strain"}, {"element", "q4"},
+              {"thickness", 1}, {"material", {{"young", 200000}, {"poisson", 0.3}}},
+              {"mesh", {{"nodes", nodes}, {"elements", elements}, {"sets", {{"bore", inner}}}}},
+              {"contact_set", "bore"},
+              {"loads", json::array({{{"node", 3 * around + around / 4}, {"force", {0.0, -100.0}}}})}}},
+            {"obstacles", json::array({{{"name", "shaft"},
+                                        {"shape", {{"type", "circle"}, {"centre", {0, 0}}, {"radius", 4.99}}}}})},
+            {"steps", 1}};
+  std::string issues;
+  try {
+    read_scene(j);
+  } catch (const SceneErrors& e) {
+    for (const auto& i : e.issues()) issues += i.pointer + ": " + i.detail + "\n";
+  }
+  EXPECT_NE(issues.find("/body/supports: leave the body free to rotate about (0, 0), and no obstacle within reach "
+                        "can stop that motion"),
+            std::string::npos)
+      << issues;
+  EXPECT_EQ(issues.find("translate"), std::string::npos) << issues;  // the shaft holds the translations
+  // With friction the shaft holds the turn too.
+  j["obstacles"][0]["friction"] = 0.3;
+  EXPECT_EQ(read_scene(j).problem.rigid.count(), 3);
+}
+
+// The Hertz half-disc with its diameter held in x and finite kinematics: a rotation about a
+// point of the diameter is free to first order only (a finite one moves the diameter in x),
+// which contact cannot hold: refused before solving, the rotation named.
+TEST(HeldByContactFinite, RotationFreeToFirstOrderOnlyIsRejected) {
+  json j = example_scene("hertz");
+  j["body"]["kinematics"] = "finite";
+  j["body"]["supports"] = json::array({{{"set", "diameter"}, {"fix", {"x"}}}});
+  j["body"]["loads"] = json::array({{{"node", 0}, {"force", {0.0, -100.0}}}});
+  std::string issues;
+  try {
+    read_scene(j);
+  } catch (const SceneErrors& e) {
+    for (const auto& i : e.issues()) issues += i.pointer + ": " + i.detail + "\n";
+  }
+  EXPECT_NE(issues.find("/body/supports: leave the body free to rotate about (0, 0): with finite kinematics a "
+                        "rotation is free only about a single supported node"),
+            std::string::npos)
+      << issues;
+}
+
+}  // namespace
+}  // namespace grip
