@@ -18,7 +18,9 @@ constexpr double kStaleContraction = 0.03;
 
 class CevStep : public StepSolver {
  public:
-  using StepSolver::StepSolver;
+  CevStep(Equilibrium& eq, const ContactParams& params, int step, const IterationObserver& obs,
+          const StopRequest& stop, double v_previous)
+      : StepSolver(eq, params, step, obs, stop), v_previous_(v_previous) {}
 
  private:
   void solve(const Vector& q_guess, const Vector& p_start, const Vector& p_star) override {
@@ -38,7 +40,7 @@ class CevStep : public StepSolver {
     pass_ = out_.passes = 1;
     out_.p = p_start;
     project_to_cone(problem_, out_.p);
-    if (!fresh_solve(q_guess) || !approach_contact()) return;
+    if (!fresh_solve(q_guess, v_previous_) || !approach_contact()) return;
     while (!error_met(error_)) {
       if (!budget_left()) return;
       const Compliance& C = eq_.compliance(out_.state, relevant_components(), params_.sparse_compliance_from);
@@ -230,14 +232,17 @@ class CevStep : public StepSolver {
       warmup_eps_ = warmup_epsilon(norms, params_.warmup_alpha, params_.warmup_first, last);
     return true;
   }
+
+  // The previous step's first contact error: the scale of this step's first solve.
+  double v_previous_ = 0.0;
 };
 
 }  // namespace
 
 StepOutcome solve_cev_step(Equilibrium& eq, const Vector& q_guess, const Vector& p_start,
                            const Vector& p_star, const ContactParams& params, int step,
-                           const IterationObserver& observer, const StopRequest& stop) {
-  return CevStep(eq, params, step, observer, stop).run(q_guess, p_start, p_star);
+                           const IterationObserver& observer, const StopRequest& stop, double v_previous) {
+  return CevStep(eq, params, step, observer, stop, v_previous).run(q_guess, p_start, p_star);
 }
 
 }  // namespace grip

@@ -44,8 +44,11 @@ class StepSolver {
   void tau_passes(const Vector& q_guess, const Vector& p_start, const Vector& p_star_in,
                   const std::function<bool()>& pass);
 
-  // One real solve at out_.p from q, accepted as the new state (an event with m = 0).
-  bool fresh_solve(const Vector& q);
+  // One real solve at out_.p from q, accepted as the new state (an event with m = 0). With
+  // v_scale > 0 (the contact error expected there), Newton stops at kInexactNewton x v_scale;
+  // it is finished to the full precision where the error found is within the tolerance, and
+  // to kInexactNewton x that error where it is more than 10x below v_scale.
+  bool fresh_solve(const Vector& q, double v_scale = 0.0);
   // A free rigid motion that no pressing contact holds yet, pushed by the load, is moved until
   // its first contact point closes its gap (and presses by the tolerance), then solved again:
   // while every point is open the linear model knows nothing that stops the motion.
@@ -139,7 +142,7 @@ class StepSolver {
 // One entry per strategy file.
 StepOutcome solve_cev_step(Equilibrium& eq, const Vector& q_guess, const Vector& p_start,
                            const Vector& p_star, const ContactParams& params, int step,
-                           const IterationObserver& observer, const StopRequest& stop);
+                           const IterationObserver& observer, const StopRequest& stop, double v_previous);
 StepOutcome solve_uzawa_step(Equilibrium& eq, const Vector& q_guess, const Vector& p_start,
                              const Vector& p_star, const ContactParams& params, int step,
                              const IterationObserver& observer, const StopRequest& stop);

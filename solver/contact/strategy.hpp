@@ -114,10 +114,13 @@ struct StepOutcome {
 
 // One load step: p_start is the first guess of the force (the previous steps' forces
 // extrapolated, like q_guess, the displacement to start Newton from), p_star the previous
-// step's force (the first pass's friction bound, penalty's springs).
+// step's force (the first pass's friction bound, penalty's springs). v_previous: the contact
+// error of the previous step's first solve (0: none), which cev's first solve of this step
+// takes as the scale of its own (its Newton tolerance, StepSolver::fresh_solve).
 StepOutcome solve_contact_step(Equilibrium& equilibrium, const Vector& q_guess,
                                const Vector& p_start, const Vector& p_star,
                                const ContactParams& params, int step,
-                               const IterationObserver& observer, const StopRequest& stop = {});
+                               const IterationObserver& observer, const StopRequest& stop = {},
+                               double v_previous = 0.0);
 
 }  // namespace grip

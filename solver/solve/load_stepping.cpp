@@ -78,6 +78,7 @@ RunResult run_load_steps(Problem& problem, const std::vector<LoadStep>& steps,
   eq.set_step(current, std::vector<double>(problem.candidates.size(), 0.0));
   std::vector<double> zeta = eq.zetas(eq.evaluate(q));
   std::optional<Vector> start_q;
+  double v_first = 0.0;  // the contact error of the last increment's first solve
   if (problem.start) {
     start_q = start_up(problem, params, current, zeta, p, result.reason);
     if (!start_q) {
@@ -129,7 +130,7 @@ RunResult run_load_steps(Problem& problem, const std::vector<LoadStep>& steps,
         break;
       }
       StepOutcome out = solve_contact_step(eq, guess, p_guess, p, params.contact, step,
-                                           observer.iteration, observer.stop_requested);
+                                           observer.iteration, observer.stop_requested, v_first);
       rec.passes += out.passes;
       rec.solves += out.solves;
       rec.newton_iterations += out.newton_iterations;
@@ -169,6 +170,7 @@ RunResult run_load_steps(Problem& problem, const std::vector<LoadStep>& steps,
         }
       }
       // Commit.
+      v_first = start_q || out.history.empty() ? 0.0 : out.history.front().v2;
       start_q.reset();
       q_before = q;
       p_before = p;
