@@ -6,13 +6,15 @@
 // forces of its two pairs. The disc is the master of the upper pair and the slave of the lower.
 // Closed forms: every body carries P (equal and opposite forces across each pair, each body's
 // forces balancing its load), and both contacts are Hertz's between cylinders of R 10 mm,
-// steel on aluminium: 1/R = 1/R1 + 1/R2, 1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2.
+// steel on aluminium: 1/R = 1/R1 + 1/R2, 1/E* = (1 - nu1^2)/E1 + (1 - nu2^2)/E2. One step of
+// P = 5000 N/mm (a 0.74 mm, a / h 15): measured a -0.80 / +0.53 %, p0 +0.85 / -0.31 % (upper /
+// lower pair), cev 7 real solves, 7 Newton; ssn the same widths. In two steps the first, at
+// P / 2 (a / h 10.5), reads the upper pair's a at -1.10 %, over the 1 % (its resolution there).
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <numbers>
 
 #include "solver/elements/plane_mesh.hpp"
@@ -94,7 +96,22 @@ json continuum(const std::string& name, double young, double poisson, json mesh,
 // Top (centre y 20, arc down), disc (centre 0), base (centre y -20, arc up): the poles touch.
 json stack(double P) {
   json top = continuum("top", 200000, 0.3, {{"half_disc", half_disc({0, 2 * kRadius}, false)}}, "arc_refined");
-  top["supports"] = json::array({{{"set", "diameter"}, {"fix", {"x"}}}});
+  // x held on the diameter and at the node on the axis nearest (0, 15): the diameter alone leaves
+  // the rotation about the centre free (it moves the diameter's nodes along y).
+  HalfDiscSpec spec;
+  const json& generated = top["mesh"]["half_disc"];
+  spec.centre = Vec2(0, 2 * kRadius);
+  spec.radius = kRadius;
+  spec.ns = generated["divisions"][0];
+  spec.nt = generated["divisions"][1];
+  spec.refine = Refinement{kSize, kExtent};
+  const PlaneMesh mesh = half_disc_mesh(spec, QuadShape::q4);
+  int axis = -1;
+  for (size_t n = 0; n < mesh.nodes.size(); ++n)
+    if (std::abs(mesh.nodes[n].x()) < 1e-9 &&
+        (axis < 0 || std::abs(mesh.nodes[n].y() - 15) < std::abs(mesh.nodes[axis].y() - 15)))
+      axis = static_cast<int>(n);
+  top["supports"] = json::array({{{"set", "diameter"}, {"fix", {"x"}}}, {{"node", axis}, {"fix", {"x"}}}});
   top["loads"] = json::array({{{"set", "diameter"}, {"traction", {0.0, -P / (2 * kRadius)}}}});
   json disc = continuum("disc", 70000, 0.33, disc_mesh({0, 0}), "rim");
   disc["supports"] = json::array({{{"set", "axis"}, {"fix", {"x"}}}});
@@ -103,7 +120,7 @@ json stack(double P) {
   return {{"bodies", {top, disc, base}},
           {"contacts", {{{"slave", "top.arc_refined"}, {"master", "disc.top"}}, {{"slave", "disc.bottom"}, {"master", "base.arc_refined"}}}},
           {"steps", 1},
-          {"solver", {{"contact", {{"method", "cev"}, {"tolerance", 1e-8}}}}}};
+          {"solver", {{"contact", {{"method", "cev"}, {"tolerance", 1e-10}}}}}};
 }
 
 // The forces of the pair on obstacle `o` (its candidates only) on body b.
@@ -120,10 +137,9 @@ Vec2 pair_force_on(const Problem& problem, const StepRecord& rec, int o, int b) 
 }
 
 TEST(StackHard, ThreeCylindersHeldByContactCarryTheForceAndMatchHertz) {
-  // Not yet: cev stalls in the first step (in one step or two: "no decrease of the contact error
-  // along the predicted force change", ||v|| 3e-6 after 5 cuts, tolerance 1e-8; measured at
-  // commit time, not traced: the disc is the master of one pair and the slave of the other).
-  if (!std::getenv("GRIP_RUN_STACK")) GTEST_SKIP() << "cev stalls at ||v|| 3e-6 in step 1 (measured)";
+  // Between two deformable bodies the free rows hold to the stopping test's bound ||v|| / scale
+  // (held.hpp), not to rounding: at the shipped tolerance 1e-8 that was 1.8e-9 of the load
+  // (measured); 1e-10 brings it under balance()'s 1e-9, as in two_bodies_held_test.cpp.
   const double P = 5000.0;  // N / mm
   const Solved s = solve_scene(stack(P));
   // Held and sound on every step, the base carries P through the lower pair.
