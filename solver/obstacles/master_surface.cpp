@@ -219,11 +219,30 @@ MasterPoint DeformedMaster::project(const Vec2& x, int slave_site) const {
   return best;
 }
 
-void DeformedMaster::force_derivative(const SurfacePoint& slave, int slave_site, double p_eta, double p_xi,
-                                      Triplets& out) const {
-  // The variables: the positions of the slave point, then of the master sites and the slave
-  // surface's sites that the pairing reads (two coordinates each, in this order).
-  std::vector<const SurfacePoint*> vars{&slave};
+// The pairing of a slave point with its derivatives: `vars` the points whose positions it reads
+// (two coordinates each, in this order: the slave point, then the master sites and the slave
+// surface's sites), the smoothed normal, the gap (x - x_m) . n, zeta, and each point's share of
+// the pair's force f (1 on the slave, -w_k on master site k).
+struct DeformedMaster::DualPairing {
+  std::vector<const SurfacePoint*> vars;
+  P2<Dual> normal;
+  Dual gap, zeta;
+  std::vector<std::pair<const SurfacePoint*, Dual>> shares;
+
+  // The gradient of s over the dofs: d s / d x_var times d x_var / d q (the points' Jacobians
+  // are constant: continuum sites, a beam's offset surface).
+  void add_gradient(const Dual& s, double scale, std::vector<std::pair<int, double>>& out) const {
+    if (!s.d.size()) return;
+    for (size_t v = 0; v < vars.size(); ++v)
+      for (const auto& col : vars[v]->jacobian)
+        out.emplace_back(col.dof, scale * (s.d[2 * v] * col.dx.x() + s.d[2 * v + 1] * col.dx.y()));
+  }
+};
+
+DeformedMaster::DualPairing DeformedMaster::dual_pairing(const SurfacePoint& slave, int slave_site) const {
+  DualPairing out;
+  std::vector<const SurfacePoint*>& vars = out.vars;
+  vars.push_back(&slave);
   std::map<std::array<int, 2>, int> master_slot;  // (chain, index) -> variable
   std::map<int, int> slave_slot;                  // slave site -> variable
   const auto use_master = [&](int chain, int k) {
@@ -272,10 +291,10 @@ void DeformedMaster::force_derivative(const SurfacePoint& slave, int slave_site,
   const P2<Dual> from = on(c.segment), segment = on(c.segment + 1) - from;
   const Dual t = c.t != 0.0 ? dot(x - from, segment) / dot(segment, segment) : Dual(0.0);
   const Dual along = c.t > 0.0 && c.t < 1.0 ? t : Dual(std::clamp(c.t, 0.0, 1.0));
-  const P2<Dual> normal = smoothed_normal<Dual>(on, n, c.segment, along);
-  const P2<Dual> f = Dual(-p_eta) * normal + Dual(p_xi) * rot90(normal);
-  // The forces at the variables' points: f on the slave, -w_k f on master site k.
-  std::vector<std::pair<const SurfacePoint*, P2<Dual>>> forces{{&slave, f}};
+  out.normal = smoothed_normal<Dual>(on, n, c.segment, along);
+  out.shares.push_back({&slave, Dual(1.0)});
+  const std::vector<double>& ref = *chains_[c.chain].reference;
+  P2<Dual> x_m{Dual(0.0), Dual(0.0)};
   if (mortar) {
     std::map<std::array<int, 2>, Dual> m;  // M_jk as in integrate_mortar, with derivatives
     for (const Piece& piece : pieces) {
@@ -288,27 +307,46 @@ void DeformedMaster::force_derivative(const SurfacePoint& slave, int slave_site,
     }
     Dual covered(0.0);
     for (const auto& entry : m) covered += entry.second;
-    for (const auto& [k, value] : m)
-      forces.push_back({&chains_[k[0]].points[k[1]], (Dual(-1.0) * value / covered) * f});
+    for (const auto& [k, value] : m) {
+      const Dual w = value / covered;
+      out.shares.push_back({&chains_[k[0]].points[k[1]], -w});
+      x_m = x_m + w * master_at(k[0])(k[1]);
+      out.zeta += w * Dual((*chains_[k[0]].reference)[k[1]]);
+    }
   } else {
-    forces.push_back({&chains_[c.chain].points[c.segment], (t - Dual(1.0)) * f});
-    forces.push_back({&chains_[c.chain].points[c.segment + 1], (Dual(0.0) - t) * f});
+    out.shares.push_back({&chains_[c.chain].points[c.segment], t - Dual(1.0)});
+    out.shares.push_back({&chains_[c.chain].points[c.segment + 1], -t});
+    x_m = from + t * segment;
+    out.zeta = Dual(ref[c.segment]) + t * Dual(ref[c.segment + 1] - ref[c.segment]);
   }
-  // Chain rule: d(J_row . force)/dq_col = sum over variables of d(force)/dx_var dx_var/dq_col
-  // (the points' Jacobians are constant: continuum sites).
-  for (const auto& [point, force] : forces) {
-    if (!force.x.d.size() && !force.y.d.size()) continue;
-    const Vector dfx = force.x.d.size() ? force.x.d : Vector::Zero(count);
-    const Vector dfy = force.y.d.size() ? force.y.d : Vector::Zero(count);
+  out.gap = dot(x - x_m, out.normal);
+  return out;
+}
+
+void DeformedMaster::force_derivative(const SurfacePoint& slave, int slave_site, double p_eta, double p_xi,
+                                      Triplets& out) const {
+  const DualPairing pairing = dual_pairing(slave, slave_site);
+  const P2<Dual> f = Dual(-p_eta) * pairing.normal + Dual(p_xi) * rot90(pairing.normal);
+  // d(J_row . share f)/dq_col = sum over variables of d(share f)/dx_var dx_var/dq_col.
+  std::vector<std::pair<int, double>> column;
+  for (const auto& [point, share] : pairing.shares) {
+    const P2<Dual> force = share * f;
     for (const auto& row : point->jacobian) {
-      const Vector d = row.dx.x() * dfx + row.dx.y() * dfy;
-      for (size_t v = 0; v < vars.size(); ++v)
-        for (const auto& col : vars[v]->jacobian) {
-          out.emplace_back(row.dof, col.dof, d[2 * v] * col.dx.x() + d[2 * v + 1] * col.dx.y());
-          out.emplace_back(col.dof, row.dof, 0.0);  // a tangent's pattern is symmetric
-        }
+      column.clear();
+      pairing.add_gradient(Dual(row.dx.x()) * force.x + Dual(row.dx.y()) * force.y, 1.0, column);
+      for (const auto& [dof, value] : column) {
+        out.emplace_back(row.dof, dof, value);
+        out.emplace_back(dof, row.dof, 0.0);  // a tangent's pattern is symmetric
+      }
     }
   }
+}
+
+void DeformedMaster::gradients(const SurfacePoint& slave, int slave_site, std::vector<std::pair<int, double>>& gap,
+                               std::vector<std::pair<int, double>>& zeta) const {
+  const DualPairing pairing = dual_pairing(slave, slave_site);
+  pairing.add_gradient(pairing.gap, 1.0, gap);
+  pairing.add_gradient(pairing.zeta, 1.0, zeta);
 }
 
 }  // namespace grip

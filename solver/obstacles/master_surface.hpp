@@ -32,6 +32,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "solver/core/body.hpp"
@@ -73,6 +74,14 @@ class DeformedMaster {
   // d force_row / d q_col) for the pair alone (continuum sites: constant point Jacobians),
   // each with its transpose's place (a zero): the pattern stays symmetric.
   void force_derivative(const SurfacePoint& slave, int slave_site, double p_eta, double p_xi, Triplets& out) const;
+  // The gradients over the dofs of the gap (x - x_m) . n and of the surface coordinate zeta of
+  // the slave point `slave` (of `slave_site`), both bodies' dofs, as (dof, derivative) entries
+  // (a dof may repeat: add them): d(s_eta)/dq = -gap gradient, d(s_xi)/dq = zeta gradient. Beside
+  // the Jacobian's part n . J, they hold the normal's turn and the mortar weights' shift, which
+  // a law p(s) (penalty) needs in its tangent: with k the penalty stiffness, these are k x the
+  // master's curvature terms, where force_derivative's are p x them.
+  void gradients(const SurfacePoint& slave, int slave_site, std::vector<std::pair<int, double>>& gap,
+                 std::vector<std::pair<int, double>>& zeta) const;
 
  private:
   struct Chain {
@@ -87,6 +96,9 @@ class DeformedMaster {
     double t = 0.0;  // along the segment, unclamped beyond the chain's ends
   };
   Closest closest(const Vec2& x) const;
+  // The pairing of a slave point in dual numbers over the positions it reads (master_surface.cpp).
+  struct DualPairing;
+  DualPairing dual_pairing(const SurfacePoint& slave, int slave_site) const;
   void integrate_mortar(const Body& body, const Vector& q, const MasterSurface& surface);
   // The master chain and segments (first, last) that slave segment a -> b integrates against;
   // none where its ends are closest to different chains.

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <tuple>
 
 #include "solver/core/body_set.hpp"
 #include "solver/solve/rigid_equilibrium.hpp"
@@ -121,9 +122,11 @@ EquilibriumState Equilibrium::evaluate(const Vector& q) const {
   return state;
 }
 
-Vector Equilibrium::penalty_forces(const EquilibriumState& paired, Triplets* tangent, const Vector* increment) const {
+Vector Equilibrium::penalty_forces(const Vector& q, const EquilibriumState& paired, Triplets* tangent,
+                                   const Vector* increment) const {
   const PenaltyLaw& law = *penalty_;
   Vector p = Vector::Zero(problem_.component_count);
+  std::vector<std::pair<int, double>> gap, zeta;  // d(gap)/dq, d(zeta)/dq: (dof, derivative)
   for (size_t i = 0; i < problem_.candidates.size(); ++i) {
     const Candidate& c = problem_.candidates[i];
     const PairedPoint& pp = paired.points[i];
@@ -134,34 +137,57 @@ Vector Equilibrium::penalty_forces(const EquilibriumState& paired, Triplets* tan
       continue;
     }
     p[c.eta] = -law.normal * paired.s[c.eta];
-    // d(s_eta)/dx = eta^T, d(s_xi)/dx = zeta_rate xi^T.
-    Eigen::RowVector2d dpn = -law.normal * pp.eta.transpose(), dpt = Eigen::RowVector2d::Zero();
-    if (c.xi >= 0 && paired.enabled[c.xi]) {
+    const bool frictional = c.xi >= 0 && paired.enabled[c.xi];
+    // p_eta = k_n gap; p_xi = start - k_t (zeta - zeta_prev) (stick) or -sign mu p_eta (slip).
+    double stick = 0.0, slip = 0.0;  // dp_xi = stick d(zeta) + slip d(p_eta)
+    if (frictional) {
       const double mu = problem_.obstacles[c.obstacle].friction;
       const double start = law.previous.size() ? law.previous[c.xi] : 0.0;
       const double trial = start - law.tangential * paired.s[c.xi];
       const double bound = mu * std::abs(p[c.eta]);
       if (std::abs(trial) <= bound || (!stick_branch_.empty() && stick_branch_[i])) {
         p[c.xi] = trial;
-        dpt = -law.tangential * pp.projection.zeta_rate * pp.xi.transpose();
+        stick = -law.tangential;
       } else {  // slip: the return to the cone
         const double sign = trial > 0 ? 1.0 : -1.0;
         p[c.xi] = sign * bound;
-        dpt = -sign * mu * dpn;
+        slip = -sign * mu;
       }
     }
-    if (increment) {  // the law's linear change over the increment, from the increment itself
-      Vec2 dx = Vec2::Zero();
-      for (const auto& j : pp.point.jacobian) dx += (*increment)[j.dof] * j.dx;
-      p[c.eta] += dpn * dx;
-      if (c.xi >= 0 && paired.enabled[c.xi]) p[c.xi] += dpt * dx;
+    if (!tangent && !increment) continue;
+    // The gradients of the gap and of zeta: against a rigid obstacle n . J and zeta_rate xi . J
+    // (its closest point); against a deformable master also the normal's turn and the mortar
+    // weights' shift with both bodies (DeformedMaster::gradients): one consistent tangent.
+    gap.clear();
+    zeta.clear();
+    const auto& master = paired.masters[c.obstacle];
+    if (master) {
+      master->gradients(problem_.body->surface_point(q, c.site, c.side), c.site, gap, zeta);
+    } else {
+      for (const auto& j : pp.point.jacobian) {
+        gap.emplace_back(j.dof, -pp.eta.dot(j.dx));
+        if (frictional) zeta.emplace_back(j.dof, pp.projection.zeta_rate * pp.xi.dot(j.dx));
+      }
     }
+    // dp_eta = k_n d(gap), dp_xi = stick d(zeta) + slip dp_eta, as (dof, dp_eta, dp_xi).
+    std::vector<std::tuple<int, double, double>> dp;
+    for (const auto& [dof, g] : gap) dp.emplace_back(dof, law.normal * g, slip * law.normal * g);
+    if (frictional)
+      for (const auto& [dof, z] : zeta) dp.emplace_back(dof, 0.0, stick * z);
+    if (increment)  // the law's linear change over the increment, from the increment itself
+      for (const auto& [dof, dpn, dpt] : dp) {
+        p[c.eta] += dpn * (*increment)[dof];
+        if (frictional) p[c.xi] += dpt * (*increment)[dof];
+      }
     if (!tangent) continue;
-    // d(T p)/dx from p's dependence on x; the residual carries it with a minus sign.
-    const Mat2 df_dx = pp.eta * dpn + pp.xi * dpt;
-    for (const auto& a : pp.point.jacobian)
-      for (const auto& b : pp.point.jacobian)
-        tangent->emplace_back(a.dof, b.dof, -a.dx.dot(df_dx * b.dx));
+    // d(T p)/dq from p's dependence on q; the residual carries it with a minus sign.
+    for (const auto& a : pp.point.jacobian) {
+      const double on_eta = a.dx.dot(pp.eta), on_xi = a.dx.dot(pp.xi);
+      for (const auto& [dof, dpn, dpt] : dp) {
+        tangent->emplace_back(a.dof, dof, -(on_eta * dpn + on_xi * dpt));
+        if (master) tangent->emplace_back(dof, a.dof, 0.0);  // a tangent's pattern is symmetric
+      }
+    }
   }
   return p;
 }
@@ -190,7 +216,7 @@ double Equilibrium::stiffness_scale(const Vector& q) const {
 
 Vector Equilibrium::residual(const Vector& q, const EquilibriumState& paired, const Vector& p_given,
                              Triplets* tangent, double* force_scale, bool body_tangent) const {
-  const Vector p = penalty_ ? penalty_forces(paired, tangent) : p_given;
+  const Vector p = penalty_ ? penalty_forces(q, paired, tangent) : p_given;
   Vector r = Vector::Zero(q.size());
   problem_.body->internal_force(q, r, body_tangent ? tangent : nullptr);
   const Vector external = problem_.load(factors_);
@@ -213,9 +239,13 @@ Vector Equilibrium::residual(const Vector& q, const EquilibriumState& paired, co
     for (const auto& a : pp.point.jacobian)
       for (const auto& b : pp.point.jacobian)
         tangent->emplace_back(a.dof, b.dof, -a.dx.dot(df_dx * b.dx));
-    // The pair's stiffness, both bodies. Not with the penalty law: with it, the free body held by
-    // its pins' springs (two_bodies_held_test, penalty) no longer converges in step 1 (free
-    // residual 0.99 after 5 cuts), while without it it takes 4 real solves; not traced yet.
+    // The pair's stiffness at the given p, both bodies (the penalty law's change of p with the
+    // positions, the gradients of the gap and zeta, is in penalty_forces). Not with the penalty
+    // law: these terms scale with p (p / element size), and at the iterates of a held body's
+    // first solve the law's forces reach 20-60 x the load (penetrations 2e-5..8e-5 mm at
+    // k 3.7e9 N/mm, two_bodies_held_test), where they pass the body's own stiffness: the
+    // tangent turns indefinite and Newton stalls at a free residual of 0.99 (measured). At the
+    // answer they are 1.6e-3 of the body's stiffness: leaving them out costs a linear rate there.
     if (const auto& master = paired.masters[c.obstacle]; master && !penalty_) {
       const size_t first = tangent->size();
       master->force_derivative(problem_.body->surface_point(q, c.site, c.side), c.site, p_eta, p_xi, *tangent);
@@ -457,7 +487,7 @@ EquilibriumState& Equilibrium::finish_penalty(EquilibriumState& state) {
   Triplets tangent;
   const Vector r = residual(state.q, state, state.p, &tangent);
   ++counters_.factorizations;
-  if (!lu_.factorize(tangent, free_index_, free_count_, 1e-4)) return finish(state, penalty_forces(state, nullptr));
+  if (!lu_.factorize(tangent, free_index_, free_count_, 1e-4)) return finish(state, penalty_forces(state.q, state, nullptr));
   Vector r_free(free_count_);
   for (int i = 0; i < r.size(); ++i)
     if (free_index_[i] >= 0) r_free[free_index_[i]] = -r[i];
@@ -465,7 +495,7 @@ EquilibriumState& Equilibrium::finish_penalty(EquilibriumState& state) {
   Vector dq = Vector::Zero(state.q.size());
   for (int i = 0; i < state.q.size(); ++i)
     if (free_index_[i] >= 0) dq[i] = dq_free[free_index_[i]];
-  const Vector p = penalty_forces(state, nullptr, &dq);
+  const Vector p = penalty_forces(state.q, state, nullptr, &dq);
   state.q += dq;
   pair(state.q, state);
   return finish(state, p);

@@ -212,9 +212,10 @@ class Equilibrium {
   // Newton's step -K_t^-1 r for the constant body tangent plus the pair's stiffness (the
   // `contact` triplets), as a low-rank correction on G.
   Vector low_rank_step(const EquilibriumState& state, const Triplets& contact, const Vector& rhs);
-  // p(q) of the penalty law at a paired state, and (if asked) its stiffness triplets. With an
+  // p(q) of the penalty law at a paired state of q, and (if asked) its stiffness triplets. With an
   // increment dq (all dofs), p(q) + (dp/dq) dq: the law linearized at q.
-  Vector penalty_forces(const EquilibriumState& paired, Triplets* tangent, const Vector* increment = nullptr) const;
+  Vector penalty_forces(const Vector& q, const EquilibriumState& paired, Triplets* tangent,
+                        const Vector* increment = nullptr) const;
   // The penalty law's answer at a converged iterate q (paired): one more Newton correction dq,
   // and the forces p(q) + (dp/dq) dq at q + dq.
   EquilibriumState& finish_penalty(EquilibriumState& state);
