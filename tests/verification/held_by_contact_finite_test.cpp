@@ -101,6 +101,17 @@ void expect_balanced(const Solved& s) {
   }
 }
 
+// The reader's issues, one "pointer: detail" per line (empty when it accepts the scene).
+std::string scene_issues(const json& j) {
+  std::string issues;
+  try {
+    read_scene(j);
+  } catch (const SceneErrors& e) {
+    for (const auto& i : e.issues()) issues += i.pointer + ": " + i.detail + "\n";
+  }
+  return issues;
+}
+
 TEST(HeldByContactFinite, TurnedDiscBalancesAboutItsDeformedShape) {
   const Solved s = solve_scene(turned_disc("finite", 0.1, 100.0, 3));
   ASSERT_TRUE(s.run.completed) << s.run.reason;
@@ -241,12 +252,7 @@ TEST(HeldByContactFinite, RotationNoContactResistsIsRejected) {
             {"obstacles", json::array({{{"name", "shaft"},
                                         {"shape", {{"type", "circle"}, {"centre", {0, 0}}, {"radius", 4.99}}}}})},
             {"steps", 1}};
-  std::string issues;
-  try {
-    read_scene(j);
-  } catch (const SceneErrors& e) {
-    for (const auto& i : e.issues()) issues += i.pointer + ": " + i.detail + "\n";
-  }
+  const std::string issues = scene_issues(j);
   EXPECT_NE(issues.find("/body/supports: leave the body free to rotate about (0, 0), and no obstacle within reach "
                         "can stop that motion"),
             std::string::npos)
@@ -265,12 +271,7 @@ TEST(HeldByContactFinite, RotationFreeToFirstOrderOnlyIsRejected) {
   j["body"]["kinematics"] = "finite";
   j["body"]["supports"] = json::array({{{"set", "diameter"}, {"fix", {"x"}}}});
   j["body"]["loads"] = json::array({{{"node", 0}, {"force", {0.0, -100.0}}}});
-  std::string issues;
-  try {
-    read_scene(j);
-  } catch (const SceneErrors& e) {
-    for (const auto& i : e.issues()) issues += i.pointer + ": " + i.detail + "\n";
-  }
+  const std::string issues = scene_issues(j);
   EXPECT_NE(issues.find("/body/supports: leave the body free to rotate about (0, 0): with finite kinematics a "
                         "rotation is free only about a single supported node"),
             std::string::npos)
