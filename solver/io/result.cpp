@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <functional>
+#include <memory>
 #include <stdexcept>
 
 #include "solver/contact/contact_error.hpp"
@@ -284,33 +285,49 @@ json result_head(const Scene& scene, const RunResult& run) {
   return head;
 }
 
-// table_json's rows, written as they are made: no document of the table's size in memory.
-void write_table(JsonWriter& w, const FlatTable& t, const std::string& index_name) {
-  std::vector<std::pair<std::string, int>> keys{{index_name, -1}};  // -1: the row index
+// table_json's rows, written as they are made (no document of the table's size in memory),
+// kRowsPerPart rows a part.
+std::vector<StepPart> table_parts(const FlatTable& t, const std::string& index_name) {
+  struct Columns {
+    std::vector<int> column;  // of each key in nlohmann's order (sorted); -1: the row index
+    std::vector<std::string> quoted;  // "key":
+  };
+  std::vector<std::pair<std::string, int>> keys{{index_name, -1}};
   for (size_t c = 0; c < t.names.size(); ++c)
     if (t.names[c] != index_name) keys.emplace_back(t.names[c], static_cast<int>(c));
-  std::sort(keys.begin(), keys.end());  // an object's keys in nlohmann's order
-  std::vector<std::string> quoted;
-  for (const auto& k : keys) quoted.push_back(json(k.first).dump() + ":");
-  const size_t width = t.names.size();
-  w.put('[');
-  for (size_t i = 0; i < t.rows; ++i) {
-    const double* row = t.values.data() + i * width;
-    w.raw(i ? ",\n{" : "\n{");
-    bool first = true;
-    for (size_t k = 0; k < keys.size(); ++k) {
-      if (keys[k].second >= 0 && std::isnan(row[keys[k].second])) continue;  // as table_json
-      if (!first) w.put(',');
-      first = false;
-      w.raw(quoted[k]);
-      if (keys[k].second < 0)
-        w.integer(static_cast<long long>(i));
-      else
-        w.number(row[keys[k].second]);
-    }
-    w.put('}');
+  std::sort(keys.begin(), keys.end());
+  auto columns = std::make_shared<Columns>();
+  for (const auto& [name, c] : keys) {
+    columns->column.push_back(c);
+    columns->quoted.push_back(json(name).dump() + ":");
   }
-  w.put(']');
+  std::vector<StepPart> parts;
+  for (size_t begin = 0;; begin += kRowsPerPart) {
+    const size_t end = std::min(begin + kRowsPerPart, t.rows);
+    parts.push_back([&t, columns, begin, end](JsonWriter& w) {
+      const size_t width = t.names.size();
+      if (begin == 0) w.put('[');
+      for (size_t i = begin; i < end; ++i) {
+        const double* row = t.values.data() + i * width;
+        w.raw(i ? ",\n{" : "\n{");
+        bool first = true;
+        for (size_t k = 0; k < columns->column.size(); ++k) {
+          const int c = columns->column[k];
+          if (c >= 0 && std::isnan(row[c])) continue;  // as table_json
+          if (!first) w.put(',');
+          first = false;
+          w.raw(columns->quoted[k]);
+          if (c < 0)
+            w.integer(static_cast<long long>(i));
+          else
+            w.number(row[c]);
+        }
+        w.put('}');
+      }
+      if (end == t.rows) w.put(']');
+    });
+    if (end == t.rows) return parts;
+  }
 }
 
 FlatTable flat_table(const FieldTable& t) {
@@ -323,38 +340,44 @@ FlatTable flat_table(const FieldTable& t) {
   return f;
 }
 
-using Streamed = std::vector<std::pair<std::string, std::function<void()>>>;
-
-// The object `small` with the members `streamed` (written by their functions) among its keys.
-void write_object(JsonWriter& w, const json& small, Streamed streamed) {
-  std::sort(streamed.begin(), streamed.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-  auto it = small.begin();
-  auto st = streamed.begin();
-  w.put('{');
-  for (bool first = true; it != small.end() || st != streamed.end(); first = false) {
+// `small`'s members [from, to), each after a comma unless it is the object's first (`first`);
+// whether the object is still without a member.
+bool write_members(JsonWriter& w, json::const_iterator from, json::const_iterator to, bool first) {
+  for (auto it = from; it != to; ++it, first = false) {
     if (!first) w.put(',');
-    if (st == streamed.end() || (it != small.end() && it.key() < st->first)) {
-      w.string(it.key());
-      w.put(':');
-      w.value(it.value());
-      ++it;
-    } else {
-      w.string(st->first);
-      w.put(':');
-      st->second();
-      ++st;
-    }
+    w.string(it.key());
+    w.put(':');
+    w.value(it.value());
   }
-  w.put('}');
+  return first;
 }
 
-void write_step(JsonWriter& w, const StepOutput& step) {
-  Streamed tables;
-  if (step.nodes) tables.emplace_back("nodes", [&] { write_table(w, *step.nodes, "node"); });
-  if (step.elements) tables.emplace_back("elements", [&] { write_table(w, *step.elements, "element"); });
-  if (step.contact_points)
-    tables.emplace_back("contact_points", [&] { w.value(contact_points_json(*step.contact_points)); });
-  write_object(w, step.summary, std::move(tables));
+using Streamed = std::vector<std::pair<std::string, std::vector<StepPart>>>;
+
+// The object `small` with the members `streamed` (their values written by their parts) among
+// its keys, in parts: each streamed value's own, and before each of them and after the last a
+// part with the small members between and the streamed key. `small` must outlive the parts.
+std::vector<StepPart> object_parts(const json& small, Streamed streamed) {
+  std::sort(streamed.begin(), streamed.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::vector<StepPart> parts;
+  auto it = small.cbegin();
+  for (auto& [key, value] : streamed) {
+    const auto from = it;
+    while (it != small.cend() && it.key() < key) ++it;
+    parts.push_back([from, to = it, name = key, start = parts.empty()](JsonWriter& w) {
+      if (start) w.put('{');
+      if (!write_members(w, from, to, start)) w.put(',');
+      w.string(name);
+      w.put(':');
+    });
+    for (StepPart& p : value) parts.push_back(std::move(p));
+  }
+  parts.push_back([from = it, to = small.cend(), start = parts.empty()](JsonWriter& w) {
+    if (start) w.put('{');
+    write_members(w, from, to, start);
+    w.put('}');
+  });
+  return parts;
 }
 
 // mesh.cells, one cell a line.
@@ -396,9 +419,20 @@ StepOutput step_output(const Problem& problem, const StepRecord& rec, const Outp
   return step;
 }
 
+std::vector<StepPart> step_parts(const StepOutput& step) {
+  Streamed tables;
+  if (step.nodes) tables.emplace_back("nodes", table_parts(*step.nodes, "node"));
+  if (step.elements) tables.emplace_back("elements", table_parts(*step.elements, "element"));
+  if (step.contact_points)
+    tables.emplace_back("contact_points", std::vector<StepPart>{[&points = *step.contact_points](JsonWriter& w) {
+                          w.value(contact_points_json(points));
+                        }});
+  return object_parts(step.summary, std::move(tables));
+}
+
 void write_step(std::ostream& out, const StepOutput& step) {
   JsonWriter w(out);
-  write_step(w, step);
+  for (const StepPart& part : step_parts(step)) part(w);
 }
 
 namespace {
@@ -407,16 +441,17 @@ namespace {
 void write_result(std::ostream& out, const Scene& scene, const RunResult& run,
                   const std::function<void(JsonWriter&, size_t)>& write_step) {
   JsonWriter w(out);
-  write_object(w, result_head(scene, run),
-               {{"mesh", [&] { write_cells(w, scene.problem.body->cells()); }},
-                {"steps", [&] {
-                   w.put('[');
-                   for (size_t k = 0; k < run.steps.size(); ++k) {
-                     w.raw(k ? ",\n" : "\n");
-                     write_step(w, k);
-                   }
-                   w.put(']');
-                 }}});
+  const json head = result_head(scene, run);
+  const StepPart mesh = [&](JsonWriter& w) { write_cells(w, scene.problem.body->cells()); };
+  const StepPart steps = [&](JsonWriter& w) {
+    w.put('[');
+    for (size_t k = 0; k < run.steps.size(); ++k) {
+      w.raw(k ? ",\n" : "\n");
+      write_step(w, k);
+    }
+    w.put(']');
+  };
+  for (const StepPart& part : object_parts(head, {{"mesh", {mesh}}, {"steps", {steps}}})) part(w);
   w.put('\n');
 }
 
@@ -424,16 +459,16 @@ void write_result(std::ostream& out, const Scene& scene, const RunResult& run,
 
 void write_result(std::ostream& out, const Scene& scene, const RunResult& run) {
   write_result(out, scene, run, [&](JsonWriter& w, size_t k) {
-    write_step(w, step_output(scene.problem, run.steps[k], scene.output));
+    const StepOutput step = step_output(scene.problem, run.steps[k], scene.output);
+    for (const StepPart& part : step_parts(step)) part(w);
   });
 }
 
 void write_result(std::ostream& out, const Scene& scene, const RunResult& run,
-                  const std::vector<std::string_view>& step_texts) {
-  if (step_texts.size() != run.steps.size())
-    throw std::logic_error("write_result: " + std::to_string(step_texts.size()) + " step texts for " +
-                           std::to_string(run.steps.size()) + " steps");
-  write_result(out, scene, run, [&](JsonWriter& w, size_t k) { w.raw(step_texts[k]); });
+                  const std::function<std::vector<std::string_view>(size_t)>& step_text) {
+  write_result(out, scene, run, [&](JsonWriter& w, size_t k) {
+    for (std::string_view piece : step_text(k)) w.raw(piece);
+  });
 }
 
 }  // namespace grip

@@ -1,6 +1,7 @@
 #pragma once
 // Results and events as JSON (DESIGN.md vocabulary). Events are the same objects whether
 // written to an NDJSON file by `grip solve --events` or streamed by the service.
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <ostream>
@@ -56,9 +57,17 @@ struct StepOutput {
 StepOutput step_output(const Problem& problem, const StepRecord& rec, const OutputOptions& output);
 // The step's text in the result's "steps" array.
 void write_step(std::ostream& out, const StepOutput& step);
-// write_result with the steps already written: step_texts[k] is write_step's text of
-// run.steps[k]. The same bytes as write_result.
+// The same text in parts, each written by its own JsonWriter (on any thread, in any order):
+// write_step's text is their texts one after another. A table's rows are split into parts of
+// kRowsPerPart, so that two threads can share a step's formatting. The parts refer to `step`.
+class JsonWriter;
+using StepPart = std::function<void(JsonWriter&)>;
+constexpr size_t kRowsPerPart = 2048;
+std::vector<StepPart> step_parts(const StepOutput& step);
+// write_result with the steps already written: step_text(k), asked for k = 0, 1, ... in turn,
+// is write_step's text of run.steps[k] in pieces (their concatenation). The same bytes as
+// write_result.
 void write_result(std::ostream& out, const Scene& scene, const RunResult& run,
-                  const std::vector<std::string_view>& step_texts);
+                  const std::function<std::vector<std::string_view>(size_t)>& step_text);
 
 }  // namespace grip

@@ -545,19 +545,25 @@ SceneErrors::SceneErrors(std::vector<SceneIssue> issues)
 Scene read_scene(const nlohmann::json& input) {
   // Stage 1: the schema (types, ranges, unknown keys); stage 2: the readers' own checks
   // (references, meshes, rigid motions). Both run, so every error is reported at once; a
-  // reader error under a value the schema already rejected is left out.
-  std::vector<SceneIssue> schema_issues = validate_against(input, SchemaName::scene);
-  if (schema_issues.empty()) return read_checked_scene(input);
+  // reader error under a value the schema already rejected is left out. The readers run
+  // first: a caller may build the schema's validator meanwhile (prepare_schema, grip solve).
+  std::optional<Scene> scene;
+  std::vector<SceneIssue> reader_issues;
   try {
-    read_checked_scene(input);
+    scene.emplace(read_checked_scene(input));
   } catch (const SceneErrors& e) {
-    for (const SceneIssue& issue : e.issues()) {
-      bool covered = false;
-      for (const SceneIssue& s : schema_issues)
-        covered |= issue.pointer == s.pointer || issue.pointer.rfind(s.pointer + "/", 0) == 0 ||
-                   s.pointer == "/";
-      if (!covered) schema_issues.push_back(issue);
-    }
+    reader_issues = e.issues();
+  }
+  std::vector<SceneIssue> schema_issues = validate_against(input, SchemaName::scene);
+  if (schema_issues.empty()) {
+    if (scene) return std::move(*scene);
+    throw SceneErrors(std::move(reader_issues));
+  }
+  for (const SceneIssue& issue : reader_issues) {
+    bool covered = false;
+    for (const SceneIssue& s : schema_issues)
+      covered |= issue.pointer == s.pointer || issue.pointer.rfind(s.pointer + "/", 0) == 0 || s.pointer == "/";
+    if (!covered) schema_issues.push_back(issue);
   }
   throw SceneErrors(std::move(schema_issues));
 }

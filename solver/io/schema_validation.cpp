@@ -665,6 +665,11 @@ std::optional<nlohmann::json> schema_default(const nlohmann::json& document, Sch
   return std::nullopt;
 }
 
+void prepare_schema(SchemaName which) {
+  const std::string_view stem = schema_file_stem(which);
+  registry().get(stem).schema(registry(), stem);
+}
+
 std::vector<SceneIssue> validate_against(const nlohmann::json& document, SchemaName which) {
   const std::string_view stem = schema_file_stem(which);
   const Loaded& loaded = registry().get(stem);

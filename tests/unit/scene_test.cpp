@@ -2,9 +2,11 @@
 // defaults filled in; only the effects a scene calls for are built.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <sstream>
 
 #include "apps/step_writer.hpp"
+#include "solver/io/json_writer.hpp"
 #include "solver/io/result.hpp"
 #include "tests/support/scenes.hpp"
 
@@ -234,6 +236,61 @@ TEST(SceneEffects, StreamedResultReadsBackAsTheBuiltOne) {
     }
 }
 
+// A step's text in parts (step_parts): long tables are cut every kRowsPerPart rows so that two
+// threads can share a step; written each by its own writer, in any order, the parts join into
+// the step's JSON: every row once with its index, NaN cells left out as table_json does, the
+// small members before and after the tables in nlohmann's key order.
+TEST(SceneEffects, StepPartsJoinIntoTheStepWhateverWritesThem) {
+  StepOutput step;
+  step.summary = {{"converged", true}, {"step", 3}, {"zz_after_the_tables", "last"}};
+  json expected = step.summary;
+  auto table = [](size_t rows, const char* index, std::vector<std::string> names, json& rows_json) {
+    FlatTable t{names, rows, {}};
+    rows_json = json::array();
+    for (size_t i = 0; i < rows; ++i) {
+      json row = {{index, i}};
+      for (size_t c = 0; c < names.size(); ++c) {
+        const double v = (c == 1 && i % 7 == 0) ? std::nan("") : std::sin(0.37 * i + c) * 1e3;
+        t.values.push_back(v);
+        if (!std::isnan(v)) row[names[c]] = v;
+      }
+      rows_json.push_back(row);
+    }
+    return t;
+  };
+  step.nodes = table(2 * kRowsPerPart + 1, "node", {"ux", "uy", "x", "y"}, expected["nodes"]);
+  step.elements = table(kRowsPerPart, "element", {"sxx", "sxy"}, expected["elements"]);
+  step.contact_points.emplace();
+  expected["contact_points"] = json::array();
+  const std::vector<StepPart> parts = step_parts(step);
+  // One part before each table (the small members and its key) and one after the last; the
+  // node table in 3 parts, the element table (exactly kRowsPerPart rows) and the contact points in 1.
+  ASSERT_EQ(parts.size(), 3u + 1 + 3 + 1 + 1);
+  std::vector<std::string> texts(parts.size());
+  for (size_t i = parts.size(); i-- > 0;) {
+    std::ostringstream out;
+    {
+      JsonWriter w(out);
+      parts[i](w);
+    }
+    texts[i] = out.str();
+  }
+  std::string joined;
+  for (const std::string& t : texts) joined += t;
+  EXPECT_EQ(json::parse(joined), expected);
+  std::ostringstream whole;
+  write_step(whole, step);
+  EXPECT_TRUE(joined == whole.str());
+  // The same through the writer, whichever thread formats which part.
+  StepWriter writer;
+  for (int k = 0; k < 3; ++k) writer.add(step);
+  for (size_t k = 0; k < 3; ++k) {
+    std::string text;
+    for (std::string_view piece : writer.text(k)) text += piece;
+    EXPECT_TRUE(text == whole.str()) << "step " << k;
+  }
+}
+
 // grip solve writes each step on a thread while the next one solves (apps/step_writer.hpp,
 // step_output taken in the solver's observer); the file must be write_result's to the byte,
 // for a single body with every field and for two bodies (master points, several tables).
@@ -249,14 +306,16 @@ TEST(SceneEffects, StepsWrittenWhileSolvingAreTheStreamedResultByteForByte) {
     const RunResult run = run_load_steps(scene.problem, scene.steps, scene.params, observer);
     ASSERT_TRUE(run.completed);
     std::ostringstream concurrent, streamed;
-    write_result(concurrent, scene, run, writer.finish());
+    write_result(concurrent, scene, run, [&](size_t k) { return writer.text(k); });
     write_result(streamed, scene, run);
     ASSERT_GT(streamed.str().size(), 10000u);
     EXPECT_TRUE(concurrent.str() == streamed.str()) << j["description"];
     // The texts must be the steps of this run: one too few is an error, not a shorter file.
-    std::vector<std::string_view> missing(run.steps.size() - 1);
+    StepWriter short_of_one;
+    for (size_t k = 0; k + 1 < run.steps.size(); ++k)
+      short_of_one.add(step_output(scene.problem, run.steps[k], scene.output));
     std::ostringstream ignored;
-    EXPECT_THROW(write_result(ignored, scene, run, missing), std::logic_error);
+    EXPECT_THROW(write_result(ignored, scene, run, [&](size_t k) { return short_of_one.text(k); }), std::logic_error);
   }
 }
 
