@@ -40,6 +40,10 @@ inline void tune_process() {
 inline void heap_on_huge_pages() {
   constexpr size_t kHeapReserve = size_t{1} << 30;
   mallopt(M_TRIM_THRESHOLD, INT_MAX);
+  // grip solve's other threads (the schema's validator, the result's writer) allocate here
+  // too: an arena of their own grows 4 KiB at a time, an mprotect and a page fault each
+  // (the validator's build: 100 of them, its allocations faulted in one page at a time).
+  mallopt(M_ARENA_MAX, 1);
   mallopt(M_TOP_PAD, kHeapReserve);
   const auto from = (reinterpret_cast<uintptr_t>(sbrk(0)) + 4095) & ~uintptr_t{4095};
   void* volatile grow = malloc(mallinfo2().fordblks + 1);  // more than the heap has free: it grows now
