@@ -323,7 +323,7 @@ bool StepSolver::literal_pass(int first_level, double alpha_fixed) {
     int trials = 0, halvings = 0;
     double a = 1.0;
     while (true) {
-      const Direction dir = direction(C, e, level, alpha_fixed);
+      const Direction dir = held_direction(C, e, level, alpha_fixed);
       if (!dir.ok) return fail("the active block of the compliance is not positive definite");
       if (!budget_left()) return false;
       const Vector pt = project(C, out_.p, out_.p - a * dir.d, e, out_.tau);
@@ -350,6 +350,29 @@ bool StepSolver::literal_pass(int first_level, double alpha_fixed) {
     }
   }
   return true;
+}
+
+Direction StepSolver::held_direction(const Compliance& C, const ContactError& e, int level, double alpha_fixed) {
+  ContactError moving = e;
+  for (;;) {
+    const Direction dir = direction(C, moving, level, alpha_fixed);
+    if (!dir.ok) return dir;
+    bool held = false;
+    for (size_t i = 0; i < problem_.candidates.size(); ++i) {
+      const Candidate& c = problem_.candidates[i];
+      // pbar = p - a d leaves the bound: the projection keeps p where it is, at every a.
+      if (moving.active[c.eta] && out_.p[c.eta] == 0.0 && dir.d[c.eta] < 0) {
+        moving.active[c.eta] = 0;
+        held = true;
+      }
+      if (c.xi >= 0 && moving.active[c.xi] && out_.p[c.xi] * dir.d[c.xi] < 0 &&
+          std::abs(out_.p[c.xi]) >= out_.tau[i] * (1 - kBoundTolerance)) {
+        moving.active[c.xi] = 0;
+        held = true;
+      }
+    }
+    if (!held) return dir;
+  }
 }
 
 // Every component with a force or a friction bound, the rigid amplitudes, and those of candidates penetrating or

@@ -83,6 +83,12 @@ class StepSolver {
   Vector project(const Compliance& C, const Vector& p, const Vector& pbar, const ContactError& e,
                  const Vector& tau) const;
 
+  // eq. 13's direction for the literal loop, on the components that eq. 13's projection lets
+  // move: a force on its bound (|p_xi| = tau, or p_eta = 0) that the direction pushes beyond it
+  // keeps its value at every alpha, as on the slipping branch, so M_n is formed without it (the
+  // others' step assumed it moved: with it the step was no descent of ||v|| at any alpha, the
+  // free beam). Its error stays in ||v||; repeated until no such force is left.
+  Direction held_direction(const Compliance& C, const ContactError& e, int level, double alpha_fixed);
   // The paper's literal loop: one real solve per eq. 13 update at acceleration `level` (cev's
   // `loop: paper`), or the multiplier update with a fixed alpha (uzawa).
   bool literal_pass(int level, double alpha_fixed);

@@ -235,8 +235,8 @@ std::pair<std::string, int> motion_words(const std::vector<BodyPart>& parts, con
 // translations always (internal forces are self-equilibrated at any state), rotations where
 // the tangent is constant (linear kinematics: an infinitesimal rotation is a null mode of K) or
 // where a finite rotation leaves the body's strain unchanged (the continuum with finite
-// kinematics, about at most one supported node: its motions then follow its current shape,
-// rigid_modes_at); a membrane (no reference stiffness) never. Records them in problem.rigid (pins come later);
+// kinematics, the von Karman beam, about at most one supported node: its motions then follow its
+// state, rigid_modes_at); a membrane (no reference stiffness) never. Records them in problem.rigid (pins come later);
 // in a scene of several bodies each body's motions on its own dofs.
 void check_rigid_modes(Reader& r, Problem& problem) {
   const std::vector<BodyPart> parts = body_parts(problem);

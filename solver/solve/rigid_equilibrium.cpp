@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "solver/core/body_set.hpp"
+#include "solver/elements/timoshenko_beam.hpp"
 
 namespace grip {
 namespace {
@@ -32,8 +33,7 @@ std::string factors_text(const Problem& problem, const LoadFactors& factors) {
   return (shown > 1 ? "at load factors " : "at load factor ") + (shown ? text : std::string("0"));
 }
 
-// Every dof a translation, x and y of one node one after the other (the continuum): a model whose
-// rigid rotations are finite ones of its nodes.
+// Every dof a translation, x and y of one node one after the other (the continuum).
 bool translation_pairs(const Body& body) {
   const Vector tx = body.rigid_translation(Vec2::UnitX()), ty = body.rigid_translation(Vec2::UnitY());
   if (tx.size() % 2 || body.rigid_rotation().size() != tx.size()) return false;
@@ -42,15 +42,48 @@ bool translation_pairs(const Body& body) {
   return true;
 }
 
+// The rotation by one radian about the origin at state q of a model with finite kinematics whose
+// strain a finite rotation of its own leaves unchanged, so that its internal forces at q do no
+// work along it (empty for a model without one):
+// - the continuum (every dof a translation): the rotation about its current positions X + u,
+//   (-y, x) at each node;
+// - the von Karman beam: its own finite rotation by c, u -> u - c w - c^2 X / 2, w -> w + c X,
+//   theta -> theta - c, leaves b.u + (b.w)^2 / 2, b.w + h.theta and b.theta unchanged at every
+//   point (u and w share their shape functions, b.X = 1, h sums to 1 at the nodal values), so
+//   its rate at q, the linear rotation with -w added to u (nodal and mid values), is one. It is
+//   not a rotation of the continuum (the arm of a vertical force stays at its reference
+//   abscissa, as the model's contact points do), but it is the model's exact null motion.
+Vector rotation_at(const Body& body, const Vector& q) {
+  if (body.traits().constant_tangent) return {};
+  Vector rot = body.rigid_rotation();
+  if (const auto* beam = dynamic_cast<const TimoshenkoBeam*>(&body)) {
+    for (int k = 0; k < beam->node_count(); ++k)
+      rot[TimoshenkoBeam::node_dof(k, 0)] -= q[TimoshenkoBeam::node_dof(k, 1)];
+    for (int e = 0; e < beam->element_count(); ++e) rot[beam->mid_dof(e, 0)] -= q[beam->mid_dof(e, 1)];
+    return rot;
+  }
+  if (!translation_pairs(body)) return {};
+  for (int d = 0; d < rot.size(); d += 2) {
+    rot[d] -= q[d + 1];
+    rot[d + 1] += q[d];
+  }
+  return rot;
+}
+
+bool has_finite_rotation(const Body& body) { return rotation_at(body, Vector::Zero(body.dof_count())).size() > 0; }
+
 }  // namespace
 
 std::string finite_rotation_refusal(const Body& body, const std::vector<int>& fixed) {
-  if (!translation_pairs(body))
-    return "a free rotation is held by contact only with linear kinematics or a model with finite rigid rotations "
-           "(the continuum): a von Karman beam's axial strain u' + w'^2 / 2 changes under a finite rotation, so only "
-           "an infinitesimal one is a null mode of its stiffness";
+  if (!has_finite_rotation(body))
+    return "a free rotation is held by contact only with linear kinematics or a model whose strain a finite "
+           "rotation leaves unchanged (the continuum with finite kinematics, the von Karman beam)";
+  // The node of a dof: a beam's three (u, w, theta; each element's mid values one more), the
+  // continuum's two.
+  const bool beam = dynamic_cast<const TimoshenkoBeam*>(&body) != nullptr;
+  auto node = [&](int d) { return beam ? d / 3 : d / 2; };
   for (int d : fixed)
-    if (d / 2 != fixed.front() / 2)
+    if (node(d) != node(fixed.front()))
       return "with finite kinematics a rotation is free only about a single supported node: supports at several "
              "nodes leave it free to first order and stop it at any finite angle";
   return "";
@@ -76,7 +109,7 @@ void for_each_turning_body(const Problem& problem, F f) {
         done[j] = 1;
       }
     const Body& body = set ? set->part(b) : whole;
-    if (body.traits().constant_tangent || !translation_pairs(body)) continue;
+    if (!has_finite_rotation(body)) continue;
     const int offset = set ? set->dof_offset(b) : 0, m = body.dof_count();
     // Translations only (the supports hold the rotation): the same motions at every state.
     Matrix T(m, 2);
@@ -84,7 +117,7 @@ void for_each_turning_body(const Problem& problem, F f) {
     bool turns = false;
     for (int j : own) {
       const Vector r = rigid.modes.col(j).segment(offset, m);
-      const Vector fit = T * (T.transpose() * r / (m / 2));  // tx, ty orthogonal, |t|^2 = m / 2
+      const Vector fit = T * (T.transpose() * T).ldlt().solve(T.transpose() * r);
       turns = turns || (r - fit).norm() > 1e-9 * r.norm();
     }
     if (turns) f(body, offset, own);
@@ -107,13 +140,8 @@ Matrix rigid_modes_at(const Problem& problem, const Vector& q) {
     Matrix B(m, 3);
     B.col(0) = body.rigid_translation(Vec2::UnitX());
     B.col(1) = body.rigid_translation(Vec2::UnitY());
-    // The rotation about the deformed positions X + u: (-y, x) at each node.
-    Vector rot = body.rigid_rotation();
-    for (int d = 0; d < m; d += 2) {
-      rot[d] -= q[offset + d + 1];
-      rot[d + 1] += q[offset + d];
-    }
-    B.col(2) = rot / body.characteristic_length();
+    // The rotation at q (the continuum: about the deformed positions X + u).
+    B.col(2) = rotation_at(body, q.segment(offset, m)) / body.characteristic_length();
     // The combinations of B that vanish at the body's supports (at most one node:
     // finite_rotation_refusal) and are the identity at its pins: a square system.
     std::vector<int> rows;

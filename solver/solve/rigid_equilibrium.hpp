@@ -26,18 +26,18 @@ std::string unreachable_equilibrium(const Problem& problem, const EquilibriumSta
 Vector amplitudes_following_supports(const Problem& problem, const LoadFactors& from, const LoadFactors& to);
 
 // Why a free rotation of `body` cannot be held by contact with finite kinematics ("" where it
-// can), its supported dofs `fixed` (the body's own numbering): the model must have finite rigid
-// rotations (every dof a translation: the continuum; a von Karman beam's strain changes under a
-// finite rotation), and the supports may hold at most one node, about which the rotation then
-// turns at any angle (supports at several nodes leave it free to first order only).
+// can), its supported dofs `fixed` (the body's own numbering): the model must have a finite
+// rotation of its own (the continuum, the von Karman beam: rigid_equilibrium.cpp), and the
+// supports may hold at most one node, about which the rotation then turns at any angle
+// (supports at several nodes leave it free to first order only).
 std::string finite_rotation_refusal(const Body& body, const std::vector<int>& fixed);
 
 // The free rigid motions of problem.rigid at the state q, 1 at their own pin and 0 at the other
 // pins. For a body with finite kinematics left free to rotate: the translations and the rotation
-// about its current shape, zero at its supports (ALGORITHM.md 7): the internal forces of a
-// deformed body balance about its deformed positions, so that is where the contact forces and
-// the load must balance too. Elsewhere problem.rigid.modes itself (a constant tangent, or
-// translations only: the same at every state).
+// at q (the continuum's about its current shape, the von Karman beam's own: rigid_equilibrium.cpp),
+// zero at its supports (ALGORITHM.md 7): the internal forces of a deformed body do no work along
+// it, so that is where the contact forces and the load must balance too. Elsewhere
+// problem.rigid.modes itself (a constant tangent, or translations only: the same at every state).
 Matrix rigid_modes_at(const Problem& problem, const Vector& q);
 // Whether rigid_modes_at changes with the state for some body of the problem.
 bool rigid_modes_follow_state(const Problem& problem);

@@ -5,6 +5,7 @@
 // stop on the same measure, StepSolver::force_precision). A check of forces against a closed
 // form or against another run is then derived as (round-off) + |dp|, never a guessed number.
 #include <Eigen/Cholesky>
+#include <Eigen/LU>
 
 #include "solver/contact/contact_error.hpp"
 #include "tests/support/scenes.hpp"
@@ -25,14 +26,54 @@ inline Vector force_correction(const Scene& scene, const StepRecord& rec) {
   const Compliance& C = eq.compliance(rec.state, idx);
   Vector v_e(idx.size());
   for (size_t a = 0; a < idx.size(); ++a) v_e[a] = e.v[idx[a]];
-  const Vector d = Eigen::LLT<Matrix>(C.sub(idx)).solve(v_e);
+  // A body held by contact: the bordered block [C G; G^T 0] (its amplitudes' rows), symmetric
+  // but indefinite.
+  const Vector d = C.bordered ? Vector(Eigen::FullPivLU<Matrix>(C.sub(idx)).solve(v_e))
+                              : Vector(Eigen::LLT<Matrix>(C.sub(idx)).solve(v_e));
   for (size_t a = 0; a < idx.size(); ++a) dp[idx[a]] = d[a];
   return dp;
 }
 
 // The largest |dp| over the normal and tangential components of every candidate.
 inline double force_precision(const Scene& scene, const StepRecord& rec) {
-  return force_correction(scene, rec).lpNorm<Eigen::Infinity>();
+  const RigidModes& rigid = scene.problem.rigid;
+  return force_correction(scene, rec).head(rigid.count() ? rigid.first : rec.p.size()).lpNorm<Eigen::Infinity>();
+}
+
+}  // namespace grip::testing
+
+namespace grip::testing {
+
+// The largest difference of the normal and tangential forces of two runs' steps of one scene.
+inline double force_difference(const Problem& problem, const StepRecord& a, const StepRecord& b) {
+  double largest = 0.0;
+  for (const Candidate& c : problem.candidates) {
+    largest = std::max(largest, std::abs(a.p[c.eta] - b.p[c.eta]));
+    if (c.xi >= 0) largest = std::max(largest, std::abs(a.p[c.xi] - b.p[c.xi]));
+  }
+  return largest;
+}
+
+// How far step `rec` of run `s` may lie from step `ref` of a run of the same scene by cev's default
+// loop, whose previous steps differed by `carried` (each step's slips are measured from the state
+// it starts from): what each run's contact error pins its forces to (force_precision), and, where
+// tau passes hold the bound at mu |p*|, p* settled to max(tau_tolerance max |p_eta|, its force
+// precision) (StepSolver::tau_passes), which moves each slipping point's force by mu times that and
+// hands the sum of those moves to the sticking points: at most (number of points) x mu x that.
+inline double agreement_bound(const Solved& s, const StepRecord& rec, const Solved& cev, const StepRecord& ref,
+                              double carried) {
+  const ContactParams& cp = s.scene.params.contact;
+  const bool passes = cp.method == ContactMethod::uzawa || cp.loop == ContactLoop::paper ||
+                      (cp.method == ContactMethod::cev && cp.friction_loop == FrictionLoop::passes);
+  double p_max = 0.0, mu = 0.0;
+  for (const Candidate& c : s.scene.problem.candidates) {
+    p_max = std::max(p_max, std::abs(ref.p[c.eta]));
+    mu = std::max(mu, s.scene.problem.obstacles[c.obstacle].friction);
+  }
+  const double own = force_precision(s.scene, rec);
+  const double settle =
+      passes ? static_cast<double>(s.scene.problem.candidates.size()) * mu * std::max(cp.tau_tolerance * p_max, own) : 0.0;
+  return 1e-9 * p_max + own + force_precision(cev.scene, ref) + settle + carried;
 }
 
 }  // namespace grip::testing
