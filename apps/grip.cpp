@@ -17,6 +17,7 @@
 #include <chrono>
 #include <ctime>
 #include <fstream>
+#include <memory>
 #include <iostream>
 #include <exception>
 #include <optional>
@@ -26,6 +27,7 @@
 
 #include "apps/process_tuning.hpp"
 #include "apps/step_writer.hpp"
+#include "apps/thread_team.hpp"
 #include "solver/io/result.hpp"
 #include "solver/io/schema_validation.hpp"
 
@@ -40,26 +42,12 @@ int usage() {
 }
 
 // The solver's independent tasks (the bodies' own factorizations and solves) on up to `threads`
-// threads: the solver starts none of its own. Empty (one after another) for one thread.
+// threads, kept for the whole solve (apps/thread_team.hpp): the solver starts none of its own.
+// Empty (one after another) for one thread.
 grip::ParallelFor on_threads(int threads) {
   if (threads <= 1) return {};
-  return [threads](int count, const std::function<void(int)>& task) {
-    std::atomic<int> next{0};
-    std::exception_ptr failure;
-    std::atomic<bool> failed{false};
-    auto work = [&] {
-      for (int k; (k = next++) < count;) try {
-          task(k);
-        } catch (...) {
-          if (!failed.exchange(true)) failure = std::current_exception();
-        }
-    };
-    std::vector<std::thread> helpers;
-    for (int t = 1; t < std::min(threads, count); ++t) helpers.emplace_back(work);
-    work();
-    for (auto& h : helpers) h.join();
-    if (failure) std::rethrow_exception(failure);
-  };
+  auto team = std::make_shared<grip::ThreadTeam>(threads);
+  return [team](int count, const std::function<void(int)>& task) { team->run(count, task); };
 }
 
 int solve(int argc, char** argv) {

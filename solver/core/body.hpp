@@ -59,7 +59,7 @@ class Body {
   // the continuum, whose sites are a subset of its nodes.
   virtual int site_node(int site) const { return site; }
   // The surface point of `site` on side +1 (upper) or -1 (lower), at state q.
-  virtual SurfacePoint surface_point(const Vector& q, int site, int side) const = 0;
+  virtual SurfacePoint surface_point(const VectorRef& q, int site, int side) const = 0;
   // The straight pieces of the contact surface between sites, each [a, b] with the body on
   // the left of a -> b: what a slave surface of another body pairs with (mortar segments).
   // Empty where the model offers no master surface.

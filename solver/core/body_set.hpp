@@ -34,7 +34,7 @@ class BodySet final : public Body {
   int node_count() const override { return node_offset_.back(); }
   Vec2 site_reference(int site) const override;
   int site_node(int site) const override;
-  SurfacePoint surface_point(const Vector& q, int site, int side) const override;
+  SurfacePoint surface_point(const VectorRef& q, int site, int side) const override;
   std::vector<std::array<int, 2>> surface_segments() const override;
   double tributary_area(int site) const override;
   double characteristic_length() const override;

@@ -10,6 +10,8 @@ using Vec2 = Eigen::Vector2d;
 using Mat2 = Eigen::Matrix2d;
 using Vector = Eigen::VectorXd;
 using Matrix = Eigen::MatrixXd;
+// A read-only view of a vector or of a contiguous part of one (no copy).
+using VectorRef = Eigen::Ref<const Vector>;
 
 // Rotation by +90 degrees: the obstacle tangent is rot90(outward normal).
 inline Vec2 rot90(const Vec2& a) { return {-a.y(), a.x()}; }

@@ -90,7 +90,7 @@ void ContinuumBody::internal_force(const Vector& q, Vector& force, Triplets* tan
   }
 }
 
-SurfacePoint ContinuumBody::surface_point(const Vector& q, int site, int /*side*/) const {
+SurfacePoint ContinuumBody::surface_point(const VectorRef& q, int site, int /*side*/) const {
   const int node = contact_.nodes[site];
   const int dx = node_dof(node, 0), dy = node_dof(node, 1);
   SurfacePoint p;

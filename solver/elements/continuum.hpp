@@ -50,7 +50,7 @@ class ContinuumBody final : public Body {
   int site_count() const override { return static_cast<int>(contact_.nodes.size()); }
   int site_node(int site) const override { return contact_.nodes[site]; }
   Vec2 site_reference(int site) const override { return mesh_.nodes[contact_.nodes[site]]; }
-  SurfacePoint surface_point(const Vector& q, int site, int side) const override;
+  SurfacePoint surface_point(const VectorRef& q, int site, int side) const override;
   // The contact sides, a q9 side as its two halves.
   std::vector<std::array<int, 2>> surface_segments() const override;
   double tributary_area(int site) const override { return contact_.lengths[site] * options_.thickness; }

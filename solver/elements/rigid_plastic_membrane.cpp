@@ -70,7 +70,7 @@ void RigidPlasticMembrane::internal_force(const Vector& q, Vector& force, Triple
   }
 }
 
-SurfacePoint RigidPlasticMembrane::surface_point(const Vector& q, int site, int /*side*/) const {
+SurfacePoint RigidPlasticMembrane::surface_point(const VectorRef& q, int site, int /*side*/) const {
   SurfacePoint p;
   p.x = nodes_[site] + q.segment<2>(node_dof(site, 0));
   p.jacobian = {{node_dof(site, 0), Vec2::UnitX()}, {node_dof(site, 1), Vec2::UnitY()}};

@@ -47,7 +47,7 @@ class RigidPlasticMembrane final : public Body {
   void internal_force(const Vector& q, Vector& force, Triplets* tangent) const override;
   int site_count() const override { return node_count(); }
   Vec2 site_reference(int site) const override { return nodes_[site]; }
-  SurfacePoint surface_point(const Vector& q, int site, int side) const override;
+  SurfacePoint surface_point(const VectorRef& q, int site, int side) const override;
   double tributary_area(int site) const override;
   double characteristic_length() const override;
   // No rigid_rotation: a membrane has no bending stiffness, so every transverse motion of a

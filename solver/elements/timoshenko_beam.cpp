@@ -99,7 +99,7 @@ void TimoshenkoBeam::internal_force(const Vector& q, Vector& force, Triplets* ta
   }
 }
 
-SurfacePoint TimoshenkoBeam::surface_point(const Vector& q, int site, int side) const {
+SurfacePoint TimoshenkoBeam::surface_point(const VectorRef& q, int site, int side) const {
   const double z = side * section_.half_depth;
   const int du = node_dof(site, 0), dw = node_dof(site, 1), dt = node_dof(site, 2);
   SurfacePoint p;

@@ -38,7 +38,7 @@ class TimoshenkoBeam final : public Body {
   void internal_force(const Vector& q, Vector& force, Triplets* tangent) const override;
   int site_count() const override { return node_count(); }
   Vec2 site_reference(int site) const override { return {x_[site], y0_}; }
-  SurfacePoint surface_point(const Vector& q, int site, int side) const override;
+  SurfacePoint surface_point(const VectorRef& q, int site, int side) const override;
   double tributary_area(int site) const override;
   double characteristic_length() const override { return x_.back() - x_.front(); }
 

@@ -209,9 +209,13 @@ class Equilibrium {
   // tangent's contact terms only.
   Vector residual(const Vector& q, const EquilibriumState& paired, const Vector& p,
                   Triplets* tangent, double* force_scale = nullptr, bool body_tangent = true) const;
-  // Newton's step -K_t^-1 r for the constant body tangent plus the pair's stiffness (the
-  // `contact` triplets), as a low-rank correction on G.
-  Vector low_rank_step(const EquilibriumState& state, const Triplets& contact, const Vector& rhs);
+  // Newton's step K_t^-1 rhs for the constant body tangent plus the pair's stiffness (the
+  // `contact` triplets): the body's factorization and a Krylov solve on the pair's dofs.
+  Vector low_rank_step(const Triplets& contact, const Vector& rhs) const;
+  // Its Krylov solve: relative residual, and the most iterations (then the step is inexact and
+  // Newton's tests decide, as for any approximate tangent).
+  static constexpr double kLowRankTolerance = 1e-13;
+  static constexpr int kLowRankIterations = 60;
   // p(q) of the penalty law at a paired state of q, and (if asked) its stiffness triplets. With an
   // increment dq (all dofs), p(q) + (dp/dq) dq: the law linearized at q.
   Vector penalty_forces(const Vector& q, const EquilibriumState& paired, Triplets* tangent,
