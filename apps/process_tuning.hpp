@@ -38,18 +38,15 @@ inline void tune_process() {
 // ulimit), nothing changes. For the service (solving on worker threads, which glibc serves
 // from arenas of their own) the tunable is the way.
 //
-// The threads of --threads (apps/thread_team.hpp) allocate from this heap too: a helper's own
-// arena (4 KiB pages) took 4,700-5,000 minor faults more than one thread on the refined two
-// cylinders (its body's factor and solves), with one arena 540-840, as with one thread. Their
-// allocations are coarse (factors, vectors), so the shared arena's lock is rarely contended.
+// One arena: every thread of grip solve allocates from this heap. An arena of a thread's own
+// grows 4 KiB at a time, an mprotect and a page fault each: the schema validator's build took
+// 100 of them; a --threads helper (apps/thread_team.hpp) took 4,700-5,000 minor faults more
+// than one thread on the refined two cylinders, with one arena 540-840. Their allocations are
+// coarse (factors, vectors, texts), so the shared arena's lock is rarely contended.
 inline void heap_on_huge_pages() {
   constexpr size_t kHeapReserve = size_t{1} << 30;
   mallopt(M_ARENA_MAX, 1);
   mallopt(M_TRIM_THRESHOLD, INT_MAX);
-  // grip solve's other threads (the schema's validator, the result's writer) allocate here
-  // too: an arena of their own grows 4 KiB at a time, an mprotect and a page fault each
-  // (the validator's build: 100 of them, its allocations faulted in one page at a time).
-  mallopt(M_ARENA_MAX, 1);
   mallopt(M_TOP_PAD, kHeapReserve);
   const auto from = (reinterpret_cast<uintptr_t>(sbrk(0)) + 4095) & ~uintptr_t{4095};
   void* volatile grow = malloc(mallinfo2().fordblks + 1);  // more than the heap has free: it grows now
