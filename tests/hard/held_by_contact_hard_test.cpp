@@ -49,7 +49,8 @@ TEST(HeldByContactHard, SlenderFreeStripShearedToTheFrictionLimit) {
 }
 
 // uzawa on the disc between two flats (tests/verification/held_by_contact_test.cpp runs it for
-// the other strategies): 864 real solves in its one step, over the default 500, because its
+// the other strategies): 864 real solves in its one step (399 since its first pass takes the
+// friction bound from the linear model, i16c), over or near the default 500, because its
 // fixed alpha = 1 / ||Z^T C Z||_inf converges at 1 - lambda_min / ||Z^T C Z||_inf per solve, and
 // the reduced compliance's condition is about 60 (lambda 1.4e-6 .. 8.1e-5, ||.||_inf 1.0e-4;
 // C's own is about 400: the elimination does not worsen it). The budget is raised to 1000 here:
