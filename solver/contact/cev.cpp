@@ -26,8 +26,7 @@ class CevStep : public StepSolver {
   void solve(const Vector& q_guess, const Vector& p_start, const Vector& p_star) override {
     if (params_.loop == ContactLoop::inner && params_.friction_loop == FrictionLoop::inner)
       return coulomb_loop(q_guess, p_start);
-    // The passes start from the previous step's force (p_star), as the paper's loop does.
-    tau_passes(q_guess, p_star, p_star, [this] {
+    tau_passes(q_guess, p_start, p_star, [this] {
       if (needs_warmup() && !warmup()) return false;
       return params_.loop == ContactLoop::paper ? literal_pass(params_.acceleration, 0.0)
                                                 : inner_pass();

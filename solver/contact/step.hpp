@@ -40,7 +40,8 @@ class StepSolver {
   virtual void solve(const Vector& q_guess, const Vector& p_start, const Vector& p_star) = 0;
 
   // The tau passes of eq. 14 (ALGORITHM.md sections 4, 5): each pass holds tau = mu |p*| and
-  // runs `pass` (a Tresca problem); passes end when p* settles.
+  // runs `pass` (a Tresca problem); passes end when p* settles. They start from p_star_in, or
+  // from p_start where the free motions follow the state (step.cpp).
   void tau_passes(const Vector& q_guess, const Vector& p_start, const Vector& p_star_in,
                   const std::function<bool()>& pass);
 
@@ -49,6 +50,13 @@ class StepSolver {
   // it is finished to the full precision where the error found is within the tolerance, and
   // to kInexactNewton x that error where it is more than 10x below v_scale.
   bool fresh_solve(const Vector& q, double v_scale = 0.0);
+  // Some normal force of p presses.
+  bool presses(const Vector& p) const;
+  // A body held by contact at its first contact (p* presses nowhere) has no friction bound in
+  // its first pass, and a motion that only friction holds (a disc turned between two flats) no
+  // equilibrium then: p* is taken instead from Coulomb's law on the linear model at the step's
+  // first state (coulomb_model.hpp; no real solve), and out_.tau with it.
+  bool bound_from_model(Vector& p_star);
   // A free rigid motion that no pressing contact holds yet, pushed by the load, is moved until
   // its first contact point closes its gap (and presses by the tolerance), then solved again:
   // while every point is open the linear model knows nothing that stops the motion.

@@ -10,8 +10,8 @@ class UzawaStep : public StepSolver {
   using StepSolver::StepSolver;
 
  private:
-  void solve(const Vector& q_guess, const Vector&, const Vector& p_star) override {
-    tau_passes(q_guess, p_star, p_star, [this] { return literal_pass(1, params_.uzawa_alpha); });
+  void solve(const Vector& q_guess, const Vector& p_start, const Vector& p_star) override {
+    tau_passes(q_guess, p_start, p_star, [this] { return literal_pass(1, params_.uzawa_alpha); });
   }
 };
 

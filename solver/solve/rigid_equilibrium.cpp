@@ -247,7 +247,36 @@ Vector amplitudes_following_supports(const Problem& problem, const LoadFactors& 
 
 Vector rigid_amplitudes(const Body& body, const Vector& q) {
   std::vector<Vector> modes = {body.rigid_translation(Vec2::UnitX()), body.rigid_translation(Vec2::UnitY())};
-  if (const Vector rot = body.rigid_rotation(); rot.size()) modes.push_back(rot);
+  const Vector rot = body.rigid_rotation();
+  if (rot.size()) modes.push_back(rot);
+  if (rot.size() && !body.traits().constant_tangent && translation_pairs(body)) {
+    // Finite kinematics: the rotation and translation that carry the reference positions X
+    // (rot = (-Y, X) at each node) closest to the current ones x = X + u, exact for a rigid
+    // motion at any angle (2D Procrustes): the centroids match, and the angle is
+    // atan2(sum a x b, sum a . b) over the centred positions a = X - X_c, b = x - x_c. The
+    // translation is that of the point at the origin, x_c - R(angle) X_c.
+    const int n = static_cast<int>(q.size() / 2);
+    Vec2 X_c = Vec2::Zero(), x_c = Vec2::Zero();
+    for (int i = 0; i < n; ++i) {
+      const Vec2 X(rot[2 * i + 1], -rot[2 * i]);
+      X_c += X / n;
+      x_c += (X + q.segment<2>(2 * i)) / n;
+    }
+    double cross = 0.0, dot = 0.0;
+    for (int i = 0; i < n; ++i) {
+      const Vec2 X(rot[2 * i + 1], -rot[2 * i]);
+      const Vec2 a = X - X_c, b = X + q.segment<2>(2 * i) - x_c;
+      cross += a.x() * b.y() - a.y() * b.x();
+      dot += a.dot(b);
+    }
+    const double angle = std::atan2(cross, dot), c = std::cos(angle), s = std::sin(angle);
+    const Vec2 t = x_c - Vec2(c * X_c.x() - s * X_c.y(), s * X_c.x() + c * X_c.y());
+    Vector out(3);
+    out << t.x(), t.y(), angle;
+    return out;
+  }
+  // Linear kinematics (or a model with rotation dofs): the least-squares fit over the
+  // infinitesimal motions, exact for those.
   Matrix B(q.size(), modes.size());
   for (size_t k = 0; k < modes.size(); ++k) B.col(k) = modes[k];
   return B.colPivHouseholderQr().solve(q);

@@ -42,8 +42,11 @@ Matrix rigid_modes_at(const Problem& problem, const Vector& q);
 // Whether rigid_modes_at changes with the state for some body of the problem.
 bool rigid_modes_follow_state(const Problem& problem);
 
-// The rigid motion fitted to q by least squares over the body's translations and rotation
-// (about the origin): (x, y, rotation in radians; no rotation for a body without one).
+// The rigid motion fitted to q: (x, y, rotation in radians; no rotation for a body without
+// one), the translation that of the point at the origin. With finite kinematics (the continuum)
+// the rotation and translation that carry the reference positions closest to the current ones
+// (exact at any angle); otherwise by least squares over the body's infinitesimal translations
+// and rotation about the origin (exact for those).
 Vector rigid_amplitudes(const Body& body, const Vector& q);
 
 }  // namespace grip

@@ -71,11 +71,15 @@ inline ::testing::AssertionResult step_invariants(const Problem& problem, const 
 }
 
 // Within each tau pass, the contact error falls at every accepted real solve.
-inline ::testing::AssertionResult monotone_contact_error(const StepRecord& rec) {
+// `within`: where the step also tests the free motions' balance (StepSolver::error_met: a body
+// turned by finite rotations), a real solve within the contact tolerance is accepted for a
+// smaller unbalance even if ||v|| rises (StepSolver::improves): rises up to `within` (the
+// tolerance) are allowed there.
+inline ::testing::AssertionResult monotone_contact_error(const StepRecord& rec, double within = 0.0) {
   for (size_t k = 1; k < rec.history.size(); ++k) {
     const auto& a = rec.history[k - 1];
     const auto& b = rec.history[k];
-    if (b.pass == a.pass && b.m > 0 && b.v2 >= a.v2)
+    if (b.pass == a.pass && b.m > 0 && b.v2 >= a.v2 && b.v2 > within)
       return ::testing::AssertionFailure() << "step " << rec.index << " pass " << b.pass << " m " << b.m
                                            << ": ||v|| rose from " << a.v2 << " to " << b.v2;
   }

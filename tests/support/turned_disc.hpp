@@ -1,0 +1,178 @@
+#pragma once
+// A disc held only by contact with finite kinematics and its rotation left free (ALGORITHM.md
+// section 7): a neo-Hookean disc (radius 10, q4, nu 0.3, no supports) squeezed between two
+// flats (mu 0.3) and turned by a couple from two opposite vertical forces at the ends of its
+// horizontal diameter. Contact alone holds its three motions. Shared by
+// tests/verification/held_by_contact_finite_test.cpp and tests/hard/held_by_contact_hard_test.cpp:
+// the scene, the balance of force and moment about any point with the deformed positions, each
+// flat's resultant, and the agreement of two runs to what the contact tolerance pins them to.
+#include <gtest/gtest.h>
+
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "solver/elements/continuum.hpp"
+#include "tests/support/held.hpp"
+
+namespace grip::testing {
+
+inline constexpr double kDiscRadius = 10.0;
+
+// Node (i, k) of the disc's grid of (grid + 1)^2 nodes (disc_between_flats).
+inline int disc_node(int grid, int i, int k) { return k * (grid + 1) + i; }
+
+// The disc between two flats (scenes.hpp) on a grid x grid mesh (even) with `kinematics`, nu =
+// 0.3 and q4 (q4_bbar is linear only), the upper flat moved down by `delta`, and a couple M =
+// 2 R F (counter-clockwise) from two opposite vertical forces F at the ends of its horizontal
+// diameter, both raised over `steps` equal steps.
+inline nlohmann::json turned_disc(const char* kinematics, double delta, double F, int steps, int grid = 32) {
+  nlohmann::json j = disc_between_flats(grid, delta);
+  j["body"]["kinematics"] = kinematics;
+  j["body"]["element"] = "q4";
+  j["body"]["material"]["poisson"] = 0.3;
+  j["body"]["loads"] = nlohmann::json::array({{{"node", disc_node(grid, grid, grid / 2)}, {"force", {0.0, F}}},
+                                              {{"node", disc_node(grid, 0, grid / 2)}, {"force", {0.0, -F}}}});
+  j["steps"] = steps;
+  return j;
+}
+
+// The resultant force and the moment about `o` of the load and the contact forces on the disc,
+// at the deformed positions X + u of the nodes they act on; and the size they are measured
+// against: the sum of the forces' magnitudes (times R for the moment).
+struct DiscBalance {
+  Vec2 force = Vec2::Zero();
+  double moment = 0.0;
+  double force_size = 0.0;
+};
+
+inline DiscBalance balance_about(const Problem& problem, const StepRecord& rec, const Vec2& o) {
+  const auto& mesh = dynamic_cast<const ContinuumBody&>(*problem.body).mesh();
+  Vector f = problem.load(rec.factors);
+  DiscBalance b;
+  b.force_size = f.cwiseAbs().sum();
+  for (size_t i = 0; i < problem.candidates.size(); ++i) {
+    const Candidate& c = problem.candidates[i];
+    const PairedPoint& pp = rec.state.points[i];
+    const Vec2 force = rec.p[c.eta] * pp.eta + (c.xi >= 0 ? rec.p[c.xi] : 0.0) * pp.xi;
+    for (const auto& j : pp.point.jacobian) f[j.dof] += j.dx.dot(force);
+    b.force_size += force.norm();
+  }
+  for (size_t n = 0; n < mesh.nodes.size(); ++n) {
+    const Vec2 x = mesh.nodes[n] + rec.state.q.segment<2>(2 * n) - o, fn = f.segment<2>(2 * n);
+    b.force += fn;
+    b.moment += x.x() * fn.y() - x.y() * fn.x();
+  }
+  return b;
+}
+
+// Each flat's resultant on the disc.
+inline Vec2 flat_resultant(const Problem& problem, const StepRecord& rec, int obstacle) {
+  Vec2 total = Vec2::Zero();
+  for (size_t i = 0; i < problem.candidates.size(); ++i) {
+    const Candidate& c = problem.candidates[i];
+    if (c.obstacle == obstacle)
+      total += rec.p[c.eta] * rec.state.points[i].eta + (c.xi >= 0 ? rec.p[c.xi] : 0.0) * rec.state.points[i].xi;
+  }
+  return total;
+}
+
+// Every converged step: held and sound (expect_held: the balance on the motions about the
+// current shape to 1e-9), and the force and the moment about two points balance to 1e-9 of the
+// forces' size (times R), measured here from the positions themselves.
+inline void expect_disc_balanced(const Solved& s) {
+  expect_held(s);
+  for (const StepRecord& rec : s.run.steps) {
+    if (!rec.converged) continue;
+    for (const Vec2& o : {Vec2(0, 0), Vec2(3, -7)}) {
+      const DiscBalance b = balance_about(s.scene.problem, rec, o);
+      EXPECT_LT(b.force.norm(), 1e-9 * b.force_size) << "step " << rec.index;
+      EXPECT_LT(std::abs(b.moment), 1e-9 * b.force_size * kDiscRadius)
+          << "step " << rec.index << " about (" << o.x() << ", " << o.y() << ")";
+      std::printf("step %d: force unbalance %.2e, moment unbalance about (%g, %g) %.2e (of the forces' size)\n",
+                  rec.index, b.force.norm() / b.force_size, o.x(), o.y(), std::abs(b.moment) / (b.force_size * kDiscRadius));
+    }
+  }
+}
+
+// What the contact tolerance pins a converged step of a body held by contact to: the step ends
+// at ||v|| <= tol, so each gap and slip of the answer is within tol of the exact one's (the
+// displacements of the contact points, and with them the body's rigid motion), and to first
+// order the forces within |dp|, [C G; G^T 0] (dp, da) = v on the active components (the
+// amplitudes' rows included; C, G at the step's state): |dp|_inf <= ||B^-1||_inf tol over the
+// contact rows. Bounds from tol itself, not from the ||v|| a run reached: near the friction
+// limit (Q / (mu P) = 0.998) cev and ssn ended at errors of 1e-11 and 1e-19, on stick/slip sets
+// that differ at a point, and their forces differed by 1e-3 N where C^-1 v of those errors
+// said 2e-6. (force_precision.hpp does the reached-error form for a supported body.)
+struct Pinned {
+  double force = 0.0;   // ||B^-1||_inf tol over the contact rows
+  double length = 0.0;  // tol
+};
+
+inline Pinned pinned_by_tolerance(const Scene& scene, const StepRecord& rec) {
+  const Problem& problem = scene.problem;
+  const ContactError e = contact_error(problem, rec.p, rec.state.s, rec.tau, rec.state.enabled);
+  std::vector<int> idx;
+  for (int i = 0; i < static_cast<int>(e.active.size()); ++i)
+    if (e.active[i]) idx.push_back(i);
+  Pinned out;
+  out.length = scene.params.contact.tolerance * problem.body->characteristic_length();
+  if (idx.empty()) return out;
+  Equilibrium eq(problem, scene.params.newton);
+  eq.set_step(rec.factors, std::vector<double>(problem.candidates.size(), 0.0));
+  const Compliance& C = eq.compliance(rec.state, idx);
+  const Matrix inverse = C.sub(idx).fullPivLu().inverse();
+  for (size_t a = 0; a < idx.size(); ++a)
+    if (!problem.rigid.is_amplitude(idx[a])) out.force = std::max(out.force, inverse.row(a).cwiseAbs().sum() * out.length);
+  return out;
+}
+
+// Two runs of the same scene agree at every step to what their contact tolerances pin them to
+// (pinned_by_tolerance, both runs' bounds added): the contact forces, plus the friction bound's
+// settling (with tau passes, p* settles to tau_tolerance of the largest normal force, which
+// moves a slipping point's bound mu times that); the displacements, plus both runs' Newton
+// correction tolerance, to which each real solve fixes them. Returns the largest differences
+// over the steps (forces relative to the largest normal force, displacements) for the report.
+inline std::pair<double, double> expect_same_answer(const Solved& a, const Solved& b) {
+  std::pair<double, double> worst{0.0, 0.0};
+  if (!a.run.completed || !b.run.completed || a.run.steps.size() != b.run.steps.size()) {
+    ADD_FAILURE() << "the runs did not both complete the same steps";
+    return worst;
+  }
+  const Problem& problem = a.scene.problem;
+  double mu = 0.0;
+  for (const ObstacleInstance& o : problem.obstacles) mu = std::max(mu, o.friction);
+  for (size_t k = 0; k < a.run.steps.size(); ++k) {
+    const StepRecord &ra = a.run.steps[k], &rb = b.run.steps[k];
+    const Pinned pa = pinned_by_tolerance(a.scene, ra), pb = pinned_by_tolerance(b.scene, rb);
+    double p_max = 0.0, dp = 0.0;
+    for (const Candidate& c : problem.candidates) {
+      p_max = std::max(p_max, std::abs(ra.p[c.eta]));
+      dp = std::max(dp, std::abs(ra.p[c.eta] - rb.p[c.eta]));
+      if (c.xi >= 0) dp = std::max(dp, std::abs(ra.p[c.xi] - rb.p[c.xi]));
+    }
+    double settle = 0.0, newton = 0.0;
+    for (const Solved* s : {&a, &b}) {
+      const ContactParams& c = s->scene.params.contact;
+      const bool passes = c.method == ContactMethod::uzawa ||
+                          (c.method == ContactMethod::cev &&
+                           (c.loop == ContactLoop::paper || c.friction_loop == FrictionLoop::passes));
+      if (passes) settle += mu * c.tau_tolerance * p_max;
+      newton += c.newton_fraction * c.tolerance * problem.body->characteristic_length();
+    }
+    const double dq = (ra.state.q - rb.state.q).lpNorm<Eigen::Infinity>();
+    const double force_bound = pa.force + pb.force + settle;
+    const double length_bound = pa.length + pb.length + newton;
+    EXPECT_LT(dp, force_bound) << "step " << k + 1;
+    EXPECT_LT(dq, length_bound) << "step " << k + 1;
+    std::printf("step %zu: forces differ by %.2e (bound %.2e, of max |p_n| %.1f), displacements by %.2e (bound "
+                "%.2e)\n",
+                k + 1, dp, force_bound, p_max, dq, length_bound);
+    worst.first = std::max(worst.first, dp / p_max);
+    worst.second = std::max(worst.second, dq);
+  }
+  return worst;
+}
+
+}  // namespace grip::testing
