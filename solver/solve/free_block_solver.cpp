@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 namespace grip {
 
@@ -53,18 +52,7 @@ bool FreeBlockSolver::factorize(const Triplets& triplets, const std::vector<int>
     scale = std::max(scale, std::abs(v[k]));
     skew = std::max(skew, std::abs(v[k] - v[mirror_[k]]));
   }
-  constexpr double kRoundOff = 1e-13;
-  symmetric_ = skew <= std::max(kRoundOff, near_symmetric_tolerance) * scale;
-  refined_ = symmetric_ && skew > kRoundOff * scale;
-  lu_instead_ = false;
-  if (refined_) {
-    exact_ = matrix_;
-    exact_norm_ = 0.0;
-    const Vector rows = exact_.cwiseAbs() * Vector::Ones(exact_.cols());
-    if (rows.size()) exact_norm_ = rows.maxCoeff();
-  } else {
-    exact_.resize(0, 0);
-  }
+  symmetric_ = skew <= std::max(1e-13, near_symmetric_tolerance) * scale;
   if (symmetric_ && skew > 0) {
     double* w = matrix_.valuePtr();
     for (int k = 0; k < matrix_.nonZeros(); ++k)
@@ -90,39 +78,11 @@ bool FreeBlockSolver::factorize(const Triplets& triplets, const std::vector<int>
     if (ok_) return true;
     symmetric_ = false;  // fall back to LU
   }
-  const Eigen::SparseMatrix<double>& block = refined_ ? exact_ : matrix_;
-  if (!lu_analysed_) lu_.analyzePattern(block);
+  if (!lu_analysed_) lu_.analyzePattern(matrix_);
   lu_analysed_ = true;
-  lu_.factorize(block);
+  lu_.factorize(matrix_);
   ok_ = lu_.info() == Eigen::Success;
-  lu_instead_ = refined_;
   return ok_;
-}
-
-template <class Rhs>
-Rhs FreeBlockSolver::solve_whole(const Rhs& b) const {
-  if (!symmetric_ || lu_instead_) return lu_.solve(b);
-  Rhs x = llt_.solve(b);
-  if (!refined_ || b.size() == 0) return x;
-  // Refinement: x += K_s^-1 (b - K x) while the residual halves a pass (as LAPACK's xGERFS
-  // stops), to its round-off: a few sums of |K| |x| + |b| times machine precision.
-  constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
-  double last = std::numeric_limits<double>::infinity();
-  for (int pass = 0; pass <= kMaxRefinements; ++pass) {
-    const Rhs r = b - exact_ * x;
-    const double error = r.cwiseAbs().maxCoeff();
-    if (!std::isfinite(error)) break;
-    if (error <= 16.0 * kEpsilon * (exact_norm_ * x.cwiseAbs().maxCoeff() + b.cwiseAbs().maxCoeff())) return x;
-    if (error > 0.5 * last) break;
-    last = error;
-    x += llt_.solve(r);
-  }
-  // The symmetric part is too far from the block for refinement: LU from now on.
-  if (!lu_analysed_) lu_.analyzePattern(exact_);
-  lu_analysed_ = true;
-  lu_.factorize(exact_);
-  lu_instead_ = true;
-  return lu_.solve(b);
 }
 
 // A simplicial factor tells beforehand whether the partial solves pay: the solve from row k
@@ -170,7 +130,7 @@ void factorize_dissected(CholmodFactor& dissected, const Eigen::SparseMatrix<dou
 }  // namespace
 
 bool FreeBlockSolver::inverse_block(const std::vector<int>& rows, Matrix& G) {
-  if (!symmetric()) return false;
+  if (!ok_ || !symmetric_) return false;
   if (split_) {  // K^-1 is block diagonal: each body's rows from its own factor
     std::vector<std::vector<int>> local(parts_.size()), at(parts_.size());
     for (size_t a = 0; a < rows.size(); ++a) {
@@ -311,7 +271,7 @@ bool CholmodFactor::quadratic_forms(const Eigen::SparseMatrix<double>& t, Vector
 
 Vector FreeBlockSolver::quadratic_forms(const Eigen::SparseMatrix<double>& t) {
   Vector out;
-  if (!symmetric()) return Vector();
+  if (!ok_ || !symmetric_) return Vector();
   if (split_) {  // t^T K^-1 t summed over the bodies, each with its rows of t
     std::vector<Triplets> local(parts_.size());
     for (int col = 0; col < t.outerSize(); ++col)
@@ -359,10 +319,9 @@ void FreeBlockSolver::for_each_part(const std::function<void(int)>& task) const 
 
 bool FreeBlockSolver::factorize_parts(double near_symmetric_tolerance) {
   std::vector<Triplets> local(parts_.size());
-  const Eigen::SparseMatrix<double>& block = refined_ ? exact_ : matrix_;  // each body decides for itself
-  for (int col = 0; col < block.outerSize(); ++col) {
+  for (int col = 0; col < matrix_.outerSize(); ++col) {
     const int b = block_of(col);
-    for (Eigen::SparseMatrix<double>::InnerIterator it(block, col); it; ++it)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(matrix_, col); it; ++it)
       local[b].emplace_back(static_cast<int>(it.row()) - starts_[b], col - starts_[b], it.value());
   }
   const int largest = static_cast<int>(matrix_.rows());
@@ -381,7 +340,7 @@ bool FreeBlockSolver::factorize_parts(double near_symmetric_tolerance) {
 }
 
 Vector FreeBlockSolver::solve(const Vector& b) const {
-  if (!split_) return solve_whole(b);
+  if (!split_) return symmetric_ ? Vector(llt_.solve(b)) : Vector(lu_.solve(b));
   Vector x(b.size());
   for_each_part([&](int k) {
     const int s = starts_[k], n = starts_[k + 1] - s;
@@ -391,7 +350,7 @@ Vector FreeBlockSolver::solve(const Vector& b) const {
 }
 
 Matrix FreeBlockSolver::solve(const Matrix& b) const {
-  if (!split_) return solve_whole(b);
+  if (!split_) return symmetric_ ? Matrix(llt_.solve(b)) : Matrix(lu_.solve(b));
   Matrix x(b.rows(), b.cols());
   for_each_part([&](int k) {
     const int s = starts_[k], n = starts_[k + 1] - s;

@@ -44,14 +44,8 @@ class FreeBlockSolver {
   // free_index: dof -> row of the free block, -1 for a prescribed dof.
   // Returns false if the block is singular.
   // near_symmetric_tolerance > 0: a block whose skew part is below that fraction of its
-  // largest entry (Newton's tangent with friction on a curved tool, or between two bodies) is
-  // factorized by Cholesky of its symmetric part, and every solve is refined against the block
-  // itself until its residual is at round-off: each pass contracts the error by
-  // |K_s^-1 (K - K_s)|, which the refinement measures rather than the tolerance assumes (with a
-  // penalty stiffness 1e3 x the body's, 1e-4 of the largest entry exceeds the body's own
-  // stiffness). A solve whose refinement does not halve its residual every pass, or does not
-  // reach round-off in kMaxRefinements passes, is done by LU of the block, and so is every later
-  // solve with this factorization. Skew below round-off (1e-13 of the largest entry) is dropped.
+  // largest entry is symmetrized (Newton's tangent with friction on a curved tool: the
+  // residual stays exact, so Newton still converges, and LDL^T serves).
   bool factorize(const Triplets& triplets, const std::vector<int>& free_index, int free_count,
                  double near_symmetric_tolerance = 0.0);
   // Several bodies: free rows [starts[b], starts[b + 1]) are body b's (starts ends with the free
@@ -76,8 +70,8 @@ class FreeBlockSolver {
   bool ok() const { return ok_; }
   // Factorized body by body (set_blocks).
   bool split() const { return split_; }
-  // Factorized by Cholesky (symmetric positive definite), and symmetric to round-off.
-  bool symmetric() const { return ok_ && symmetric_ && !refined_; }
+  // Factorized by Cholesky (symmetric positive definite).
+  bool symmetric() const { return ok_ && symmetric_; }
   // The free block as factorized (both triangles).
   const Eigen::SparseMatrix<double>& matrix() const { return matrix_; }
   // The next factorize() builds its pattern afresh (the free set changed).
@@ -94,10 +88,6 @@ class FreeBlockSolver {
   // The bodies' blocks: factorizes each diagonal block of matrix_ on its own (split_), or
   // leaves split_ false where an entry couples two bodies.
   bool factorize_parts(double near_symmetric_tolerance);
-  // Cholesky's solution of b, refined against exact_ (a near-symmetric block), or LU's.
-  template <class Rhs>
-  Rhs solve_whole(const Rhs& b) const;
-  static constexpr int kMaxRefinements = 12;
   int block_of(int row) const;
   // The bodies' tasks: through parallel_ where a thread's start (tens of microseconds) is
   // small beside the work (kParallelRows free rows or more), else one after another.
@@ -113,18 +103,10 @@ class FreeBlockSolver {
   std::vector<int> rows_, cols_;  // the triplet sequence the pattern was built from
   std::vector<int> slot_;         // triplet k -> index in matrix_.valuePtr(), -1 if dropped
   std::vector<int> mirror_;        // value index -> index of its transpose entry
-  // LU: mutable, since a near-symmetric block whose refinement fails falls back to it in solve().
-  mutable Eigen::SparseLU<Eigen::SparseMatrix<double>> lu_;
-  // A near-symmetric block as given (matrix_ holds its symmetric part), its |.|_inf, and whether
-  // refinement gave way to LU.
-  Eigen::SparseMatrix<double> exact_;
-  double exact_norm_ = 0.0;
-  bool refined_ = false;
-  mutable bool lu_instead_ = false;
+  Eigen::SparseLU<Eigen::SparseMatrix<double>> lu_;
   CholmodFactor llt_;
   CholmodFactor dissected_;  // nested-dissection order, for inverse_block only
-  mutable bool lu_analysed_ = false;
-  bool llt_analysed_ = false, dissected_analysed_ = false;
+  bool lu_analysed_ = false, llt_analysed_ = false, dissected_analysed_ = false;
   size_t dissected_fails_at_ = 0;  // the fewest rows for which the dissected factor did not pay; 0: none yet
   bool symmetric_ = false;
   bool ok_ = false;
