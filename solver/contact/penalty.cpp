@@ -3,7 +3,11 @@
 // conditions (it falls as the penalty stiffness grows). A body held by contact is held by the
 // penalty springs: its rigid amplitudes are solved with the deformation (Equilibrium with the
 // pins free), first with springs of 1e-2, 1e-4, 1e-6 x the largest stiffness on its pins,
-// each solve from the last, then without them.
+// each solve from the last, then without them. Where that fails, the step is solved again with
+// the law's stiffness ramped up from 1e-3 x its own (PenaltyStep::levels).
+#include <algorithm>
+#include <cmath>
+
 #include "solver/contact/step.hpp"
 
 namespace grip {
@@ -22,22 +26,10 @@ class PenaltyStep : public StepSolver {
     law.previous = p_previous;  // the springs start from the last step's force
     Vector q0 = q_guess;
     touch(q0, p_start);
-    EquilibriumState s;
-    s.converged = true;
-    int solves = 1;
-    if (problem_.rigid.count())
-      // Springs on the pins, weakened a hundredfold a solve, each solve from the last: the
-      // answer carries no regularization, only the penalty springs hold the body.
-      for (double spring = kPinSpring; spring > 1e-7 && s.converged; spring *= 1e-2) {
-        law.pin_spring = spring * eq_.stiffness_scale(q_guess);
-        eq_.set_penalty(law);
-        s = eq_.solve(q0, p_start);
-        if (s.converged) q0 = s.q;
-        ++solves;
-      }
-    law.pin_spring = 0.0;
-    eq_.set_penalty(law);
-    if (s.converged) s = eq_.solve(q0, p_start);
+    const double pin_scale = problem_.rigid.count() ? eq_.stiffness_scale(q_guess) : 0.0;
+    int solves = 0;
+    EquilibriumState s = levels(law, pin_scale, q0, p_start, 1.0, solves);
+    if (!s.converged) s = levels(law, pin_scale, q0, p_start, kRamp, solves);
     eq_.set_penalty(std::nullopt);
     pass_ = out_.passes = 1;
     if (!s.converged) {
@@ -51,6 +43,34 @@ class PenaltyStep : public StepSolver {
     accept(std::move(s), p);
     out_.converged = true;
     emit(solves, 0, 0, 0, 0.0);
+  }
+
+  // One solve per level, each from the last. A body held by contact has springs on its pins,
+  // weakened a hundredfold a level, then none (the answer carries no regularization, only the
+  // penalty springs hold the body). With `ramp` < 1 the law's stiffnesses start at ramp x theirs
+  // and grow geometrically to theirs at the last level (four levels): where the law's full
+  // stiffness fails from a first touch (Newton's iterates press the few points that touch at
+  // 15-60 x the load and crawl ring by ring: two_bodies_held_test), a soft law finds the contact
+  // zone in a few iterations and each stiffer level starts next to its answer.
+  EquilibriumState levels(const PenaltyLaw& law, double pin_scale, Vector q, const Vector& p_start, double ramp,
+                          int& solves) {
+    const bool held = problem_.rigid.count() > 0;
+    const int count = held || ramp < 1.0 ? kLevels : 1;
+    EquilibriumState s;
+    s.reason = "no level solved";
+    for (int level = 0; level < count; ++level) {
+      PenaltyLaw at = law;
+      const double stiffer = std::pow(ramp, static_cast<double>(count - 1 - level) / std::max(1, count - 1));
+      at.normal *= stiffer;
+      at.tangential *= stiffer;
+      at.pin_spring = held && level + 1 < count ? kPinSpring * std::pow(1e-2, level) * pin_scale : 0.0;
+      eq_.set_penalty(at);
+      s = eq_.solve(q, p_start);
+      ++solves;
+      if (!s.converged) return s;
+      q = s.q;
+    }
+    return s;
   }
 
   // A body held by contact with no point pressing yet (its first step): nothing but the pin
@@ -73,6 +93,9 @@ class PenaltyStep : public StepSolver {
   // Newton's iterates bounded while points switch between stick and slip (a free slide is
   // held by sticking springs only).
   static constexpr double kPinSpring = 1e-2;
+  // Levels of pin springs (a held body) or of the stiffness ramp, and the ramp's first factor.
+  static constexpr int kLevels = 4;
+  static constexpr double kRamp = 1e-3;
 };
 
 }  // namespace

@@ -239,14 +239,13 @@ Vector Equilibrium::residual(const Vector& q, const EquilibriumState& paired, co
     for (const auto& a : pp.point.jacobian)
       for (const auto& b : pp.point.jacobian)
         tangent->emplace_back(a.dof, b.dof, -a.dx.dot(df_dx * b.dx));
-    // The pair's stiffness at the given p, both bodies (the penalty law's change of p with the
-    // positions, the gradients of the gap and zeta, is in penalty_forces). Not with the penalty
-    // law: these terms scale with p (p / element size), and at the iterates of a held body's
-    // first solve the law's forces reach 20-60 x the load (penetrations 2e-5..8e-5 mm at
-    // k 3.7e9 N/mm, two_bodies_held_test), where they pass the body's own stiffness: the
-    // tangent turns indefinite and Newton stalls at a free residual of 0.99 (measured). At the
-    // answer they are 1.6e-3 of the body's stiffness: leaving them out costs a linear rate there.
-    if (const auto& master = paired.masters[c.obstacle]; master && !penalty_) {
+    // The pair's stiffness at the iterate's forces, both bodies (the penalty law's change of p
+    // with the positions, the gradients of the gap and zeta, is in penalty_forces): the whole
+    // consistent tangent, given forces or the law's. These terms scale with p (p / element size):
+    // where a penalty law's iterates press a few points at 15-60 x the load they pass the body's
+    // own stiffness and the tangent is indefinite; the penalty strategy then starts its law soft
+    // (penalty.cpp) rather than leaving them out, which cost a linear rate at the answer.
+    if (const auto& master = paired.masters[c.obstacle]) {
       const size_t first = tangent->size();
       master->force_derivative(problem_.body->surface_point(q, c.site, c.side), c.site, p_eta, p_xi, *tangent);
       for (size_t k = first; k < tangent->size(); ++k)

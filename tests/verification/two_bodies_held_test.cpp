@@ -137,13 +137,9 @@ TEST_P(TwoBodiesHeld, CylindersUnderAForceMatchHertz) {
 // The state of a force P, held by contact, and the state of the displacement that P gave its
 // node, held by the support: the same fields (as for one body, held_by_contact_test.cpp).
 TEST_P(TwoBodiesHeld, CylindersUnderAForceOrItsDisplacementGiveTheSameFields) {
-  // Penalty: with the rotation held on the axis, the force half fails its first step (free
-  // residual 0.996 after 5 cuts, measured with the law's exact gap gradients in the tangent, with
-  // and without the pair's fixed-p stiffness; without the gradients Newton stopped at 1.1e-5 of
-  // the force scale after 40 iterations). The first spring level's iterates press a few points
-  // at 20-60 x the load, where the pair's geometric stiffness (p / element size) passes the
-  // body's own: see Equilibrium::residual and the report of issue 19.
-  if (GetParam().contact.value("method", "") == "penalty") GTEST_SKIP() << "penalty: Newton does not converge here";
+  // Penalty: with the rotation held on the axis, the law's full stiffness from the first touch
+  // fails the force half's first solve (Newton's iterates press a few points at 15-60 x the load
+  // and crawl ring by ring); the strategy then ramps the law's stiffness up (penalty.cpp).
   const double P = 5000.0;  // N / mm
   // Between two bodies the pairing moves with the state, so no real solve reproduces the linear
   // model to rounding: every strategy stops at ||v|| <= tol, which pins the forces to about
@@ -179,7 +175,10 @@ TEST_P(TwoBodiesHeld, CylindersUnderAForceOrItsDisplacementGiveTheSameFields) {
               "support carries %.12g; forces differ by %.2e, displacements by %.2e (relative)\n",
               name(), rec.solves, rec.newton_iterations, delta, drec.solves, drec.newton_iterations, carried,
               p_diff / p_max, q_diff / q_max);
-  const double agree = exact_model() ? 1e-6 : 2e-4;
+  // Penalty has no contact loop: both halves are one law solved by Newton to its residual test,
+  // so they agree as closely as the exact linear models do (measured 3.8e-14).
+  const bool penalty = GetParam().contact.value("method", "") == "penalty";
+  const double agree = exact_model() || penalty ? 1e-6 : 2e-4;
   EXPECT_LT(p_diff, agree * p_max);
   EXPECT_LT(q_diff, agree * q_max);
   EXPECT_NEAR(carried, P, agree * P);
