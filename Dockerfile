@@ -18,10 +18,12 @@ RUN cmake -S . -B /build -G Ninja -DCMAKE_BUILD_TYPE=Release \
  && cmake --build /build --target grip \
  && strip /build/apps/grip /build/apps/grip-server
 
+# SuiteSparse is linked from its static archives (solver/CMakeLists.txt); its METIS, LAPACK
+# and OpenMP stay shared.
 FROM debian:12-slim
 RUN apt-get update -qq \
  && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
-      libcpp-httplib0.11 libspdlog1.10 libfmt9 libsqlite3-0 libpq5 libcholmod3 libumfpack5 \
+      libcpp-httplib0.11 libspdlog1.10 libfmt9 libsqlite3-0 libpq5 libmetis5 liblapack3 libgomp1 \
  && rm -rf /var/lib/apt/lists/* \
  && useradd --system --uid 10001 --user-group --home-dir /var/lib/grip --create-home grip
 # grip serve and grip healthcheck run grip-server from grip's directory (apps/CMakeLists.txt).
