@@ -12,24 +12,42 @@
 
 namespace grip::testing {
 
-// dp over every component (zero off the active set E of the step's final contact error).
-inline Vector force_correction(const Scene& scene, const StepRecord& rec) {
+// The active set E of a converged step's final contact error, with v_E and the compliance
+// block C_EE at the step's state (bordered by the amplitudes' rows for a body held by contact).
+struct ActiveBlock {
+  std::vector<int> idx;
+  Vector v;
+  Matrix C;
+  bool bordered = false;
+};
+
+inline ActiveBlock active_block(const Scene& scene, const StepRecord& rec) {
   const Problem& problem = scene.problem;
   const ContactError e = contact_error(problem, rec.p, rec.state.s, rec.tau, rec.state.enabled);
-  std::vector<int> idx;
+  ActiveBlock out;
   for (int i = 0; i < static_cast<int>(e.active.size()); ++i)
-    if (e.active[i]) idx.push_back(i);
-  Vector dp = Vector::Zero(rec.p.size());
-  if (idx.empty()) return dp;
+    if (e.active[i]) out.idx.push_back(i);
+  if (out.idx.empty()) return out;
   Equilibrium eq(problem, scene.params.newton);
   eq.set_step(rec.factors, std::vector<double>(problem.candidates.size(), 0.0));
-  const Compliance& C = eq.compliance(rec.state, idx);
-  Vector v_e(idx.size());
-  for (size_t a = 0; a < idx.size(); ++a) v_e[a] = e.v[idx[a]];
+  const Compliance& C = eq.compliance(rec.state, out.idx);
+  out.C = C.sub(out.idx);
+  out.bordered = C.bordered;
+  out.v.resize(out.idx.size());
+  for (size_t a = 0; a < out.idx.size(); ++a) out.v[a] = e.v[out.idx[a]];
+  return out;
+}
+
+// dp over every component (zero off the active set E of the step's final contact error).
+inline Vector force_correction(const Scene& scene, const StepRecord& rec) {
+  const ActiveBlock E = active_block(scene, rec);
+  const std::vector<int>& idx = E.idx;
+  Vector dp = Vector::Zero(rec.p.size());
+  if (idx.empty()) return dp;
   // A body held by contact: the bordered block [C G; G^T 0] (its amplitudes' rows), symmetric
   // but indefinite.
-  const Vector d = C.bordered ? Vector(Eigen::FullPivLU<Matrix>(C.sub(idx)).solve(v_e))
-                              : Vector(Eigen::LLT<Matrix>(C.sub(idx)).solve(v_e));
+  const Vector d = E.bordered ? Vector(Eigen::FullPivLU<Matrix>(E.C).solve(E.v))
+                              : Vector(Eigen::LLT<Matrix>(E.C).solve(E.v));
   for (size_t a = 0; a < idx.size(); ++a) dp[idx[a]] = d[a];
   return dp;
 }

@@ -14,6 +14,7 @@
 #include <cstdio>
 
 #include "solver/elements/continuum.hpp"
+#include "tests/support/force_precision.hpp"
 #include "tests/support/held.hpp"
 
 namespace grip::testing {
@@ -112,17 +113,12 @@ struct Pinned {
 
 inline Pinned pinned_by_tolerance(const Scene& scene, const StepRecord& rec) {
   const Problem& problem = scene.problem;
-  const ContactError e = contact_error(problem, rec.p, rec.state.s, rec.tau, rec.state.enabled);
-  std::vector<int> idx;
-  for (int i = 0; i < static_cast<int>(e.active.size()); ++i)
-    if (e.active[i]) idx.push_back(i);
+  const ActiveBlock E = active_block(scene, rec);
+  const std::vector<int>& idx = E.idx;
   Pinned out;
   out.length = scene.params.contact.tolerance * problem.body->characteristic_length();
   if (idx.empty()) return out;
-  Equilibrium eq(problem, scene.params.newton);
-  eq.set_step(rec.factors, std::vector<double>(problem.candidates.size(), 0.0));
-  const Compliance& C = eq.compliance(rec.state, idx);
-  const Matrix inverse = C.sub(idx).fullPivLu().inverse();
+  const Matrix inverse = E.C.fullPivLu().inverse();
   for (size_t a = 0; a < idx.size(); ++a)
     if (!problem.rigid.is_amplitude(idx[a])) out.force = std::max(out.force, inverse.row(a).cwiseAbs().sum() * out.length);
   return out;
