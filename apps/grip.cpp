@@ -26,7 +26,7 @@
 #include <vector>
 
 #include "apps/process_tuning.hpp"
-#include "apps/step_writer.hpp"
+#include "apps/result_writer.hpp"
 #include "apps/thread_team.hpp"
 #include "solver/io/result.hpp"
 #include "solver/io/schema_validation.hpp"
@@ -101,15 +101,16 @@ int solve(int argc, char** argv) {
   };
   std::printf("%5s %12s %6s %6s %6s %12s %7s %6s %6s %9s  %s\n", "step", "load_factor", "iters",
               "passes", "newton", "||v||_2", "contact", "stick", "slip", "ms", "status");
-  // With --out, each finished step is written on a thread of its own while the next one solves.
-  std::optional<grip::StepWriter> writer;
-  if (!out_path.empty()) writer.emplace(out_path);
+  // With --out, the result is written on a thread of its own while the solve runs: the members
+  // known before it, then each finished step while the next one solves.
+  std::optional<grip::ResultWriter> writer;
+  if (!out_path.empty()) writer.emplace(out_path, scene);
   grip::SteppingObserver observer;
   observer.step_started = [&](int step, double lf) { emit(grip::step_started_event(step, lf)); };
   observer.iteration = [&](const grip::IterationEvent& ev) { emit(grip::iteration_event(ev)); };
   observer.step_finished = [&](const grip::StepRecord& rec) {
     emit(grip::step_finished_event(rec));
-    if (writer) writer->add(grip::step_output(scene.problem, rec, scene.output));
+    if (writer) writer->add_step(rec);
     const auto& last = rec.history.empty() ? grip::IterationEvent{} : rec.history.back();
     std::printf("%5d %12.6g %6d %6d %6d %12.3e %7d %6d %6d %9.2f  %s\n", rec.index,
                 rec.load_factor, rec.solves, rec.passes, rec.newton_iterations, last.v2,
@@ -128,11 +129,8 @@ int solve(int argc, char** argv) {
   std::printf("total: %ld contact iterations, %ld Newton iterations, %ld factorizations, %.3f s\n",
               run.counters.solves, run.counters.newton_iterations, run.counters.factorizations,
               run.seconds);
-  if (!out_path.empty()) {
-    std::ofstream& out = *writer->file();
-    grip::write_result(out, scene, run, [&](size_t k) { return writer->text(k); });
-    out.close();
-    if (!out) {
+  if (writer) {  // the last step's text and the members the run decides
+    if (!writer->finish(run)) {
       std::fprintf(stderr, "cannot write %s\n", out_path.c_str());
       return 2;
     }

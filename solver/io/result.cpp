@@ -261,33 +261,31 @@ json effects_json(const Scene& scene, const RunResult& run) {
 
 namespace {
 
-// Everything but the steps and the mesh.
-json result_head(const Scene& scene, const RunResult& run) {
-  json head = {{"scene", scene.effective},
-          {"effects", effects_json(scene, run)},
-          {"summary",
-           {{"completed", run.completed}, {"reason", run.reason}, {"steps", run.steps.size()},
-            {"contact_iterations", run.counters.solves},
-            {"newton_iterations", run.counters.newton_iterations},
-            {"factorizations", run.counters.factorizations}, {"seconds", run.seconds}}}};
-  if (const auto* all = dynamic_cast<const BodySet*>(scene.problem.body.get())) {
-    // Each body's rows of the nodes and elements tables and of mesh.cells.
-    json bodies = json::array();
-    int first_element = 0;
-    for (int b = 0; b < all->count(); ++b) {
-      const int elements = static_cast<int>(all->part(b).cells().size());
-      bodies.push_back({{"name", all->name(b)}, {"first_node", all->node_offset(b)}, {"nodes", all->part(b).node_count()},
-                        {"first_element", first_element}, {"elements", elements}});
-      first_element += elements;
-    }
-    head["bodies"] = bodies;
+// Each body's rows of the nodes and elements tables and of mesh.cells (several bodies only).
+std::optional<json> bodies_json(const Body& body) {
+  const auto* all = dynamic_cast<const BodySet*>(&body);
+  if (!all) return std::nullopt;
+  json bodies = json::array();
+  int first_element = 0;
+  for (int b = 0; b < all->count(); ++b) {
+    const int elements = static_cast<int>(all->part(b).cells().size());
+    bodies.push_back({{"name", all->name(b)}, {"first_node", all->node_offset(b)}, {"nodes", all->part(b).node_count()},
+                      {"first_element", first_element}, {"elements", elements}});
+    first_element += elements;
   }
-  return head;
+  return bodies;
+}
+
+json summary_json(const RunResult& run) {
+  return {{"completed", run.completed}, {"reason", run.reason}, {"steps", run.steps.size()},
+          {"contact_iterations", run.counters.solves},
+          {"newton_iterations", run.counters.newton_iterations},
+          {"factorizations", run.counters.factorizations}, {"seconds", run.seconds}};
 }
 
 // table_json's rows, written as they are made (no document of the table's size in memory),
 // kRowsPerPart rows a part.
-std::vector<StepPart> table_parts(const FlatTable& t, const std::string& index_name) {
+std::vector<ResultPart> table_parts(const FlatTable& t, const std::string& index_name) {
   struct Columns {
     std::vector<int> column;  // of each key in nlohmann's order (sorted); -1: the row index
     std::vector<std::string> quoted;  // "key":
@@ -301,7 +299,7 @@ std::vector<StepPart> table_parts(const FlatTable& t, const std::string& index_n
     columns->column.push_back(c);
     columns->quoted.push_back(json(name).dump() + ":");
   }
-  std::vector<StepPart> parts;
+  std::vector<ResultPart> parts;
   for (size_t begin = 0;; begin += kRowsPerPart) {
     const size_t end = std::min(begin + kRowsPerPart, t.rows);
     parts.push_back([&t, columns, begin, end](JsonWriter& w) {
@@ -352,14 +350,14 @@ bool write_members(JsonWriter& w, json::const_iterator from, json::const_iterato
   return first;
 }
 
-using Streamed = std::vector<std::pair<std::string, std::vector<StepPart>>>;
+using Streamed = std::vector<std::pair<std::string, std::vector<ResultPart>>>;
 
 // The object `small` with the members `streamed` (their values written by their parts) among
 // its keys, in parts: each streamed value's own, and before each of them and after the last a
 // part with the small members between and the streamed key. `small` must outlive the parts.
-std::vector<StepPart> object_parts(const json& small, Streamed streamed) {
+std::vector<ResultPart> object_parts(const json& small, Streamed streamed) {
   std::sort(streamed.begin(), streamed.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-  std::vector<StepPart> parts;
+  std::vector<ResultPart> parts;
   auto it = small.cbegin();
   for (auto& [key, value] : streamed) {
     const auto from = it;
@@ -370,7 +368,7 @@ std::vector<StepPart> object_parts(const json& small, Streamed streamed) {
       w.string(name);
       w.put(':');
     });
-    for (StepPart& p : value) parts.push_back(std::move(p));
+    for (ResultPart& p : value) parts.push_back(std::move(p));
   }
   parts.push_back([from = it, to = small.cend(), start = parts.empty()](JsonWriter& w) {
     if (start) w.put('{');
@@ -399,9 +397,12 @@ void write_cells(JsonWriter& w, const std::vector<std::vector<int>>& cells) {
 json result_json(const Scene& scene, const RunResult& run) {
   json steps = json::array();
   for (const auto& rec : run.steps) steps.push_back(step_json(scene.problem, rec, scene.output));
-  json r = result_head(scene, run);
-  r["mesh"] = {{"cells", scene.problem.body->cells()}};
-  r["steps"] = std::move(steps);
+  json r = {{"scene", scene.effective},
+            {"effects", effects_json(scene, run)},
+            {"summary", summary_json(run)},
+            {"mesh", {{"cells", scene.problem.body->cells()}}},
+            {"steps", std::move(steps)}};
+  if (auto bodies = bodies_json(*scene.problem.body)) r["bodies"] = std::move(*bodies);
   return r;
 }
 
@@ -419,12 +420,12 @@ StepOutput step_output(const Problem& problem, const StepRecord& rec, const Outp
   return step;
 }
 
-std::vector<StepPart> step_parts(const StepOutput& step) {
+std::vector<ResultPart> step_parts(const StepOutput& step) {
   Streamed tables;
   if (step.nodes) tables.emplace_back("nodes", table_parts(*step.nodes, "node"));
   if (step.elements) tables.emplace_back("elements", table_parts(*step.elements, "element"));
   if (step.contact_points)
-    tables.emplace_back("contact_points", std::vector<StepPart>{[&points = *step.contact_points](JsonWriter& w) {
+    tables.emplace_back("contact_points", std::vector<ResultPart>{[&points = *step.contact_points](JsonWriter& w) {
                           w.value(contact_points_json(points));
                         }});
   return object_parts(step.summary, std::move(tables));
@@ -432,43 +433,50 @@ std::vector<StepPart> step_parts(const StepOutput& step) {
 
 void write_step(std::ostream& out, const StepOutput& step) {
   JsonWriter w(out);
-  for (const StepPart& part : step_parts(step)) part(w);
+  for (const ResultPart& part : step_parts(step)) part(w);
 }
 
-namespace {
-
-// The result with each step written by write_step(k).
-void write_result(std::ostream& out, const Scene& scene, const RunResult& run,
-                  const std::function<void(JsonWriter&, size_t)>& write_step) {
-  JsonWriter w(out);
-  const json head = result_head(scene, run);
-  const StepPart mesh = [&](JsonWriter& w) { write_cells(w, scene.problem.body->cells()); };
-  const StepPart steps = [&](JsonWriter& w) {
-    w.put('[');
-    for (size_t k = 0; k < run.steps.size(); ++k) {
-      w.raw(k ? ",\n" : "\n");
-      write_step(w, k);
+std::vector<ResultPart> result_head_parts(const Scene& scene) {
+  return {[&scene](JsonWriter& w) {
+    w.put('{');
+    if (const auto bodies = bodies_json(*scene.problem.body)) {
+      w.raw("\"bodies\":");
+      w.value(*bodies);
+      w.put(',');
     }
-    w.put(']');
-  };
-  for (const StepPart& part : object_parts(head, {{"mesh", {mesh}}, {"steps", {steps}}})) part(w);
-  w.put('\n');
+    w.raw("\"mesh\":");
+    write_cells(w, scene.problem.body->cells());
+    w.raw(",\"scene\":");
+    w.value(scene.effective);
+    w.raw(",\"steps\":[");
+  }};
 }
 
-}  // namespace
+std::vector<ResultPart> result_step_parts(const StepOutput& step, size_t k) {
+  std::vector<ResultPart> parts{[k](JsonWriter& w) { w.raw(k ? ",\n" : "\n"); }};
+  for (ResultPart& part : step_parts(step)) parts.push_back(std::move(part));
+  return parts;
+}
+
+std::vector<ResultPart> result_tail_parts(const Scene& scene, const RunResult& run) {
+  auto tail = std::make_shared<const std::pair<json, json>>(effects_json(scene, run), summary_json(run));
+  return {[tail](JsonWriter& w) {
+    w.raw("],\"effects\":");
+    w.value(tail->first);
+    w.raw(",\"summary\":");
+    w.value(tail->second);
+    w.raw("}\n");
+  }};
+}
 
 void write_result(std::ostream& out, const Scene& scene, const RunResult& run) {
-  write_result(out, scene, run, [&](JsonWriter& w, size_t k) {
+  JsonWriter w(out);
+  for (const ResultPart& part : result_head_parts(scene)) part(w);
+  for (size_t k = 0; k < run.steps.size(); ++k) {
     const StepOutput step = step_output(scene.problem, run.steps[k], scene.output);
-    for (const StepPart& part : step_parts(step)) part(w);
-  });
-}
-
-void write_result(std::ostream& out, const Scene& scene, const RunResult& run,
-                  const std::function<std::vector<std::string_view>(size_t)>& step_text) {
-  write_result(out, scene, run, [&](JsonWriter& w, size_t k) {
-    for (std::string_view piece : step_text(k)) w.raw(piece);
-  });
+    for (const ResultPart& part : result_step_parts(step, k)) part(w);
+  }
+  for (const ResultPart& part : result_tail_parts(scene, run)) part(w);
 }
 
 }  // namespace grip

@@ -23,10 +23,15 @@ nlohmann::json step_json(const Problem& problem, const StepRecord& rec, const Ou
 // What was simulated (friction, nonlinearity, plasticity, moving obstacles, contact unknowns)
 // and the work it took (factorizations, equilibrium solves).
 nlohmann::json effects_json(const Scene& scene, const RunResult& run);
-// The whole result: the effective scene, a summary and every step.
+// The whole result: the effective scene, a summary and every step. A JSON document, whose
+// members have no order; results are written by write_result (below), never from this.
 nlohmann::json result_json(const Scene& scene, const RunResult& run);
 // The same document written as it is made (the step tables row by row, never held as JSON):
 // for large meshes, where building the document took more time and memory than the solve.
+// Its members in the order a result is written as it is solved (result_head_parts,
+// result_step_parts, result_tail_parts): those known before the solve (bodies, mesh, scene),
+// the steps, then those the run decides (effects, summary). The one way a result is written:
+// `grip solve --out` streams the same parts, the service stores this text.
 void write_result(std::ostream& out, const Scene& scene, const RunResult& run);
 
 // A FieldTable's rows in one block (row after row), as a step's output keeps them.
@@ -37,8 +42,8 @@ struct FlatTable {
 };
 // One step of the result as write_result writes it, taken from the record when the step
 // finishes: its small members as JSON, its tables copied. Writing it reads neither the problem
-// nor the record, so `grip solve` writes each step on a thread of its own while the next step
-// solves (the solver itself stays single-threaded).
+// nor the record, so `grip solve` formats each step and writes it to the file on a thread of
+// its own while the next step solves (the solver itself stays single-threaded).
 // A contact point of a step's "contact_points" (body and master: several bodies only).
 struct ContactPointRow {
   int node = 0;
@@ -61,13 +66,16 @@ void write_step(std::ostream& out, const StepOutput& step);
 // write_step's text is their texts one after another. A table's rows are split into parts of
 // kRowsPerPart, so that two threads can share a step's formatting. The parts refer to `step`.
 class JsonWriter;
-using StepPart = std::function<void(JsonWriter&)>;
+using ResultPart = std::function<void(JsonWriter&)>;
 constexpr size_t kRowsPerPart = 2048;
-std::vector<StepPart> step_parts(const StepOutput& step);
-// write_result with the steps already written: step_text(k), asked for k = 0, 1, ... in turn,
-// is write_step's text of run.steps[k] in pieces (their concatenation). The same bytes as
-// write_result.
-void write_result(std::ostream& out, const Scene& scene, const RunResult& run,
-                  const std::function<std::vector<std::string_view>(size_t)>& step_text);
+std::vector<ResultPart> step_parts(const StepOutput& step);
+// write_result's text in parts, one after another: the head (`{"bodies":..,"mesh":..,"scene":..,
+// "steps":[`; it reads the effective scene and the body's mesh, which a solve leaves alone, so
+// it may be written while the scene solves), then each step k = 0, 1, ... (its separator and
+// step_parts(step)), then the tail (`],"effects":..,"summary":..}` and a newline; it holds
+// what it writes). A run that fails at step k has its steps up to k and the reason in summary.
+std::vector<ResultPart> result_head_parts(const Scene& scene);
+std::vector<ResultPart> result_step_parts(const StepOutput& step, size_t k);
+std::vector<ResultPart> result_tail_parts(const Scene& scene, const RunResult& run);
 
 }  // namespace grip

@@ -2,10 +2,15 @@
 // defaults filled in; only the effects a scene calls for are built.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
+#include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <sstream>
 
-#include "apps/step_writer.hpp"
+#include "apps/result_writer.hpp"
 #include "solver/io/json_writer.hpp"
 #include "solver/io/result.hpp"
 #include "tests/support/scenes.hpp"
@@ -264,7 +269,7 @@ TEST(SceneEffects, StepPartsJoinIntoTheStepWhateverWritesThem) {
   step.elements = table(kRowsPerPart, "element", {"sxx", "sxy"}, expected["elements"]);
   step.contact_points.emplace();
   expected["contact_points"] = json::array();
-  const std::vector<StepPart> parts = step_parts(step);
+  const std::vector<ResultPart> parts = step_parts(step);
   // One part before each table (the small members and its key) and one after the last; the
   // node table in 3 parts, the element table (exactly kRowsPerPart rows) and the contact points in 1.
   ASSERT_EQ(parts.size(), 3u + 1 + 3 + 1 + 1);
@@ -283,42 +288,55 @@ TEST(SceneEffects, StepPartsJoinIntoTheStepWhateverWritesThem) {
   std::ostringstream whole;
   write_step(whole, step);
   EXPECT_TRUE(joined == whole.str());
-  // The same through the writer, whichever thread formats which part.
-  StepWriter writer;
-  for (int k = 0; k < 3; ++k) writer.add(step);
-  for (size_t k = 0; k < 3; ++k) {
-    std::string text;
-    for (std::string_view piece : writer.text(k)) text += piece;
-    EXPECT_TRUE(text == whole.str()) << "step " << k;
-  }
 }
 
-// grip solve writes each step on a thread while the next one solves (apps/step_writer.hpp,
-// step_output taken in the solver's observer); the file must be write_result's to the byte,
-// for a single body with every field and for two bodies (master points, several tables).
+std::string file_text(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// grip solve writes its result while it solves (apps/result_writer.hpp: the head before the
+// solve, each step as the solver's observer hands it over, the tail after); the file must be
+// write_result's to the byte: a single body with every field, two bodies (master points,
+// several tables), and a run that fails at step 7 (block_under_shear), whose file must still be
+// a whole result with the six steps solved before, the failed one and the reason.
 TEST(SceneEffects, StepsWrittenWhileSolvingAreTheStreamedResultByteForByte) {
   json hertz = testing::example_scene("hertz");
   hertz["steps"] = 3;
-  json two = testing::example_scene("two-cylinders");
-  for (const json& j : {hertz, two}) {
+  const std::filesystem::path path =
+      std::filesystem::temp_directory_path() / ("grip_scene_test_" + std::to_string(getpid()) + ".json");
+  for (const json& j : {hertz, testing::example_scene("two-cylinders"), testing::block_under_shear()}) {
     Scene scene = read_scene(j);
-    StepWriter writer;
-    SteppingObserver observer;
-    observer.step_finished = [&](const StepRecord& rec) { writer.add(step_output(scene.problem, rec, scene.output)); };
-    const RunResult run = run_load_steps(scene.problem, scene.steps, scene.params, observer);
-    ASSERT_TRUE(run.completed);
-    std::ostringstream concurrent, streamed;
-    write_result(concurrent, scene, run, [&](size_t k) { return writer.text(k); });
+    RunResult run;
+    {
+      ResultWriter writer(path.string(), scene);
+      SteppingObserver observer;
+      observer.step_finished = [&](const StepRecord& rec) { writer.add_step(rec); };
+      run = run_load_steps(scene.problem, scene.steps, scene.params, observer);
+      ASSERT_TRUE(writer.finish(run));
+    }
+    std::ostringstream streamed;
     write_result(streamed, scene, run);
-    ASSERT_GT(streamed.str().size(), 10000u);
-    EXPECT_TRUE(concurrent.str() == streamed.str()) << j["description"];
-    // The texts must be the steps of this run: one too few is an error, not a shorter file.
-    StepWriter short_of_one;
-    for (size_t k = 0; k + 1 < run.steps.size(); ++k)
-      short_of_one.add(step_output(scene.problem, run.steps[k], scene.output));
-    std::ostringstream ignored;
-    EXPECT_THROW(write_result(ignored, scene, run, [&](size_t k) { return short_of_one.text(k); }), std::logic_error);
+    const std::string written = file_text(path);
+    ASSERT_GT(written.size(), 10000u);
+    EXPECT_TRUE(written == streamed.str()) << j["description"];
+    // Known before the solve first, the steps, then what the run decides.
+    std::vector<size_t> at;
+    for (const char* key : {"\"mesh\":{", "\"scene\":{", "\"steps\":[", "],\"effects\":{", "},\"summary\":{"})
+      at.push_back(written.find(key));
+    EXPECT_TRUE(std::is_sorted(at.begin(), at.end()) && at.back() != std::string::npos) << written.substr(0, 200);
+    const json r = json::parse(written);
+    EXPECT_EQ(r, result_json(scene, run));
+    ASSERT_EQ(r["steps"].size(), run.steps.size());
+    EXPECT_EQ(r["summary"]["completed"], run.completed);
+    if (run.completed) continue;
+    ASSERT_EQ(run.steps.size(), 7u);
+    for (int k = 0; k < 6; ++k) EXPECT_TRUE(r["steps"][k]["converged"].get<bool>()) << k;
+    EXPECT_FALSE(r["steps"][6]["converged"].get<bool>());
+    const std::string reason = r["summary"]["reason"];
+    EXPECT_NE(reason.find("step 7 failed: the shear load exceeds what friction can hold"), std::string::npos) << reason;
   }
+  std::filesystem::remove(path);
 }
 
 }  // namespace
