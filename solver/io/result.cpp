@@ -190,7 +190,26 @@ json step_json(const Problem& problem, const StepRecord& rec, const OutputOption
   return step_json(problem, rec, output, nullptr);
 }
 
+namespace {
+
+json counters_json(const RunResult& run) {
+  long passes = 0;
+  for (const auto& rec : run.steps) passes += rec.passes;
+  return {{"factorizations", run.counters.factorizations},
+          {"equilibrium_solves", run.counters.solves},
+          {"newton_iterations", run.counters.newton_iterations},
+          {"tau_passes", passes}};
+}
+
+}  // namespace
+
 json effects_json(const Scene& scene, const RunResult& run) {
+  json effects = effects_json(scene);
+  effects["counters"] = counters_json(run);
+  return effects;
+}
+
+json effects_json(const Scene& scene) {
   const Problem& problem = scene.problem;
   const Body::Traits traits = problem.body->traits();
   bool friction = false, moving = false;
@@ -200,8 +219,6 @@ json effects_json(const Scene& scene, const RunResult& run) {
     for (const Vec2& t : o.translations) moving |= t.norm() > 0;
   }
   for (const Candidate& c : problem.candidates) tangential += c.xi >= 0;
-  long passes = 0;
-  for (const auto& rec : run.steps) passes += rec.passes;
   json effects = {{"friction", friction},
           {"geometric_nonlinearity", traits.geometric_nonlinearity},
           {"plasticity", traits.plasticity},
@@ -210,12 +227,7 @@ json effects_json(const Scene& scene, const RunResult& run) {
           {"contact_candidates", problem.candidates.size()},
           {"contact_unknowns", problem.component_count},
           {"held_by_contact", problem.rigid.names},
-          {"unknowns_per_contact_point", tangential > 0 ? 2 : 1},
-          {"counters",
-           {{"factorizations", run.counters.factorizations},
-            {"equilibrium_solves", run.counters.solves},
-            {"newton_iterations", run.counters.newton_iterations},
-            {"tau_passes", passes}}}};
+          {"unknowns_per_contact_point", tangential > 0 ? 2 : 1}};
   // How the free motions were held (ALGORITHM.md 7), and that no regularization is left.
   if (problem.rigid.count())
     effects["held_by_contact_by"] =
@@ -458,8 +470,9 @@ std::vector<ResultPart> result_step_parts(const StepOutput& step, size_t k) {
   return parts;
 }
 
-std::vector<ResultPart> result_tail_parts(const Scene& scene, const RunResult& run) {
-  auto tail = std::make_shared<const std::pair<json, json>>(effects_json(scene, run), summary_json(run));
+std::vector<ResultPart> result_tail_parts(json effects, const RunResult& run) {
+  effects["counters"] = counters_json(run);
+  auto tail = std::make_shared<const std::pair<json, json>>(std::move(effects), summary_json(run));
   return {[tail](JsonWriter& w) {
     w.raw("],\"effects\":");
     w.value(tail->first);
@@ -476,7 +489,7 @@ void write_result(std::ostream& out, const Scene& scene, const RunResult& run) {
     const StepOutput step = step_output(scene.problem, run.steps[k], scene.output);
     for (const ResultPart& part : result_step_parts(step, k)) part(w);
   }
-  for (const ResultPart& part : result_tail_parts(scene, run)) part(w);
+  for (const ResultPart& part : result_tail_parts(effects_json(scene), run)) part(w);
 }
 
 }  // namespace grip
