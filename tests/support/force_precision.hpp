@@ -1,9 +1,10 @@
 #pragma once
-// What the contact tolerance pins a converged step's forces to. The step ends at ||v|| <= tol,
-// not at v = 0: to first order the exact forces (same active set) are p - dp with
-// dp_E = C_EE^-1 v_E, C the compliance at the step's state (ALGORITHM.md 9; the tau passes
-// stop on the same measure, StepSolver::force_precision). A check of forces against a closed
-// form or against another run is then derived as (round-off) + |dp|, never a guessed number.
+// What the contact error a converged step reached pins its forces to. The step ends at
+// ||v|| <= tol, not at v = 0: to first order the exact forces (same active set) are p - dp with
+// A dp_E = v_E, A the compliance block at the step's state (ALGORITHM.md 9; the tau passes stop on
+// C_EE^-1 v, StepSolver::force_precision), coupled with the slipping points where the friction
+// bound moves (force_error). A check of forces against a closed form or against another run is
+// then derived as (round-off) + |dp|, never a guessed number.
 #include <Eigen/LU>
 #include <limits>
 
