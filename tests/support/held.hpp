@@ -72,7 +72,13 @@ inline void expect_held(const Solved& s) {
       tolerances.length = (1 + 1e-6) * rec.p.head(s.scene.problem.rigid.first).cwiseAbs().maxCoeff() *
                           s.scene.problem.rigid.scale / c.penalty_factor;
     EXPECT_TRUE(step_invariants(s.scene.problem, rec, tolerances));
-    // ssn's events report its Newton iterates, which no ||v|| test accepts.
+    // ssn's events report its Newton iterates, which no ||v|| test accepts. Where the free motions
+    // follow the state, the step's test has a second part (error_met: the amplitudes' rows to
+    // Newton's tolerance), and StepSolver::improves accepts a rise of ||v|| only to a value within
+    // tol, for a smaller unbalance: a rise ending within tol is the solver's criterion, not a
+    // loosening. Measured (i16h): one such rise, 1.28e-9 -> 2.49e-9 at tol 2.83e-7, in 50 accepted
+    // updates (friction_loop passes, the 65 x 65 disc turned near the friction limit); none with
+    // cev, its passes or its paper loop on the 33 x 33 disc, nor cev on the von Karman beam free to turn.
     if (c.method != ContactMethod::ssn)
       EXPECT_TRUE(monotone_contact_error(rec, rigid_modes_follow_state(s.scene.problem)
                                                   ? c.tolerance * s.scene.problem.body->characteristic_length()

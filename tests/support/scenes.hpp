@@ -111,12 +111,14 @@ namespace grip::testing {
 
 // The Coulomb cone holds to 1e-9 of the largest normal force where the friction bound moves
 // with p_eta inside the iteration (cev's default, ssn); to the tau-pass tolerance with tau passes.
+inline bool friction_bound_moves(const ContactParams& c) {
+  return c.method == ContactMethod::ssn ||
+         (c.method == ContactMethod::cev && c.loop == ContactLoop::inner && c.friction_loop == FrictionLoop::inner);
+}
+
 inline InvariantTolerances tolerances_of(const Scene& scene) {
   const ContactParams& c = scene.params.contact;
-  const bool bound_moves = c.method == ContactMethod::ssn || (c.method == ContactMethod::cev &&
-                                                               c.loop == ContactLoop::inner &&
-                                                               c.friction_loop == FrictionLoop::inner);
-  return {c.tolerance * scene.problem.body->characteristic_length(), bound_moves ? 1e-9 : c.tau_tolerance};
+  return {c.tolerance * scene.problem.body->characteristic_length(), friction_bound_moves(c) ? 1e-9 : c.tau_tolerance};
 }
 
 // Every step converged, satisfies the contact invariants, and lowers ||v|| monotonically.

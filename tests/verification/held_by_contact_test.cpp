@@ -264,7 +264,6 @@ TEST_P(HeldByContactStrategy, BeamOnAFlatPushedAlongIt) {
     const Solved s = solve_scene(with(beam_lying_on_a_flat(kinematics)));
     const Solved cev = solve_scene(beam_lying_on_a_flat(kinematics));
     expect_held(s);
-    double carried = 0.0;
     EXPECT_EQ(s.scene.problem.rigid.count(), std::string(kinematics) == "linear" ? 3 : 2);
     ASSERT_EQ(s.run.steps.size(), 5u) << s.run.reason;
     for (int k = 0; k < 4; ++k) {
@@ -273,17 +272,13 @@ TEST_P(HeldByContactStrategy, BeamOnAFlatPushedAlongIt) {
       const Vec2 R = contact_resultant(s.scene.problem, rec, 0);
       EXPECT_NEAR(-R.x(), 20.0 * rec.factors[2], balance(s.scene) * 200) << kinematics << " step " << rec.index;
       EXPECT_NEAR(R.y(), 200.0, balance(s.scene) * 200);
-      // The same forces as cev's default loop, to what each run's contact error pins them to.
+      // The same forces as cev's default loop, to what each run's contact error pins them to
+      // (agreement_bound). Not for penalty: its forces follow its law, p = k s, not v = 0.
       const StepRecord& ref = cev.run.steps[k];
       const double diff = force_difference(s.scene.problem, rec, ref);
-      const double bound = agreement_bound(s, rec, cev, ref, carried);
-      // Not for penalty (its forces follow its law, p = k s, not v = 0) nor ssn (it stops on its
-      // own residual: on the von Karman beam its forces lay 4.7e-6 and 9.7e-5 from cev's at the
-      // first two levels against bounds of 3.5e-6 and 7.5e-5, measured, not traced).
-      const ContactMethod method = s.scene.params.contact.method;
-      if (method != ContactMethod::penalty && method != ContactMethod::ssn)
+      const double bound = agreement_bound(s, k, cev);
+      if (s.scene.params.contact.method != ContactMethod::penalty)
         EXPECT_LE(diff, bound) << kinematics << " step " << rec.index;
-      carried = diff;
       std::printf("%s: %s beam, Q/(mu N) = %.3f: %d real solves, %d Newton; forces differ from cev's by %.2e "
                   "(bound %.2e)\n",
                   name(), kinematics, 20.0 * rec.factors[2] / 60.0, rec.solves, rec.newton_iterations, diff, bound);
