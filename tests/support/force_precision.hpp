@@ -95,3 +95,32 @@ inline double agreement_bound(const Solved& s, const StepRecord& rec, const Solv
 }
 
 }  // namespace grip::testing
+
+namespace grip::testing {
+
+// Two runs whose previous steps ended at positions that differ by what their contact tolerance
+// allows (dzeta of each point along its obstacle) measure this step's slips from different
+// references (s_xi = zeta - zeta_previous): a sticking point then holds a different position, so
+// their forces differ by C_EE^-1 dzeta on the active block of this step (rec of run s). Friction's
+// history, which the previous step's force difference (agreement_bound's `carried`) does not
+// cover: the paper's loop on the free beam, 1.3e-3 from cev at the first push level where step 1's
+// forces differed by 8.7e-5 only.
+inline double reference_shift(const Solved& s, const StepRecord& rec, const StepRecord& previous,
+                              const StepRecord& previous_ref) {
+  const ActiveBlock E = active_block(s.scene, rec);
+  if (E.idx.empty()) return 0.0;
+  const Problem& problem = s.scene.problem;
+  Vector shift = Vector::Zero(E.idx.size());
+  for (size_t a = 0; a < E.idx.size(); ++a)
+    for (size_t i = 0; i < problem.candidates.size(); ++i)
+      if (problem.candidates[i].xi == E.idx[a])
+        shift[a] = previous.state.points[i].projection.zeta - previous_ref.state.points[i].projection.zeta;
+  const Vector dp = E.bordered ? Vector(Eigen::FullPivLU<Matrix>(E.C).solve(shift))
+                               : Vector(Eigen::LLT<Matrix>(E.C).solve(shift));
+  double largest = 0.0;
+  for (size_t a = 0; a < E.idx.size(); ++a)
+    if (!problem.rigid.is_amplitude(E.idx[a])) largest = std::max(largest, std::abs(dp[a]));
+  return largest;
+}
+
+}  // namespace grip::testing
