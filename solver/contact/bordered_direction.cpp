@@ -98,7 +98,8 @@ namespace grip {
 // step then meets the equilibrium rows on the linear model whatever n or alpha, so the load
 // balances to rounding at convergence (a linear body), not only to the contact tolerance.
 Vector StepSolver::project(const Compliance& C, const Vector& p, const Vector& pbar, const ContactError& e,
-                           const Vector& tau) const {
+                           const Vector& tau, const Vector* asked) const {
+  const Vector& step = asked ? *asked : pbar;
   Vector out = project_forces(problem_, p, pbar, e, tau);
   if (!C.bordered) return out;
   const RigidModes& rigid = problem_.rigid;
@@ -111,7 +112,7 @@ Vector StepSolver::project(const Compliance& C, const Vector& p, const Vector& p
     Vector r = Vector::Zero(k);
     for (int b = 0; b < k; ++b)
       for (int j = 0; j < out.size(); ++j)
-        if (!rigid.is_amplitude(j) && out[j] != pbar[j]) r[b] += C(j, amplitude[b]) * (out[j] - pbar[j]);
+        if (!rigid.is_amplitude(j) && out[j] != step[j]) r[b] += C(j, amplitude[b]) * (out[j] - step[j]);
     std::vector<int> inside;
     for (size_t i = 0; i < problem_.candidates.size(); ++i) {
       const Candidate& c = problem_.candidates[i];

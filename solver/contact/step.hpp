@@ -88,15 +88,21 @@ class StepSolver {
   // amplitudes eliminated, eq. 13 on the positive definite block of the null space of G^T.
   Direction bordered_direction(const Compliance& C, const ContactError& err, int level, double alpha_fixed);
   // eq. 13's projection of pbar (project_forces), keeping a held body's equilibrium rows met.
+  // `asked` (if given): the forces the direction's step assumed, where they differ from pbar
+  // (held_direction's forces put on their bound): the rows are kept against those.
   Vector project(const Compliance& C, const Vector& p, const Vector& pbar, const ContactError& e,
-                 const Vector& tau) const;
+                 const Vector& tau, const Vector* asked = nullptr) const;
 
   // eq. 13's direction for the literal loop, on the components that eq. 13's projection lets
   // move: a force on its bound (|p_xi| = tau, or p_eta = 0) that the direction pushes beyond it
   // keeps its value at every alpha, as on the slipping branch, so M_n is formed without it (the
   // others' step assumed it moved: with it the step was no descent of ||v|| at any alpha, the
   // free beam). Its error stays in ||v||; repeated until no such force is left.
-  Direction held_direction(const Compliance& C, const ContactError& e, int level, double alpha_fixed);
+  // With the trial length a: a force that p - a d carries beyond its bound is put on it (the
+  // projection's value) and held the same way; pbar gets the trial's forces, `asked` the same
+  // with the held forces where they were (what the direction assumed; project keeps the rows).
+  Direction held_direction(const Compliance& C, const ContactError& e, int level, double alpha_fixed, double a,
+                           Vector& pbar, Vector& asked);
   // The paper's literal loop: one real solve per eq. 13 update at acceleration `level` (cev's
   // `loop: paper`), or the multiplier update with a fixed alpha (uzawa).
   bool literal_pass(int level, double alpha_fixed);
@@ -147,6 +153,8 @@ class StepSolver {
   long newton_emitted_ = 0;  // the Newton counter at the last event
   double warmup_eps_ = 0.0;
   bool coulomb_ = false;  // the friction bound moves with p (no tau passes)
+  bool literal_ = false;  // the passes run the literal loop (literal_pass)
+  double pin_forces_ = 0.0;  // > 0: the literal loop's passes pin p_eta to this (tau_passes)
   long own_newton_iterations_ = 0;  // Newton iterations made outside the oracle (ssn)
   std::vector<char> is_normal_;
   ContactError error_;
