@@ -149,6 +149,8 @@ class StepSolver {
   bool coulomb_ = false;  // the friction bound moves with p (no tau passes)
   long own_newton_iterations_ = 0;  // Newton iterations made outside the oracle (ssn)
   std::vector<char> is_normal_;
+  int beyond_friction_ = 0;    // accepted states in a row beyond what friction holds (accept)
+  std::string friction_limit_;  // why, once shown: budget_left ends the step with it
   ContactError error_;
   StepOutcome out_;
 };
