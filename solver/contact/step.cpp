@@ -6,6 +6,7 @@
 
 #include "solver/contact/acceleration.hpp"
 #include "solver/contact/coulomb_model.hpp"
+#include "solver/solve/friction_limit.hpp"
 #include "solver/solve/rigid_equilibrium.hpp"
 
 namespace grip {
@@ -239,6 +240,14 @@ void StepSolver::accept(EquilibriumState s, const Vector& p) {
   out_.p = p;
   if (coulomb_) out_.tau = friction_bounds(problem_, p);
   error_ = error_at(out_.p, out_.state.s, out_.state.enabled);
+  // A load beyond what friction holds (friction_limit.hpp), shown at two accepted states in a
+  // row, ends the step at the next budget check: the paper's loop otherwise spends its whole
+  // budget turning a disc about its squeezed shape (500 real solves, 26 s of CPU on 33 x 33).
+  if (problem_.rigid.count() && !error_met(error_)) {
+    std::string why = friction_limit_exceeded(problem_, out_.state, out_.p, out_.tau, eq_.factors());
+    if (why.empty()) beyond_friction_ = 0;
+    else if (++beyond_friction_ >= 2) friction_limit_ = std::move(why);
+  }
   if (strict_balance_) {
     // Newton's share of the tolerance of the size of the forces (the sum of the load's and the
     // contact forces' magnitudes), in the amplitudes' unit (s = scale R^T (F + T p)).
@@ -260,6 +269,7 @@ bool StepSolver::budget_left() {
     out_.stopped = true;
     return fail("stopped on request");
   }
+  if (!friction_limit_.empty()) return fail(friction_limit_);
   if (eq_.counters().solves < solves_at_start_ + params_.max_iterations) return true;
   return fail("contact error " + std::to_string(error_.norm2) + " above tolerance " +
               std::to_string(tol_) + " after " + std::to_string(params_.max_iterations) +

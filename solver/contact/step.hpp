@@ -157,6 +157,8 @@ class StepSolver {
   double pin_forces_ = 0.0;  // > 0: the literal loop's passes pin p_eta to this (tau_passes)
   long own_newton_iterations_ = 0;  // Newton iterations made outside the oracle (ssn)
   std::vector<char> is_normal_;
+  int beyond_friction_ = 0;    // accepted states in a row beyond what friction holds (accept)
+  std::string friction_limit_;  // why, once shown: budget_left ends the step with it
   ContactError error_;
   StepOutcome out_;
 };

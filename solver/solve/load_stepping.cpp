@@ -5,6 +5,7 @@
 #include <cmath>
 #include <optional>
 
+#include "solver/solve/friction_limit.hpp"
 #include "solver/solve/rigid_equilibrium.hpp"
 
 namespace grip {
@@ -139,6 +140,18 @@ RunResult run_load_steps(Problem& problem, const std::vector<LoadStep>& steps,
       if (!out.epsilon_used.empty()) rec.epsilon_used = out.epsilon_used;
       if (!out.converged) {
         if (out.stopped) result.stopped = true;
+        // A load beyond what friction holds at the normal forces the attempt reached
+        // (friction_limit.hpp): no retry or cut of the increment can help. Before: a disc
+        // squeezed between two flats and turned beyond the limit (33 x 33) cut its increment 5
+        // times, 443 real solves.
+        if (!out.stopped)
+          if (std::string why = friction_limit_exceeded(problem, out.state, out.p, out.tau, target); !why.empty()) {
+            rec.reason = std::move(why);
+            rec.p = out.p;
+            rec.tau = out.tau;
+            rec.state = std::move(out.state);
+            break;
+          }
         // A poor extrapolation (after the start-up step, or where contact changes) is retried
         // from the previous force before the increment is cut: a cut changes the load path.
         if (!out.stopped && !from_previous_force && extrapolated) {

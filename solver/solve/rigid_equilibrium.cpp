@@ -20,19 +20,6 @@ bool translation_free(const Problem& problem, const Vec2& d) {
   return (R * c - t).norm() <= 1e-9 * t.norm();
 }
 
-std::string factors_text(const Problem& problem, const LoadFactors& factors) {
-  std::string text;
-  int shown = 0;
-  for (size_t k = 0; k < factors.size(); ++k) {
-    if (factors[k] == 0.0) continue;
-    char value[32];
-    std::snprintf(value, sizeof value, "%.6g", factors[k]);
-    const std::string name = k < problem.case_names.size() ? problem.case_names[k] + " " : "";
-    text += (shown++ ? ", " : "") + name + value;
-  }
-  return (shown > 1 ? "at load factors " : "at load factor ") + (shown ? text : std::string("0"));
-}
-
 // Every dof a translation, x and y of one node one after the other (the continuum).
 bool translation_pairs(const Body& body) {
   const Vector tx = body.rigid_translation(Vec2::UnitX()), ty = body.rigid_translation(Vec2::UnitY());
@@ -158,6 +145,19 @@ Matrix rigid_modes_at(const Problem& problem, const Vector& q) {
   return modes;
 }
 
+std::string load_factors_text(const Problem& problem, const LoadFactors& factors) {
+  std::string text;
+  int shown = 0;
+  for (size_t k = 0; k < factors.size(); ++k) {
+    if (factors[k] == 0.0) continue;
+    char value[32];
+    std::snprintf(value, sizeof value, "%.6g", factors[k]);
+    const std::string name = k < problem.case_names.size() ? problem.case_names[k] + " " : "";
+    text += (shown++ ? ", " : "") + name + value;
+  }
+  return (shown > 1 ? "at load factors " : "at load factor ") + (shown ? text : std::string("0"));
+}
+
 std::string unreachable_equilibrium(const Problem& problem, const EquilibriumState& paired,
                                     const LoadFactors& factors) {
   if (problem.rigid.count() == 0 || problem.candidates.empty()) return "";
@@ -176,7 +176,7 @@ std::string unreachable_equilibrium(const Problem& problem, const EquilibriumSta
   const double scale = resultant.norm();
   if (scale == 0.0) return "";
   const double N = -resultant.dot(n), Q = std::abs(resultant.dot(t));
-  const std::string at = factors_text(problem, factors);
+  const std::string at = load_factors_text(problem, factors);
   if (translation_free(problem, n) && N <= 1e-12 * scale)
     return "the load pulls the body off every obstacle: contact can only push, and the load's resultant (" +
            std::to_string(resultant.x()) + ", " + std::to_string(resultant.y()) + ") points away from the obstacles " +

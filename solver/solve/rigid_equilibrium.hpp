@@ -18,6 +18,9 @@ namespace grip {
 std::string unreachable_equilibrium(const Problem& problem, const EquilibriumState& paired,
                                     const LoadFactors& factors);
 
+// "at load factor 1.05", or "at load factors press 1, shear 1.05" (the non-zero ones, named).
+std::string load_factors_text(const Problem& problem, const LoadFactors& factors);
+
 // The change of the rigid amplitudes (problem.rigid, in their unit) that follows the supports
 // from load factors `from` to `to`: for each body with free rigid motions, the rigid motion that
 // fits the change of its prescribed values by least squares and has the least norm over its dofs

@@ -13,6 +13,7 @@
 // clang-format off
 #include "grip_process.hpp"
 #include "tests/support/scenes.hpp"
+#include "tests/support/turned_disc.hpp"
 // clang-format on
 
 namespace grip::testing {
@@ -104,6 +105,32 @@ TEST(JobService, AShearLoadAboveWhatFrictionHoldsFailsTheJobWithItsReason) {
   ASSERT_EQ(r["steps"].size(), 7u);
   for (int k = 0; k < 6; ++k) EXPECT_TRUE(r["steps"][k]["converged"].get<bool>());
   EXPECT_EQ(r["effects"]["held_by_contact"].size(), 3u);
+}
+
+// A couple beyond what friction holds on a disc squeezed between two flats (the normal forces
+// come from its deformation, so no check before solving decides it): a failed job whose reason
+// says why, with the two steps solved before it in its result, and no fields for the failed step.
+TEST(JobService, ACoupleAboveWhatFrictionHoldsFailsTheJobWithItsReason) {
+  TempDir dir;
+  SqliteStore store((dir.path() / "grip.sqlite").string());
+  JobService service(store, ServiceOptions{});
+  service.start();
+  const std::string id = service.submit(turned_beyond_the_limit()).job.record.id;
+  const auto events = events_to_end(service, id);
+  EXPECT_EQ(events.back().type, "job_failed");
+  const std::string reason = nlohmann::json::parse(events.back().data)["reason"];
+  EXPECT_NE(reason.find("step 3 failed: the couple exceeds what friction can hold: M / (mu sum N r) = 1.06"),
+            std::string::npos)
+      << reason;
+  EXPECT_EQ(service.job(id)->record.status, JobStatus::failed);
+  const auto result = service.result(id);
+  ASSERT_TRUE(result);
+  const nlohmann::json r = nlohmann::json::parse(*result);
+  ASSERT_EQ(r["steps"].size(), 3u);
+  for (int k = 0; k < 2; ++k) EXPECT_TRUE(r["steps"][k]["converged"].get<bool>());
+  EXPECT_FALSE(r["steps"][2]["converged"].get<bool>());
+  EXPECT_FALSE(r["steps"][2].contains("nodes"));
+  EXPECT_EQ(r["steps"][2]["cuts"], 0);
 }
 
 TEST(JobService, RecoveryRunsInterruptedJobsAgainAboveTheirOldEventIds) {

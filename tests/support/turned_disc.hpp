@@ -11,10 +11,12 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <vector>
 
 #include "solver/elements/continuum.hpp"
 #include "tests/support/force_precision.hpp"
 #include "tests/support/held.hpp"
+#include "tests/support/result_checks.hpp"
 
 namespace grip::testing {
 
@@ -35,6 +37,19 @@ inline nlohmann::json turned_disc(const char* kinematics, double delta, double F
   j["body"]["loads"] = nlohmann::json::array({{{"node", disc_node(grid, grid, grid / 2)}, {"force", {0.0, F}}},
                                               {{"node", disc_node(grid, 0, grid / 2)}, {"force", {0.0, -F}}}});
   j["steps"] = steps;
+  return j;
+}
+
+// The same disc on a grid x grid mesh squeezed by 0.1 mm in a first step, then turned by the
+// couple 2 R F x each of `turns` in one step each (load cases squeeze and turn).
+inline nlohmann::json turned_in_stages(int grid, double F, const std::vector<double>& turns) {
+  using nlohmann::json;
+  json j = turned_disc("finite", 0.1, F, 1, grid);
+  for (json& load : j["body"]["loads"]) load["case"] = "turn";
+  j["obstacles"][1]["motion"]["case"] = "squeeze";
+  j.erase("steps");
+  j["stages"] = json::array({{{"steps", 1}, {"factors", {{"squeeze", 1}}}}});
+  for (const double f : turns) j["stages"].push_back({{"steps", 1}, {"factors", {{"squeeze", 1}, {"turn", f}}}});
   return j;
 }
 
@@ -147,6 +162,64 @@ inline std::pair<double, double> expect_same_answer(const Solved& a, const Solve
     worst.second = std::max(worst.second, dq);
   }
   return worst;
+}
+
+// The disc (33 x 33 nodes) squeezed, turned by 0.9 x the couple of F = 1369 N, then by 1.05 x it:
+// beyond what friction holds (the first turn carries Q / (mu P) = 0.914 on each flat, so 1.05
+// asks about 1.066). No static equilibrium exists at the last step: a disc turned about its
+// squeezed shape re-flattens wherever it touches, so only friction resists the couple, and P is
+// fixed by the squeeze.
+inline nlohmann::json turned_beyond_the_limit() { return turned_in_stages(32, 1369.0, {0.9, 1.05}); }
+
+// The run of turned_beyond_the_limit: the first two steps converged and balanced, the third
+// failed at once (no cut of its increment) with the reason in words, no NaN; its ratio
+// M / (mu sum N r) against the closed form of the scene, 2 R F / (mu (P_top + P_bottom) h) with
+// h = R - delta / 2 (the flats' distance from the centre, the levers of the two flats' friction
+// about a turn between them) and P from the converged previous step. Returns the ratio reported.
+inline double expect_turned_beyond_the_limit(const Solved& s) {
+  EXPECT_TRUE(result_is_finite(s));
+  EXPECT_FALSE(s.run.completed);
+  if (s.run.steps.size() != 3u) {
+    ADD_FAILURE() << "steps " << s.run.steps.size() << ": " << s.run.reason;
+    return 0.0;
+  }
+  EXPECT_TRUE(s.run.steps[0].converged && s.run.steps[1].converged) << s.run.reason;
+  expect_disc_balanced(s);
+  const StepRecord& failed = s.run.steps[2];
+  EXPECT_FALSE(failed.converged);
+  EXPECT_EQ(failed.cuts, 0) << failed.reason;
+  const std::string& why = failed.reason;
+  const std::string head = "the couple exceeds what friction can hold: M / (mu sum N r) = ";
+  EXPECT_EQ(why.find(head), 0u) << why;
+  EXPECT_NE(why.find("at load factors turn 1.05, squeeze 1 (the body turns about"), std::string::npos) << why;
+  EXPECT_NE(why.find("no static equilibrium exists"), std::string::npos) << why;
+  EXPECT_NE(s.run.reason.find("step 3 failed: " + head), std::string::npos) << s.run.reason;
+  if (why.find(head) != 0) return 0.0;
+  const double ratio = std::stod(why.substr(head.size()));
+  // The closed form from the previous step's normal forces.
+  const StepRecord& before = s.run.steps[1];
+  const double P = flat_resultant(s.scene.problem, before, 0).y() - flat_resultant(s.scene.problem, before, 1).y();
+  const double F = 1369.0 * 1.05, mu = 0.3, h = kDiscRadius - 0.1 / 2;
+  const double closed = 2 * kDiscRadius * F / (mu * P * h);
+  // The diagnosis reads the normal forces where the attempt stopped, not the previous step's:
+  // they differ by the change of P over the step (the couple lowers the squeeze force), the
+  // unbalance of the two flats, and the levers by the displacements (|u| / R at the loaded
+  // nodes, the contact points' distance from the flats' lines); all read from that state.
+  const Vec2 lower = flat_resultant(s.scene.problem, failed, 0), upper = flat_resultant(s.scene.problem, failed, 1);
+  const double P_now = lower.y() - upper.y();
+  double drift = std::abs(P_now / P - 1) + std::abs(lower.y() + upper.y()) / P_now;
+  const Problem& problem = s.scene.problem;
+  for (int k = 0; k < static_cast<int>(problem.candidates.size()); ++k)
+    if (failed.p[problem.candidates[k].eta] < 0)
+      drift += std::abs(failed.state.s[problem.candidates[k].eta]) / kDiscRadius / 2;
+  for (const int node : {disc_node(32, 32, 16), disc_node(32, 0, 16)})
+    drift += failed.state.q.segment<2>(2 * node).norm() / kDiscRadius / 2;
+  EXPECT_GT(ratio, 1.0);
+  EXPECT_NEAR(ratio, closed, drift * closed + 1e-6);
+  std::printf("beyond the limit: M / (mu sum N r) = %.6f, closed form %.6f (P %.3f of the previous step, %.3f at the "
+              "state reached; bound %.2e); failed step: %d real solves, %d Newton, %d cuts\n",
+              ratio, closed, P, P_now, drift * closed, failed.solves, failed.newton_iterations, failed.cuts);
+  return ratio;
 }
 
 }  // namespace grip::testing
