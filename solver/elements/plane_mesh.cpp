@@ -48,22 +48,29 @@ std::vector<double> side_weights(const PlaneMesh& mesh, const std::vector<int>& 
   return out;
 }
 
-// Connected parts of the mesh (elements sharing a node): the part of each node, -1 if none.
+// Connected parts of the mesh (elements sharing a node): the part of each node, -1 if none;
+// parts numbered in the order of their first node.
 std::vector<int> node_parts(const PlaneMesh& mesh, int& count) {
   std::vector<int> parent(mesh.nodes.size());
   std::iota(parent.begin(), parent.end(), 0);
-  std::function<int(int)> root = [&](int i) { return parent[i] == i ? i : parent[i] = root(parent[i]); };
+  auto root = [&](int i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];  // path halving
+    return i;
+  };
   std::vector<char> used(mesh.nodes.size(), 0);
   for (const auto& e : mesh.elements)
     for (int a : e) {
       used[a] = 1;
       parent[root(a)] = root(e.front());
     }
-  std::map<int, int> index;
-  std::vector<int> part(mesh.nodes.size(), -1);
+  std::vector<int> part(mesh.nodes.size(), -1), index(mesh.nodes.size(), -1);  // index: of a root
+  count = 0;
   for (size_t i = 0; i < part.size(); ++i)
-    if (used[i]) part[i] = index.emplace(root(static_cast<int>(i)), static_cast<int>(index.size())).first->second;
-  count = static_cast<int>(index.size());
+    if (used[i]) {
+      int& k = index[root(static_cast<int>(i))];
+      if (k < 0) k = count++;
+      part[i] = k;
+    }
   return part;
 }
 
@@ -172,11 +179,16 @@ std::vector<MeshIssue> check_mesh(const PlaneMesh& mesh, QuadShape shape) {
   std::vector<Vec2> checks;
   for (int a = 0; a < n; ++a) checks.push_back(quad_node_natural(shape, a));
   for (const GaussPoint& g : quad_gauss_rule(shape)) checks.push_back({g.xi, g.eta});
-  std::vector<ShapeGradients> dN_nat(checks.size());
+  // dN[c * n + a]: node a's natural derivatives at check point c.
+  std::vector<Vec2> dN(checks.size() * n);
   Vector N;
-  for (size_t c = 0; c < checks.size(); ++c) quad_shape_functions(shape, checks[c].x(), checks[c].y(), N, dN_nat[c]);
+  ShapeGradients dN_c;
+  for (size_t c = 0; c < checks.size(); ++c) {
+    quad_shape_functions(shape, checks[c].x(), checks[c].y(), N, dN_c);
+    for (int a = 0; a < n; ++a) dN[c * n + a] = dN_c.row(a).transpose();
+  }
   std::vector<char> used(mesh.nodes.size(), 0);
-  std::vector<int> sorted(n);
+  Vec2 x[9];  // the element's nodes
   for (int e = 0; e < static_cast<int>(mesh.elements.size()); ++e) {
     const auto& el = mesh.elements[e];
     if (static_cast<int>(el.size()) != n) {
@@ -193,24 +205,32 @@ std::vector<MeshIssue> check_mesh(const PlaneMesh& mesh, QuadShape shape) {
         used[a] = 1;  // even in a faulty element: one fault, one message
       }
     if (!ids_ok) continue;
-    std::copy(el.begin(), el.end(), sorted.begin());
-    std::sort(sorted.begin(), sorted.end());
-    if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) {
+    bool repeated = false;  // at most 9 ids: pairs, not a sort
+    for (int a = 1; a < n; ++a)
+      for (int b = 0; b < a; ++b) repeated |= el[a] == el[b];
+    if (repeated) {
       issues.push_back({e, -1, "names a node twice"});
       continue;
     }
-    Vec2 lo = mesh.nodes[el[0]], hi = lo;
+    for (int a = 0; a < n; ++a) x[a] = mesh.nodes[el[a]];
+    Vec2 lo = x[0], hi = lo;
     for (int a = 1; a < n; ++a) {
-      lo = lo.cwiseMin(mesh.nodes[el[a]]);
-      hi = hi.cwiseMax(mesh.nodes[el[a]]);
+      lo = lo.cwiseMin(x[a]);
+      hi = hi.cwiseMax(x[a]);
     }
     const double size2 = (hi - lo).squaredNorm();
     for (size_t c = 0; c < checks.size(); ++c) {
-      // det of J = X^T dN (as quad_point's detJ), summed node by node: a dynamic-size product
-      // per check point took twice the instructions (3,700 elements of Hertz a/h 20: 7.4 M, now 3.4 M).
-      Mat2 J = Mat2::Zero();
-      for (int a = 0; a < n; ++a) J += mesh.nodes[el[a]] * dN_nat[c].row(a);
-      const double det = J.determinant();
+      // det of J = X^T dN (as quad_point's detJ), summed node by node in plain doubles (Eigen's
+      // dynamic-size rows took 3 times the instructions: 10.8 M for 11,520 elements of Hertz a/h 40).
+      double j00 = 0.0, j01 = 0.0, j10 = 0.0, j11 = 0.0;
+      for (int a = 0; a < n; ++a) {
+        const Vec2& d = dN[c * n + a];
+        j00 += x[a].x() * d.x();
+        j01 += x[a].x() * d.y();
+        j10 += x[a].y() * d.x();
+        j11 += x[a].y() * d.y();
+      }
+      const double det = j00 * j11 - j10 * j01;
       if (!(det > 1e-12 * size2)) {
         issues.push_back({e, -1, std::string(det < 0 ? "is inverted or its nodes are not counter-clockwise"
                                                      : "has zero area") +
@@ -230,20 +250,28 @@ InvalidMesh::InvalidMesh(std::vector<MeshIssue> all)
                             " " + all[0].detail),
       issues(std::move(all)) {}
 
-std::vector<std::vector<int>> boundary_sides(const PlaneMesh& mesh, QuadShape shape) {
-  // Every element side by its end nodes, sorted (a vector, not a map: this ran for every
-  // scene read, 46,000 sides at a/h 40); the sides that appear once.
+namespace {
+
+// The boundary sides (boundary_sides) whose end nodes both have (*in)[node] set (all sides
+// without `in`), in the order of their sorted end nodes.
+std::vector<std::vector<int>> boundary_sides_within(const PlaneMesh& mesh, QuadShape shape,
+                                                    const std::vector<char>* in) {
+  // Every element side by its end nodes, sorted (a vector, not a map); the sides that appear
+  // once. Whether a side is on the boundary depends on its end nodes only, so the sides outside
+  // `in` are left out before the sort (a contact set's: 200 of the 46,000 sides of Hertz a/h 40,
+  // whose full sort took 11 M instructions at every scene read).
   struct Side {
     std::pair<int, int> key;
     int element, local;
   };
   const auto& locals = local_sides(shape);
   std::vector<Side> all;
-  all.reserve(mesh.elements.size() * locals.size());
+  if (!in) all.reserve(mesh.elements.size() * locals.size());
   for (int e = 0; e < static_cast<int>(mesh.elements.size()); ++e)
     for (int l = 0; l < static_cast<int>(locals.size()); ++l) {
       const auto& el = mesh.elements[e];
-      all.push_back({std::minmax(el[locals[l].front()], el[locals[l].back()]), e, l});
+      const int a = el[locals[l].front()], b = el[locals[l].back()];
+      if (!in || ((*in)[a] && (*in)[b])) all.push_back({std::minmax(a, b), e, l});
     }
   std::sort(all.begin(), all.end(), [](const Side& a, const Side& b) { return a.key < b.key; });
   std::vector<std::vector<int>> sides;
@@ -260,6 +288,12 @@ std::vector<std::vector<int>> boundary_sides(const PlaneMesh& mesh, QuadShape sh
   return sides;
 }
 
+}  // namespace
+
+std::vector<std::vector<int>> boundary_sides(const PlaneMesh& mesh, QuadShape shape) {
+  return boundary_sides_within(mesh, shape, nullptr);
+}
+
 BoundaryPart boundary_part(const PlaneMesh& mesh, QuadShape shape, const std::vector<int>& set) {
   std::vector<char> in(mesh.nodes.size(), 0);
   for (int i : set) in.at(i) = 1;
@@ -267,8 +301,8 @@ BoundaryPart boundary_part(const PlaneMesh& mesh, QuadShape shape, const std::ve
   std::map<int, int> next;  // along the boundary, body on the left
   std::set<int> has_previous;
   std::map<int, double> length;
-  for (const auto& side : boundary_sides(mesh, shape)) {
-    if (!std::all_of(side.begin(), side.end(), [&](int a) { return in[a] != 0; })) continue;
+  for (const auto& side : boundary_sides_within(mesh, shape, &in)) {
+    if (!std::all_of(side.begin(), side.end(), [&](int a) { return in[a] != 0; })) continue;  // a q9 side's middle
     part.sides.push_back(side);
     const std::vector<double> w = side_weights(mesh, side);
     for (size_t a = 0; a < side.size(); ++a) length[side[a]] += w[a];
@@ -320,6 +354,31 @@ ElementQuality element_quality(const PlaneMesh& mesh) {
     q.max_aspect_ratio = std::max(q.max_aspect_ratio, longest / shortest);
   }
   return q;
+}
+
+bool corner_angles_within(const PlaneMesh& mesh, double lo, double hi) {
+  // A corner's angle is atan2(cross, dot) of its sides (element_quality); it lies above the
+  // angle a when the corner (dot, cross) turns counter-clockwise from (cos a, sin a). That sign
+  // decides where the corner is more than 1e-12 radians from the limit, far beyond the
+  // rounding of either, and atan2 in degrees, element_quality's value, decides the rest.
+  const double degrees = 180.0 / std::acos(-1.0);
+  const Vec2 lo_dir(std::cos(lo / degrees), std::sin(lo / degrees)), hi_dir(std::cos(hi / degrees), std::sin(hi / degrees));
+  for (const auto& el : mesh.elements)
+    for (int a = 0; a < 4; ++a) {
+      const Vec2& here = mesh.nodes[el[a]];
+      const Vec2 next = mesh.nodes[el[(a + 1) % 4]] - here, previous = mesh.nodes[el[(a + 3) % 4]] - here;
+      const Vec2 corner(next.dot(previous), std::abs(next.x() * previous.y() - next.y() * previous.x()));
+      const double above_lo = lo_dir.x() * corner.y() - lo_dir.y() * corner.x();
+      const double above_hi = hi_dir.x() * corner.y() - hi_dir.y() * corner.x();
+      const double margin2 = 1e-24 * corner.squaredNorm();
+      if (above_lo * above_lo > margin2 && above_hi * above_hi > margin2) {
+        if (above_lo < 0 || above_hi > 0) return false;
+        continue;
+      }
+      const double angle = std::atan2(corner.y(), corner.x()) * degrees;
+      if (!(angle >= lo && angle <= hi)) return false;
+    }
+  return true;
 }
 
 std::string free_rigid_motion(const PlaneMesh& mesh, const std::vector<char>& fixed_dof) {
