@@ -21,7 +21,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "solver/elements/plane_mesh.hpp"
+#include "solver/elements/corner_angles.hpp"
 
 namespace grip {
 namespace {

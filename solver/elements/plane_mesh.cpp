@@ -1,5 +1,7 @@
 #include "solver/elements/plane_mesh.hpp"
 
+#include "solver/elements/corner_angles.hpp"
+
 #include <Eigen/Dense>
 #include <array>
 #include <algorithm>

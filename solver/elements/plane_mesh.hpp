@@ -58,10 +58,6 @@ BoundaryPart boundary_part(const PlaneMesh& mesh, QuadShape shape, const std::ve
 std::string free_rigid_motion(const PlaneMesh& mesh, const std::vector<char>& fixed_dof);
 
 ElementQuality element_quality(const PlaneMesh& mesh);
-// Whether every corner angle lies in [lo, hi] degrees: element_quality's min_angle >= lo and
-// max_angle <= hi for a mesh with elements, at a fraction of its cost (atan2 only for corners
-// within 1e-12 of a limit).
-bool corner_angles_within(const PlaneMesh& mesh, double lo, double hi);
 
 // Local refinement of a generated mesh: elements of about `size` within `extent` of a point,
 // growing geometrically beyond it so that the given divisions fill the body.

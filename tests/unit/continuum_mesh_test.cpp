@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <set>
 
+#include "solver/elements/corner_angles.hpp"
 #include "solver/elements/plane_mesh.hpp"
 
 namespace grip {
