@@ -171,8 +171,9 @@ void reverse_element(std::vector<int>& element, QuadShape shape) {
 namespace {
 
 // det of J = X^T dN (as quad_point's detJ) for an element of N nodes x with the natural
-// derivatives dN at one point, summed node by node in plain doubles (with Eigen's dynamic-size
-// rows check_mesh took 3 times the instructions: 10.8 M for the 11,520 elements of Hertz a/h 40).
+// derivatives dN at one point, summed node by node in plain doubles (check_mesh for the 11,520
+// elements of Hertz a/h 40: 10.8 M instructions with Eigen's dynamic-size rows and a sort of
+// each element's ids, 8.6 M so).
 template <int N>
 double det_j(const Vec2* x, const Vec2* dN) {
   double j00 = 0.0, j01 = 0.0, j10 = 0.0, j11 = 0.0;
