@@ -21,7 +21,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "solver/elements/plane_mesh.hpp"
+#include "solver/elements/corner_angles.hpp"
 
 namespace grip {
 namespace {
@@ -227,8 +227,7 @@ PlaneMesh build_half_disc(const HalfDiscSpec& spec, QuadShape shape) {
 constexpr double kAngleSlack = 60.0;
 
 bool well_shaped(const PlaneMesh& mesh) {
-  const ElementQuality q = element_quality(mesh);
-  return q.min_angle >= 90 - kAngleSlack && q.max_angle <= 90 + kAngleSlack;
+  return corner_angles_within(mesh, 90 - kAngleSlack, 90 + kAngleSlack);
 }
 
 }  // namespace

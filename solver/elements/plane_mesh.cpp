@@ -1,13 +1,15 @@
 #include "solver/elements/plane_mesh.hpp"
 
+#include "solver/elements/corner_angles.hpp"
+
 #include <Eigen/Dense>
+#include <array>
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <functional>
 #include <numbers>
 #include <numeric>
-#include <set>
 #include <sstream>
 #include <stdexcept>
 
@@ -27,20 +29,15 @@ std::string point_text(const Vec2& p) {
 }
 
 // Integral of each node's shape function along a side (2 or 3 nodes), by 3-point Gauss.
-std::vector<double> side_weights(const PlaneMesh& mesh, const std::vector<int>& side) {
+std::array<double, 3> side_weights(const PlaneMesh& mesh, const std::vector<int>& side) {
   static const double g[3] = {-std::sqrt(0.6), 0.0, std::sqrt(0.6)}, w[3] = {5.0 / 9, 8.0 / 9, 5.0 / 9};
   const bool quadratic = side.size() == 3;
-  std::vector<double> out(side.size(), 0.0);
+  std::array<double, 3> out{0.0, 0.0, 0.0};
   for (int k = 0; k < 3; ++k) {
     const double s = g[k];
-    std::vector<double> N, dN;
-    if (quadratic) {
-      N = {0.5 * s * (s - 1), 1 - s * s, 0.5 * s * (s + 1)};
-      dN = {s - 0.5, -2 * s, s + 0.5};
-    } else {
-      N = {0.5 * (1 - s), 0.5 * (1 + s)};
-      dN = {-0.5, 0.5};
-    }
+    const double N[3] = {quadratic ? 0.5 * s * (s - 1) : 0.5 * (1 - s), quadratic ? 1 - s * s : 0.5 * (1 + s),
+                         quadratic ? 0.5 * s * (s + 1) : 0.0};
+    const double dN[3] = {quadratic ? s - 0.5 : -0.5, quadratic ? -2 * s : 0.5, quadratic ? s + 0.5 : 0.0};
     Vec2 dx = Vec2::Zero();
     for (size_t a = 0; a < side.size(); ++a) dx += dN[a] * mesh.nodes[side[a]];
     for (size_t a = 0; a < side.size(); ++a) out[a] += w[k] * N[a] * dx.norm();
@@ -48,22 +45,29 @@ std::vector<double> side_weights(const PlaneMesh& mesh, const std::vector<int>& 
   return out;
 }
 
-// Connected parts of the mesh (elements sharing a node): the part of each node, -1 if none.
+// Connected parts of the mesh (elements sharing a node): the part of each node, -1 if none;
+// parts numbered in the order of their first node.
 std::vector<int> node_parts(const PlaneMesh& mesh, int& count) {
   std::vector<int> parent(mesh.nodes.size());
   std::iota(parent.begin(), parent.end(), 0);
-  std::function<int(int)> root = [&](int i) { return parent[i] == i ? i : parent[i] = root(parent[i]); };
+  auto root = [&](int i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];  // path halving
+    return i;
+  };
   std::vector<char> used(mesh.nodes.size(), 0);
   for (const auto& e : mesh.elements)
     for (int a : e) {
       used[a] = 1;
       parent[root(a)] = root(e.front());
     }
-  std::map<int, int> index;
-  std::vector<int> part(mesh.nodes.size(), -1);
+  std::vector<int> part(mesh.nodes.size(), -1), index(mesh.nodes.size(), -1);  // index: of a root
+  count = 0;
   for (size_t i = 0; i < part.size(); ++i)
-    if (used[i]) part[i] = index.emplace(root(static_cast<int>(i)), static_cast<int>(index.size())).first->second;
-  count = static_cast<int>(index.size());
+    if (used[i]) {
+      int& k = index[root(static_cast<int>(i))];
+      if (k < 0) k = count++;
+      part[i] = k;
+    }
   return part;
 }
 
@@ -164,6 +168,26 @@ void reverse_element(std::vector<int>& element, QuadShape shape) {
   }
 }
 
+namespace {
+
+// det of J = X^T dN (as quad_point's detJ) for an element of N nodes x with the natural
+// derivatives dN at one point, summed node by node in plain doubles (check_mesh for the 11,520
+// elements of Hertz a/h 40: 10.8 M instructions with Eigen's dynamic-size rows and a sort of
+// each element's ids, 8.6 M so).
+template <int N>
+double det_j(const Vec2* x, const Vec2* dN) {
+  double j00 = 0.0, j01 = 0.0, j10 = 0.0, j11 = 0.0;
+  for (int a = 0; a < N; ++a) {
+    j00 += x[a].x() * dN[a].x();
+    j01 += x[a].x() * dN[a].y();
+    j10 += x[a].y() * dN[a].x();
+    j11 += x[a].y() * dN[a].y();
+  }
+  return j00 * j11 - j10 * j01;
+}
+
+}  // namespace
+
 std::vector<MeshIssue> check_mesh(const PlaneMesh& mesh, QuadShape shape) {
   std::vector<MeshIssue> issues;
   const int n = quad_node_count(shape), nodes = static_cast<int>(mesh.nodes.size());
@@ -172,11 +196,16 @@ std::vector<MeshIssue> check_mesh(const PlaneMesh& mesh, QuadShape shape) {
   std::vector<Vec2> checks;
   for (int a = 0; a < n; ++a) checks.push_back(quad_node_natural(shape, a));
   for (const GaussPoint& g : quad_gauss_rule(shape)) checks.push_back({g.xi, g.eta});
-  std::vector<ShapeGradients> dN_nat(checks.size());
+  // dN[c * n + a]: node a's natural derivatives at check point c.
+  std::vector<Vec2> dN(checks.size() * n);
   Vector N;
-  for (size_t c = 0; c < checks.size(); ++c) quad_shape_functions(shape, checks[c].x(), checks[c].y(), N, dN_nat[c]);
+  ShapeGradients dN_c;
+  for (size_t c = 0; c < checks.size(); ++c) {
+    quad_shape_functions(shape, checks[c].x(), checks[c].y(), N, dN_c);
+    for (int a = 0; a < n; ++a) dN[c * n + a] = dN_c.row(a).transpose();
+  }
   std::vector<char> used(mesh.nodes.size(), 0);
-  std::vector<int> sorted(n);
+  Vec2 x[9];  // the element's nodes
   for (int e = 0; e < static_cast<int>(mesh.elements.size()); ++e) {
     const auto& el = mesh.elements[e];
     if (static_cast<int>(el.size()) != n) {
@@ -193,24 +222,22 @@ std::vector<MeshIssue> check_mesh(const PlaneMesh& mesh, QuadShape shape) {
         used[a] = 1;  // even in a faulty element: one fault, one message
       }
     if (!ids_ok) continue;
-    std::copy(el.begin(), el.end(), sorted.begin());
-    std::sort(sorted.begin(), sorted.end());
-    if (std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) {
+    bool repeated = false;  // at most 9 ids: pairs, not a sort
+    for (int a = 1; a < n; ++a)
+      for (int b = 0; b < a; ++b) repeated |= el[a] == el[b];
+    if (repeated) {
       issues.push_back({e, -1, "names a node twice"});
       continue;
     }
-    Vec2 lo = mesh.nodes[el[0]], hi = lo;
+    for (int a = 0; a < n; ++a) x[a] = mesh.nodes[el[a]];
+    Vec2 lo = x[0], hi = lo;
     for (int a = 1; a < n; ++a) {
-      lo = lo.cwiseMin(mesh.nodes[el[a]]);
-      hi = hi.cwiseMax(mesh.nodes[el[a]]);
+      lo = lo.cwiseMin(x[a]);
+      hi = hi.cwiseMax(x[a]);
     }
     const double size2 = (hi - lo).squaredNorm();
     for (size_t c = 0; c < checks.size(); ++c) {
-      // det of J = X^T dN (as quad_point's detJ), summed node by node: a dynamic-size product
-      // per check point took twice the instructions (3,700 elements of Hertz a/h 20: 7.4 M, now 3.4 M).
-      Mat2 J = Mat2::Zero();
-      for (int a = 0; a < n; ++a) J += mesh.nodes[el[a]] * dN_nat[c].row(a);
-      const double det = J.determinant();
+      const double det = n == 4 ? det_j<4>(x, &dN[c * n]) : det_j<9>(x, &dN[c * n]);
       if (!(det > 1e-12 * size2)) {
         issues.push_back({e, -1, std::string(det < 0 ? "is inverted or its nodes are not counter-clockwise"
                                                      : "has zero area") +
@@ -230,20 +257,28 @@ InvalidMesh::InvalidMesh(std::vector<MeshIssue> all)
                             " " + all[0].detail),
       issues(std::move(all)) {}
 
-std::vector<std::vector<int>> boundary_sides(const PlaneMesh& mesh, QuadShape shape) {
-  // Every element side by its end nodes, sorted (a vector, not a map: this ran for every
-  // scene read, 46,000 sides at a/h 40); the sides that appear once.
+namespace {
+
+// The boundary sides (boundary_sides) whose end nodes both have (*in)[node] set (all sides
+// without `in`), in the order of their sorted end nodes.
+std::vector<std::vector<int>> boundary_sides_within(const PlaneMesh& mesh, QuadShape shape,
+                                                    const std::vector<char>* in) {
+  // Every element side by its end nodes, sorted (a vector, not a map); the sides that appear
+  // once. Whether a side is on the boundary depends on its end nodes only, so the sides outside
+  // `in` are left out before the sort (a contact set's: 200 of the 46,000 sides of Hertz a/h 40,
+  // whose full sort took 11 M instructions at every scene read).
   struct Side {
     std::pair<int, int> key;
     int element, local;
   };
   const auto& locals = local_sides(shape);
   std::vector<Side> all;
-  all.reserve(mesh.elements.size() * locals.size());
+  if (!in) all.reserve(mesh.elements.size() * locals.size());
   for (int e = 0; e < static_cast<int>(mesh.elements.size()); ++e)
     for (int l = 0; l < static_cast<int>(locals.size()); ++l) {
       const auto& el = mesh.elements[e];
-      all.push_back({std::minmax(el[locals[l].front()], el[locals[l].back()]), e, l});
+      const int a = el[locals[l].front()], b = el[locals[l].back()];
+      if (!in || ((*in)[a] && (*in)[b])) all.push_back({std::minmax(a, b), e, l});
     }
   std::sort(all.begin(), all.end(), [](const Side& a, const Side& b) { return a.key < b.key; });
   std::vector<std::vector<int>> sides;
@@ -260,41 +295,53 @@ std::vector<std::vector<int>> boundary_sides(const PlaneMesh& mesh, QuadShape sh
   return sides;
 }
 
+}  // namespace
+
+std::vector<std::vector<int>> boundary_sides(const PlaneMesh& mesh, QuadShape shape) {
+  return boundary_sides_within(mesh, shape, nullptr);
+}
+
 BoundaryPart boundary_part(const PlaneMesh& mesh, QuadShape shape, const std::vector<int>& set) {
-  std::vector<char> in(mesh.nodes.size(), 0);
+  const size_t nodes = mesh.nodes.size();
+  std::vector<char> in(nodes, 0);
   for (int i : set) in.at(i) = 1;
   BoundaryPart part;
-  std::map<int, int> next;  // along the boundary, body on the left
-  std::set<int> has_previous;
-  std::map<int, double> length;
-  for (const auto& side : boundary_sides(mesh, shape)) {
-    if (!std::all_of(side.begin(), side.end(), [&](int a) { return in[a] != 0; })) continue;
-    part.sides.push_back(side);
-    const std::vector<double> w = side_weights(mesh, side);
-    for (size_t a = 0; a < side.size(); ++a) length[side[a]] += w[a];
-    for (size_t a = 0; a + 1 < side.size(); ++a) {
-      next.emplace(side[a], side[a + 1]);
-      has_previous.insert(side[a + 1]);
+  // Per node (vectors, not maps and sets: 15 M instructions for the 2000-node contact set of a
+  // flat): the next node along the boundary (body on the left), whether a side leads in,
+  // whether a side holds it, and its tributary length.
+  std::vector<int> next(nodes, -1);
+  std::vector<char> has_previous(nodes, 0), on_side(nodes, 0);
+  std::vector<double> length(nodes, 0.0);
+  for (auto& side : boundary_sides_within(mesh, shape, &in)) {
+    if (!std::all_of(side.begin(), side.end(), [&](int a) { return in[a] != 0; })) continue;  // a q9 side's middle
+    const std::array<double, 3> w = side_weights(mesh, side);
+    for (size_t a = 0; a < side.size(); ++a) {
+      length[side[a]] += w[a];
+      on_side[side[a]] = 1;
     }
+    for (size_t a = 0; a + 1 < side.size(); ++a) {
+      if (next[side[a]] < 0) next[side[a]] = side[a + 1];
+      has_previous[side[a + 1]] = 1;
+    }
+    part.sides.push_back(std::move(side));
   }
   for (int i : set)
-    if (!length.count(i))
+    if (!on_side[i])
       throw std::invalid_argument("node " + std::to_string(i) +
                                   " lies on no boundary side whose nodes all belong to the set");
   // Runs start where no side leads in (then closed loops, at their smallest node).
   std::vector<int> starts;
-  for (const auto& [node, l] : length)
-    if (!has_previous.count(node)) starts.push_back(node);
-  for (const auto& [node, l] : length) starts.push_back(node);
-  std::set<int> visited;
+  for (size_t i = 0; i < nodes; ++i)
+    if (on_side[i] && !has_previous[i]) starts.push_back(static_cast<int>(i));
+  for (size_t i = 0; i < nodes; ++i)
+    if (on_side[i]) starts.push_back(static_cast<int>(i));
+  std::vector<char> visited(nodes, 0);
   for (int s : starts)
-    for (int i = s; !visited.count(i);) {
-      visited.insert(i);
+    for (int i = s; !visited[i]; i = next[i]) {
+      visited[i] = 1;
       part.nodes.push_back(i);
       part.lengths.push_back(length[i]);
-      const auto it = next.find(i);
-      if (it == next.end()) break;
-      i = it->second;
+      if (next[i] < 0) break;
     }
   return part;
 }
@@ -320,6 +367,31 @@ ElementQuality element_quality(const PlaneMesh& mesh) {
     q.max_aspect_ratio = std::max(q.max_aspect_ratio, longest / shortest);
   }
   return q;
+}
+
+bool corner_angles_within(const PlaneMesh& mesh, double lo, double hi) {
+  // A corner's angle is atan2(cross, dot) of its sides (element_quality); it lies above the
+  // angle a when the corner (dot, cross) turns counter-clockwise from (cos a, sin a). That sign
+  // decides where the corner is more than 1e-12 radians from the limit, far beyond the
+  // rounding of either, and atan2 in degrees, element_quality's value, decides the rest.
+  const double degrees = 180.0 / std::acos(-1.0);
+  const Vec2 lo_dir(std::cos(lo / degrees), std::sin(lo / degrees)), hi_dir(std::cos(hi / degrees), std::sin(hi / degrees));
+  for (const auto& el : mesh.elements)
+    for (int a = 0; a < 4; ++a) {
+      const Vec2& here = mesh.nodes[el[a]];
+      const Vec2 next = mesh.nodes[el[(a + 1) % 4]] - here, previous = mesh.nodes[el[(a + 3) % 4]] - here;
+      const Vec2 corner(next.dot(previous), std::abs(next.x() * previous.y() - next.y() * previous.x()));
+      const double above_lo = lo_dir.x() * corner.y() - lo_dir.y() * corner.x();
+      const double above_hi = hi_dir.x() * corner.y() - hi_dir.y() * corner.x();
+      const double margin2 = 1e-24 * corner.squaredNorm();
+      if (above_lo * above_lo > margin2 && above_hi * above_hi > margin2) {
+        if (above_lo < 0 || above_hi > 0) return false;
+        continue;
+      }
+      const double angle = std::atan2(corner.y(), corner.x()) * degrees;
+      if (!(angle >= lo && angle <= hi)) return false;
+    }
+  return true;
 }
 
 std::string free_rigid_motion(const PlaneMesh& mesh, const std::vector<char>& fixed_dof) {

@@ -12,7 +12,6 @@
 //   "supports": [{"set" | "node", "fix": ["x", "y"], "values": {"x", "y"}, "case"}]
 //   "loads": [{"set" | "node", "force": [fx, fy] (on each node) | "traction": [tx, ty] (per
 //     unit area of the set's boundary sides), "case"}]
-#include <map>
 #include <stdexcept>
 
 #include "solver/elements/continuum.hpp"
@@ -190,13 +189,17 @@ void for_each_object(Reader& r, json& body, const std::string& ptr, const char* 
 
 void read_continuum_supports(Reader& r, json& body, const std::string& ptr, const PlaneMesh& mesh,
                              Problem& problem) {
-  std::map<int, std::pair<std::string, double>> fixed;  // dof -> (pointer of its support, value)
+  // Per dof: the support that fixes it (an index of `pointers`, -1 for none) and its value.
+  std::vector<int> fixed_by(2 * mesh.nodes.size(), -1);
+  std::vector<double> fixed_value(fixed_by.size(), 0.0);
+  std::vector<std::string> pointers;
   for_each_object(r, body, ptr, "supports", [&](json& s, const std::string& sp) {
     const auto nodes = read_target(r, s, sp, mesh);
     const int load_case = r.load_case(s, sp);
     json* fix = r.array(s, sp, "fix", true);
     json* values = r.object(s, sp, "values", false);
     if (!fix || !nodes) return;
+    pointers.push_back(sp);
     if (fix->empty()) r.error(sp + "/fix", "names no component (\"x\", \"y\")");
     for (size_t c = 0; c < fix->size(); ++c) {
       const json& comp = (*fix)[c];
@@ -208,17 +211,17 @@ void read_continuum_supports(Reader& r, json& body, const std::string& ptr, cons
       const double value = values && values->contains(name) ? r.number(*values, sp + "/values", name.c_str()) : 0.0;
       for (int node : *nodes) {
         const int dof = ContinuumBody::node_dof(node, name == "x" ? 0 : 1);
-        const auto it = fixed.find(dof);
-        if (it != fixed.end()) {
+        if (fixed_by[dof] >= 0) {
           // The same zero support twice (a corner in two sets) is harmless; two prescribed
           // values of one dof are ambiguous.
-          if (value != 0.0 || it->second.second != 0.0)
+          if (value != 0.0 || fixed_value[dof] != 0.0)
             r.error(sp + "/fix/" + std::to_string(c), "prescribes " + name + " of node " + std::to_string(node) +
-                                                          ", which " + it->second.first +
+                                                          ", which " + pointers[fixed_by[dof]] +
                                                           " fixes already: give each dof one support");
           continue;
         }
-        fixed[dof] = {sp, value};
+        fixed_by[dof] = static_cast<int>(pointers.size()) - 1;
+        fixed_value[dof] = value;
         problem.constraints.push_back({dof, value, load_case});
       }
     }

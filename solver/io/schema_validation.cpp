@@ -38,32 +38,31 @@ class Rewriter {
  public:
   explicit Rewriter(const json& root) : root_(root) {}
 
-  json schema(const json& s) const {
+  // In place on a subschema it owns (moved in and out: copying each subtree at each level took
+  // 9.5 M of the 17 M instructions of the scene validator's build).
+  json schema(json s) const {
     if (s.is_boolean()) return s.get<bool>() ? json::object() : json{{"not", json::object()}};
     if (!s.is_object()) return s;
-    json out = s;
     for (const char* key : {"additionalProperties", "additionalItems", "contains", "propertyNames", "not",
                             "if", "then", "else"})
-      if (s.contains(key)) out[key] = schema(s[key]);
+      if (s.contains(key)) s[key] = schema(std::move(s[key]));
     for (const char* key : {"properties", "patternProperties", "definitions"})
       if (s.contains(key) && s[key].is_object())
-        for (auto& [name, sub] : s[key].items()) out[key][name] = schema(sub);
+        for (json& sub : s[key]) sub = schema(std::move(sub));
     if (s.contains("dependencies") && s["dependencies"].is_object())
-      for (auto& [name, sub] : s["dependencies"].items())
-        if (!sub.is_array()) out["dependencies"][name] = schema(sub);
-    if (s.contains("items"))
-      out["items"] = s["items"].is_array() ? list(s["items"]) : schema(s["items"]);
+      for (json& sub : s["dependencies"])
+        if (!sub.is_array()) sub = schema(std::move(sub));
+    if (s.contains("items")) s["items"] = s["items"].is_array() ? list(std::move(s["items"])) : schema(std::move(s["items"]));
     for (const char* key : {"allOf", "anyOf", "oneOf"})
-      if (s.contains(key) && s[key].is_array()) out[key] = list(s[key]);
-    if (out.contains("oneOf")) split_discriminated(out);
-    return out;
+      if (s.contains(key) && s[key].is_array()) s[key] = list(std::move(s[key]));
+    if (s.contains("oneOf")) split_discriminated(s);
+    return s;
   }
 
  private:
-  json list(const json& a) const {
-    json out = json::array();
-    for (const auto& sub : a) out.push_back(schema(sub));
-    return out;
+  json list(json a) const {
+    for (json& sub : a) sub = schema(std::move(sub));
+    return a;
   }
 
   const json& local(const json& s) const {
@@ -125,7 +124,7 @@ class Loaded {
   const json& doc() const {
     std::call_once(doc_once_, [this] {
       const json original = json::parse(text);
-      doc_ = Rewriter(original).schema(original);
+      doc_ = Rewriter(original).schema(original);  // a copy of the original, rewritten in place
     });
     return doc_;
   }

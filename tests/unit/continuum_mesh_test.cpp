@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <set>
 
+#include "solver/elements/corner_angles.hpp"
 #include "solver/elements/plane_mesh.hpp"
 
 namespace grip {
@@ -96,6 +97,39 @@ TEST(ElementQuality, AspectRatioAndCornerAngles) {
   EXPECT_NEAR(q.max_aspect_ratio, 2.0, 1e-12);
   EXPECT_NEAR(q.min_angle, 45.0, 1e-12);
   EXPECT_NEAR(q.max_angle, 135.0, 1e-12);
+}
+
+// corner_angles_within decides by the sign of a cross product, with atan2 only near a limit:
+// it must agree with element_quality (the definition) for limits on either side of the
+// mesh's extreme angles and exactly at them (ties), on a uniform grid (every corner 90
+// degrees), the grid with nodes moved by 1e-3, and a refined half-disc.
+TEST(ElementQuality, CornerAnglesWithinAgreesWithTheExtremeAngles) {
+  RectangleSpec spec;
+  spec.size = {3, 2};
+  spec.nx = 30;
+  spec.ny = 20;
+  const PlaneMesh grid = rectangle_mesh(spec, QuadShape::q4);
+  PlaneMesh moved = grid;
+  unsigned state = 12345;
+  for (Vec2& x : moved.nodes) {
+    state = state * 1103515245u + 12345u;
+    const double u = (state >> 8) / double(1 << 24) - 0.5;
+    state = state * 1103515245u + 12345u;
+    x += 1e-3 * Vec2(u, (state >> 8) / double(1 << 24) - 0.5);
+  }
+  HalfDiscSpec disc;
+  disc.radius = 10;
+  disc.ns = 60;
+  disc.nt = 30;
+  disc.refine = Refinement{0.1, 1.0};
+  for (const PlaneMesh& mesh : {grid, moved, half_disc_mesh(disc, QuadShape::q4)}) {
+    const ElementQuality q = element_quality(mesh);
+    for (double lo : {q.min_angle - 1e-6, std::nextafter(q.min_angle, 0.0), q.min_angle,
+                      std::nextafter(q.min_angle, 180.0), q.min_angle + 1e-6})
+      for (double hi : {q.max_angle - 1e-6, std::nextafter(q.max_angle, 0.0), q.max_angle,
+                        std::nextafter(q.max_angle, 180.0), q.max_angle + 1e-6})
+        EXPECT_EQ(corner_angles_within(mesh, lo, hi), q.min_angle >= lo && q.max_angle <= hi) << lo << " " << hi;
+  }
 }
 
 // From the fewest divisions a refinement admits up, weak and strong, every element is valid
@@ -280,6 +314,30 @@ TEST(BoundaryPart, OrderedCounterClockwiseWithTributaryLengths) {
   }
   const PlaneMesh mesh = rectangle_mesh(spec, QuadShape::q4);
   EXPECT_THROW(boundary_part(mesh, QuadShape::q4, {0, 2}), std::invalid_argument);  // no side between them
+}
+
+// boundary_part sorts only the sides whose end nodes are in the set: its sides must be those
+// of boundary_sides (every side used by one element) whose nodes all belong to the set, in the
+// same order, for q4 and q9 half-discs and their arc, refined arc and diameter.
+TEST(BoundaryPart, SidesAreTheBoundarySidesWithinTheSet) {
+  HalfDiscSpec disc;
+  disc.radius = 10;
+  disc.ns = 40;
+  disc.nt = 20;
+  disc.refine = Refinement{0.2, 1.5};
+  for (QuadShape shape : {QuadShape::q4, QuadShape::q9}) {
+    const PlaneMesh mesh = half_disc_mesh(disc, shape);
+    const auto all = boundary_sides(mesh, shape);
+    for (const char* name : {"arc", "arc_refined", "diameter"}) {
+      const std::vector<int>& set = mesh.sets.at(name);
+      std::vector<std::vector<int>> expected;
+      for (const auto& side : all)
+        if (std::all_of(side.begin(), side.end(), [&](int a) { return std::count(set.begin(), set.end(), a) > 0; }))
+          expected.push_back(side);
+      EXPECT_FALSE(expected.empty());
+      EXPECT_EQ(boundary_part(mesh, shape, set).sides, expected) << name;
+    }
+  }
 }
 
 TEST(FreeRigidMotion, NamesTheMotionsTheSupportsLeave) {
