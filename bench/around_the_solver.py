@@ -22,9 +22,14 @@ import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from scaling import hertz_scene  # noqa: E402
+from scaling import block_scene, hertz_scene  # noqa: E402
 
-CASES = [(40, 0.0), (40, 0.3), (20, 0.0), (20, 0.3)]
+# Hertz at the two refinements (every field of every step written), and the flat under a
+# block with 2000 contact nodes (10 and 40 element rows; 2000 divisions are the reader's most), friction 0.3 (the last step written).
+CASES = [("a/h 40, mu 0.0", lambda: hertz_scene(40, 0.0)), ("a/h 40, mu 0.3", lambda: hertz_scene(40, 0.3)),
+         ("a/h 20, mu 0.0", lambda: hertz_scene(20, 0.0)), ("a/h 20, mu 0.3", lambda: hertz_scene(20, 0.3)),
+         ("flat, 2000 contact nodes", lambda: block_scene(2000, 10)),
+         ("flat, 2001 contact nodes, 40 rows", lambda: block_scene(2001, 40))]
 
 
 def run(grip, scene_path, out_path):
@@ -52,14 +57,14 @@ def main():
     print("|---|---|---|---|---|---|---|---|---|---|")
     with tempfile.TemporaryDirectory() as tmp:
         for _ in range(args.runs):
-            for a_over_h, mu in CASES:
-                scene = Path(tmp) / f"hertz_{a_over_h}_{mu}.json"
-                scene.write_text(json.dumps(hertz_scene(a_over_h, mu)))
+            for number, (label, make) in enumerate(CASES):
+                scene = Path(tmp) / f"case_{number}.json"
+                scene.write_text(json.dumps(make()))
                 for name, grip in binaries:
                     load = os.getloadavg()[0]
                     r = run(grip, str(scene), str(Path(tmp) / "out.json"))
                     outside = (r["wall"] - r["solver"]) / r["solver"]
-                    print(f"| a/h {a_over_h}, mu {mu} | {name or grip} | {load:.1f} | {r['wall']:.3f} | {r['solver']:.3f} | "
+                    print(f"| {label} | {name or grip} | {load:.1f} | {r['wall']:.3f} | {r['solver']:.3f} | "
                           f"{100 * outside:.1f} % | {r['user']:.2f} | {r['sys']:.2f} | {r['minflt']} | "
                           f"{r['csw'][0]} + {r['csw'][1]} |", flush=True)
 
