@@ -168,12 +168,14 @@ TEST_P(StoreContract, AnExpiredLeaseIsTakenOverAndTheOldRunIsFencedOut) {
   auto store = open();
   JobRecord r = new_job("job-a");
   store->insert_job(r);
-  const auto run1 = store->claim_job("dead", "2025-01-01T00:00:01.000Z", 0.2);
+  // PostgreSQL times leases by its own clock: the lease must outlast the calls before the "not
+  // yet expired" check on a loaded machine (0.2 s did not, under a CI build beside a Docker build).
+  const auto run1 = store->claim_job("dead", "2025-01-01T00:00:01.000Z", 2.0);
   ASSERT_TRUE(run1);
   EXPECT_TRUE(store->append_events({event(*run1, 1), event(*run1, 2), event(*run1, 3)}).empty());
   EXPECT_EQ(store->job("job-a", false)->last_seq, 3);
   EXPECT_EQ(store->requeue_expired("2025-01-01T00:00:01.100Z"), 0);  // not yet expired
-  std::this_thread::sleep_for(400ms);
+  std::this_thread::sleep_for(2200ms);
   EXPECT_EQ(store->requeue_expired("2025-01-01T00:00:02.000Z"), 1);
   auto j = store->job("job-a", false);
   EXPECT_EQ(j->status, JobStatus::accepted);
