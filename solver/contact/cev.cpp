@@ -61,13 +61,8 @@ class CevStep : public StepSolver {
   // The semismooth Newton on the model; where it stalls, tau passes on the model (Tresca
   // problems solved by eq. 13 on the model, the bound updated from the model's p_eta).
   Vector predict_coulomb(const Compliance& C, int& inner, int& halvings) {
-    CoulombModelParams mp;
-    mp.target = model_target();
-    mp.augmentation = params_.augmentation;
-    mp.max_iterations = params_.max_inner_iterations;
-    mp.max_halvings = params_.max_halvings;
-    const CoulombModelSolution sol =
-        solve_coulomb_model(problem_, C, out_.p, out_.state.s, out_.state.enabled, mp);
+    const double target = model_target();
+    const CoulombModelSolution sol = solve_model(C, target);
     inner = sol.iterations;
     halvings = sol.halvings;
     if (sol.converged) return sol.p;
@@ -86,7 +81,7 @@ class CevStep : public StepSolver {
       sl += model_change(dense, next - pl);
       pl = next;
       project_to_cone(problem_, pl);
-      if (contact_error(problem_, pl, sl, friction_bounds(problem_, pl), out_.state.enabled).norm2 <= mp.target ||
+      if (contact_error(problem_, pl, sl, friction_bounds(problem_, pl), out_.state.enabled).norm2 <= target ||
           change == 0.0)
         break;
     }

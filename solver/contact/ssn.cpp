@@ -191,12 +191,7 @@ class SsnStep : public StepSolver {
   bool start_from_model() {
     if (!problem_.rigid.count() || error_.norm2 <= tol_) return true;
     const Compliance& C = eq_.compliance(out_.state, relevant_components());
-    CoulombModelParams mp;
-    mp.target = 0.1 * tol_;
-    mp.augmentation = params_.augmentation;
-    mp.max_iterations = params_.max_inner_iterations;
-    mp.max_halvings = params_.max_halvings;
-    const CoulombModelSolution model = solve_coulomb_model(problem_, C, out_.p, out_.state.s, out_.state.enabled, mp);
+    const CoulombModelSolution model = solve_model(C, 0.1 * tol_);
     out_.inner_iterations += model.iterations;
     // Not converged on the model is still a start (the von Karman beam: 1.3e-5 after 4 iterations).
     if (!presses(model.p) || !(model.error.norm2 < error_.norm2)) return true;

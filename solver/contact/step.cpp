@@ -141,15 +141,18 @@ bool StepSolver::presses(const Vector& p) const {
   return false;
 }
 
-bool StepSolver::bound_from_model(Vector& p_star) {
-  const Compliance& C = eq_.compliance(out_.state, relevant_components());
+CoulombModelSolution StepSolver::solve_model(const Compliance& C, double target) const {
   CoulombModelParams mp;
-  mp.target = 0.1 * tol_;
+  mp.target = target;
   mp.augmentation = params_.augmentation;
   mp.max_iterations = params_.max_inner_iterations;
   mp.max_halvings = params_.max_halvings;
-  const CoulombModelSolution model =
-      solve_coulomb_model(problem_, C, out_.p, out_.state.s, out_.state.enabled, mp);
+  return solve_coulomb_model(problem_, C, out_.p, out_.state.s, out_.state.enabled, mp);
+}
+
+bool StepSolver::bound_from_model(Vector& p_star) {
+  const Compliance& C = eq_.compliance(out_.state, relevant_components());
+  const CoulombModelSolution model = solve_model(C, 0.1 * tol_);
   out_.inner_iterations += model.iterations;
   if (!presses(model.p)) return fail("the linear model at the step's first state presses no point");
   for (const Candidate& c : problem_.candidates) p_star[c.eta] = model.p[c.eta];

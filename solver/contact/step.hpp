@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "solver/contact/contact_error.hpp"
+#include "solver/contact/coulomb_model.hpp"
 #include "solver/contact/strategy.hpp"
 
 namespace grip {
@@ -52,6 +53,9 @@ class StepSolver {
   bool fresh_solve(const Vector& q, double v_scale = 0.0);
   // Some normal force of p presses.
   bool presses(const Vector& p) const;
+  // Coulomb's law on the linear model C at the current state, from out_.p, solved to `target`
+  // with the step's inner limits (coulomb_model.hpp; no real solve).
+  CoulombModelSolution solve_model(const Compliance& C, double target) const;
   // A body held by contact at its first contact (p* presses nowhere) has no friction bound in
   // its first pass, and a motion that only friction holds (a disc turned between two flats) no
   // equilibrium then: p* is taken instead from Coulomb's law on the linear model at the step's

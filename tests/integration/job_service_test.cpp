@@ -84,24 +84,32 @@ TEST(JobService, DismissalStopsARunningJobWithinOneIterationAndFreesTheWorker) {
   EXPECT_EQ(service.job(next)->record.status, JobStatus::successful);
 }
 
-// A body held only by contact under a shear load above mu N (ALGORITHM.md 7): a failed job
-// whose reason says why, with the steps solved before it in its result.
-TEST(JobService, AShearLoadAboveWhatFrictionHoldsFailsTheJobWithItsReason) {
+// Runs `scene` as a job that must fail with `reason` (the text after "step k failed: "); its
+// stored result.
+nlohmann::json failed_job_result(const nlohmann::json& scene, const std::string& reason) {
   TempDir dir;
   SqliteStore store((dir.path() / "grip.sqlite").string());
   JobService service(store, ServiceOptions{});
   service.start();
-  const std::string id = service.submit(block_under_shear()).job.record.id;
+  const std::string id = service.submit(scene).job.record.id;
   const auto events = events_to_end(service, id);
   EXPECT_EQ(events.back().type, "job_failed");
-  const std::string reason = nlohmann::json::parse(events.back().data)["reason"];
-  EXPECT_NE(reason.find("step 7 failed: the shear load exceeds what friction can hold: Q / (mu N) = 1.05"),
-            std::string::npos)
-      << reason;
+  const std::string said = nlohmann::json::parse(events.back().data)["reason"];
+  EXPECT_NE(said.find(reason), std::string::npos) << said;
   EXPECT_EQ(service.job(id)->record.status, JobStatus::failed);
   const auto result = service.result(id);
-  ASSERT_TRUE(result);
-  const nlohmann::json r = nlohmann::json::parse(*result);
+  if (!result) {
+    ADD_FAILURE() << "no result stored for the failed job";
+    return nlohmann::json::object();
+  }
+  return nlohmann::json::parse(*result);
+}
+
+// A body held only by contact under a shear load above mu N (ALGORITHM.md 7): a failed job
+// whose reason says why, with the steps solved before it in its result.
+TEST(JobService, AShearLoadAboveWhatFrictionHoldsFailsTheJobWithItsReason) {
+  const nlohmann::json r = failed_job_result(
+      block_under_shear(), "step 7 failed: the shear load exceeds what friction can hold: Q / (mu N) = 1.05");
   ASSERT_EQ(r["steps"].size(), 7u);
   for (int k = 0; k < 6; ++k) EXPECT_TRUE(r["steps"][k]["converged"].get<bool>());
   EXPECT_EQ(r["effects"]["held_by_contact"].size(), 3u);
@@ -111,21 +119,9 @@ TEST(JobService, AShearLoadAboveWhatFrictionHoldsFailsTheJobWithItsReason) {
 // come from its deformation, so no check before solving decides it): a failed job whose reason
 // says why, with the two steps solved before it in its result, and no fields for the failed step.
 TEST(JobService, ACoupleAboveWhatFrictionHoldsFailsTheJobWithItsReason) {
-  TempDir dir;
-  SqliteStore store((dir.path() / "grip.sqlite").string());
-  JobService service(store, ServiceOptions{});
-  service.start();
-  const std::string id = service.submit(turned_beyond_the_limit()).job.record.id;
-  const auto events = events_to_end(service, id);
-  EXPECT_EQ(events.back().type, "job_failed");
-  const std::string reason = nlohmann::json::parse(events.back().data)["reason"];
-  EXPECT_NE(reason.find("step 3 failed: the couple exceeds what friction can hold: M / (mu sum N r) = 1.06"),
-            std::string::npos)
-      << reason;
-  EXPECT_EQ(service.job(id)->record.status, JobStatus::failed);
-  const auto result = service.result(id);
-  ASSERT_TRUE(result);
-  const nlohmann::json r = nlohmann::json::parse(*result);
+  const nlohmann::json r = failed_job_result(
+      turned_beyond_the_limit(),
+      "step 3 failed: the couple exceeds what friction can hold: M / (mu sum N r) = 1.06");
   ASSERT_EQ(r["steps"].size(), 3u);
   for (int k = 0; k < 2; ++k) EXPECT_TRUE(r["steps"][k]["converged"].get<bool>());
   EXPECT_FALSE(r["steps"][2]["converged"].get<bool>());
