@@ -90,7 +90,7 @@ void StepSolver::tau_passes(const Vector& q_guess, const Vector& p_start, const 
   out_.p = strict_balance_ ? p_start : p_star_in;
   Vector p_star = p_star_in;
   const bool no_friction = frictionless();
-  for (int pass_index = 1; pass_index <= params_.max_tau_passes; ++pass_index) {
+  for (int pass_index = 1; passes_to_budget_ || pass_index <= params_.max_tau_passes; ++pass_index) {
     pass_ = pass_index;
     out_.passes = pass_index;
     out_.tau = friction_bounds(problem_, p_star);
@@ -120,7 +120,8 @@ void StepSolver::tau_passes(const Vector& q_guess, const Vector& p_start, const 
     // beam on a flat): there a small change says only that the last pass stopped early, not
     // that p* settled, and accepting it left |p_t| = mu |p*| up to 4e-3 mu max |p_n| above
     // mu |p_n|. Their passes go on until p* settles to tau_tolerance; the accelerated loop then
-    // pins the forces of its passes to that precision (literal_pass), uzawa's settle without.
+    // pins the forces of its passes to that precision (literal_pass), uzawa's settle without
+    // (within its budget, not max_tau_passes: uzawa.cpp).
     const double settled = params_.tau_tolerance * scale;
     if (change <= settled || (!literal_ && change <= force_precision())) {
       out_.converged = true;
@@ -128,7 +129,7 @@ void StepSolver::tau_passes(const Vector& q_guess, const Vector& p_start, const 
     }
     if (literal_ && change <= force_precision()) pin_forces_ = 0.1 * settled;
     for (const Candidate& c : problem_.candidates) p_star[c.eta] = out_.p[c.eta];
-    if (pass_index == params_.max_tau_passes)
+    if (!passes_to_budget_ && pass_index == params_.max_tau_passes)
       fail("the friction bound did not settle in " + std::to_string(pass_index) + " tau passes");
   }
   if (no_friction && out_.reason.empty()) out_.converged = true;
@@ -274,6 +275,9 @@ bool StepSolver::budget_left() {
   }
   if (!friction_limit_.empty()) return fail(friction_limit_);
   if (eq_.counters().solves < solves_at_start_ + params_.max_iterations) return true;
+  if (error_met(error_))  // what is left is the tau passes' p*
+    return fail("the friction bound did not settle in " + std::to_string(params_.max_iterations) +
+                " contact iterations (" + std::to_string(pass_) + " tau passes; ||v|| within the tolerance)");
   return fail("contact error " + std::to_string(error_.norm2) + " above tolerance " +
               std::to_string(tol_) + " after " + std::to_string(params_.max_iterations) +
               " contact iterations");

@@ -159,6 +159,7 @@ class StepSolver {
   bool coulomb_ = false;  // the friction bound moves with p (no tau passes)
   bool literal_ = false;  // the passes run the literal loop (literal_pass)
   double pin_forces_ = 0.0;  // > 0: the literal loop's passes pin p_eta to this (tau_passes)
+  bool passes_to_budget_ = false;  // the tau passes end at the budget, not max_tau_passes (uzawa)
   long own_newton_iterations_ = 0;  // Newton iterations made outside the oracle (ssn)
   std::vector<char> is_normal_;
   int beyond_friction_ = 0;    // accepted states in a row beyond what friction holds (accept)

@@ -50,8 +50,8 @@ TEST(HeldByContactHard, SlenderFreeStripShearedToTheFrictionLimit) {
 }
 
 // uzawa on the disc between two flats (tests/verification/held_by_contact_test.cpp runs it for
-// the other strategies): 864 real solves in its one step (399 since its first pass takes the
-// friction bound from the linear model, i16c), over or near the default 500, because its
+// the other strategies): 730 real solves in its one step (measured at i16j, the same on main
+// 832a23b; 864 when written), over the default 500, because its
 // fixed alpha = 1 / ||Z^T C Z||_inf converges at 1 - lambda_min / ||Z^T C Z||_inf per solve, and
 // the reduced compliance's condition is about 60 (lambda 1.4e-6 .. 8.1e-5, ||.||_inf 1.0e-4;
 // C's own is about 400: the elimination does not worsen it). The budget is raised to 1000 here:
@@ -203,8 +203,8 @@ TEST(HeldByContactHardSlow, FiniteDiscTurnedNearTheFrictionLimitByThePapersLoopA
 }
 
 // uzawa on the turned finite disc of the verification (33 x 33 nodes, squeeze and couple raised
-// together over 3 steps): 13, 111, 175 real solves (5 s of CPU, measured), the same balance and
-// cev default's answer.
+// together over 3 steps): 296 real solves in all (13, 111, 175 when written; 5 s of CPU), the
+// same balance and cev default's answer.
 TEST(HeldByContactHard, UzawaTurnsTheFiniteDisc) {
   const json scene = turned_disc("finite", 0.1, 100.0, 3);
   const Solved cev = solve_scene(scene);
