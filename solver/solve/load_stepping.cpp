@@ -50,9 +50,19 @@ std::optional<Vector> start_up(const Problem& problem, const SteppingParams& par
   return s.q;
 }
 
-// cev's default loop: Coulomb's law at every state it accepts (the bound mu |p_eta| moves with p).
-bool coulomb_loop(const ContactParams& c) {
-  return c.method == ContactMethod::cev && c.loop == ContactLoop::inner && c.friction_loop == FrictionLoop::inner;
+// cev's default loop, with the user's tolerance and budgets: Coulomb's law at every state it
+// accepts (the bound mu |p_eta| moves with p). Its model's fallback solves with n = infinity.
+ContactParams coulomb_loop(ContactParams c) {
+  c.method = ContactMethod::cev;
+  c.loop = ContactLoop::inner;
+  c.friction_loop = FrictionLoop::inner;
+  c.acceleration = kAccelerationInfinity;
+  return c;
+}
+
+bool is_coulomb_loop(const ContactParams& c) {
+  return c.method == ContactMethod::cev && c.loop == ContactLoop::inner && c.friction_loop == FrictionLoop::inner &&
+         c.acceleration == kAccelerationInfinity;
 }
 
 // Adds an attempt's counts and events to the step's record.
@@ -154,34 +164,27 @@ RunResult run_load_steps(Problem& problem, const std::vector<LoadStep>& steps,
         // A load beyond what friction holds (friction_limit.hpp): no retry or cut of the
         // increment can help. Before: a disc squeezed between two flats and turned beyond the
         // limit (33 x 33) cut its increment 5 times, 443 real solves. Decided for every strategy
-        // on the state of cev's default loop from this attempt's start, which lies on Coulomb's
-        // law at every state it accepts: ssn's iterates do not until they converge, penalty's
-        // Newton failed before it reached one, and the bounds of the tau passes lag p, so they
-        // found the limit late or not at all, each with its own ratio (1.064-1.083 for one
-        // scene). Where the user chose that loop, its attempt is that state; else it is run
-        // once a target (a retry from the previous force has the same target).
-        if (!out.stopped && problem.rigid.count()) {
-          const bool own = coulomb_loop(params.contact);
-          StepOutcome coulomb_out;
-          if (!own && target != probed) {
-            probed = target;
-            ContactParams coulomb = params.contact;
-            coulomb.method = ContactMethod::cev;
-            coulomb.loop = ContactLoop::inner;
-            coulomb.friction_loop = FrictionLoop::inner;
-            // From a compliance formed at its own first state, not at the failed attempt's last one:
-            // the same run whichever strategy failed before it.
-            eq.refresh_compliance();
-            coulomb_out = solve_contact_step(eq, guess, p_guess, p, coulomb, step, observer.iteration,
-                                             observer.stop_requested, v_first);
-            count_attempt(rec, coulomb_out);
-            if (coulomb_out.stopped) {
-              out.stopped = result.stopped = true;
-              out.reason = coulomb_out.reason;
-            }
-          }
-          StepOutcome& decided = own ? out : coulomb_out;
-          if (!decided.stopped && !decided.converged)
+        // on one run: cev's default loop from this attempt's start, whose every accepted state
+        // lies on Coulomb's law, with a compliance formed afresh at its first state (not the one
+        // the failed attempt, or cev's previous step, left: the same run whichever strategy came
+        // before). ssn's iterates lie on Coulomb's law only once they converge, penalty's Newton
+        // failed before it reached a state, and the bounds of the tau passes lag p, so they found
+        // the limit late or not at all, each with its own ratio (1.064-1.078 for one scene); cev
+        // default's own attempt, from the compliance of its previous step, stopped 1.3e-4 away
+        // in the squeeze force. Run once a target (a retry from the previous force has the same
+        // target); after cev default's own attempt only where that attempt shows the limit.
+        if (!out.stopped && problem.rigid.count() && target != probed &&
+            (!is_coulomb_loop(params.contact) ||
+             !friction_limit_exceeded(problem, out.state, out.p, out.tau, target).empty())) {
+          probed = target;
+          eq.refresh_compliance();
+          StepOutcome decided = solve_contact_step(eq, guess, p_guess, p, coulomb_loop(params.contact), step,
+                                                   observer.iteration, observer.stop_requested, v_first);
+          count_attempt(rec, decided);
+          if (decided.stopped) {
+            out.stopped = result.stopped = true;
+            out.reason = decided.reason;
+          } else if (!decided.converged) {
             if (std::string why = friction_limit_exceeded(problem, decided.state, decided.p, decided.tau, target);
                 !why.empty()) {
               rec.reason = std::move(why);
@@ -190,6 +193,7 @@ RunResult run_load_steps(Problem& problem, const std::vector<LoadStep>& steps,
               rec.state = std::move(decided.state);
               break;
             }
+          }
         }
         // A poor extrapolation (after the start-up step, or where contact changes) is retried
         // from the previous force before the increment is cut: a cut changes the load path.

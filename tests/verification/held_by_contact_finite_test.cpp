@@ -215,8 +215,8 @@ TEST(HeldByContactFinite, RotationNoContactResistsIsRejected) {
 // strategy decides it on cev default's loop from its failed attempt's start (load_stepping.cpp),
 // so it reports cev default's ratio, to what the two decided states differ by (expect_same_limit);
 // before, ssn found it after a cut (47 real solves, 1077 Newton) and penalty not at all (5 cuts,
-// "Newton did not converge"), and the ratios were 1.06407-1.07838. uzawa: tests/hard (its squeeze
-// and first turn take 270 real solves).
+// "Newton did not converge"), and the ratios were 1.06407-1.07838 (now 1.06646, penalty 1.06648).
+// uzawa: tests/hard (its squeeze and first turn take 270 real solves).
 const Solved& cev_beyond_the_limit() {
   static const Solved s = solve_scene(turned_beyond_the_limit());
   return s;
