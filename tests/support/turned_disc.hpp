@@ -171,6 +171,35 @@ inline std::pair<double, double> expect_same_answer(const Solved& a, const Solve
 // fixed by the squeeze.
 inline nlohmann::json turned_beyond_the_limit() { return turned_in_stages(32, 1369.0, {0.9, 1.05}); }
 
+// The ratio M / (mu sum N r) of the run's failed step's reason, or 0 where it gives none.
+inline constexpr const char* kCoupleLimit = "the couple exceeds what friction can hold: M / (mu sum N r) = ";
+inline double limit_ratio(const Solved& s) {
+  if (s.run.steps.empty()) return 0.0;
+  const std::string& why = s.run.steps.back().reason;
+  return why.find(kCoupleLimit) == 0 ? std::stod(why.substr(std::string(kCoupleLimit).size())) : 0.0;
+}
+
+// What the ratio of the failed step reads at the state `now` beyond what it reads at `ref`, relative:
+// the squeeze force P = P_lower - P_upper (|P_now / P_ref - 1|), the unbalance of the two flats
+// (with it the moment of the normal forces depends on the centre of the turn), the levers of
+// friction by the pressed points' positions (their |s_eta| against `ref`'s, or against the flats'
+// lines without `geometry`, over the two levers 2R), and the couple's arm by its loaded nodes'
+// displacements (against `ref`'s, or against none, over the arm 2R).
+inline double limit_drift(const Problem& problem, const StepRecord& now, const StepRecord& ref, bool geometry) {
+  const Vec2 lower = flat_resultant(problem, now, 0), upper = flat_resultant(problem, now, 1);
+  const Vec2 lower_ref = flat_resultant(problem, ref, 0), upper_ref = flat_resultant(problem, ref, 1);
+  const double P_now = lower.y() - upper.y(), P_ref = lower_ref.y() - upper_ref.y();
+  double drift = std::abs(P_now / P_ref - 1) + std::abs(lower.y() + upper.y()) / P_now +
+                 std::abs(lower_ref.y() + upper_ref.y()) / P_ref;
+  for (const Candidate& c : problem.candidates)
+    if (now.p[c.eta] < 0 || (geometry && ref.p[c.eta] < 0))
+      drift += std::abs(now.state.s[c.eta] - (geometry ? ref.state.s[c.eta] : 0.0)) / kDiscRadius / 2;
+  for (const int node : {disc_node(32, 32, 16), disc_node(32, 0, 16)})
+    drift += (now.state.q.segment<2>(2 * node) - (geometry ? Vec2(ref.state.q.segment<2>(2 * node)) : Vec2::Zero())).norm() /
+             kDiscRadius / 2;
+  return drift;
+}
+
 // The run of turned_beyond_the_limit: the first two steps converged and balanced, the third
 // failed at once (no cut of its increment) with the reason in words, no NaN; its ratio
 // M / (mu sum N r) against the closed form of the scene, 2 R F / (mu (P_top + P_bottom) h) with
@@ -189,13 +218,13 @@ inline double expect_turned_beyond_the_limit(const Solved& s) {
   EXPECT_FALSE(failed.converged);
   EXPECT_EQ(failed.cuts, 0) << failed.reason;
   const std::string& why = failed.reason;
-  const std::string head = "the couple exceeds what friction can hold: M / (mu sum N r) = ";
+  const std::string head = kCoupleLimit;
   EXPECT_EQ(why.find(head), 0u) << why;
   EXPECT_NE(why.find("at load factors turn 1.05, squeeze 1 (the body turns about"), std::string::npos) << why;
   EXPECT_NE(why.find("no static equilibrium exists"), std::string::npos) << why;
   EXPECT_NE(s.run.reason.find("step 3 failed: " + head), std::string::npos) << s.run.reason;
-  if (why.find(head) != 0) return 0.0;
-  const double ratio = std::stod(why.substr(head.size()));
+  const double ratio = limit_ratio(s);
+  if (ratio == 0.0) return 0.0;
   // The closed form from the previous step's normal forces.
   const StepRecord& before = s.run.steps[1];
   const double P = flat_resultant(s.scene.problem, before, 0).y() - flat_resultant(s.scene.problem, before, 1).y();
@@ -205,21 +234,30 @@ inline double expect_turned_beyond_the_limit(const Solved& s) {
   // they differ by the change of P over the step (the couple lowers the squeeze force), the
   // unbalance of the two flats, and the levers by the displacements (|u| / R at the loaded
   // nodes, the contact points' distance from the flats' lines); all read from that state.
-  const Vec2 lower = flat_resultant(s.scene.problem, failed, 0), upper = flat_resultant(s.scene.problem, failed, 1);
-  const double P_now = lower.y() - upper.y();
-  double drift = std::abs(P_now / P - 1) + std::abs(lower.y() + upper.y()) / P_now;
-  const Problem& problem = s.scene.problem;
-  for (int k = 0; k < static_cast<int>(problem.candidates.size()); ++k)
-    if (failed.p[problem.candidates[k].eta] < 0)
-      drift += std::abs(failed.state.s[problem.candidates[k].eta]) / kDiscRadius / 2;
-  for (const int node : {disc_node(32, 32, 16), disc_node(32, 0, 16)})
-    drift += failed.state.q.segment<2>(2 * node).norm() / kDiscRadius / 2;
+  const double P_now = flat_resultant(s.scene.problem, failed, 0).y() - flat_resultant(s.scene.problem, failed, 1).y();
+  const double drift = limit_drift(s.scene.problem, failed, before, false);
   EXPECT_GT(ratio, 1.0);
   EXPECT_NEAR(ratio, closed, drift * closed + 1e-6);
   std::printf("beyond the limit: M / (mu sum N r) = %.6f, closed form %.6f (P %.3f of the previous step, %.3f at the "
               "state reached; bound %.2e); failed step: %d real solves, %d Newton, %d cuts\n",
               ratio, closed, P, P_now, drift * closed, failed.solves, failed.newton_iterations, failed.cuts);
   return ratio;
+}
+
+// Every strategy reports the ratio of one decision (load_stepping.cpp: cev's default loop from
+// the failed attempt's start): the same as cev default's run `reference`, but for what the two
+// decided states differ by (limit_drift between them) and the rounding of the two printed ratios
+// (6 digits: 5e-6 of the ratio each).
+inline void expect_same_limit(const Solved& reference, const Solved& s) {
+  const double r = limit_ratio(reference), ratio = limit_ratio(s);
+  if (r == 0.0 || ratio == 0.0 || reference.run.steps.size() != 3u || s.run.steps.size() != 3u) {
+    ADD_FAILURE() << "no ratio to compare: " << reference.run.reason << " / " << s.run.reason;
+    return;
+  }
+  const double gap = (limit_drift(s.scene.problem, s.run.steps[2], reference.run.steps[2], true) + 1e-5) * r;
+  EXPECT_NEAR(ratio, r, gap);
+  std::printf("ratio %.6f against cev default's %.6f: differ by %.2e (bound %.2e)\n", ratio, r, std::abs(ratio - r),
+              gap);
 }
 
 }  // namespace grip::testing
