@@ -81,13 +81,11 @@ double distance(const LoadFactors& a, const LoadFactors& b) {
   return std::sqrt(d);
 }
 
-}  // namespace
+using Clock = std::chrono::steady_clock;
 
-RunResult run_load_steps(Problem& problem, const std::vector<LoadStep>& steps,
-                         const SteppingParams& params, const SteppingObserver& observer) {
-  using Clock = std::chrono::steady_clock;
-  const auto run_start = Clock::now();
-  RunResult result;
+// The steps in order into `result`, up to the first that fails.
+void step_through(Problem& problem, const std::vector<LoadStep>& steps, const SteppingParams& params,
+                  const SteppingObserver& observer, RunResult& result) {
   Equilibrium eq(problem, params.newton);
   const int ndof = problem.body->dof_count();
   // The rigid amplitudes' unit: length per force of the stiffest dof (problem.hpp).
@@ -109,7 +107,7 @@ RunResult run_load_steps(Problem& problem, const std::vector<LoadStep>& steps,
     start_q = start_up(problem, params, current, zeta, p, result.reason);
     if (!start_q) {
       result.counters = eq.counters();
-      return result;
+      return;
     }
   }
 
@@ -251,6 +249,34 @@ RunResult run_load_steps(Problem& problem, const std::vector<LoadStep>& steps,
   }
   result.completed = result.reason.empty();
   result.counters = eq.counters();
+}
+
+}  // namespace
+
+RunResult run_load_steps(Problem& problem, const std::vector<LoadStep>& steps,
+                         const SteppingParams& params, const SteppingObserver& observer) {
+  const auto run_start = Clock::now();
+  RunResult result;
+  try {
+    step_through(problem, steps, params, observer, result);
+  } catch (const std::exception& e) {
+    // An exception from the solver (out of memory) or from an observer fails the step it came
+    // from, and the steps before are kept: grip solve still writes a whole result, and the
+    // service stores them, instead of the process ending or the job losing its steps.
+    const size_t k = result.steps.size();
+    StepRecord rec;
+    rec.index = static_cast<int>(k) + 1;
+    if (k < steps.size()) {
+      rec.stage = steps[k].stage;
+      rec.factors = steps[k].factors;
+      rec.load_factor = rec.factors.empty() ? 0.0 : rec.factors.front();
+    }
+    rec.reason = std::string("solver error: ") + e.what();
+    result.reason = "step " + std::to_string(rec.index) + " failed: " + rec.reason;
+    result.completed = false;
+    result.steps.push_back(std::move(rec));
+    if (observer.step_finished) observer.step_finished(result.steps.back());
+  }
   result.seconds = std::chrono::duration<double>(Clock::now() - run_start).count();
   return result;
 }

@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 
 #include "apps/result_writer.hpp"
 #include "solver/io/json_writer.hpp"
@@ -336,6 +337,45 @@ TEST(SceneEffects, StepsWrittenWhileSolvingAreTheStreamedResultByteForByte) {
     const std::string reason = r["summary"]["reason"];
     EXPECT_NE(reason.find("step 7 failed: the shear load exceeds what friction can hold"), std::string::npos) << reason;
   }
+  std::filesystem::remove(path);
+}
+
+// An exception during a step (here from the observer, as the service's event store throws when
+// its database is gone; the solver's own would be out of memory) fails that step with the
+// exception's text and keeps the steps before: the written result is whole, its step 1 the
+// same as an undisturbed run's, and nothing escapes to end grip solve.
+TEST(SceneEffects, AnExceptionDuringAStepFailsThatStepAndKeepsTheStepsBefore) {
+  json hertz = testing::example_scene("hertz");
+  hertz["steps"] = 3;
+  Scene undisturbed = read_scene(hertz);
+  const RunResult whole = run_load_steps(undisturbed.problem, undisturbed.steps, undisturbed.params);
+  ASSERT_TRUE(whole.completed);
+
+  Scene scene = read_scene(hertz);
+  const std::filesystem::path path =
+      std::filesystem::temp_directory_path() / ("grip_scene_throw_" + std::to_string(getpid()) + ".json");
+  RunResult run;
+  {
+    ResultWriter writer(path.string(), scene);
+    SteppingObserver observer;
+    observer.step_started = [](int step, double) {
+      if (step == 2) throw std::runtime_error("the event store is unavailable");
+    };
+    observer.step_finished = [&](const StepRecord& rec) { writer.add_step(rec); };
+    run = run_load_steps(scene.problem, scene.steps, scene.params, observer);
+    ASSERT_TRUE(writer.finish(run));
+  }
+  EXPECT_FALSE(run.completed);
+  EXPECT_EQ(run.reason, "step 2 failed: solver error: the event store is unavailable");
+  ASSERT_EQ(run.steps.size(), 2u);
+  EXPECT_TRUE(run.steps[0].converged);
+  EXPECT_FALSE(run.steps[1].converged);
+  EXPECT_EQ(run.steps[1].load_factor, undisturbed.steps[1].factors.front());
+  EXPECT_EQ(run.steps[0].p, whole.steps[0].p);
+  const json r = json::parse(file_text(path));
+  EXPECT_EQ(r, result_json(scene, run));
+  EXPECT_EQ(r["steps"].size(), 2u);
+  EXPECT_EQ(r["summary"]["completed"], false);
   std::filesystem::remove(path);
 }
 
