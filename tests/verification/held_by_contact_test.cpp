@@ -41,16 +41,17 @@ int node_at(const json& scene, const Vec2& x) {
   return 0;
 }
 
-// Measured with the budget raised (held_direction, step.hpp): the paper's loop with n = 3 takes
-// 342-10551 real solves a level on the beam lying on a flat, uzawa 2127-10842 (a fixed-alpha gradient
-// on a reduced compliance of condition ~650): over the 500 of a step. Both run in tests/hard
-// (HeldByContactHardSlow), as does uzawa on the disc (864).
+// Measured with the budget raised (tests/hard held_by_contact_hard_test.cpp, where p* settles to
+// tau_tolerance): the paper's loop with n = 3 takes 830-2971 real solves a level on the beam lying
+// on a flat, uzawa 752-13966 (a fixed-alpha gradient on a reduced compliance of condition ~650):
+// over the 500 of a step. Both run in tests/hard (HeldByContactHardSlow), as does uzawa on the
+// disc (730).
 const char* const kPaperBeamSlow =
-    "the paper's loop with n = 3 needs up to 10551 real solves a level on the beam lying on a flat, over the 500 of "
+    "the paper's loop with n = 3 needs 830 to 2971 real solves a level on the beam lying on a flat, over the 500 of "
     "a step; it runs in tests/hard";
 const char* const kUzawaSlow =
-    "uzawa's fixed alpha needs thousands of real solves a level on the beam's compliance (2127 to 10842 measured), "
-    "and 864 on the disc, over the 500 of a step; both run in tests/hard";
+    "uzawa's fixed alpha needs 752 to 13966 real solves a level on the beam's compliance, and 730 on the disc, "
+    "over the 500 of a step; both run in tests/hard";
 
 const Strategy kStrategies[] = {
     {"cev", json::object()},
