@@ -56,6 +56,7 @@ class SsnStep : public StepSolver {
     augmentations(out_.state);
     const int components = problem_.component_count;
     int restarts = 0;
+    previous_error_ = error_.norm2;
     // Only a state from the oracle ends the loop: the step is judged on a real solve.
     for (int it = 1; !error_met(error_); ++it) {
       if (!budget_left()) return;
@@ -117,6 +118,7 @@ class SsnStep : public StepSolver {
         accept(std::move(solved), p_cone);
         ++m_;
         emit(1, 0, halvings, 0, 0.0);
+        if (drifting()) return;
         continue;
       }
       restarts = 0;
@@ -138,6 +140,7 @@ class SsnStep : public StepSolver {
         accept(std::move(solved), p_cone);
         ++m_;
         emit(1, 0, halvings, 0, a, 1);
+        if (drifting()) return;
       } else {
         // Reported in the event, not accepted: out_.state stays the last real solve's.
         const ContactError e = error_at(p_cone, now.s, now.enabled);
@@ -155,6 +158,20 @@ class SsnStep : public StepSolver {
     }
     out_.converged = true;
     final_check();
+  }
+
+  // A load with no equilibrium near (a disc turned beyond what friction holds): Newton cannot
+  // converge, and its real solves drift away, each state's contact error above the one before
+  // (14 in a row there, 1.4e-3 to 6.2e-3, until its 500 iterations were spent: 20 real solves,
+  // 7 of its 8 s of CPU). In tests/verification and tests/hard no ssn attempt rose more than 4
+  // times in a row (the beam on a cylinder with mu 5, an attempt before a cut); twice that ends
+  // the step (the disc: 13 real solves, 262 Newton), and the caller decides what it is.
+  bool drifting() {
+    rises_ = error_.norm2 > previous_error_ ? rises_ + 1 : 0;
+    previous_error_ = error_.norm2;
+    if (rises_ < kMaxRises) return false;
+    return !fail("semismooth Newton: the contact error grew at " + std::to_string(kMaxRises) +
+                 " real solves in a row (to " + std::to_string(error_.norm2) + "): its iterates drift");
   }
 
   // A body held by contact starts a step unbalanced: the load grew, the forces are the last
@@ -312,6 +329,9 @@ class SsnStep : public StepSolver {
   double scaled_length(const Vector& F) const { return F.cwiseQuotient(r_).norm(); }
 
   static constexpr int kMaxRestarts = 5;
+  static constexpr int kMaxRises = 8;
+  int rises_ = 0;                // real solves in a row whose contact error rose (drifting)
+  double previous_error_ = 0.0;  // the contact error of the loop's last real solve
   std::vector<int> free_index_;
   int free_count_ = 0;
   Vector length_scales_;
