@@ -83,6 +83,16 @@ double distance(const LoadFactors& a, const LoadFactors& b) {
 
 using Clock = std::chrono::steady_clock;
 
+// The record of step `index` (from 1), before it is solved.
+StepRecord step_record(const LoadStep& step, int index) {
+  StepRecord rec;
+  rec.index = index;
+  rec.stage = step.stage;
+  rec.factors = step.factors;
+  rec.load_factor = step.factors.empty() ? 0.0 : step.factors.front();
+  return rec;
+}
+
 // The steps in order into `result`, up to the first that fails.
 void step_through(Problem& problem, const std::vector<LoadStep>& steps, const SteppingParams& params,
                   const SteppingObserver& observer, RunResult& result) {
@@ -117,11 +127,7 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
     const auto step_start = Clock::now();
     for (size_t o = 0; o < target_step.friction.size() && o < problem.obstacles.size(); ++o)
       problem.obstacles[o].friction = target_step.friction[o];
-    StepRecord rec;
-    rec.index = step;
-    rec.stage = target_step.stage;
-    rec.factors = target_step.factors;
-    rec.load_factor = target_step.factors.empty() ? 0.0 : target_step.factors.front();
+    StepRecord rec = step_record(target_step, step);
     if (observer.step_started) observer.step_started(step, rec.load_factor);
     // Sub-increments toward the target; a failure halves the increment.
     const LoadFactors from = current;
@@ -264,13 +270,7 @@ RunResult run_load_steps(Problem& problem, const std::vector<LoadStep>& steps,
     // from, and the steps before are kept: grip solve still writes a whole result, and the
     // service stores them, instead of the process ending or the job losing its steps.
     const size_t k = result.steps.size();
-    StepRecord rec;
-    rec.index = static_cast<int>(k) + 1;
-    if (k < steps.size()) {
-      rec.stage = steps[k].stage;
-      rec.factors = steps[k].factors;
-      rec.load_factor = rec.factors.empty() ? 0.0 : rec.factors.front();
-    }
+    StepRecord rec = step_record(k < steps.size() ? steps[k] : LoadStep{}, static_cast<int>(k) + 1);
     rec.reason = std::string("solver error: ") + e.what();
     result.reason = "step " + std::to_string(rec.index) + " failed: " + rec.reason;
     result.completed = false;
