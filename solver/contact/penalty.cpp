@@ -4,9 +4,13 @@
 // penalty springs: its rigid amplitudes are solved with the deformation (Equilibrium with the
 // pins free), first with springs of 1e-2, 1e-4, 1e-6 x the largest stiffness on its pins,
 // each solve from the last, then without them. Where that fails, the step is solved again with
-// the law's stiffness ramped up from 1e-3 x its own (PenaltyStep::levels).
+// the law's stiffness ramped up from 1e-3 x its own (PenaltyStep::levels). Its step converges
+// only where its answer meets the tolerance and obeys its law (no tension, friction within the
+// cone); otherwise it fails with the error and penetration it reached.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <string>
 
 #include "solver/contact/step.hpp"
 
@@ -41,8 +45,50 @@ class PenaltyStep : public StepSolver {
     out_.tau = friction_bounds(problem_, p_star);
     const Vector p = s.p;
     accept(std::move(s), p);
-    out_.converged = true;
     emit(solves, 0, 0, 0, 0.0);
+    if (!obeys_law()) return;
+    // `converged` only where the step's tolerance is met (docs/algorithm.md#tolerance): its
+    // answer's error is about |p| / k, which no cut of the increment lowers.
+    if (!error_met(error_)) {
+      out_.definitive = true;
+      double penetration = 0.0;
+      for (const Candidate& c : problem_.candidates) penetration = std::max(penetration, out_.state.s[c.eta]);
+      const double raise = error_.norm2 > tol_ ? error_.norm2 / tol_ : 1.0;
+      fail("penalty: contact error " + to_text(error_.norm2) + " above the bound " + to_text(tol_) +
+           " (penetration " + to_text(penetration) + ", k_n = " + to_text(law.normal) +
+           "): a penalty stiffness (or a tolerance) about " + to_text(raise) + " x larger would meet it");
+      return;
+    }
+    out_.converged = true;
+  }
+
+  // Its forces obey its own law: no tension, and friction within mu |p_n| (its regularized
+  // cone), to the tolerance of the largest normal force. The force the strategy reports is the
+  // law linearized over Newton's last correction (Equilibrium::finish_penalty); at loads tiny
+  // against k that crossed the law's kink: p_n = +7.3 on an open point, |p_t| = 15.5 mu |p_n|
+  // (the held block with E x 1e6).
+  bool obeys_law() {
+    double largest = 0.0;
+    for (const Candidate& c : problem_.candidates) largest = std::max(largest, std::abs(out_.p[c.eta]));
+    const double slack = params_.tolerance * largest;
+    for (size_t i = 0; i < problem_.candidates.size(); ++i) {
+      const Candidate& c = problem_.candidates[i];
+      const double pn = out_.p[c.eta], pt = c.xi >= 0 ? out_.p[c.xi] : 0.0;
+      const double mu = problem_.obstacles[c.obstacle].friction;
+      if (pn > slack)
+        return fail("penalty: its normal force pulls at contact point " + std::to_string(i) + " (p_n = " + to_text(pn) +
+                    "): its law gives no tension");
+      if (std::abs(pt) > mu * std::abs(pn) * (1 + 1e-9) + slack)
+        return fail("penalty: its friction force at contact point " + std::to_string(i) + " (|p_t| = " +
+                    to_text(std::abs(pt)) + ") exceeds mu |p_n| = " + to_text(mu * std::abs(pn)));
+    }
+    return true;
+  }
+
+  static std::string to_text(double x) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.3g", x);
+    return buf;
   }
 
   // One solve per level, each from the last. A body held by contact has springs on its pins,

@@ -184,10 +184,8 @@ class SsnStep : public StepSolver {
   // and solved once (3 real solves a level then).
   bool restore_equilibrium() {
     const RigidModes& rigid = problem_.rigid;
-    if (!rigid.count() || error_.norm2 <= tol_) return true;
-    double unbalance = 0.0;
-    for (int k = 0; k < rigid.count(); ++k) unbalance = std::max(unbalance, std::abs(error_.v[rigid.first + k]));
-    if (unbalance <= 0.1 * tol_) return true;
+    if (!rigid.count() || error_met(error_)) return true;
+    if (unbalance(error_) <= 0.1 * std::min(tol_, balance_tol_)) return true;
     const Compliance& C = eq_.compliance(out_.state, relevant_components());
     if (!C.bordered) return true;
     const Direction dir = bordered_direction(C, error_, kAccelerationInfinity, 0.0);
@@ -206,7 +204,7 @@ class SsnStep : public StepSolver {
   // starts instead from Coulomb's law on the linear model at this state (cev's first iteration,
   // no real solve), solved once.
   bool start_from_model() {
-    if (!problem_.rigid.count() || error_.norm2 <= tol_) return true;
+    if (!problem_.rigid.count() || error_met(error_)) return true;
     const Compliance& C = eq_.compliance(out_.state, relevant_components());
     const CoulombModelSolution model = solve_model(C, 0.1 * tol_);
     out_.inner_iterations += model.iterations;

@@ -121,6 +121,12 @@ class StepSolver {
   void emit(int trials, int inner, int halvings, int n, double alpha, int own_newton = 0);
 
   bool frictionless() const;
+  // The step's bound on ||v|| at state s (docs/algorithm.md#tolerance): tolerance x the body's
+  // largest displacement there (at most its characteristic length), never below the round-off
+  // of the gaps and slips at their coordinates' size (then *round_off is set).
+  double bound_at(const EquilibriumState& s, double* scale = nullptr, bool* round_off = nullptr) const;
+  // The largest displacement of q, a rotation times its length scale.
+  double displacement_size(const Vector& q) const;
   // The step's stopping test: ||v|| <= tol, and where the body's free motions follow its state
   // (rigid_modes_at: finite kinematics, a free rotation) its amplitudes' rows, the residuals at
   // its pins, to Newton's residual tolerance (newton_fraction x tolerance) relative to the size
@@ -133,7 +139,7 @@ class StepSolver {
   bool improves(const ContactError& e, double v0) const {
     return e.norm2 < v0 || (e.norm2 <= tol_ && unbalance(e) < unbalance(error_));
   }
-  // The largest amplitude row of e where error_met tests it, else 0.
+  // The largest amplitude row of e (every body held by contact), else 0.
   double unbalance(const ContactError& e) const;
   // The contact error at (p, s): with the bounds out_.tau of the pass, or with Coulomb's
   // bounds mu |p_eta| of p itself.
@@ -148,7 +154,10 @@ class StepSolver {
   const IterationObserver& observer_;
   const StopRequest& stop_;
   std::chrono::steady_clock::time_point start_;
-  double tol_ = 0.0;
+  double tol_ = 0.0;            // the bound on ||v|| at the accepted state (bound_at)
+  double scale_ = 0.0;          // the displacement it is relative to
+  bool at_round_off_ = false;   // the round-off of the gaps set it, not tolerance x scale_
+  Vector length_scales_;        // of the body's dofs (a rotation's: a length)
   bool strict_balance_ = false;  // error_met tests the amplitudes' rows
   double balance_tol_ = 0.0;     // their bound, at the accepted state (accept)
   NewtonParams newton_base_;  // Newton's tests at the contact tolerance (couple_newton)

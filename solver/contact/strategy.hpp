@@ -5,6 +5,7 @@
 // with a penalty law; its error falls as k grows). Each solves one load step given an
 // equilibrium oracle, and reports every real solve to an observer. One file per strategy
 // (cev.cpp, uzawa.cpp, penalty.cpp); what they share is in step.hpp.
+#include <algorithm>
 #include <functional>
 #include <string>
 #include <vector>
@@ -29,7 +30,9 @@ struct ContactParams {
   ContactMethod method = ContactMethod::cev;
   ContactLoop loop = ContactLoop::inner;
   FrictionLoop friction_loop = FrictionLoop::inner;
-  // ||v||_2 <= tolerance * (body's characteristic length) ends a step.
+  // A step ends when ||v||_2 <= tolerance x the body's largest displacement (at most its
+  // characteristic length; never below the round-off of the gaps), and a body held by contact
+  // balances its loads to tolerance x their size (docs/algorithm.md#tolerance).
   double tolerance = 1e-8;
   int acceleration = kAccelerationInfinity;
   EpsilonSource epsilon = EpsilonSource::exact;
@@ -78,6 +81,13 @@ struct ContactParams {
   double penalty_factor = 1e3;
 };
 
+// The contact tolerance Newton's tests are coupled to (couple_newton): the step's own, but at
+// most the default for penalty, whose answer's error |p| / k no Newton precision changes (its
+// tolerance only judges that answer: docs/algorithm.md#tolerance).
+inline double newton_coupling_tolerance(const ContactParams& c) {
+  return c.method == ContactMethod::penalty ? std::min(c.tolerance, ContactParams{}.tolerance) : c.tolerance;
+}
+
 struct IterationEvent {
   int step = 0;           // load step, 1-based
   int pass = 0;           // tau pass, 1-based
@@ -108,6 +118,11 @@ struct StepOutcome {
   int newton_iterations = 0;
   int inner_iterations = 0;
   double v2 = 0.0;
+  double bound = 0.0;          // the bound ||v|| was held to at the last accepted state
+  double scale = 0.0;          // the displacement that bound is relative to
+  bool at_round_off = false;   // the round-off of the gaps set the bound
+  bool definitive = false;     // no retry or cut of the increment can help (penalty's error)
+  bool budget_spent = false;   // ended by max_iterations real solves
   std::string epsilon_used;  // "exact" or "warmup", where a finite n needed it
   std::vector<IterationEvent> history;
 };

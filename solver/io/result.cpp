@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <stdexcept>
 
@@ -113,6 +114,13 @@ json step_json(const Problem& problem, const StepRecord& rec, const OutputOption
     j["equilibrium"] = {{"relative_residual", rec.state.relative_residual},
                         {"at_round_off_floor", rec.state.at_floor}};
   if (!rec.epsilon_used.empty()) j["epsilon"] = rec.epsilon_used;
+  if (rec.state.q.size() && rec.bound > 0) {
+    double penetration = -std::numeric_limits<double>::infinity();
+    for (const PairedPoint& pp : rec.state.points) penetration = std::max(penetration, -pp.projection.gap);
+    j["contact_error"] = {{"v2", rec.contact_error}, {"bound", rec.bound}, {"displacement_scale", rec.scale},
+                          {"at_round_off", rec.at_round_off},
+                          {"penetration", rec.state.points.empty() ? 0.0 : penetration}};
+  }
   if (problem.rigid.count() && rec.converged) {
     // The rigid motion fitted to the displacement (translation of the point at the origin);
     // in a scene of several bodies, of each body with motions held by contact.

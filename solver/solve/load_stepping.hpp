@@ -34,6 +34,10 @@ struct StepRecord {
   int passes = 0, solves = 0, newton_iterations = 0, inner_iterations = 0;
   double seconds = 0.0;
   std::string epsilon_used;
+  // The contact error reached (||v||_2 of the last accepted state), the bound it was held to,
+  // the displacement that bound is relative to, and whether round-off set it instead.
+  double contact_error = 0.0, bound = 0.0, scale = 0.0;
+  bool at_round_off = false;
   Vector p, tau, reactions;
   EquilibriumState state;
   FieldTable site_fields, element_fields;  // taken at the converged state, before commit
