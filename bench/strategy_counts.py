@@ -54,7 +54,7 @@ def main():
             for label, changes in STRATEGIES:
                 s = run(args.grip, scene, changes, work)
                 steps = max(s["steps"], 1)
-                status = "ok" if s["completed"] else s["reason"].split(":")[0][:60]
+                status = "ok" if s["completed"] else s["reason"][:120].replace("|", "/")
                 rows.append((scene, label, s["contact_iterations"] / steps,
                              s["newton_iterations"] / steps, s["steps"], status))
                 print(f"{scene} {label}: done", file=sys.stderr)
