@@ -2,6 +2,7 @@
 
 #include <Eigen/Cholesky>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 #include "solver/contact/acceleration.hpp"
@@ -33,6 +34,14 @@ constexpr long kProgressNewton = 200;
 // The round-off of a gap or slip, in units of eps x the size of the coordinates it is a
 // difference of, per contact component (bound_at).
 constexpr double kRoundOffGaps = 4.0;
+
+// A length in a message: small errors and bounds in three significant digits (to_string's six
+// decimals printed the bound 2e-15 as 0.000000).
+std::string length_text(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", x);
+  return buf;
+}
 
 double inf_norm(const Matrix& A) {
   return A.size() ? A.cwiseAbs().rowwise().sum().maxCoeff() : 0.0;
@@ -332,9 +341,8 @@ bool StepSolver::budget_left() {
   if (error_met(error_))  // what is left is the tau passes' p*
     return fail("the friction bound did not settle in " + std::to_string(params_.max_iterations) +
                 " contact iterations (" + std::to_string(pass_) + " tau passes; ||v|| within the tolerance)");
-  return fail("contact error " + std::to_string(error_.norm2) + " above tolerance " +
-              std::to_string(tol_) + " after " + std::to_string(params_.max_iterations) +
-              " contact iterations");
+  return fail("contact error " + length_text(error_.norm2) + " above tolerance " + length_text(tol_) + " after " +
+              std::to_string(params_.max_iterations) + " contact iterations");
 }
 
 bool StepSolver::line_search(const Vector& pl, const Vector& du, int& trials) {
@@ -363,7 +371,7 @@ bool StepSolver::line_search(const Vector& pl, const Vector& du, int& trials) {
     }
   }
   return fail("no decrease of the contact error along the predicted force change (||v|| = " +
-              std::to_string(v0) + ")");
+              length_text(v0) + ")");
 }
 
 bool StepSolver::loosen_newton(double v_ref) {
