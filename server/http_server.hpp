@@ -1,6 +1,6 @@
 #pragma once
-// The HTTP/JSON API (DESIGN.md) over JobService: thin handlers, problem+json (RFC 9457) for
-// every error, OGC API - Processes aliases. cpp-httplib stays inside http_server.cpp.
+// The HTTP/JSON API (docs/design.md#the-api) over JobService: thin handlers, problem+json (RFC
+// 9457) for every error, OGC API - Processes aliases. cpp-httplib stays inside http_server.cpp.
 //
 // Connections: a thread each for the connection's life, with deadlines and limits per
 // connection and client (FrontLimits, server/http_front.hpp). Event streams are counted and
