@@ -103,18 +103,17 @@ double StepSolver::bound_at(const EquilibriumState& s, double* scale, bool* roun
   const double d = std::min(displacement_size(s.q), L);
   // The gaps and slips are differences of coordinates (the point's, its pairing's, the
   // surface coordinate zeta): each carries their rounding, eps x their size, whatever the
-  // displacement; and Newton stopped at its own floor leaves its last correction as noise.
+  // displacement. Never looser than tolerance x L, the bound before it moved with D.
   double size = 0.0;
   for (const PairedPoint& pp : s.points)
     size = std::max({size, pp.point.x.cwiseAbs().maxCoeff(), pp.projection.point.cwiseAbs().maxCoeff(),
                      std::abs(pp.projection.zeta)});
-  const double rounding = std::max(kRoundOffGaps * std::numeric_limits<double>::epsilon() * size *
-                                       std::sqrt(static_cast<double>(std::max(1, problem_.component_count))),
-                                   s.at_floor ? s.noise : 0.0);
+  const double rounding = kRoundOffGaps * std::numeric_limits<double>::epsilon() * size *
+                          std::sqrt(static_cast<double>(std::max(1, problem_.component_count)));
   const double relative = params_.tolerance * d;
   if (scale) *scale = d;
   if (round_off) *round_off = rounding > relative;
-  return std::max(relative, rounding);
+  return std::min(std::max(relative, rounding), params_.tolerance * L);
 }
 
 double StepSolver::unbalance(const ContactError& e) const {

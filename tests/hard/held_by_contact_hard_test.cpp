@@ -199,7 +199,7 @@ TEST(HeldByContactHard, FiniteDiscTurnedNearTheFrictionLimit) {
 // the 33 x 33 disc instead (below).
 TEST(HeldByContactHardSlow, FiniteDiscTurnedNearTheFrictionLimitByThePapersLoopAndPenalty) {
   expect_turned_near_the_limit({"cev_paper", {{"loop", "paper"}}});
-  expect_turned_near_the_limit({"penalty", {{"method", "penalty"}}});
+  expect_turned_near_the_limit({"penalty", {{"method", "penalty"}, {"tolerance", 1e-2}}});  // its error: |p| / k
 }
 
 // uzawa on the turned finite disc of the verification (33 x 33 nodes, squeeze and couple raised

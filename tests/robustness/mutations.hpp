@@ -172,8 +172,7 @@ inline double relative_length(const Scene& scene, const StepRecord& rec) {
                      std::abs(pp.projection.zeta)});
   const double floor = 10 * 4 * std::numeric_limits<double>::epsilon() * size *
                        std::sqrt(static_cast<double>(std::max(1, problem.component_count)));
-  return std::max(scene.params.contact.tolerance * displacement_scale(problem, rec.state.q),
-                  std::max(floor, rec.state.at_floor ? 10 * rec.state.noise : 0.0));
+  return std::max(scene.params.contact.tolerance * displacement_scale(problem, rec.state.q), floor);
 }
 
 // Every converged step: finite, on Coulomb's law (no tension, the cone, friction against the

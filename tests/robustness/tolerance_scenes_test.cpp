@@ -162,9 +162,9 @@ TEST(RobustnessPenalty, SheetSaysWhatItReached) {
               l.run.completed ? "completed" : l.run.reason.c_str());
 }
 
-// Two cylinders with uzawa: no stretch of more than 200 Newton iterations (and one solve) without
+// (Slow: minutes under load, label hard_slow.) Two cylinders with uzawa: no stretch of more than 200 Newton iterations (and one solve) without
 // an event, and the step ends within its budget: converged, or failed with the reason.
-TEST(RobustnessBudget, UzawaOnTwoCylindersReportsAsItGoesAndEndsWithTheReason) {
+TEST(RobustnessBudgetSlow, UzawaOnTwoCylindersReportsAsItGoesAndEndsWithTheReason) {
   nlohmann::json j = robustness_scene("two-cylinders__uzawa");
   int silent = 0, most_silent = 0;
   SteppingObserver obs;
