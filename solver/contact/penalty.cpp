@@ -63,14 +63,15 @@ class PenaltyStep : public StepSolver {
   }
 
   // Its forces obey its own law: no tension, and friction within mu |p_n| (its regularized
-  // cone), to the tolerance of the largest normal force. The force the strategy reports is the
+  // cone). The force the strategy reports is the
   // law linearized over Newton's last correction (Equilibrium::finish_penalty); at loads tiny
   // against k that crossed the law's kink: p_n = +7.3 on an open point, |p_t| = 15.5 mu |p_n|
   // (the held block with E x 1e6).
+  // A force off its law by no more than rounding (1e-9 of the largest normal force) is put on it.
   bool obeys_law() {
     double largest = 0.0;
     for (const Candidate& c : problem_.candidates) largest = std::max(largest, std::abs(out_.p[c.eta]));
-    const double slack = params_.tolerance * largest;
+    const double slack = 1e-9 * largest;
     for (size_t i = 0; i < problem_.candidates.size(); ++i) {
       const Candidate& c = problem_.candidates[i];
       const double pn = out_.p[c.eta], pt = c.xi >= 0 ? out_.p[c.xi] : 0.0;
@@ -82,6 +83,9 @@ class PenaltyStep : public StepSolver {
         return fail("penalty: its friction force at contact point " + std::to_string(i) + " (|p_t| = " +
                     to_text(std::abs(pt)) + ") exceeds mu |p_n| = " + to_text(mu * std::abs(pn)));
     }
+    for (const Candidate& c : problem_.candidates) out_.p[c.eta] = std::min(0.0, out_.p[c.eta]);
+    out_.tau = friction_bounds(problem_, out_.p);
+    clip_to_bounds(problem_, out_.tau, out_.p);
     return true;
   }
 

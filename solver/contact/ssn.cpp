@@ -60,9 +60,11 @@ class SsnStep : public StepSolver {
     // Only a state from the oracle ends the loop: the step is judged on a real solve.
     for (int it = 1; !error_met(error_); ++it) {
       if (!budget_left()) return;
-      if (it > params_.max_iterations)
+      if (it > params_.max_iterations) {
+        out_.budget_spent = true;  // ends the step: no cut (load_stepping.cpp)
         return void(fail("semismooth Newton did not converge in " + std::to_string(params_.max_iterations) +
                          " iterations (contact error " + std::to_string(error_.norm2) + ")"));
+      }
       Triplets tangent;
       const EquilibriumState paired = eq_.evaluate(q);
       const Vector R = eq_.residual(q, p, &tangent);
