@@ -369,8 +369,17 @@ bool StepSolver::line_search(const Vector& pl, const Vector& du, int& trials) {
       return true;
     }
   }
+  if (reached_precision()) return true;
   return fail("no decrease of the contact error along the predicted force change (||v|| = " +
               length_text(v0) + ")");
+}
+
+bool StepSolver::reached_precision() {
+  if (error_.norm2 > params_.tolerance * problem_.body->characteristic_length() || unbalance(error_) > balance_tol_)
+    return false;
+  tol_ = error_.norm2;
+  at_round_off_ = true;
+  return true;
 }
 
 bool StepSolver::loosen_newton(double v_ref) {
@@ -469,6 +478,7 @@ bool StepSolver::literal_pass(int first_level, double alpha_fixed) {
         --level;  // fall back to a smaller n, with a fresh alpha
         a = 1.0;
       }
+      if (halvings > params_.max_halvings && reached_precision()) return true;
       if (halvings > params_.max_halvings)
         return fail("alpha halved " + std::to_string(params_.max_halvings) +
                     " times without a decrease of the contact error");

@@ -78,6 +78,11 @@ class StepSolver {
   // with a smaller ||v|| is accepted. du is the linear model's displacement change for pl - p
   // (Newton starts from it). `trials` counts the real solves.
   bool line_search(const Vector& pl, const Vector& du, int& trials);
+  // No real solve lowers ||v|| any more (the line search, or alpha's halvings) where it is
+  // within tolerance x L, the bound before it moved with D: the precision the real solves allow
+  // is reached (their round-off: the mortar pairs of two bodies). The step converges there with
+  // that error as its bound, and says so (at_round_off). True if so.
+  bool reached_precision();
   // Inexact real solves (kInexactNewton, step.cpp): Newton's correction test for a trial
   // whose contact error starts at v_ref, loosened to that fraction of v_ref (true if looser
   // than the full precision); and back to the full precision.

@@ -161,9 +161,8 @@ inline double displacement_scale(const Problem& problem, const Vector& q) {
 }
 
 // The gaps of a converged step against its tolerance relative to its displacement, computed here
-// from the state (not from the solver's bound): a gap or penetration within tolerance x D of every
-// pressing point, with the round-off of the coordinates (eps x their size, 10 x per component) as
-// the floor.
+// from the state: a gap or penetration within tolerance x D of every pressing point, with the
+// round-off of the coordinates (eps x their size, 10 x per component) as the floor.
 inline double relative_length(const Scene& scene, const StepRecord& rec) {
   const Problem& problem = scene.problem;
   double size = 0.0;
@@ -172,7 +171,10 @@ inline double relative_length(const Scene& scene, const StepRecord& rec) {
                      std::abs(pp.projection.zeta)});
   const double floor = 10 * 4 * std::numeric_limits<double>::epsilon() * size *
                        std::sqrt(static_cast<double>(std::max(1, problem.component_count)));
-  return std::max(scene.params.contact.tolerance * displacement_scale(problem, rec.state.q), floor);
+  // A step that says it stopped at the precision its solves allow (at_round_off) is held to the
+  // bound it states.
+  return std::max({scene.params.contact.tolerance * displacement_scale(problem, rec.state.q), floor,
+                   rec.at_round_off ? rec.bound : 0.0});
 }
 
 // Every converged step: finite, on Coulomb's law (no tension, the cone, friction against the
