@@ -74,8 +74,9 @@ StepOutcome StepSolver::run(const Vector& q_guess, const Vector& p_start, const 
   // displacement (the last state's, extrapolated) until a state is accepted (accept).
   const double guess_scale = displacement_size(q_guess);
   if (guess_scale > 0)
-    eq_.params().displacement_tolerance = params_.newton_fraction * newton_tolerance *
-                                          std::min(guess_scale, problem_.body->characteristic_length());
+    eq_.params().displacement_tolerance =
+        std::max(params_.newton_fraction * newton_tolerance * std::min(guess_scale, problem_.body->characteristic_length()),
+                 10 * std::numeric_limits<double>::epsilon() * problem_.body->characteristic_length());
   newton_base_ = eq_.params();
   eq_.set_compliance_reuse(params_.reuse_compliance && params_.method == ContactMethod::cev &&
                            params_.loop == ContactLoop::inner);
@@ -98,17 +99,21 @@ double StepSolver::displacement_size(const Vector& q) const {
   return d;
 }
 
+double StepSolver::coordinate_size(const EquilibriumState& s) const {
+  double size = problem_.body->characteristic_length();
+  for (const PairedPoint& pp : s.points)
+    size = std::max({size, pp.point.x.cwiseAbs().maxCoeff(), pp.projection.point.cwiseAbs().maxCoeff(),
+                     std::abs(pp.projection.zeta)});
+  return size;
+}
+
 double StepSolver::bound_at(const EquilibriumState& s, double* scale, bool* round_off) const {
   const double L = problem_.body->characteristic_length();
   const double d = std::min(displacement_size(s.q), L);
   // The gaps and slips are differences of coordinates (the point's, its pairing's, the
   // surface coordinate zeta): each carries their rounding, eps x their size, whatever the
   // displacement. Never looser than tolerance x L, the bound before it moved with D.
-  double size = 0.0;
-  for (const PairedPoint& pp : s.points)
-    size = std::max({size, pp.point.x.cwiseAbs().maxCoeff(), pp.projection.point.cwiseAbs().maxCoeff(),
-                     std::abs(pp.projection.zeta)});
-  const double rounding = kRoundOffGaps * std::numeric_limits<double>::epsilon() * size *
+  const double rounding = kRoundOffGaps * std::numeric_limits<double>::epsilon() * coordinate_size(s) *
                           std::sqrt(static_cast<double>(std::max(1, problem_.component_count)));
   const double relative = params_.tolerance * d;
   if (scale) *scale = d;
@@ -293,7 +298,11 @@ void StepSolver::accept(EquilibriumState s, const Vector& p) {
   out_.state = std::move(s);
   out_.p = p;
   tol_ = bound_at(out_.state, &scale_, &at_round_off_);
-  newton_base_.displacement_tolerance = params_.newton_fraction * tol_;
+  // A correction below the rounding of the positions (10 eps x their size) is noise: Newton's
+  // correction test no tighter (a strip with finite kinematics under loads x 1e-6 otherwise
+  // ran its 40 iterations at that floor, which its residual test does not see).
+  newton_base_.displacement_tolerance =
+      std::max(params_.newton_fraction * tol_, 10 * std::numeric_limits<double>::epsilon() * coordinate_size(out_.state));
   eq_.params().displacement_tolerance = newton_base_.displacement_tolerance;
   if (coulomb_) out_.tau = friction_bounds(problem_, p);
   error_ = error_at(out_.p, out_.state.s, out_.state.enabled);

@@ -130,6 +130,9 @@ class StepSolver {
   // largest displacement there (at most its characteristic length), never below the round-off
   // of the gaps and slips at their coordinates' size (then *round_off is set).
   double bound_at(const EquilibriumState& s, double* scale = nullptr, bool* round_off = nullptr) const;
+  // The size of the contact points' coordinates at s (their positions, pairings and zeta; at
+  // least the body's length): what their rounding is relative to.
+  double coordinate_size(const EquilibriumState& s) const;
   // The largest displacement of q, a rotation times its length scale.
   double displacement_size(const Vector& q) const;
   // The step's stopping test: ||v|| <= tol, and where the body's free motions follow its state
