@@ -64,6 +64,16 @@ class Body {
   // the left of a -> b: what a slave surface of another body pairs with (mortar segments).
   // Empty where the model offers no master surface.
   virtual std::vector<std::array<int, 2>> surface_segments() const { return {}; }
+  // Nodes of the boundary that carry no site (the continuum's boundary outside its contact
+  // set): with the sites, every boundary point that the step checks hold against the obstacles.
+  virtual std::vector<int> nodes_without_site() const { return {}; }
+  // The current position of such a node (an index of node_count()).
+  virtual Vec2 node_position(const VectorRef& /*q*/, int /*node*/) const { return Vec2::Zero(); }
+  // Makes boundary nodes sites, with the boundary sides that join them to the boundary (their
+  // indices after the existing sites, which keep theirs): a node that entered an obstacle outside
+  // the contact set becomes a contact candidate. Returns the sites added; none where the model
+  // cannot (its every boundary node is already a site).
+  virtual std::vector<int> add_sites(const std::vector<int>& /*nodes*/) { return {}; }
   // Surface area that a site's contact force acts on (tributary length x width).
   virtual double tributary_area(int site) const = 0;
   // Characteristic length (size of the undeformed body): the scale of relative tolerances.

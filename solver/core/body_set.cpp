@@ -53,6 +53,18 @@ int BodySet::site_node(int site) const {
   return node_offset_[b] + parts_[b]->site_node(site - site_offset_[b]);
 }
 
+std::vector<int> BodySet::nodes_without_site() const {
+  std::vector<int> out;
+  for (int b = 0; b < count(); ++b)
+    for (int node : parts_[b]->nodes_without_site()) out.push_back(node_offset_[b] + node);
+  return out;
+}
+
+Vec2 BodySet::node_position(const VectorRef& q, int node) const {
+  const int b = body_of_node(node);
+  return parts_[b]->node_position(q.segment(dof_offset_[b], parts_[b]->dof_count()), node - node_offset_[b]);
+}
+
 SurfacePoint BodySet::surface_point(const VectorRef& q, int site, int side) const {
   const int b = body_of_site(site);
   // A view of the body's part of q: a copy of it per point made pairing quadratic (12 % of the

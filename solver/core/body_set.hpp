@@ -36,6 +36,8 @@ class BodySet final : public Body {
   int site_node(int site) const override;
   SurfacePoint surface_point(const VectorRef& q, int site, int side) const override;
   std::vector<std::array<int, 2>> surface_segments() const override;
+  std::vector<int> nodes_without_site() const override;
+  Vec2 node_position(const VectorRef& q, int node) const override;
   double tributary_area(int site) const override;
   double characteristic_length() const override;
   // The whole set translated, or rotated (when every body has a rotation).

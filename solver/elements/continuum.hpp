@@ -53,6 +53,11 @@ class ContinuumBody final : public Body {
   SurfacePoint surface_point(const VectorRef& q, int site, int side) const override;
   // The contact sides, a q9 side as its two halves.
   std::vector<std::array<int, 2>> surface_segments() const override;
+  std::vector<int> nodes_without_site() const override;
+  Vec2 node_position(const VectorRef& q, int node) const override {
+    return mesh_.nodes[node] + Vec2(q[node_dof(node, 0)], q[node_dof(node, 1)]);
+  }
+  std::vector<int> add_sites(const std::vector<int>& nodes) override;
   double tributary_area(int site) const override { return contact_.lengths[site] * options_.thickness; }
   double characteristic_length() const override { return length_; }
 

@@ -109,6 +109,13 @@ json step_json(const Problem& problem, const StepRecord& rec, const OutputOption
   j.erase("type");
   j["inner_iterations"] = rec.inner_iterations;
   j["cuts"] = rec.cuts;
+  // The step checks (solver/solve/step_checks.hpp): the worst value of each over the step.
+  const StepChecks& c = rec.checks;
+  j["checks"] = {{"balance", c.balance},         {"tension", c.tension},
+                 {"cone", c.cone},               {"penetration", c.penetration},
+                 {"normal_turn", c.normal_turn}, {"obstacle_motion", c.obstacle_motion},
+                 {"boundary_points", c.boundary_points}};
+  if (!rec.notes.empty()) j["notes"] = rec.notes;
   if (rec.converged)
     j["equilibrium"] = {{"relative_residual", rec.state.relative_residual},
                         {"at_round_off_floor", rec.state.at_floor}};

@@ -383,6 +383,7 @@ void read_solver(Reader& r, json& scene, SteppingParams& params) {
     // 0: the body's characteristic length (written back as 0, meaning "automatic").
     params.contact_reach = r.number(*contact, cp, "reach", 0.0);
     if (params.contact_reach < 0) r.error(cp + "/reach", "is negative");
+    params.fail_outside_candidates = r.choice(*contact, cp, "outside_candidates", {"add", "fail"}, "add") == "fail";
     if (json* acc = r.object(*contact, cp, "acceleration", false)) {
       const std::string ap = cp + "/acceleration";
       if (!acc->contains("n")) (*acc)["n"] = "inf";

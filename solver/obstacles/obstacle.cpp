@@ -10,6 +10,8 @@
 
 namespace grip {
 
+double Obstacle::smallest_radius() const { return std::numeric_limits<double>::infinity(); }
+
 double Obstacle::zeta_difference(double zeta1, double zeta0) const {
   const double diff = zeta1 - zeta0;
   const double p = period();
@@ -79,6 +81,7 @@ class Circle final : public Obstacle {
   }
 
   double period() const override { return kTwoPi * radius_; }
+  double smallest_radius() const override { return radius_; }
 
  private:
   Vec2 centre_;
@@ -236,6 +239,13 @@ class Profile final : public Obstacle {
     start_ = Extension{pieces_.front().start, -rot90(n0), n0, 0.0, -1.0};
     const Vec2 n1 = last.normal_at_end();
     end_ = Extension{last.end, rot90(n1), n1, zeta, 1.0};
+  }
+
+  double smallest_radius() const override {
+    double r = std::numeric_limits<double>::infinity();
+    for (const Piece& p : pieces_)
+      if (p.arc) r = std::min(r, p.radius);
+    return r;
   }
 
   Projection project(const Vec2& x) const override {

@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <optional>
 
+#include "solver/solve/candidate_growth.hpp"
 #include "solver/solve/friction_limit.hpp"
 #include "solver/solve/rigid_equilibrium.hpp"
 
@@ -96,10 +98,11 @@ StepRecord step_record(const LoadStep& step, int index) {
 // The steps in order into `result`, up to the first that fails.
 void step_through(Problem& problem, const std::vector<LoadStep>& steps, const SteppingParams& params,
                   const SteppingObserver& observer, RunResult& result) {
-  Equilibrium eq(problem, params.newton);
+  auto eq = std::make_unique<Equilibrium>(problem, params.newton);
+  EquilibriumCounters spent;  // by the oracles that candidates added since replaced
   const int ndof = problem.body->dof_count();
   // The rigid amplitudes' unit: length per force of the stiffest dof (problem.hpp).
-  if (problem.rigid.count()) problem.rigid.scale = 1.0 / eq.stiffness_scale(Vector::Zero(ndof));
+  if (problem.rigid.count()) problem.rigid.scale = 1.0 / eq->stiffness_scale(Vector::Zero(ndof));
   const size_t cases = steps.empty() ? 1 : steps.front().factors.size();
   Vector q = Vector::Zero(ndof), q_before = q;
   Vector p = Vector::Zero(problem.component_count), p_before = p;
@@ -109,17 +112,19 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
   const bool extrapolate_forces =
       std::none_of(problem.obstacles.begin(), problem.obstacles.end(), [](const ObstacleInstance& o) { return o.master.has_value(); });
   LoadFactors current(cases, 0.0), before = current;
-  eq.set_step(current, std::vector<double>(problem.candidates.size(), 0.0));
-  std::vector<double> zeta = eq.zetas(eq.evaluate(q));
+  eq->set_step(current, std::vector<double>(problem.candidates.size(), 0.0));
+  std::vector<double> zeta = eq->zetas(eq->evaluate(q));
   std::optional<Vector> start_q;
   double v_first = 0.0;  // the contact error of the last increment's first solve
   if (problem.start) {
     start_q = start_up(problem, params, current, zeta, p, result.reason);
     if (!start_q) {
-      result.counters = eq.counters();
+      result.counters = eq->counters();
       return;
     }
   }
+  auto checker = std::make_unique<StepChecker>(problem, params.contact, params.contact_reach);
+  AcceptedContact accepted = accepted_contact(eq->evaluate(q), p);
 
   for (size_t k = 0; k < steps.size(); ++k) {
     const LoadStep& target_step = steps[k];
@@ -154,15 +159,79 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
       if (!extrapolated && problem.rigid.count())
         p_guess.segment(problem.rigid.first, problem.rigid.count()) +=
             amplitudes_following_supports(problem, current, target);
-      eq.set_step(target, zeta);
+      eq->set_step(target, zeta);
       // A load that no static equilibrium can carry: no cut of the increment can help.
-      if (std::string why = unreachable_equilibrium(problem, eq.evaluate(guess), target); !why.empty()) {
+      if (std::string why = unreachable_equilibrium(problem, eq->evaluate(guess), target); !why.empty()) {
         rec.reason = std::move(why);
         break;
       }
-      StepOutcome out = solve_contact_step(eq, guess, p_guess, p, params.contact, step,
+      // An obstacle that moves farther than the body's element size or its own radius in one
+      // increment can pass through the body into a state that satisfies every contact condition.
+      // Such an increment is cut into as many parts as the travel asks for, up to as many as
+      // max_cuts halvings make: beyond, the step fails before any solve.
+      StepChecks attempt;
+      std::string too_far;
+      if (const double parts = std::ceil(checker->increment(current, target, attempt, too_far) - 1e-9); !too_far.empty()) {
+        if (parts * (1.0 / increment) > std::ldexp(1.0, params.max_cuts)) {
+          rec.checks.worst_of(attempt);
+          rec.reason = "refused by the step checks: " + too_far + " (more than " +
+                       std::to_string(1 << params.max_cuts) + " parts of the step would be needed)";
+          break;
+        }
+        increment = (t - done) / parts;
+        ++rec.cuts;
+        continue;
+      }
+      StepOutcome out = solve_contact_step(*eq, guess, p_guess, p, params.contact, step,
                                            observer.iteration, observer.stop_requested, v_first);
       count_attempt(rec, out);
+      bool refused = false;  // converged, but the step checks refused the state
+      if (out.converged) {
+        std::vector<OutsidePoint> outside;
+        std::string why = checker->state(*eq, out.state, out.p, accepted, attempt, outside);
+        if (params.fail_outside_candidates)
+          std::erase_if(outside, [](const OutsidePoint& o) { return !o.entered; });
+        if (!outside.empty()) {
+          const CandidateGrowth g = params.fail_outside_candidates ? CandidateGrowth{} : add_candidates_for(problem, outside);
+          if (g.grew()) {
+            // The same increment again with the new candidates, from the last accepted state.
+            rec.notes.push_back(g.note);
+            spent.solves += eq->counters().solves;
+            spent.newton_iterations += eq->counters().newton_iterations;
+            spent.factorizations += eq->counters().factorizations;
+            spent.compliance_forms += eq->counters().compliance_forms;
+            spent.compliance_columns += eq->counters().compliance_columns;
+            eq = std::make_unique<Equilibrium>(problem, params.newton);
+            p = grown_components(p, g, problem);
+            p_before = grown_components(p_before, g, problem);
+            zeta.resize(problem.candidates.size(), 0.0);
+            eq->set_step(current, zeta);
+            const EquilibriumState now = eq->evaluate(q);
+            for (size_t i = g.old_candidates; i < problem.candidates.size(); ++i) zeta[i] = now.points[i].projection.zeta;
+            accepted.p = grown_components(accepted.p, g, problem);
+            for (size_t i = g.old_candidates; i < problem.candidates.size(); ++i) accepted.eta.push_back(now.points[i].eta);
+            for (StepRecord& done_step : result.steps) grow_record(done_step, g, problem);
+            grow_record(rec, g, problem);
+            checker = std::make_unique<StepChecker>(problem, params.contact, params.contact_reach);
+            continue;
+          }
+          std::string nodes;
+          for (const OutsidePoint& o : outside)
+            if (o.entered && nodes.size() < 200) nodes += (nodes.empty() ? "" : ", ") + std::to_string(o.node);
+          if (!nodes.empty()) {
+            rec.checks.worst_of(attempt);
+            rec.reason = "nodes " + nodes + " entered an obstacle outside the contact candidates" +
+                         (params.fail_outside_candidates ? " (solver.contact.outside_candidates: fail)" : "");
+            break;
+          }
+        }
+        if (!why.empty()) {
+          rec.checks.worst_of(attempt);
+          out.converged = false;
+          out.reason = "refused by the step checks: " + why;
+          refused = true;
+        }
+      }
       if (!out.converged) {
         if (out.stopped) result.stopped = true;
         // A load beyond what friction holds (friction_limit.hpp): no retry or cut of the
@@ -177,12 +246,12 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
         // default's own attempt, from the compliance of its previous step, stopped 1.3e-4 away
         // in the squeeze force. Run once a target (a retry from the previous force has the same
         // target); after cev default's own attempt only where that attempt shows the limit.
-        if (!out.stopped && problem.rigid.count() && target != probed &&
+        if (!refused && !out.stopped && problem.rigid.count() && target != probed &&
             (!is_coulomb_loop(params.contact) ||
              !friction_limit_exceeded(problem, out.state, out.p, out.tau, target).empty())) {
           probed = target;
-          eq.refresh_compliance();
-          StepOutcome decided = solve_contact_step(eq, guess, p_guess, p, coulomb_loop(params.contact), step,
+          eq->refresh_compliance();
+          StepOutcome decided = solve_contact_step(*eq, guess, p_guess, p, coulomb_loop(params.contact), step,
                                                    observer.iteration, observer.stop_requested, v_first);
           count_attempt(rec, decided);
           if (decided.stopped) {
@@ -222,7 +291,7 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
         rec.converged = true;
         rec.p = out.p;
         rec.tau = out.tau;
-        rec.reactions = eq.reactions(out.state, out.p);
+        rec.reactions = eq->reactions(out.state, out.p);
         rec.warning = problem.body->validity_warning(out.state.q);
         if (params.record_fields.empty() || params.record_fields[k]) {
           rec.site_fields = problem.body->site_fields(out.state.q);
@@ -230,6 +299,8 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
         }
       }
       // Commit.
+      rec.checks.worst_of(attempt);
+      accepted = accepted_contact(out.state, out.p);
       v_first = start_q || out.history.empty() ? 0.0 : out.history.front().v2;
       start_q.reset();
       q_before = q;
@@ -239,7 +310,7 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
       p = out.p;
       current = target;
       done = t;
-      zeta = eq.zetas(out.state);
+      zeta = eq->zetas(out.state);
       problem.body->commit(q);
       if (t == 1.0) {
         rec.state = std::move(out.state);
@@ -254,7 +325,12 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
     if (!ok) break;
   }
   result.completed = result.reason.empty();
-  result.counters = eq.counters();
+  result.counters = eq->counters();
+  result.counters.solves += spent.solves;
+  result.counters.newton_iterations += spent.newton_iterations;
+  result.counters.factorizations += spent.factorizations;
+  result.counters.compliance_forms += spent.compliance_forms;
+  result.counters.compliance_columns += spent.compliance_columns;
 }
 
 }  // namespace

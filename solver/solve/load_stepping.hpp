@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "solver/contact/strategy.hpp"
+#include "solver/solve/step_checks.hpp"
 
 namespace grip {
 
@@ -17,6 +18,10 @@ struct SteppingParams {
   // An obstacle pairs with a site only if it comes this close over the load path (length;
   // 0: the body's characteristic length). Read by the scene layer when building candidates.
   double contact_reach = 0.0;
+  // A boundary point outside the contact candidates that enters an obstacle (or a site that
+  // comes within reach of one it was not paired with): false adds it to the candidates for the
+  // rest of the run (a note in the step), true fails the step naming the node.
+  bool fail_outside_candidates = false;
   // Steps whose fields (nodes, elements) are kept; empty: every step.
   std::vector<char> record_fields;
 };
@@ -29,6 +34,8 @@ struct StepRecord {
   bool converged = false;
   std::string reason;
   std::string warning;         // the converged state lies beyond the model's accurate range
+  std::vector<std::string> notes;  // what the step changed in the problem (candidates added)
+  StepChecks checks;           // the step checks' worst values (step_checks.hpp)
   int cuts = 0;                // sub-increments this step needed beyond one
   int restarts = 0;            // attempts from the extrapolated force retried from the last one
   int passes = 0, solves = 0, newton_iterations = 0, inner_iterations = 0;

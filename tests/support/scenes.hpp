@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "solver/io/scene.hpp"
+#include "tests/support/contact_checks.hpp"
 
 namespace grip::testing {
 
@@ -97,9 +98,17 @@ inline nlohmann::json beam_lying_on_a_flat(const std::string& kinematics) {
   return j;
 }
 
+// Solved, with the step checks of every converged step held to their limits (issue 33.1).
 inline Solved solve_scene(const nlohmann::json& j) {
   Solved s{read_scene(j), {}};
   s.run = run_load_steps(s.scene.problem, s.scene.steps, s.scene.params);
+  const ContactParams& c = s.scene.params.contact;
+  const bool moving_bound = c.method == ContactMethod::ssn ||
+                            (c.method == ContactMethod::cev && c.loop == ContactLoop::inner && c.friction_loop == FrictionLoop::inner);
+  for (const StepRecord& rec : s.run.steps)
+    if (rec.converged)
+      EXPECT_TRUE(step_checks_within_limits(s.scene.problem, rec, c.tolerance * s.scene.problem.body->characteristic_length(),
+                                            moving_bound ? 1e-9 : c.tau_tolerance));
   return s;
 }
 
