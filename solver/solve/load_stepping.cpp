@@ -171,7 +171,10 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
       // max_cuts halvings make: beyond, the step fails before any solve.
       StepChecks attempt;
       std::string too_far;
-      if (const double parts = std::ceil(checker->increment(current, target, attempt, too_far) - 1e-9); !too_far.empty()) {
+      auto check_start = Clock::now();
+      const double travel = checker->increment(current, target, attempt, too_far);
+      result.check_seconds += std::chrono::duration<double>(Clock::now() - check_start).count();
+      if (const double parts = std::ceil(travel - 1e-9); !too_far.empty()) {
         if (parts * (1.0 / increment) > std::ldexp(1.0, params.max_cuts)) {
           rec.checks.worst_of(attempt);
           rec.reason = "refused by the step checks: " + too_far + " (more than " +
@@ -188,7 +191,9 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
       bool refused = false;  // converged, but the step checks refused the state
       if (out.converged) {
         std::vector<OutsidePoint> outside;
+        check_start = Clock::now();
         std::string why = checker->state(*eq, out.state, out.p, accepted, attempt, outside);
+        result.check_seconds += std::chrono::duration<double>(Clock::now() - check_start).count();
         if (params.fail_outside_candidates)
           std::erase_if(outside, [](const OutsidePoint& o) { return !o.entered; });
         if (!outside.empty()) {

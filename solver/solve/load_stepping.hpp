@@ -61,6 +61,7 @@ struct RunResult {
   std::string reason;
   EquilibriumCounters counters;
   double seconds = 0.0;
+  double check_seconds = 0.0;  // spent in the step checks (bench/results/robustness.md)
 };
 
 RunResult run_load_steps(Problem& problem, const std::vector<LoadStep>& steps,
