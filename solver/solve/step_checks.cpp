@@ -20,26 +20,32 @@ std::string num(double x) {
 }
 
 // The rigid motions of each body (translations along x and y, the rotation where the model has
-// one), each on that body's dofs only.
-std::vector<Vector> body_modes(const Body& body) {
-  std::vector<Vector> modes;
+// one), each on that body's dofs only, with the body's characteristic length.
+struct BodyModes {
+  std::vector<Vector> modes;  // x, y, and the rotation if any
+  double length;
+};
+std::vector<BodyModes> body_modes(const Body& body) {
+  std::vector<BodyModes> out;
   auto add = [&](const Body& part, int offset) {
+    BodyModes b{{}, part.characteristic_length()};
     for (const Vec2& d : {Vec2(Vec2::UnitX()), Vec2(Vec2::UnitY())}) {
       Vector m = Vector::Zero(body.dof_count());
       m.segment(offset, part.dof_count()) = part.rigid_translation(d);
-      modes.push_back(std::move(m));
+      b.modes.push_back(std::move(m));
     }
     if (const Vector r = part.rigid_rotation(); r.size()) {
       Vector m = Vector::Zero(body.dof_count());
       m.segment(offset, part.dof_count()) = r;
-      modes.push_back(std::move(m));
+      b.modes.push_back(std::move(m));
     }
+    out.push_back(std::move(b));
   };
   if (const auto* set = dynamic_cast<const BodySet*>(&body))
     for (int b = 0; b < set->count(); ++b) add(set->part(b), set->dof_offset(b));
   else
     add(body, 0);
-  return modes;
+  return out;
 }
 
 }  // namespace
@@ -57,10 +63,11 @@ void StepChecks::worst_of(const StepChecks& o) {
 StepCheckLimits check_limits(const Problem& problem, const ContactParams& contact) {
   StepCheckLimits l;
   // A converged state balances to Newton's residual test (newton_fraction x tolerance of the
-  // forces) except on a held body's amplitude rows, which ||v|| <= tol x L bounds only in
-  // length units: 1e-3 of the forces it carries is far above what an accurate step leaves there
-  // (docs/robustness.md#limits) and far below the 12-38 % of the held bodies of issue 33.
-  l.balance = 1e-3;
+  // forces) except on a held body's amplitude rows, which ||v|| <= tol x L bounds only in length
+  // units: up to 5.7 % of the forces on the verification scenes today (a block pushed onto a
+  // wall), 12-38 % on the held bodies of issue 33. 0.1 refuses the latter and keeps the former
+  // until the tolerance follows the load (issue 33.2), then 1e-3 (docs/robustness.md#limits).
+  l.balance = 0.1;
   // The strategies put p_n <= 0 exactly; penalty's linearized law within rounding.
   l.tension = 1e-6;
   // Coulomb's cone: to rounding where the bound moves with p_n, to the tau passes' tolerance
@@ -147,10 +154,17 @@ std::string StepChecker::state(const Equilibrium& eq, const EquilibriumState& s,
     carried[k.dof] += std::abs(residual[k.dof]);
     residual[k.dof] = 0.0;
   }
-  for (const Vector& m : body_modes(body)) {
-    const double scale = m.cwiseAbs().dot(carried);
-    const double off = std::abs(m.dot(residual));
-    if (off > 0) c.balance = std::max(c.balance, scale > 0 ? off / scale : 1.0);
+  // Each resultant over what the body carries: along an axis that carries nothing (a vertical
+  // load), over what the other axis carries; a moment over that times the body's length.
+  for (const BodyModes& b : body_modes(body)) {
+    std::vector<double> scales;
+    for (const Vector& m : b.modes) scales.push_back(m.cwiseAbs().dot(carried));
+    const double translations = std::max(scales[0], scales[1]);
+    for (size_t k = 0; k < b.modes.size(); ++k) {
+      const double scale = std::max(scales[k], k < 2 ? translations : translations * b.length);
+      const double off = std::abs(b.modes[k].dot(residual));
+      if (off > 0) c.balance = std::max(c.balance, scale > 0 ? off / scale : 1.0);
+    }
   }
   if (c.balance > limits_.balance)
     fail("a body is out of balance by " + num(c.balance) + " of the forces it carries (limit " + num(limits_.balance) + ")");
