@@ -16,7 +16,7 @@
 // alpha * M_n without that.
 #include <vector>
 
-#include "solver/core/types.hpp"
+#include "solver/model/types.hpp"
 
 namespace grip {
 

@@ -4,7 +4,7 @@
 // s_xi is the incremental slip; tau = nu |p*_eta| is the friction bound of the current pass.
 #include <vector>
 
-#include "solver/core/problem.hpp"
+#include "solver/problem/problem.hpp"
 
 namespace grip {
 

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "solver/contact/contact_error.hpp"
-#include "solver/solve/equilibrium.hpp"
+#include "solver/equilibrium/equilibrium.hpp"
 
 namespace grip {
 

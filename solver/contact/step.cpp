@@ -6,8 +6,8 @@
 
 #include "solver/contact/acceleration.hpp"
 #include "solver/contact/coulomb_model.hpp"
-#include "solver/solve/friction_limit.hpp"
-#include "solver/solve/rigid_equilibrium.hpp"
+#include "solver/contact/friction_limit.hpp"
+#include "solver/equilibrium/rigid_equilibrium.hpp"
 
 namespace grip {
 namespace {

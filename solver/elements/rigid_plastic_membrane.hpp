@@ -19,7 +19,7 @@
 // by R / (R + t/2)).
 #include <vector>
 
-#include "solver/core/body.hpp"
+#include "solver/model/body.hpp"
 
 namespace grip {
 

@@ -9,8 +9,8 @@
 
 #include "solver/contact/contact_error.hpp"
 #include "solver/contact/master_reading.hpp"
-#include "solver/core/body_set.hpp"
-#include "solver/solve/rigid_equilibrium.hpp"
+#include "solver/model/body_set.hpp"
+#include "solver/equilibrium/rigid_equilibrium.hpp"
 
 namespace grip {
 

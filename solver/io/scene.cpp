@@ -9,11 +9,11 @@
 #include <optional>
 #include <sstream>
 
-#include "solver/core/body_set.hpp"
+#include "solver/model/body_set.hpp"
 #include "solver/io/json_depth.hpp"
 #include "solver/io/scene_reader.hpp"
 #include "solver/io/schema_validation.hpp"
-#include "solver/solve/rigid_equilibrium.hpp"
+#include "solver/equilibrium/rigid_equilibrium.hpp"
 
 namespace grip {
 namespace {

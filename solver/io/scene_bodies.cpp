@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <set>
 
-#include "solver/core/body_set.hpp"
+#include "solver/model/body_set.hpp"
 #include "solver/elements/continuum.hpp"
 #include "solver/elements/timoshenko_beam.hpp"
 #include "solver/io/scene_reader.hpp"

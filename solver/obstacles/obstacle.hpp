@@ -15,7 +15,7 @@
 #include <variant>
 #include <vector>
 
-#include "solver/core/types.hpp"
+#include "solver/model/types.hpp"
 
 namespace grip {
 

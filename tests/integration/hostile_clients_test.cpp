@@ -261,6 +261,29 @@ TEST(HostileClients, ConnectionsPastTheLimitPerAddressAreRefusedWith503) {
   EXPECT_NE(server.log().find("127.0.2.1: connection refused"), std::string::npos);
 }
 
+// Every connection thread taken (--http-threads 2, both held by slow heads): the reserved
+// threads still answer /v1/health and /v1/ready, and refuse the rest with 503 + Retry-After.
+TEST(HostileClients, HealthIsAnsweredWhenEveryConnectionThreadIsTaken) {
+  TempDir dir;
+  ServerProcess server(dir.path() / "grip.sqlite", {"--http-threads", "2"}, dir.path() / "server.log");
+  std::vector<int> held;
+  for (int i = 0; i < 2; ++i) {
+    held.push_back(connect_from("127.0.2.1", server.port()));
+    send_all(held.back(), "GET /v1/health HTTP/1.1\r\nHost: grip\r\n");  // never ends
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  const Api api(server.port());
+  const auto health = api.client(3).Get("/v1/health");
+  ASSERT_TRUE(health);
+  EXPECT_EQ(health->status, 200);
+  const auto jobs = api.client(3).Get("/v1/jobs");
+  ASSERT_TRUE(jobs);
+  EXPECT_EQ(jobs->status, 503);
+  EXPECT_FALSE(jobs->get_header_value("Retry-After").empty());
+  EXPECT_EQ(json::parse(jobs->body).value("type", std::string()), "urn:grip:problem:server-busy") << jobs->body;
+  for (int fd : held) ::close(fd);
+}
+
 // Oversize heads say which limit they hit.
 TEST(HostileClients, OversizeHeadersAndUrlsNameTheLimitTheyHit) {
   TempDir dir;

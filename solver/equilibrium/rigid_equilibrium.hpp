@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "solver/solve/equilibrium.hpp"
+#include "solver/equilibrium/equilibrium.hpp"
 
 namespace grip {
 

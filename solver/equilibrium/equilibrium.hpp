@@ -10,9 +10,9 @@
 #include <string>
 #include <vector>
 
-#include "solver/core/parallel.hpp"
-#include "solver/core/problem.hpp"
-#include "solver/solve/free_block_solver.hpp"
+#include "solver/model/parallel.hpp"
+#include "solver/problem/problem.hpp"
+#include "solver/equilibrium/free_block_solver.hpp"
 
 namespace grip {
 

@@ -6,7 +6,7 @@
 // a disc squeezed between two flats and turned by a couple).
 #include <string>
 
-#include "solver/solve/equilibrium.hpp"
+#include "solver/equilibrium/equilibrium.hpp"
 
 namespace grip {
 

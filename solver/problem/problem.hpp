@@ -1,12 +1,12 @@
 #pragma once
 // A contact problem in typed form: one deformable body, rigid obstacles, supports, loads, and
-// the contact candidates. Built from a scene by solver/io; solved by solver/solve.
+// the contact candidates. Built from a scene by solver/io; solved by solver/stepping.
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include "solver/core/body.hpp"
+#include "solver/model/body.hpp"
 #include "solver/obstacles/master_surface.hpp"
 #include "solver/obstacles/obstacle.hpp"
 
