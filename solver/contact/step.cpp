@@ -506,7 +506,8 @@ void StepSolver::final_check() {
          "the step");
     return;
   }
-  // A free motion that no pressing point resists has no determined amplitude (ALGORITHM.md 7).
+  // A free motion that no pressing point resists has no determined amplitude
+  // (docs/algorithm.md#bodies-held-only-by-contact).
   for (int k = 0; k < problem_.rigid.count(); ++k)
     if (!mode_held(k))
       fail("no contact holds the body's free motion (" + problem_.rigid.names[k] +
