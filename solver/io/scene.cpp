@@ -9,11 +9,11 @@
 #include <optional>
 #include <sstream>
 
-#include "solver/core/body_set.hpp"
+#include "solver/model/body_set.hpp"
 #include "solver/io/json_depth.hpp"
 #include "solver/io/scene_reader.hpp"
 #include "solver/io/schema_validation.hpp"
-#include "solver/solve/rigid_equilibrium.hpp"
+#include "solver/equilibrium/rigid_equilibrium.hpp"
 
 namespace grip {
 namespace {
@@ -77,8 +77,9 @@ std::unique_ptr<Obstacle> read_shape(Reader& r, json& j, const std::string& ptr)
 
 // ---- solver parameters
 
-// solver.start: {"node", "component": "x" | "y", "value", "obstacle"} (ALGORITHM.md section 9):
-// the first step starts from a solve with that displacement prescribed and no contact.
+// solver.start: {"node", "component": "x" | "y", "value", "obstacle"}
+// (docs/algorithm.md#load-stepping-and-cuts): the first step starts from a solve with that
+// displacement prescribed and no contact.
 void read_start(Reader& r, json& scene, Problem& problem) {
   const bool membrane = scene.contains("body") && scene["body"].is_object() &&
                         scene["body"].value("model", "") == "rigid_plastic_membrane";
@@ -231,13 +232,14 @@ std::pair<std::string, int> motion_words(const std::vector<BodyPart>& parts, con
   return {moved > 1 ? "move together (" + words + ")" : words, std::max(first, 0)};
 }
 
-// Free rigid motions are held by contact (ALGORITHM.md section 7) where the model allows it:
-// translations always (internal forces are self-equilibrated at any state), rotations where
-// the tangent is constant (linear kinematics: an infinitesimal rotation is a null mode of K) or
-// where a finite rotation leaves the body's strain unchanged (the continuum with finite
-// kinematics, the von Karman beam, about at most one supported node: its motions then follow its
-// state, rigid_modes_at); a membrane (no reference stiffness) never. Records them in problem.rigid (pins come later);
-// in a scene of several bodies each body's motions on its own dofs.
+// Free rigid motions are held by contact (docs/algorithm.md#bodies-held-only-by-contact) where the
+// model allows it: translations always (internal forces are self-equilibrated at any state),
+// rotations where the tangent is constant (linear kinematics: an infinitesimal rotation is a null
+// mode of K) or where a finite rotation leaves the body's strain unchanged (the continuum with
+// finite kinematics, the von Karman beam, about at most one supported node: its motions then follow
+// its state, rigid_modes_at); a membrane (no reference stiffness) never. Records them in
+// problem.rigid (pins come later); in a scene of several bodies each body's motions on its own
+// dofs.
 void check_rigid_modes(Reader& r, Problem& problem) {
   const std::vector<BodyPart> parts = body_parts(problem);
   for (size_t b = 0; b < parts.size(); ++b) {
@@ -474,7 +476,11 @@ std::vector<double> read_step_factors(Reader& r, json& scene) {
 
 // The load path: without stages every case follows `steps`; with stages each stage ramps the
 // factors it names linearly from where the previous stage left them, with its own friction.
-std::vector<LoadStep> read_load_path(Reader& r, json& scene, std::vector<ObstacleInstance>& obstacles) {
+// `cases_known`: the bodies and obstacles, which name the load cases, were read without an
+// error; otherwise a reader that stopped early (at a bad mesh) may not have met a case a stage
+// names, and "names no load case" would be an error of its own making.
+std::vector<LoadStep> read_load_path(Reader& r, json& scene, std::vector<ObstacleInstance>& obstacles,
+                                     bool cases_known) {
   std::vector<double> base_friction;
   for (const auto& o : obstacles) base_friction.push_back(o.friction);
   const size_t cases = r.cases.size();
@@ -503,7 +509,8 @@ std::vector<LoadStep> read_load_path(Reader& r, json& scene, std::vector<Obstacl
         size_t k = 0;
         while (k < cases && r.cases[k] != name) ++k;
         if (k == cases) {
-          r.error(sp + "/factors/" + token(name), "names no load case (cases: " + Reader::list(r.cases) + ")");
+          if (cases_known)
+            r.error(sp + "/factors/" + token(name), "names no load case (cases: " + Reader::list(r.cases) + ")");
           continue;
         }
         target[k] = r.number(*f, sp + "/factors", name.c_str());
@@ -614,7 +621,7 @@ Scene read_checked_scene(const nlohmann::json& input) {
     }
   }
   if (several && r.issues.empty()) scene_io::read_contacts(r, e, scene.problem);
-  scene.steps = read_load_path(r, e, scene.problem.obstacles);
+  scene.steps = read_load_path(r, e, scene.problem.obstacles, r.issues.empty());
   scene.load_cases = r.cases;
   scene.problem.case_names = r.cases;
   if (scene.problem.body)

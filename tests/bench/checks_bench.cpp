@@ -1,4 +1,4 @@
-// grip_checks_bench: the cost of the step checks (solver/solve/step_checks.hpp) on the shipped
+// grip_checks_bench: the cost of the step checks (solver/stepping/step_checks.hpp) on the shipped
 // examples: each solved `repeats` times (default 3), the fastest run's whole solve and the time
 // spent in the checks. Run by hand; the numbers go to bench/results/robustness.md.
 //   build/tests/bench/grip_checks_bench [repeats]

@@ -40,8 +40,8 @@
 #include "solver/io/scene.hpp"
 #include "tests/support/contact_profile.hpp"
 #include "tests/support/elastica.hpp"
-#include "solver/solve/equilibrium.hpp"
-#include "solver/solve/load_stepping.hpp"
+#include "solver/equilibrium/equilibrium.hpp"
+#include "solver/stepping/load_stepping.hpp"
 
 #ifndef GRIP_SOURCE_DIR
 #define GRIP_SOURCE_DIR "."
@@ -373,7 +373,7 @@ struct Strategy {
 };
 
 // Real solves per load step for the loops that are known to stall (the paper's literal loop
-// and uzawa, ALGORITHM.md sections 8-9): they stop there, recorded as not reaching the
+// and uzawa, docs/algorithm.md#reading-the-paper): they stop there, recorded as not reaching the
 // tolerance, and their increments are not cut.
 constexpr int kCappedIterations = 300;
 

@@ -8,7 +8,7 @@
 #include <sstream>
 
 #include "solver/contact/contact_error.hpp"
-#include "solver/solve/load_stepping.hpp"
+#include "solver/stepping/load_stepping.hpp"
 
 namespace grip::testing {
 
@@ -18,7 +18,7 @@ struct InvariantTolerances {
 };
 
 // The step checks that load stepping made before accepting a converged step (issue 33.1,
-// solver/solve/step_checks.hpp) stayed within the limits docs/robustness.md states, and were
+// solver/stepping/step_checks.hpp) stayed within the limits docs/robustness.md states, and were
 // made (a scene with obstacles has boundary points checked). `tau_relative` as above.
 inline ::testing::AssertionResult step_checks_within_limits(const Problem& problem, const StepRecord& rec,
                                                             double tolerance_length, double tau_relative) {

@@ -1,7 +1,7 @@
 #pragma once
-// Bodies held only by contact (ALGORITHM.md section 7), in scenes of one body or several: the
-// balance of load and contact forces on each free rigid motion, the checks of every converged
-// step, and the strategies run on them.
+// Bodies held only by contact (docs/algorithm.md#bodies-held-only-by-contact), in scenes of one
+// body or several: the balance of load and contact forces on each free rigid motion, the checks of
+// every converged step, and the strategies run on them.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "solver/core/body_set.hpp"
-#include "solver/solve/rigid_equilibrium.hpp"
+#include "solver/model/body_set.hpp"
+#include "solver/equilibrium/rigid_equilibrium.hpp"
 #include "tests/support/contact_profile.hpp"
 #include "tests/support/result_checks.hpp"
 #include "tests/support/two_bodies.hpp"

@@ -1,0 +1,287 @@
+#pragma once
+// SOLVE(U, p) of docs/algorithm.md#equilibrium-for-given-contact-forces: equilibrium of eq. 1-2 for
+// given contact forces p, by Newton's method with the pairing, T(u) and the stiffness of the
+// follower contact load d(T(u) p)/du re-evaluated at every iterate. Also the contact compliance
+// C = T^T K^-1 T.
+#include <Eigen/SparseCore>
+#include <Eigen/SparseLU>
+#include <limits>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "solver/model/parallel.hpp"
+#include "solver/problem/problem.hpp"
+#include "solver/equilibrium/free_block_solver.hpp"
+
+namespace grip {
+
+// Newton's stopping tests, each always reachable in floating point
+// (docs/algorithm.md#newtons-stopping-tests-and-the-round-off-floor). An iterate is converged when
+// one of them holds:
+// - correction: the largest correction, in length units (rotations times their dof's length
+//   scale), is below `displacement_tolerance` (the contact loop's precision);
+// - residual: the largest free residual, in force units (moments over the length scale), is
+//   below `residual_tolerance` times the force scale (the largest of the applied loads, the
+//   internal forces, which hold the reactions, and the contact forces);
+// - round-off floor: after a first correction, the residual is within `floor_factor` x
+//   machine precision of the scale of the sums that form it (|K| |q| + force scale), where
+//   a further correction is noise. Recorded in the state.
+// couple_newton() sets the first two from the contact tolerance.
+struct NewtonParams {
+  int max_iterations = 40;
+  double displacement_tolerance = 1e-10;  // length
+  double residual_tolerance = 1e-11;      // relative to the force scale
+  double floor_factor = 1e2;
+  // Diverged when a correction exceeds this many body lengths.
+  double divergence_lengths = 10.0;
+  // Steps of the line search along a Newton correction.
+  int max_backtracks = 8;
+  // Runs the bodies' own factorizations and solves of a scene of several bodies (the solver
+  // starts no threads of its own); empty: one after another.
+  ParallelFor parallel;
+};
+
+// Newton's tests as a fraction of the contact tolerance (relative to `length`, the body's
+// characteristic length): the contact error has a floor of about ||K^-1|| x the Newton
+// residual, so Newton must be that much tighter
+// (docs/algorithm.md#newtons-stopping-tests-and-the-round-off-floor).
+inline void couple_newton(NewtonParams& newton, double contact_tolerance, double fraction, double length) {
+  newton.displacement_tolerance = fraction * contact_tolerance * length;
+  newton.residual_tolerance = fraction * contact_tolerance;
+}
+
+// The kinematics of one candidate at a state.
+struct PairedPoint {
+  SurfacePoint point;
+  Projection projection;  // in the obstacle's moved frame: point already translated
+  Vec2 eta, xi;           // eta = -normal (into the obstacle), xi = tangent
+};
+
+struct EquilibriumState {
+  Vector q;
+  Vector p;                   // the contact forces in equilibrium (given, or from the penalty law)
+  Vector s;                   // (s_eta, s_xi) per component
+  std::vector<PairedPoint> points;
+  // Per obstacle: the master surface of a pair of bodies in this state's configuration (null
+  // for a rigid obstacle); its force_derivative() is the pair's stiffness.
+  std::vector<std::shared_ptr<const DeformedMaster>> masters;
+  std::vector<char> enabled;  // component has a non-zero column of T on the free dofs
+  int newton_iterations = 0;
+  bool converged = false;
+  // Converged at the round-off floor (not by the correction or residual test); then the
+  // last correction (length units) is the noise of the displacements.
+  bool at_floor = false;
+  double noise = 0.0;
+  double relative_residual = 0.0;  // final free residual over the force scale
+  std::string reason;              // why Newton failed
+};
+
+struct EquilibriumCounters {
+  long solves = 0;            // calls of solve(): real equilibrium solves
+  long newton_iterations = 0;
+  long factorizations = 0;
+  long compliance_forms = 0;    // G formed afresh (each on a factorization of its own)
+  long compliance_columns = 0;  // columns of G solved for, all forms together
+};
+
+// The penalty baseline (strategy `penalty`): p_eta = -k_n <s_eta>, and a tangential spring
+// k_t on the incremental slip from the previous step's force, returned to the Coulomb cone.
+struct PenaltyLaw {
+  double normal = 0.0;      // k_n, force / length
+  double tangential = 0.0;  // k_t, force / length
+  Vector previous;          // the previous step's forces (the tangential springs start there)
+  // A body held by contact (problem.rigid): its amplitudes are solved with the deformation (the
+  // pins are free dofs), held by the springs; `pin_spring` (force / length) on each pin keeps
+  // Newton non-singular while fewer points press or stick than hold every motion.
+  double pin_spring = 0.0;
+};
+
+// Factorizations of blocks of a compliance, kept by the inner contact solver (coulomb_model.cpp)
+// for as long as the compliance stays the same: dense (C's active block) or sparse (the
+// saddle-point systems of the sparse form).
+struct ComplianceFactor;
+struct SaddleFactor;
+
+// The contact compliance C = T^T K^-1 T on a subset of the components (the ones that can
+// take part in this iteration); zero elsewhere. Dense (`block`) or, for large contact zones,
+// sparse: T on the free dofs and the body's factorization, C z = T^T K^-1 T z by one sparse
+// solve, nothing of size components^2 (Equilibrium::compliance).
+struct Compliance {
+  std::vector<int> position;  // component -> row of `block` (or column of `t`), -1 where not computed
+  Matrix block;               // the dense form; empty in the sparse form
+  mutable std::shared_ptr<ComplianceFactor> factor;  // reset whenever `block` changes
+  // With the rigid amplitudes' border [C G; G^T 0] (docs/algorithm.md#bodies-held-only-by-contact):
+  // indefinite, no Cholesky. Dense form only.
+  bool bordered = false;
+  // The sparse form: `body` is the body's factorization of K (free dofs), `t` is T on the free
+  // dofs (free dofs x rows), `diagonal` is C's diagonal.
+  const FreeBlockSolver* body = nullptr;
+  Eigen::SparseMatrix<double> t;
+  Vector diagonal_entries;
+  std::vector<int> normal_of;  // row -> the row of its candidate's normal (tangent rows), else -1
+  mutable std::shared_ptr<SaddleFactor> saddle;  // reset whenever `t` or `body` changes
+
+  bool sparse() const { return body != nullptr; }
+  int size() const { return sparse() ? static_cast<int>(t.cols()) : static_cast<int>(block.rows()); }
+  double diagonal(int i) const { return sparse() ? diagonal_entries[i] : block(i, i); }
+  // C z over the rows (one sparse solve in the sparse form).
+  Vector apply(const Vector& z) const;
+  // Dense form only:
+  double operator()(int a, int b) const {
+    const int i = position[a], j = position[b];
+    return i < 0 || j < 0 ? 0.0 : block(i, j);
+  }
+  // C restricted to the given components, in their order.
+  Matrix sub(const std::vector<int>& components) const;
+};
+
+// Never the sparse form (Equilibrium::compliance's `sparse_from`).
+inline constexpr int kDenseCompliance = std::numeric_limits<int>::max();
+
+class Equilibrium {
+ public:
+  // `extra` prescribes further dofs at absolute values (the start-up solve).
+  Equilibrium(const Problem& problem, NewtonParams params, std::vector<Constraint> extra = {});
+
+  // Sets the load factor (loads, prescribed dofs, obstacle positions) and the surface
+  // coordinates zeta of the last converged step that the slips s_xi are measured from.
+  void set_step(LoadFactors factors, std::vector<double> zeta_previous);
+  const LoadFactors& factors() const { return factors_; }
+
+  EquilibriumState solve(const Vector& q_guess, const Vector& p);
+  // Newton continued from a converged state at the current tests (tightened since): the same
+  // real solve finished more precisely, not counted as another.
+  void continue_solve(EquilibriumState& state, const Vector& p);
+  // With a penalty law set, solve() ignores its p and finds p(q) from the law.
+  // A body held by contact then has its pins free (PenaltyLaw::pin_spring).
+  void set_penalty(std::optional<PenaltyLaw> law);
+  // The largest diagonal entry of the body's stiffness at q: a scale for penalty stiffnesses.
+  double stiffness_scale(const Vector& q) const;
+  // The pairing and s at q, without solving (e.g. the reference configuration).
+  EquilibriumState evaluate(const Vector& q) const;
+  // C = T^T K^-1 T over the given components, from the body's own tangent (symmetric), as
+  // C = T_s^T G T_s: G = K^-1 restricted to the surface dofs of the candidates asked for so
+  // far, one solve per surface dof with one factorization of K, and T_s the rows of T at
+  // those dofs (two or three non-zeros per column), so each call costs O(components^2),
+  // nothing per free dof. A constant tangent gives one G per run. A changing one gives G at state.q,
+  // or, with reuse on, the G of an earlier state, of this load step or an earlier one
+  // (refresh_compliance() renews it): the inner loop's linear model is then approximate, the
+  // real solves still decide. The reference stays valid until the next call.
+  // From `sparse_from` components on (and for a body not held by contact, whose tangent is
+  // Cholesky-factorized), the sparse form instead: T on the free dofs, K's factorization and C's
+  // diagonal (t_j^T K^-1 t_j by partial forward solves), no G; its reference is a separate one,
+  // valid until the next sparse call.
+  const Compliance& compliance(const EquilibriumState& state, const std::vector<int>& components,
+                               int sparse_from = kDenseCompliance);
+  // Reuse G across real solves and load steps for a changing tangent.
+  void set_compliance_reuse(bool on) { compliance_reuse_ = on; }
+  // The next compliance() forms G afresh at its state.
+  void refresh_compliance() { g_valid_ = constant_tangent_ && g_valid_; }
+  // The last compliance() used a G formed at an earlier state (a changing tangent only).
+  bool compliance_reused() const { return compliance_reused_; }
+  // The linear model's displacement change K^-1 T dp for a force change dp, from the last
+  // compliance (its components only, with the tangent its G came from): where the next
+  // solve should start. One sparse solve.
+  Vector predicted_change(const Compliance& C, const Vector& dp) const;
+  // R = A(q) - lambda F - T(q) p on every dof, and (if asked) the triplets of dR/dq, with
+  // the pairing evaluated at q.
+  Vector residual(const Vector& q, const Vector& p, Triplets* tangent) const;
+  // The applied loads and the contact forces p on every dof at a paired state: F + T p.
+  Vector applied_forces(const EquilibriumState& paired, const Vector& p) const;
+  // Residual forces at the fixed dofs (the reactions on the body), full dof vector.
+  Vector reactions(const EquilibriumState& state, const Vector& p) const;
+  // The surface coordinate of every candidate's pairing point (for the next step's slips).
+  std::vector<double> zetas(const EquilibriumState& state) const;
+
+  const Problem& problem() const { return problem_; }
+  bool is_free(int dof) const { return free_index_[dof] >= 0; }
+  const EquilibriumCounters& counters() const { return counters_; }
+  const NewtonParams& params() const { return params_; }
+  NewtonParams& params() { return params_; }
+
+ private:
+  void pair(const Vector& q, EquilibriumState& state) const;
+  EquilibriumState newton(const Vector& q_guess, const Vector& p);
+  // A converged iterate: admissibility and the forces in equilibrium (penalty law).
+  EquilibriumState& finish(EquilibriumState& state, const Vector& p) const;
+  // R = A(q) - lambda F - T p on all dofs; tangent of R (with the contact load stiffness).
+  // force_scale (if asked): the largest of |A(q)|, |lambda F| and |T p| over all dofs, in
+  // force units (the scale Newton's residual test is relative to). Without body_tangent, the
+  // tangent's contact terms only.
+  Vector residual(const Vector& q, const EquilibriumState& paired, const Vector& p,
+                  Triplets* tangent, double* force_scale = nullptr, bool body_tangent = true) const;
+  // Newton's step K_t^-1 rhs for the constant body tangent plus the pair's stiffness (the
+  // `contact` triplets): the body's factorization and a Krylov solve on the pair's dofs.
+  Vector low_rank_step(const Triplets& contact, const Vector& rhs) const;
+  // Its Krylov solve: relative residual, and the most iterations (then the step is inexact and
+  // Newton's tests decide, as for any approximate tangent).
+  static constexpr double kLowRankTolerance = 1e-13;
+  static constexpr int kLowRankIterations = 60;
+  // p(q) of the penalty law at a paired state of q, and (if asked) its stiffness triplets. With an
+  // increment dq (all dofs), p(q) + (dp/dq) dq: the law linearized at q.
+  Vector penalty_forces(const Vector& q, const EquilibriumState& paired, Triplets* tangent,
+                        const Vector* increment = nullptr) const;
+  // The penalty law's answer at a converged iterate q (paired): one more Newton correction dq,
+  // and the forces p(q) + (dp/dq) dq at q + dq.
+  EquilibriumState& finish_penalty(EquilibriumState& state);
+  // Step length along the Newton correction dq at q: the natural monotonicity test with the
+  // factorization `solver` of the step's tangent; at most the body's trust-region fraction.
+  double line_search(const Vector& q, const Vector& dq, const Vector& p, const FreeBlockSolver& solver) const;
+  double free_length_norm(const Vector& dq) const;
+  double scaled_free_max(const Vector& r) const;
+  void add_rigid_border(const EquilibriumState& state);
+  // free_index_ from the supports, the start-up's dofs and (unless pins_free_) the pins.
+  void index_free_dofs();
+  bool pins_free_ = false;
+  // The penalty law's trial tangential force at each candidate: its sign (0 off contact or
+  // without friction), at a paired state.
+  std::vector<signed char> trial_signs(const EquilibriumState& paired) const;
+  // Candidates that penalty_forces() takes on the stick branch of the law whatever their
+  // trial (Newton's iterates only; empty otherwise): see solve().
+  std::vector<char> stick_branch_;
+  // Adds free dofs to G's surface: one solve with the body's factorization per dof.
+  void extend_surface_compliance(const std::vector<int>& added);
+  // The body's tangent that G (or the sparse form) comes from: kept, or factorized at state.q
+  // (a changing tangent without reuse). False if it is singular.
+  bool compliance_tangent(const EquilibriumState& state);
+  const Compliance& sparse_compliance(const EquilibriumState& state, const std::vector<int>& components);
+
+  const Problem& problem_;
+  NewtonParams params_;
+  LoadFactors factors_;
+  std::vector<double> zeta_previous_;
+  std::vector<Constraint> extra_;
+  std::optional<PenaltyLaw> penalty_;
+  std::vector<int> free_index_;  // dof -> free index, -1 if prescribed
+  std::vector<char> is_pin_;     // dof holds a rigid amplitude (problem.rigid.pins)
+  int free_count_ = 0;
+  Vector length_scales_;
+  EquilibriumCounters counters_;
+  // The body's own tangent, factorized once when it is constant (linear kinematics): then
+  // Newton is a modified Newton on it and the compliance reuses it.
+  bool factorize_body_tangent(const Vector& q);
+  bool constant_tangent_ = false;
+  bool has_pairs_ = false;  // a contact pair of two bodies (a deformable master)
+  bool body_factorized_ = false;
+  FreeBlockSolver body_lu_;  // the body's own tangent (compliance, constant tangents)
+  // Newton's tangent, with the contact terms. For a changing tangent (finite kinematics) the
+  // pair's stiffness is among its entries and couples the bodies: one factorization of the
+  // whole, since a low-rank correction of the bodies' own factors would need G on the pair's
+  // dofs afresh at every iterate (13 such G's cost 6x one factorization, two cylinders).
+  FreeBlockSolver lu_;
+  double body_tangent_norm_ = 0.0;  // |K|_inf of the constant body tangent (round-off scale)
+  std::vector<int> surface_free_;  // surface row of G -> free index
+  std::vector<int> surface_row_;   // free index -> surface row of G, -1 off the surface
+  Matrix g_;                       // G = K^-1 on the surface dofs
+  bool g_valid_ = false;
+  bool compliance_reuse_ = false, compliance_reused_ = false;
+  Eigen::SparseMatrix<double> t_surface_;  // the last compliance's T_s (surface rows x block)
+  Compliance c_;
+  long g_version_ = 0, c_version_ = -1;  // G's content; the G that c_ was formed from
+  Compliance sparse_;                     // the sparse form
+  long tangent_version_ = 0, sparse_version_ = -1;  // body_lu_'s content; the one sparse_ uses
+};
+
+}  // namespace grip

@@ -1,0 +1,362 @@
+#include "solver/equilibrium/free_block_solver.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace grip {
+
+bool FreeBlockSolver::factorize(const Triplets& triplets, const std::vector<int>& free_index,
+                                int free_count, double near_symmetric_tolerance) {
+  bool same = triplets.size() == rows_.size();
+  for (size_t k = 0; same && k < triplets.size(); ++k)
+    same = triplets[k].row() == rows_[k] && triplets[k].col() == cols_[k];
+  if (!same) {
+    // New pattern: build it, remember where every triplet lands, analyse it once.
+    rows_.resize(triplets.size());
+    cols_.resize(triplets.size());
+    Triplets pattern;
+    for (size_t k = 0; k < triplets.size(); ++k) {
+      rows_[k] = triplets[k].row();
+      cols_[k] = triplets[k].col();
+      const int i = free_index[rows_[k]], j = free_index[cols_[k]];
+      if (i >= 0 && j >= 0) pattern.emplace_back(i, j, 1.0);
+    }
+    matrix_.resize(free_count, free_count);
+    matrix_.setFromTriplets(pattern.begin(), pattern.end());
+    matrix_.makeCompressed();
+    slot_.assign(triplets.size(), -1);
+    for (size_t k = 0; k < triplets.size(); ++k) {
+      const int i = free_index[rows_[k]], j = free_index[cols_[k]];
+      if (i >= 0 && j >= 0) slot_[k] = static_cast<int>(&matrix_.coeffRef(i, j) - matrix_.valuePtr());
+    }
+    // Where each entry's transpose lives (the pattern of a tangent is symmetric).
+    mirror_.assign(matrix_.nonZeros(), -1);
+    for (int col = 0; col < matrix_.outerSize(); ++col)
+      for (Eigen::SparseMatrix<double>::InnerIterator it(matrix_, col); it; ++it) {
+        const double* t = &matrix_.coeffRef(it.col(), it.row());
+        mirror_[&it.valueRef() - matrix_.valuePtr()] = static_cast<int>(t - matrix_.valuePtr());
+      }
+    lu_analysed_ = llt_analysed_ = dissected_analysed_ = false;
+    dissected_fails_at_ = 0;
+    coupled_ = starts_.size() < 3;  // one body
+    for (int col = 0; !coupled_ && col < matrix_.outerSize(); ++col)
+      for (Eigen::SparseMatrix<double>::InnerIterator it(matrix_, col); it; ++it)
+        if (block_of(static_cast<int>(it.row())) != block_of(col)) coupled_ = true;
+  }
+  std::fill(matrix_.valuePtr(), matrix_.valuePtr() + matrix_.nonZeros(), 0.0);
+  for (size_t k = 0; k < triplets.size(); ++k)
+    if (slot_[k] >= 0) matrix_.valuePtr()[slot_[k]] += triplets[k].value();
+  const double* v = matrix_.valuePtr();
+  double scale = 0.0, skew = 0.0;
+  for (int k = 0; k < matrix_.nonZeros(); ++k) {
+    scale = std::max(scale, std::abs(v[k]));
+    skew = std::max(skew, std::abs(v[k] - v[mirror_[k]]));
+  }
+  symmetric_ = skew <= std::max(1e-13, near_symmetric_tolerance) * scale;
+  if (symmetric_ && skew > 0) {
+    double* w = matrix_.valuePtr();
+    for (int k = 0; k < matrix_.nonZeros(); ++k)
+      if (mirror_[k] > k) w[k] = w[mirror_[k]] = 0.5 * (w[k] + w[mirror_[k]]);
+  }
+  split_ = !coupled_;
+  if (split_) return factorize_parts(near_symmetric_tolerance);
+  if (symmetric_) {
+    if (!llt_analysed_) {  // the ordering: once per pattern
+      // CHOLMOD's own choice: supernodal where dense blocks pay (2D continua), simplicial for
+      // banded blocks (beams, membranes), where the supernodal BLAS calls on tiny blocks cost
+      // more than the arithmetic (the beam's compliance: 30 % of its time in dtrsm). L L^T
+      // either way (inverse_block reads L).
+      llt_.cholmod().supernodal = CHOLMOD_AUTO;
+      llt_.cholmod().final_ll = 1;
+      llt_.analyzePattern(matrix_);
+    }
+    llt_analysed_ = true;
+    llt_.factorize(matrix_);
+    // Not positive definite, or a pivot at round-off (the supports do not hold the body):
+    // (min/max diag L)^2 is the min/max of LDL^T's D.
+    ok_ = llt_.info() == Eigen::Success && llt_.rcond() > 1e-14;
+    if (ok_) return true;
+    symmetric_ = false;  // fall back to LU
+  }
+  if (!lu_analysed_) lu_.analyzePattern(matrix_);
+  lu_analysed_ = true;
+  lu_.factorize(matrix_);
+  ok_ = lu_.info() == Eigen::Success;
+  return ok_;
+}
+
+// A simplicial factor tells beforehand whether the partial solves pay: the solve from row k
+// reaches the path from k to the root of the elimination tree (parent of column j: its first
+// row below the diagonal), so their work, |rows|^2 x the mean path length, is known without
+// copying the factor (a beam's or a membrane's banded block: the dense solves win).
+namespace {
+
+bool partial_solves_pay(const cholmod_factor* L, const std::vector<int>& rows) {
+  if (L->is_super) return true;  // sampled in inverse_block
+  const int n = static_cast<int>(L->n);
+  const int *lp = static_cast<const int*>(L->p), *li = static_cast<const int*>(L->i),
+            *lnz = static_cast<const int*>(L->nz), *perm = static_cast<const int*>(L->Perm);
+  std::vector<int> path(n, 1), position(n);
+  double nnz_l = 0.0;
+  for (int j = n - 1; j >= 0; --j) {  // a parent's index is larger than its child's
+    int parent = n;
+    for (int t = lp[j] + 1; t < lp[j] + lnz[j]; ++t) parent = std::min(parent, li[t]);
+    if (parent < n) path[j] = path[parent] + 1;
+    nnz_l += lnz[j];
+  }
+  for (int k = 0; k < n; ++k) position[perm ? perm[k] : k] = k;
+  double reach = 0.0;
+  for (int r : rows) reach += path[position[r]];
+  const double s = static_cast<double>(rows.size());
+  return s * reach <= 2.0 * nnz_l * s;
+}
+
+}  // namespace
+
+namespace {
+
+// A second factorization of the same block in nested-dissection order: short elimination-tree
+// paths where the fill-reducing order of a thin strip is nearly banded.
+void order_by_nested_dissection(CholmodFactor& dissected) {
+  dissected.cholmod().nmethods = 1;
+  dissected.cholmod().method[0].ordering = CHOLMOD_NESDIS;
+}
+
+void factorize_dissected(CholmodFactor& dissected, const Eigen::SparseMatrix<double>& matrix) {
+  order_by_nested_dissection(dissected);
+  dissected.compute(matrix);
+}
+
+}  // namespace
+
+bool FreeBlockSolver::inverse_block(const std::vector<int>& rows, Matrix& G) {
+  if (!ok_ || !symmetric_) return false;
+  if (split_) {  // K^-1 is block diagonal: each body's rows from its own factor
+    std::vector<std::vector<int>> local(parts_.size()), at(parts_.size());
+    for (size_t a = 0; a < rows.size(); ++a) {
+      const int b = block_of(rows[a]);
+      local[b].push_back(rows[a] - starts_[b]);
+      at[b].push_back(static_cast<int>(a));
+    }
+    std::vector<Matrix> blocks(parts_.size());
+    std::vector<char> ok(parts_.size(), 1);
+    for_each_part([&](int b) {
+      if (!local[b].empty()) ok[b] = parts_[b]->inverse_block(local[b], blocks[b]);
+    });
+    if (!std::all_of(ok.begin(), ok.end(), [](char c) { return c != 0; })) return false;
+    G.setZero(static_cast<int>(rows.size()), static_cast<int>(rows.size()));
+    for (size_t b = 0; b < parts_.size(); ++b)
+      for (size_t i = 0; i < at[b].size(); ++i)
+        for (size_t j = 0; j < at[b].size(); ++j) G(at[b][i], at[b][j]) = blocks[b](i, j);
+    return true;
+  }
+  if (llt_.inverse_block(rows, G)) return true;
+  // More rows only lengthen the partial solves against the same factor's pattern.
+  if (dissected_fails_at_ && rows.size() >= dissected_fails_at_) return false;
+  if (!dissected_analysed_) {
+    order_by_nested_dissection(dissected_);
+    dissected_.analyzePattern(matrix_);
+    dissected_analysed_ = true;
+  }
+  dissected_.factorize(matrix_);
+  if (dissected_.info() == Eigen::Success && dissected_.inverse_block(rows, G)) return true;
+  dissected_fails_at_ = dissected_fails_at_ ? std::min(dissected_fails_at_, rows.size()) : rows.size();
+  return false;
+}
+
+bool CholmodFactor::forward_solves(const Eigen::SparseMatrix<double>& columns,
+                                   const std::function<bool(int, const int*, const double*, int)>& use) {
+  if (!m_cholmodFactor) return false;
+  cholmod_common* cc = &cholmod();
+  cholmod_factor* L = cholmod_copy_factor(m_cholmodFactor, cc);  // the partial solve makes it simplicial
+  if (!L) return false;
+  const int n = static_cast<int>(L->n);
+  std::vector<int> position(n);  // row of P b that b's entry f lands in
+  const int* perm = static_cast<const int*>(L->Perm);
+  for (int k = 0; k < n; ++k) position[perm ? perm[k] : k] = k;
+  int most = 1;
+  for (int a = 0; a < columns.outerSize(); ++a)
+    most = std::max(most, static_cast<int>(columns.outerIndexPtr()[a + 1] - columns.outerIndexPtr()[a]));
+  cholmod_dense* B = cholmod_zeros(n, 1, CHOLMOD_REAL, cc);
+  cholmod_sparse* bset = cholmod_allocate_sparse(n, 1, most, true, true, 0, CHOLMOD_PATTERN, cc);
+  cholmod_dense *X = nullptr, *Y = nullptr, *E = nullptr;
+  cholmod_sparse* xset = nullptr;
+  bool ok = B && bset;
+  std::vector<int> pattern;
+  for (int a = 0; ok && a < columns.outerSize(); ++a) {
+    pattern.clear();
+    for (Eigen::SparseMatrix<double>::InnerIterator it(columns, a); it; ++it) {
+      static_cast<double*>(B->x)[position[it.row()]] = it.value();
+      pattern.push_back(position[it.row()]);
+    }
+    if (pattern.empty()) {  // a column without entries in this block: x = 0
+      ok = use(a, nullptr, nullptr, 0);
+      continue;
+    }
+    std::sort(pattern.begin(), pattern.end());
+    static_cast<int*>(bset->p)[0] = 0;
+    static_cast<int*>(bset->p)[1] = static_cast<int>(pattern.size());
+    std::copy(pattern.begin(), pattern.end(), static_cast<int*>(bset->i));
+    ok = cholmod_solve2(CHOLMOD_L, L, B, bset, &X, &xset, &Y, &E, cc);
+    for (int k : pattern) static_cast<double*>(B->x)[k] = 0.0;
+    if (!ok) break;
+    const int* xi = static_cast<const int*>(xset->i);
+    ok = use(a, xi, static_cast<const double*>(X->x), static_cast<const int*>(xset->p)[1]);
+  }
+  cholmod_free_dense(&B, cc);
+  cholmod_free_dense(&X, cc);
+  cholmod_free_dense(&Y, cc);
+  cholmod_free_dense(&E, cc);
+  cholmod_free_sparse(&bset, cc);
+  cholmod_free_sparse(&xset, cc);
+  cholmod_free_factor(&L, cc);
+  return ok;
+}
+
+bool CholmodFactor::inverse_block(const std::vector<int>& rows, Matrix& G) {
+  if (!m_cholmodFactor || !partial_solves_pay(m_cholmodFactor, rows)) return false;
+  const cholmod_factor* L = m_cholmodFactor;
+  const int n = static_cast<int>(L->n), s = static_cast<int>(rows.size());
+  Eigen::SparseMatrix<double> units(n, s);  // the unit columns of the rows
+  std::vector<Eigen::Triplet<double>> ones;
+  for (int a = 0; a < s; ++a) ones.emplace_back(rows[a], a, 1.0);
+  units.setFromTriplets(ones.begin(), ones.end());
+  std::vector<std::vector<std::pair<int, double>>> by_row(n);  // W's rows: (column, value)
+  // W^T W costs sum |row|^2 <= s^2 x (mean column length) multiply-adds; dense solves would
+  // cost 4 nnz(L) per row. Where W is not sparse enough (thin strips: long elimination-tree
+  // paths), give up after a few columns.
+  double nnz_l = 0.0;  // the entries a solve goes through (supernodal: its dense blocks)
+  if (L->is_super)
+    nnz_l = static_cast<double>(L->xsize);
+  else
+    for (int j = 0; j < n; ++j) nnz_l += static_cast<const int*>(L->nz)[j];
+  const double budget = 2.0 * nnz_l * s;  // half the dense solves' flops
+  double pairs = 0.0, reach = 0.0;
+  constexpr int kSample = 8;
+  const bool ok = forward_solves(units, [&](int a, const int* xi, const double* xv, int count) {
+    reach += count;
+    if (a + 1 == std::min(s, kSample) && static_cast<double>(s) * s * reach / (a + 1) > budget) return false;
+    for (int t = 0; t < count; ++t)
+      if (xv[xi[t]] != 0.0) {
+        auto& row = by_row[xi[t]];
+        pairs += 2.0 * row.size() + 1.0;
+        row.emplace_back(a, xv[xi[t]]);
+      }
+    return pairs < budget;
+  });
+  if (!ok) return false;
+  G.setZero(s, s);
+  for (const auto& row : by_row)
+    for (const auto& [a, va] : row) {
+      double* column = &G(0, a);
+      for (const auto& [b, vb] : row) column[b] += va * vb;
+    }
+  return true;
+}
+
+bool CholmodFactor::quadratic_forms(const Eigen::SparseMatrix<double>& t, Vector& out, double max_mean_reach) {
+  out.setZero(t.cols());
+  double reach = 0.0;
+  constexpr int kSample = 8;
+  return forward_solves(t, [&](int a, const int* xi, const double* xv, int count) {
+    reach += count;
+    if (max_mean_reach > 0 && a + 1 == std::min(static_cast<int>(t.cols()), kSample) && reach / (a + 1) > max_mean_reach)
+      return false;
+    double sum = 0.0;
+    for (int k = 0; k < count; ++k) sum += xv[xi[k]] * xv[xi[k]];
+    out[a] = sum;
+    return true;
+  });
+}
+
+Vector FreeBlockSolver::quadratic_forms(const Eigen::SparseMatrix<double>& t) {
+  Vector out;
+  if (!ok_ || !symmetric_) return Vector();
+  if (split_) {  // t^T K^-1 t summed over the bodies, each with its rows of t
+    std::vector<Triplets> local(parts_.size());
+    for (int col = 0; col < t.outerSize(); ++col)
+      for (Eigen::SparseMatrix<double>::InnerIterator it(t, col); it; ++it) {
+        const int b = block_of(static_cast<int>(it.row()));
+        local[b].emplace_back(static_cast<int>(it.row()) - starts_[b], col, it.value());
+      }
+    std::vector<Vector> forms(parts_.size());
+    for_each_part([&](int b) {
+      Eigen::SparseMatrix<double> tb(starts_[b + 1] - starts_[b], t.cols());
+      tb.setFromTriplets(local[b].begin(), local[b].end());
+      forms[b] = parts_[b]->quadratic_forms(tb);
+    });
+    out.setZero(t.cols());
+    for (const Vector& f : forms) {
+      if (f.size() != t.cols()) return Vector();
+      out += f;
+    }
+    return out;
+  }
+  // A path through more than 1/32 of the rows on average: the nested-dissection order instead.
+  if (llt_.quadratic_forms(t, out, matrix_.rows() / 32.0)) return out;
+  CholmodFactor dissected;
+  factorize_dissected(dissected, matrix_);
+  if (dissected.info() == Eigen::Success && dissected.quadratic_forms(t, out, 0.0)) return out;
+  return Vector();
+}
+
+void FreeBlockSolver::set_blocks(std::vector<int> starts, ParallelFor parallel) {
+  starts_ = std::move(starts);
+  parallel_ = std::move(parallel);
+  parts_.clear();
+  for (size_t b = 0; b + 1 < starts_.size(); ++b) parts_.push_back(std::make_unique<FreeBlockSolver>());
+  forget_pattern();
+}
+
+int FreeBlockSolver::block_of(int row) const {
+  return static_cast<int>(std::upper_bound(starts_.begin(), starts_.end(), row) - starts_.begin()) - 1;
+}
+
+void FreeBlockSolver::for_each_part(const std::function<void(int)>& task) const {
+  const int count = static_cast<int>(parts_.size());
+  run_each(matrix_.rows() >= kParallelRows ? parallel_ : ParallelFor(), count, task);
+}
+
+bool FreeBlockSolver::factorize_parts(double near_symmetric_tolerance) {
+  std::vector<Triplets> local(parts_.size());
+  for (int col = 0; col < matrix_.outerSize(); ++col) {
+    const int b = block_of(col);
+    for (Eigen::SparseMatrix<double>::InnerIterator it(matrix_, col); it; ++it)
+      local[b].emplace_back(static_cast<int>(it.row()) - starts_[b], col - starts_[b], it.value());
+  }
+  const int largest = static_cast<int>(matrix_.rows());
+  if (static_cast<int>(identity_.size()) < largest) {
+    identity_.resize(largest);
+    for (int k = 0; k < largest; ++k) identity_[k] = k;
+  }
+  std::vector<char> ok(parts_.size(), 0);
+  for_each_part([&](int b) {
+    ok[b] = parts_[b]->factorize(local[b], identity_, starts_[b + 1] - starts_[b], near_symmetric_tolerance);
+  });
+  ok_ = std::all_of(ok.begin(), ok.end(), [](char c) { return c != 0; });
+  symmetric_ = ok_;
+  for (const auto& part : parts_) symmetric_ = symmetric_ && part->symmetric();
+  return ok_;
+}
+
+Vector FreeBlockSolver::solve(const Vector& b) const {
+  if (!split_) return symmetric_ ? Vector(llt_.solve(b)) : Vector(lu_.solve(b));
+  Vector x(b.size());
+  for_each_part([&](int k) {
+    const int s = starts_[k], n = starts_[k + 1] - s;
+    x.segment(s, n) = parts_[k]->solve(Vector(b.segment(s, n)));
+  });
+  return x;
+}
+
+Matrix FreeBlockSolver::solve(const Matrix& b) const {
+  if (!split_) return symmetric_ ? Matrix(llt_.solve(b)) : Matrix(lu_.solve(b));
+  Matrix x(b.rows(), b.cols());
+  for_each_part([&](int k) {
+    const int s = starts_[k], n = starts_[k + 1] - s;
+    x.middleRows(s, n) = parts_[k]->solve(Matrix(b.middleRows(s, n)));
+  });
+  return x;
+}
+
+}  // namespace grip

@@ -1,0 +1,115 @@
+#pragma once
+// Factorizes the free-dof block of a tangent given as triplets, reusing the sparsity pattern
+// and the symbolic analysis while the triplet sequence repeats (it does from one Newton
+// iterate to the next: the assembly loops are fixed and contact terms are always emitted).
+// A symmetric positive definite block (the body's own tangent; Newton's without friction on
+// curved tools) is factorized by CHOLMOD's supernodal Cholesky with a fill-reducing ordering,
+// many times cheaper than the LU that an unsymmetric (or indefinite) one needs.
+#include <Eigen/CholmodSupport>
+#include <Eigen/SparseCore>
+#include <Eigen/SparseLU>
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include "solver/model/body.hpp"
+#include "solver/model/parallel.hpp"
+
+namespace grip {
+
+// CHOLMOD's supernodal L L^T, with its reciprocal condition estimate (min/max of diag(L))^2.
+class CholmodFactor : public Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>> {
+ public:
+  CholmodFactor() { cholmod().print = 0; }  // a non-SPD block is a result, not a message
+  double rcond() { return m_cholmodFactor ? cholmod_rcond(m_cholmodFactor, &cholmod()) : 0.0; }
+  // K^-1 on the given rows, |rows|^2, as W^T W with W = L^-1 P E: each column of W is a sparse
+  // forward solve that touches only the elimination-tree path of its row (CHOLMOD's partial
+  // solve, on a simplicial copy of the factor), where a dense solve costs 2 nnz(L) flops per
+  // row. False where CHOLMOD fails.
+  bool inverse_block(const std::vector<int>& rows, Matrix& G);
+  // t_j^T K^-1 t_j = |L^-1 P t_j|^2 for every column of t (free dofs x columns), by partial
+  // forward solves. False where CHOLMOD fails, or (with `max_mean_reach` > 0) where the first
+  // columns' solves reach more than that many rows on average (long elimination-tree paths).
+  bool quadratic_forms(const Eigen::SparseMatrix<double>& t, Vector& out, double max_mean_reach);
+
+ private:
+  // x = L^-1 P b for each sparse column b of `columns` (free dofs), on a simplicial copy of the
+  // factor: `use(column, rows of x, values of x, count)` sees each; false from it stops.
+  bool forward_solves(const Eigen::SparseMatrix<double>& columns,
+                      const std::function<bool(int, const int*, const double*, int)>& use);
+};
+
+class FreeBlockSolver {
+ public:
+  // free_index: dof -> row of the free block, -1 for a prescribed dof.
+  // Returns false if the block is singular.
+  // near_symmetric_tolerance > 0: a block whose skew part is below that fraction of its
+  // largest entry is symmetrized (Newton's tangent with friction on a curved tool: the
+  // residual stays exact, so Newton still converges, and LDL^T serves).
+  bool factorize(const Triplets& triplets, const std::vector<int>& free_index, int free_count,
+                 double near_symmetric_tolerance = 0.0);
+  // Several bodies: free rows [starts[b], starts[b + 1]) are body b's (starts ends with the free
+  // count). Where the block has no entry between two bodies (the bodies' own tangent; Newton's
+  // where bodies meet rigid tools only, or where a pair's stiffness enters as a low-rank
+  // correction), each body's block is factorized and solved on its own, the bodies' tasks run
+  // through `parallel` (the solver starts no threads). Else one factorization of the whole.
+  void set_blocks(std::vector<int> starts, ParallelFor parallel);
+  Vector solve(const Vector& b) const;
+  Matrix solve(const Matrix& b) const;
+  // K^-1 on the given rows where K is Cholesky-factorized (CholmodFactor::inverse_block);
+  // false otherwise (then solve() for unit right-hand sides). Where the factor's own ordering
+  // gives the rows long elimination-tree paths (thin strips: a fill-reducing ordering there is
+  // nearly banded), a second factorization in nested-dissection order, for G only: analysed
+  // once per pattern, and not tried again for as many rows or more once it did not pay (a
+  // beam's or a membrane's band: its analysis and factorization were 21 % of the beam's time).
+  bool inverse_block(const std::vector<int>& rows, Matrix& G);
+  // t_j^T K^-1 t_j for every column of t (free dofs x columns) where K is Cholesky-factorized
+  // (partial forward solves; on a nested-dissection factorization where the body's own gives
+  // long elimination-tree paths, as for G); an empty vector otherwise.
+  Vector quadratic_forms(const Eigen::SparseMatrix<double>& t);
+  bool ok() const { return ok_; }
+  // Factorized body by body (set_blocks).
+  bool split() const { return split_; }
+  // Factorized by Cholesky (symmetric positive definite).
+  bool symmetric() const { return ok_ && symmetric_; }
+  // The free block as factorized (both triangles).
+  const Eigen::SparseMatrix<double>& matrix() const { return matrix_; }
+  // The next factorize() builds its pattern afresh (the free set changed).
+  void forget_pattern() {
+    rows_.clear();
+    cols_.clear();
+    ok_ = false;
+    dissected_analysed_ = false;
+    dissected_fails_at_ = 0;
+    for (auto& part : parts_) part->forget_pattern();
+  }
+
+ private:
+  // The bodies' blocks: factorizes each diagonal block of matrix_ on its own (split_), or
+  // leaves split_ false where an entry couples two bodies.
+  bool factorize_parts(double near_symmetric_tolerance);
+  int block_of(int row) const;
+  // The bodies' tasks: through parallel_ where a thread's start (tens of microseconds) is
+  // small beside the work (kParallelRows free rows or more), else one after another.
+  void for_each_part(const std::function<void(int)>& task) const;
+  static constexpr int kParallelRows = 2000;
+  std::vector<int> starts_;  // body b's free rows begin at starts_[b]; empty: one body
+  ParallelFor parallel_;
+  std::vector<std::unique_ptr<FreeBlockSolver>> parts_;
+  std::vector<int> identity_;  // dof -> row for the parts (their triplets are in local rows)
+  bool coupled_ = true;        // the pattern has entries between bodies
+  bool split_ = false;
+  Eigen::SparseMatrix<double> matrix_;
+  std::vector<int> rows_, cols_;  // the triplet sequence the pattern was built from
+  std::vector<int> slot_;         // triplet k -> index in matrix_.valuePtr(), -1 if dropped
+  std::vector<int> mirror_;        // value index -> index of its transpose entry
+  Eigen::SparseLU<Eigen::SparseMatrix<double>> lu_;
+  CholmodFactor llt_;
+  CholmodFactor dissected_;  // nested-dissection order, for inverse_block only
+  bool lu_analysed_ = false, llt_analysed_ = false, dissected_analysed_ = false;
+  size_t dissected_fails_at_ = 0;  // the fewest rows for which the dissected factor did not pay; 0: none yet
+  bool symmetric_ = false;
+  bool ok_ = false;
+};
+
+}  // namespace grip
