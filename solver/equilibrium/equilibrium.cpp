@@ -2,8 +2,6 @@
 
 #include <algorithm>
 
-#include "solver/model/body_set.hpp"
-
 namespace grip {
 
 Equilibrium::Equilibrium(const Problem& problem, NewtonParams params, std::vector<Constraint> extra)
@@ -30,10 +28,10 @@ void Equilibrium::index_free_dofs() {
     if (free_index_[i] == 0) free_index_[i] = free_count_++;
   // Several bodies: each body's free rows follow one another (its dofs do), so its own tangent
   // is a diagonal block of the free block, factorized on its own (FreeBlockSolver::set_blocks).
-  if (const auto* set = dynamic_cast<const BodySet*>(problem_.body.get())) {
+  if (const Body& body = *problem_.body; body.part_count() > 0) {
     std::vector<int> starts;
-    for (int b = 0; b <= set->count(); ++b) {
-      const int end = set->dof_offset(b);
+    for (int b = 0; b <= body.part_count(); ++b) {
+      const int end = body.dof_offset(b);
       starts.push_back(static_cast<int>(
           std::count_if(free_index_.begin(), free_index_.begin() + end, [](int f) { return f >= 0; })));
     }

@@ -5,9 +5,6 @@
 #include <cmath>
 #include <cstdio>
 
-#include "solver/model/body_set.hpp"
-#include "solver/elements/timoshenko_beam.hpp"
-
 namespace grip {
 namespace {
 
@@ -42,13 +39,8 @@ bool translation_pairs(const Body& body) {
 //   abscissa, as the model's contact points do), but it is the model's exact null motion.
 Vector rotation_at(const Body& body, const Vector& q) {
   if (body.traits().constant_tangent) return {};
+  if (Vector own = body.own_rotation_at(q); own.size()) return own;  // the beam's (TimoshenkoBeam)
   Vector rot = body.rigid_rotation();
-  if (const auto* beam = dynamic_cast<const TimoshenkoBeam*>(&body)) {
-    for (int k = 0; k < beam->node_count(); ++k)
-      rot[TimoshenkoBeam::node_dof(k, 0)] -= q[TimoshenkoBeam::node_dof(k, 1)];
-    for (int e = 0; e < beam->element_count(); ++e) rot[beam->mid_dof(e, 0)] -= q[beam->mid_dof(e, 1)];
-    return rot;
-  }
   if (!translation_pairs(body)) return {};
   for (int d = 0; d < rot.size(); d += 2) {
     rot[d] -= q[d + 1];
@@ -65,12 +57,8 @@ std::string finite_rotation_refusal(const Body& body, const std::vector<int>& fi
   if (!has_finite_rotation(body))
     return "a free rotation is held by contact only with linear kinematics or a model whose strain a finite "
            "rotation leaves unchanged (the continuum with finite kinematics, the von Karman beam)";
-  // The node of a dof: a beam's three (u, w, theta; each element's mid values one more), the
-  // continuum's two.
-  const bool beam = dynamic_cast<const TimoshenkoBeam*>(&body) != nullptr;
-  auto node = [&](int d) { return beam ? d / 3 : d / 2; };
   for (int d : fixed)
-    if (node(d) != node(fixed.front()))
+    if (body.dof_node(d) != body.dof_node(fixed.front()))
       return "with finite kinematics a rotation is free only about a single supported node: supports at several "
              "nodes leave it free to first order and stop it at any finite angle";
   return "";
@@ -84,7 +72,6 @@ template <class F>
 void for_each_turning_body(const Problem& problem, F f) {
   const RigidModes& rigid = problem.rigid;
   const Body& whole = *problem.body;
-  const auto* set = dynamic_cast<const BodySet*>(&whole);
   std::vector<char> done(rigid.count(), 0);
   for (int k = 0; k < rigid.count(); ++k) {
     if (done[k]) continue;
@@ -95,9 +82,9 @@ void for_each_turning_body(const Problem& problem, F f) {
         own.push_back(j);
         done[j] = 1;
       }
-    const Body& body = set ? set->part(b) : whole;
+    const Body& body = whole.part(b);
     if (!has_finite_rotation(body)) continue;
-    const int offset = set ? set->dof_offset(b) : 0, m = body.dof_count();
+    const int offset = whole.dof_offset(b), m = body.dof_count();
     // Translations only (the supports hold the rotation): the same motions at every state.
     Matrix T(m, 2);
     T << body.rigid_translation(Vec2::UnitX()), body.rigid_translation(Vec2::UnitY());
@@ -198,15 +185,14 @@ Vector amplitudes_following_supports(const Problem& problem, const LoadFactors& 
   Vector change = Vector::Zero(rigid.count());
   if (rigid.count() == 0 || rigid.scale <= 0) return change;
   const Body& whole = *problem.body;
-  const auto* set = dynamic_cast<const BodySet*>(&whole);
   const int n = whole.dof_count();
   auto factor = [](const LoadFactors& f, int c) { return c < static_cast<int>(f.size()) ? f[c] : 0.0; };
   std::vector<char> done(rigid.count(), 0);
   for (int k = 0; k < rigid.count(); ++k) {
     if (done[k]) continue;
     const int b = rigid.body[k];
-    const Body& body = set ? set->part(b) : whole;
-    const int offset = set ? set->dof_offset(b) : 0, m = body.dof_count();
+    const Body& body = whole.part(b);
+    const int offset = whole.dof_offset(b), m = body.dof_count();
     // The body's rigid motions (translations x, y, rotation) on the whole problem's dofs.
     std::vector<Vector> modes = {body.rigid_translation(Vec2::UnitX()), body.rigid_translation(Vec2::UnitY())};
     if (const Vector rot = body.rigid_rotation(); rot.size()) modes.push_back(rot / body.characteristic_length());
