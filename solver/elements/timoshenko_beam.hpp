@@ -45,7 +45,7 @@ class TimoshenkoBeam final : public Body {
   Vector rigid_translation(const Vec2& d) const override;
   Vector rigid_rotation() const override;
   // Its own finite rotation (the von Karman beam's exact null motion): the rigid rotation with -w
-  // added to u, nodal and mid values (rigid_equilibrium.cpp, rotation_at).
+  // added to u, nodal and mid values (solver/problem/rigid_modes.cpp, rotation_at).
   Vector own_rotation_at(const Vector& q) const override;
   // Three dofs a node (u, w, theta); each element's mid values three more after the nodes'.
   int dof_node(int dof) const override { return dof / 3; }

@@ -4,7 +4,7 @@
 
 #include <algorithm>
 
-#include "solver/equilibrium/rigid_equilibrium.hpp"
+#include "solver/problem/rigid_modes.hpp"
 
 namespace grip {
 

@@ -8,7 +8,7 @@
 #include <functional>
 #include <limits>
 
-#include "solver/equilibrium/rigid_equilibrium.hpp"
+#include "solver/problem/rigid_modes.hpp"
 
 namespace grip {
 

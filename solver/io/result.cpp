@@ -10,7 +10,7 @@
 #include "solver/contact/contact_error.hpp"
 #include "solver/contact/master_reading.hpp"
 #include "solver/model/body_set.hpp"
-#include "solver/equilibrium/rigid_equilibrium.hpp"
+#include "solver/problem/rigid_modes.hpp"
 
 namespace grip {
 

@@ -76,7 +76,7 @@ class Body {
   virtual Vector rigid_rotation() const { return {}; }
   // For a model with a changing tangent whose own finite rotation is not the turn of its current
   // positions (the von Karman beam): the rate of that rotation at q, by one radian about the
-  // origin. Empty (default): the model has none of its own (rigid_equilibrium.cpp).
+  // origin. Empty (default): the model has none of its own (solver/problem/rigid_modes.cpp).
   virtual Vector own_rotation_at(const Vector& /*q*/) const { return {}; }
   // The node that a dof moves (default: two dofs a node, x and y).
   virtual int dof_node(int dof) const { return dof / 2; }

@@ -6,7 +6,8 @@
 #include <optional>
 
 #include "solver/contact/friction_limit.hpp"
-#include "solver/equilibrium/rigid_equilibrium.hpp"
+#include "solver/contact/held_by_contact.hpp"
+#include "solver/problem/rigid_modes.hpp"
 
 namespace grip {
 namespace {
