@@ -125,7 +125,7 @@ int solve(int argc, char** argv) {
       grip::run_load_steps(scene.problem, scene.steps, scene.params, observer);
   const auto solved = now();
   emit(run.completed ? nlohmann::json{{"type", "job_finished"}}
-                     : nlohmann::json{{"type", "job_failed"}, {"reason", run.reason}});
+                     : grip::job_failed_event(run.failure, run.reason, run.failure_step));
   std::printf("total: %ld contact iterations, %ld Newton iterations, %ld factorizations, %.3f s\n",
               run.counters.solves, run.counters.newton_iterations, run.counters.factorizations,
               run.seconds);

@@ -33,7 +33,7 @@ class PenaltyStep : public StepSolver {
     eq_.set_penalty(std::nullopt);
     pass_ = out_.passes = 1;
     if (!s.converged) {
-      fail("equilibrium solve failed: " + s.reason);
+      fail(s.failure, "equilibrium solve failed: " + s.reason);
       return;
     }
     Vector p_star = Vector::Zero(problem_.component_count);
@@ -58,6 +58,7 @@ class PenaltyStep : public StepSolver {
     const int count = held || ramp < 1.0 ? kLevels : 1;
     EquilibriumState s;
     s.reason = "no level solved";
+    s.failure = FailureKind::newton_diverged;
     for (int level = 0; level < count; ++level) {
       PenaltyLaw at = law;
       const double stiffer = std::pow(ramp, static_cast<double>(count - 1 - level) / std::max(1, count - 1));

@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "solver/core/failure.hpp"
+#include "solver/core/number_text.hpp"
 #include "solver/core/parallel.hpp"
 #include "solver/core/problem.hpp"
 #include "solver/solve/free_block_solver.hpp"
@@ -73,6 +75,7 @@ struct EquilibriumState {
   double noise = 0.0;
   double relative_residual = 0.0;  // final free residual over the force scale
   std::string reason;              // why Newton failed
+  FailureKind failure = FailureKind::none;  // newton_diverged, or invalid_state (the body refuses q)
 };
 
 struct EquilibriumCounters {
