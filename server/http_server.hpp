@@ -1,6 +1,6 @@
 #pragma once
-// The HTTP/JSON API (DESIGN.md) over JobService: thin handlers, problem+json (RFC 9457) for
-// every error, OGC API - Processes aliases. cpp-httplib stays inside http_server.cpp.
+// The HTTP/JSON API (docs/design.md#the-api) over JobService: thin handlers, problem+json (RFC
+// 9457) for every error, OGC API - Processes aliases. cpp-httplib stays inside http_server.cpp.
 //
 // Threads: cpp-httplib serves one connection per pool thread for the connection's life, so
 // event streams are counted and refused with 503 beyond `max_streams`, the pool is sized

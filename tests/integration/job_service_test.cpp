@@ -105,8 +105,9 @@ nlohmann::json failed_job_result(const nlohmann::json& scene, const std::string&
   return nlohmann::json::parse(*result);
 }
 
-// A body held only by contact under a shear load above mu N (ALGORITHM.md 7): a failed job
-// whose reason says why, with the steps solved before it in its result.
+// A body held only by contact under a shear load above mu N
+// (docs/algorithm.md#bodies-held-only-by-contact): a failed job whose reason says why, with the
+// steps solved before it in its result.
 TEST(JobService, AShearLoadAboveWhatFrictionHoldsFailsTheJobWithItsReason) {
   const nlohmann::json r = failed_job_result(
       block_under_shear(), "step 7 failed: the shear load exceeds what friction can hold: Q / (mu N) = 1.05");

@@ -45,7 +45,7 @@ def failure_text(failure: Optional[dict], reason: str = "") -> str:
     return f"{failure.get('message', reason)} [{kind}" + (f": {advice}]" if advice else "]")
 
 PAPER_SCENES = ("sheet-stretching", "beam-on-cylinder")
-# File stems of the paper's figures (docs: README "Python client").
+# File stems of the paper's figures (documented in clients/python/README.md).
 PAPER_NAMES = {
     "sheet-stretching": {"shapes": "fig4_sheet_shapes", "strain": "fig5_sheet_strain",
                          "contact_normal": "sheet_normal_stress",
