@@ -42,6 +42,13 @@ void failed(JobOutcome& o, FailureKind kind, std::string message, int step = 0) 
   o.failure_step = step;
 }
 
+// The outcome's log line (one format for every end of a run; a failure at warning).
+void log_outcome(const std::string& id, JobStatus status, std::int64_t iterations, const std::string& message,
+                 double seconds) {
+  spdlog::log(status == JobStatus::successful ? spdlog::level::info : spdlog::level::warn,
+              "job {} {} in {:.3f} s: {} contact iterations; {}", id, to_string(status), seconds, iterations, message);
+}
+
 StoredEvent stored(std::int64_t seq, const json& event) {
   return {seq, event.at("type").get<std::string>(), event.dump()};
 }
@@ -601,6 +608,7 @@ void JobService::run_job(const std::shared_ptr<ActiveJob>& job, const JobRecord&
   }
   if (!scene) {
     outcome.finished = now_iso8601();
+    log_outcome(id, outcome.status, 0, outcome.message, 0.0);
     finish(job, std::move(outcome), seq);
     return;
   }
@@ -613,6 +621,7 @@ void JobService::run_job(const std::shared_ptr<ActiveJob>& job, const JobRecord&
                " steps; this service takes at most " + std::to_string(lim.max_nodes) + " nodes and " +
                std::to_string(lim.max_steps) + " steps");
     outcome.finished = now_iso8601();
+    log_outcome(id, outcome.status, 0, outcome.message, 0.0);
     finish(job, std::move(outcome), seq);
     return;
   }
@@ -716,11 +725,10 @@ void JobService::run_job(const std::shared_ptr<ActiveJob>& job, const JobRecord&
       spdlog::error("job {}: cannot build its result: {}", id, e.what());
     }
   }
-  const std::string status(to_string(outcome.status));
+  const JobStatus status = outcome.status;
   const std::string message = outcome.message;
   finish(job, std::move(outcome), seq);
-  spdlog::log(status == "successful" ? spdlog::level::info : spdlog::level::warn,
-              "job {} {} in {:.3f} s: {} contact iterations; {}", id, status, seconds, iterations, message);
+  log_outcome(id, status, iterations, message, seconds);
 }
 
 }  // namespace grip::server

@@ -125,11 +125,16 @@ void expect_job_ends_with(const Api& api, const std::string& id, const std::stri
   }
 }
 
-TEST(FailureKinds, JobLimitAndDismissedFromTheService) {
+TEST(FailureKinds, JobLimitFromTheService) {
   Server server({"--workers", "1", "--max-iterations", "5"});
   const Api api = server.api();
   expect_job_ends_with(api, api.submit(example("beam-on-cylinder")), "failed", "job_limit");
-  const std::string running = api.submit(beam_scene(40, 4000));
+}
+
+TEST(FailureKinds, DismissedFromTheService) {
+  Server server({"--workers", "1"});
+  const Api api = server.api();
+  const std::string running = api.submit(beam_scene(40, 4000));  // about 1.7 s
   api.wait_status(running, {"running"});
   ASSERT_EQ(api.del("/v1/jobs/" + running)->status, 200);
   expect_job_ends_with(api, running, "dismissed", "dismissed");
