@@ -65,7 +65,10 @@ StepOutcome StepSolver::run(const Vector& q_guess, const Vector& p_start, const 
   // attempt ended on: a cut step's attempts and the job's limit count them as well.
   int reported = 0;
   for (const IterationEvent& ev : out_.history) reported += ev.trials;
-  if (out_.solves > reported) emit(out_.solves - reported, 0, 0, 0, 0.0);
+  if (out_.solves > reported) {
+    m_ = 0;  // no update: like a pass's starting solve, it is no step of the pass's descent
+    emit(out_.solves - reported, 0, 0, 0, 0.0);
+  }
   out_.newton_iterations =
       static_cast<int>(eq_.counters().newton_iterations - newton0 + own_newton_iterations_);
   out_.v2 = error_.norm2;
@@ -544,7 +547,8 @@ void StepSolver::emit(int trials, int inner, int halvings, int n, double alpha, 
   ev.alpha = alpha;
   ev.v2 = error_.norm2;
   ev.v_inf = error_.norm_inf;
-  const bool forces = out_.p.size() == problem_.component_count && out_.tau.size() == problem_.candidates.size();
+  const bool forces = out_.p.size() == problem_.component_count &&
+                      static_cast<size_t>(out_.tau.size()) == problem_.candidates.size();
   for (size_t i = 0; forces && i < problem_.candidates.size(); ++i) {
     switch (contact_state(problem_, i, out_.p, out_.tau)) {
       case ContactState::open: ++ev.open; break;
