@@ -24,7 +24,7 @@
 
 // After Eigen (through the solver's headers): httplib.h brings <resolv.h>, whose `_res`
 // macro breaks Eigen's headers.
-#include <httplib.h>
+#include "server/http_front.hpp"
 
 namespace grip::server {
 
@@ -173,12 +173,12 @@ json job_document(const JobView& v) {
 
 struct HttpServer::Impl {
   Impl(JobService& s, HttpOptions o, std::atomic<int>& streams)
-      : service(s), options(std::move(o)), open_streams(streams) {}
+      : service(s), options(std::move(o)), open_streams(streams), svr(options.front) {}
 
   JobService& service;
   HttpOptions options;
   std::atomic<int>& open_streams;
-  httplib::Server svr;
+  HttpFront svr;
   std::atomic<bool> stopping{false};
   std::atomic<std::int64_t> requests{0};
   int listen_fd = -1;  // the listening socket, seen by the socket-options hook
@@ -212,10 +212,8 @@ struct HttpServer::Impl {
 };
 
 void HttpServer::Impl::hooks() {
-  const int threads = options.threads > 0 ? options.threads : options.max_streams + 32;
-  svr.new_task_queue = [threads] { return new httplib::ThreadPool(static_cast<size_t>(threads)); };
+  // Threads, deadlines and limits per connection: HttpFront (server/http_front.hpp).
   svr.set_payload_max_length(options.max_body_bytes);
-  svr.set_keep_alive_timeout(2);
   svr.set_tcp_nodelay(true);  // events are small writes: no Nagle delay
   // Instead of the default options: SO_REUSEADDR only (the default's SO_REUSEPORT would let a
   // second server bind the same port unnoticed), and the socket kept so that bind() can
@@ -226,12 +224,29 @@ void HttpServer::Impl::hooks() {
     ::setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
     if (listen_fd < 0) listen_fd = sock;
   });
-  svr.set_read_timeout(10);
-  svr.set_write_timeout(10);
 
   svr.set_pre_routing_handler([this](const Request& req, Response& res) {
     request_start = std::chrono::steady_clock::now();
     ++requests;
+    ConnectionNote* note = HttpFront::note();
+    if (note && note->overflow && req.path != "/v1/health" && req.path != "/v1/ready") {
+      res.set_header("Retry-After", "1");
+      problem(res, req, 503, "server-busy", "Server busy",
+              "every connection this server serves at once (" +
+                  std::to_string(options.front.max_connections) +
+                  ") is taken; only /v1/health and /v1/ready are answered; retry later");
+      return httplib::Server::HandlerResponse::Handled;
+    }
+    // A body of unknown length would be read until the client closes (curl -X POST without
+    // data held a thread for 10 s).
+    if ((req.method == "POST" || req.method == "PUT" || req.method == "PATCH") &&
+        !req.has_header("Content-Length") && !req.has_header("Transfer-Encoding")) {
+      if (note) note->close = true;
+      res.set_header("Connection", "close");
+      problem(res, req, 411, "length-required", "Length required",
+              req.method + " needs a Content-Length (or Transfer-Encoding: chunked)");
+      return httplib::Server::HandlerResponse::Handled;
+    }
     if (!options.token || req.path == "/v1/health" || is_page_request(req))
       return httplib::Server::HandlerResponse::Unhandled;
     const std::string auth = req.get_header_value("Authorization");
@@ -248,8 +263,29 @@ void HttpServer::Impl::hooks() {
 
   // Errors that no handler described (unknown route, 413, unreadable request): a problem
   // document. Bodies a handler already set are left alone.
-  svr.set_error_handler(httplib::Server::HandlerWithResponse([](const Request& req, Response& res) {
+  svr.set_error_handler(httplib::Server::HandlerWithResponse([this](const Request& req, Response& res) {
     if (!res.body.empty()) return httplib::Server::HandlerResponse::Unhandled;
+    // What the connection ran into says more than httplib's status (400 for all of these).
+    if (const ConnectionNote* note = HttpFront::note()) {
+      const auto& front = options.front;
+      if (res.status == 400 && note->deadline_missed) {
+        res.set_header("Connection", "close");
+        problem(res, req, 408, "request-timeout", "Request timeout",
+                note->in_body ? "the request body did not arrive within " + std::to_string(front.body.count()) + " ms"
+                              : "the request head did not arrive within " + std::to_string(front.head.count()) + " ms");
+        spdlog::warn("{}: 408: request {} too slow", note->client, note->in_body ? "body" : "head");
+        return httplib::Server::HandlerResponse::Handled;
+      }
+      if (res.status == 400 && (note->head_too_large || note->line_too_long)) {
+        res.set_header("Connection", "close");
+        problem(res, req, 431, "header-too-large", "Request header fields too large",
+                note->head_too_large
+                    ? "the request head is over this server's limit of " + std::to_string(HttpFront::kMaxHead) + " bytes"
+                    : "a header line is over this server's limit of " + std::to_string(HttpFront::kMaxLine) + " bytes");
+        spdlog::warn("{}: 431: request head over its limit", note->client);
+        return httplib::Server::HandlerResponse::Handled;
+      }
+    }
     switch (res.status) {
       case 404: {
         // A known route asked with another method: 405 and the methods it takes.
@@ -266,6 +302,11 @@ void HttpServer::Impl::hooks() {
       case 413:
         problem(res, req, 413, "payload-too-large", "Payload too large",
                 "the request body is over this server's limit");
+        break;
+      case 414:
+        problem(res, req, 414, "uri-too-long", "URI too long",
+                "the request line is over this server's limit of " + std::to_string(HttpFront::kMaxLine) + " bytes");
+        spdlog::warn("{}: 414: request line over its limit", req.remote_addr);
         break;
       default:
         problem(res, req, res.status, "http-" + std::to_string(res.status),
@@ -307,6 +348,11 @@ void HttpServer::Impl::hooks() {
 void HttpServer::Impl::routes() {
   // ---- service
   svr.Get("/v1/health", [](const Request&, Response& res) { send_json(res, 200, {{"status", "ok"}}); });
+  // Browsers ask for it on every page load; the page names no icon.
+  svr.Get("/favicon.ico", [](const Request&, Response& res) {
+    res.status = 204;
+    res.set_header("Cache-Control", "public, max-age=86400");
+  });
   svr.Get("/v1/ready", [this](const Request& req, Response& res) {
     if (!service.ready()) {
       res.set_header("Retry-After", "5");
@@ -412,8 +458,14 @@ void HttpServer::Impl::submit(const Request& req, Response& res, const httplib::
     return problem(res, req, 413, "payload-too-large", "Payload too large",
                    "the request body is over this server's limit of " +
                        std::to_string(options.max_body_bytes) + " bytes");
-  if (!complete)
+  if (!complete) {
+    if (const ConnectionNote* note = HttpFront::note(); note && note->deadline_missed) {
+      res.set_header("Connection", "close");
+      return problem(res, req, 408, "request-timeout", "Request timeout",
+                     "the request body did not arrive within " + std::to_string(options.front.body.count()) + " ms");
+    }
     return problem(res, req, 400, "unreadable-body", "Unreadable body", "the request body could not be read");
+  }
   const std::string type = lower(req.get_header_value("Content-Type"));
   const std::string media = type.substr(0, type.find(';'));
   auto trimmed = media;
@@ -600,11 +652,13 @@ void HttpServer::Impl::events(const Request& req, Response& res) {
         std::string out;
         if (state->first && !ndjson) out = "retry: 1000\n\n";
         state->first = false;
-        // Wait at most a second, so the server can stop promptly.
+        // A client that went away frees its slot now, not at the next write (the heartbeat
+        // 15 s on): each wait (at most 500 ms) is preceded by a look at the socket.
+        if (!sink.is_writable()) return false;
         const auto now = std::chrono::steady_clock::now();
         const auto until_ping = std::chrono::duration_cast<std::chrono::milliseconds>(
             state->last_write + heartbeat - now);
-        const auto wait = std::clamp(until_ping, std::chrono::milliseconds(0), std::chrono::milliseconds(1000));
+        const auto wait = std::clamp(until_ping, std::chrono::milliseconds(0), std::chrono::milliseconds(500));
         const EventBatch batch = service.wait_events(id, state->last, wait);
         if (!batch.found) {
           sink.done();

@@ -69,8 +69,20 @@ const std::vector<Flag>& flags() {
        [](ServeConfig& c, const std::string& v) { c.service.queue_capacity = static_cast<int>(integer(v, "--queue", 1, 1000000)); }},
       {"streams", "GRIP_STREAMS", "N", "open event streams (default 32)",
        [](ServeConfig& c, const std::string& v) { c.http.max_streams = static_cast<int>(integer(v, "--streams", 1, 10000)); }},
-      {"http-threads", "GRIP_HTTP_THREADS", "N", "HTTP threads (default: streams + 32)",
-       [](ServeConfig& c, const std::string& v) { c.http.threads = static_cast<int>(integer(v, "--http-threads", 2, 20000)); }},
+      {"http-threads", "GRIP_HTTP_THREADS", "N", "connections served at once, a thread each (default 1024)",
+       [](ServeConfig& c, const std::string& v) { c.http.front.max_connections = static_cast<int>(integer(v, "--http-threads", 2, 20000)); }},
+      {"per-client", "GRIP_PER_CLIENT", "N", "open connections from one client address (default 64)",
+       [](ServeConfig& c, const std::string& v) { c.http.front.per_client = static_cast<int>(integer(v, "--per-client", 1, 100000)); }},
+      {"idle-connections", "GRIP_IDLE_CONNECTIONS", "N", "keep-alive connections kept waiting (default 64)",
+       [](ServeConfig& c, const std::string& v) { c.http.front.max_idle = static_cast<int>(integer(v, "--idle-connections", 0, 100000)); }},
+      {"head-timeout", "GRIP_HEAD_TIMEOUT", "S", "seconds for a whole request head (default 5)",
+       [](ServeConfig& c, const std::string& v) {
+         c.http.front.head = std::chrono::milliseconds(static_cast<long long>(1000 * real(v, "--head-timeout", 0.1)));
+       }},
+      {"body-timeout", "GRIP_BODY_TIMEOUT", "S", "seconds for a whole request body (default 10)",
+       [](ServeConfig& c, const std::string& v) {
+         c.http.front.body = std::chrono::milliseconds(static_cast<long long>(1000 * real(v, "--body-timeout", 0.1)));
+       }},
       {"max-body", "GRIP_MAX_BODY", "BYTES", "largest request body (default 8388608)",
        [](ServeConfig& c, const std::string& v) { c.http.max_body_bytes = static_cast<size_t>(integer(v, "--max-body", 1024, 1LL << 34)); }},
       {"max-nodes", "GRIP_MAX_NODES", "N", "nodes per job (default 100000)",
@@ -174,11 +186,13 @@ int serve(const ServeConfig& config) {
   std::signal(SIGPIPE, SIG_IGN);
 
   const ServeConfig& c = config;
-  const int threads = c.http.threads > 0 ? c.http.threads : c.http.max_streams + 32;
+  const FrontLimits& f = c.http.front;
   spdlog::info("grip serve: host {} port {} db {} workers {} queue {} streams {} http-threads {}",
                c.http.host, c.http.port, is_postgresql_url(c.db) ? redacted_url(c.db) : c.db,
                c.service.workers > 0 ? c.service.workers : static_cast<int>(std::thread::hardware_concurrency()),
-               c.service.queue_capacity, c.http.max_streams, threads);
+               c.service.queue_capacity, c.http.max_streams, f.max_connections);
+  spdlog::info("connections: {} per client, {} kept idle, head within {} s, body within {} s",
+               f.per_client, f.max_idle, f.head.count() / 1000.0, f.body.count() / 1000.0);
   spdlog::info("limits: body {} bytes, {} nodes, {} steps, {} contact iterations, {} s per job",
                c.http.max_body_bytes, c.service.limits.max_nodes, c.service.limits.max_steps,
                c.service.limits.max_iterations, c.service.limits.max_seconds);
