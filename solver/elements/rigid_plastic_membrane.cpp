@@ -4,7 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "solver/core/number_text.hpp"
+#include "solver/model/number_text.hpp"
 
 namespace grip {
 

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "solver/core/problem.hpp"
+#include "solver/problem/problem.hpp"
 #include "solver/io/scene.hpp"
 
 namespace grip::scene_io {

@@ -1,4 +1,4 @@
-#include "solver/solve/load_stepping.hpp"
+#include "solver/stepping/load_stepping.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -6,8 +6,8 @@
 #include <optional>
 #include <tuple>
 
-#include "solver/solve/friction_limit.hpp"
-#include "solver/solve/rigid_equilibrium.hpp"
+#include "solver/contact/friction_limit.hpp"
+#include "solver/equilibrium/rigid_equilibrium.hpp"
 
 namespace grip {
 namespace {
