@@ -39,9 +39,6 @@ CREATE TABLE IF NOT EXISTS grip_jobs (
   generation BIGINT NOT NULL DEFAULT 0,
   lease_expires TIMESTAMPTZ
 );
-ALTER TABLE grip_jobs ADD COLUMN IF NOT EXISTS failure_kind TEXT NOT NULL DEFAULT '';
-ALTER TABLE grip_jobs ADD COLUMN IF NOT EXISTS failure_step INTEGER NOT NULL DEFAULT 0;
-ALTER TABLE grip_jobs ADD COLUMN IF NOT EXISTS steps_completed INTEGER NOT NULL DEFAULT 0;
 CREATE INDEX IF NOT EXISTS grip_jobs_by_status ON grip_jobs (status, ord);
 CREATE TABLE IF NOT EXISTS grip_events (
   job_id TEXT NOT NULL,
@@ -59,8 +56,7 @@ CREATE TABLE IF NOT EXISTS grip_results (
 // Columns read by read_job, in this order.
 constexpr const char* kJobColumns =
     "id, ord, status, created, started, finished, updated, message, steps, nodes, "
-    "idempotency_key, last_seq, attempts, solve_seconds, iterations, owner, generation, failure_kind, "
-    "failure_step, steps_completed";
+    "idempotency_key, last_seq, attempts, solve_seconds, iterations, owner, generation";
 
 using Param = std::optional<std::string>;
 
@@ -284,10 +280,7 @@ JobRecord read_job(const Result& r, int row, bool with_scene) {
   j.iterations = r.int64(row, 14);
   j.owner = r.text(row, 15);
   j.generation = r.int64(row, 16);
-  j.failure_kind = r.text(row, 17);
-  j.failure_step = static_cast<int>(r.int64(row, 18));
-  j.steps_completed = static_cast<int>(r.int64(row, 19));
-  if (with_scene) j.scene = r.text(row, 20);
+  if (with_scene) j.scene = r.text(row, 17);
   return j;
 }
 
@@ -559,10 +552,7 @@ std::optional<JobStatus> PostgresStore::finish_job(const Lease& lease, const Job
       "status = CASE WHEN cur.status = 'dismissed' OR $3::text = 'dismissed' THEN 'dismissed' ELSE $3::text END, "
       "message = CASE WHEN cur.status = 'dismissed' OR $3::text = 'dismissed' THEN 'dismissed' ELSE $4::text END, "
       "finished = $5::text, updated = $5::text, solve_seconds = $6::float8, iterations = $7::bigint, "
-      "last_seq = greatest(j.last_seq, $8::bigint), "
-      "failure_kind = CASE WHEN cur.status = 'dismissed' OR $3::text = 'dismissed' THEN 'dismissed' ELSE $13::text END, "
-      "failure_step = CASE WHEN cur.status = 'dismissed' OR $3::text = 'dismissed' THEN 0 ELSE $14::integer END, "
-      "steps_completed = $15::integer FROM cur WHERE j.id = cur.id RETURNING j.id, j.status), "
+      "last_seq = greatest(j.last_seq, $8::bigint) FROM cur WHERE j.id = cur.id RETURNING j.id, j.status), "
       "res AS (INSERT INTO grip_results (job_id, data) SELECT id, $9::text FROM upd WHERE "
       "upd.status <> 'dismissed' AND $9::text IS NOT NULL ON CONFLICT (job_id) DO UPDATE SET data = EXCLUDED.data), "
       "ev AS (INSERT INTO grip_events (job_id, seq, type, data) SELECT id, $8::bigint, "
@@ -571,8 +561,7 @@ std::optional<JobStatus> PostgresStore::finish_job(const Lease& lease, const Job
       "SELECT status, pg_notify('grip', 'e' || id) FROM upd",
       {lease.job_id, num(lease.generation), std::string(to_string(o.status)), o.message, o.finished,
        num(o.solve_seconds), num(o.iterations), num(o.terminal.seq), o.result, o.terminal.type,
-       o.terminal.data, std::string(kDismissedEvent), o.failure_kind, num(std::int64_t{o.failure_step}),
-       num(std::int64_t{o.steps_completed})});
+       o.terminal.data, std::string(kDismissedEvent)});
   if (r.rows() == 0) return std::nullopt;
   return parse_job_status(r.text(0, 0));
 }

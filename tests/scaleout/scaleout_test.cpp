@@ -265,8 +265,7 @@ TEST(Scaleout, ThreeReplicasOnePostgresNothingLostNothingRunTwice) {
     expect_complete(s.events, id);
     EXPECT_EQ(s.events.back().type, "job_finished") << id;
     int iterations = 0;
-    for (const auto& e : s.events)
-      if (e.type == "iteration") iterations += json::parse(e.data)["trials"].get<int>();  // real solves
+    for (const auto& e : s.events) iterations += e.type == "iteration";
     EXPECT_EQ(iterations, doc["iterations"].get<int>()) << id;
   }
   load_done = true;
