@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -14,6 +15,8 @@
 #include <regex>
 #include <sstream>
 
+#include "server/body_budget.hpp"
+#include "server/gzip.hpp"
 #include "server/tar.hpp"
 #include "server/ui.hpp"
 #include "server/util.hpp"
@@ -105,6 +108,21 @@ std::optional<std::int64_t> decode_cursor(const std::string& c) {
 
 std::string job_path(const std::string& id) { return "/v1/jobs/" + id; }
 
+// Accept-Encoding names gzip (or *) without q=0.
+bool accepts_gzip(const Request& req) {
+  std::stringstream list(lower(req.get_header_value("Accept-Encoding")));
+  std::string item;
+  while (std::getline(list, item, ',')) {
+    const size_t semi = item.find(';');
+    std::string coding = item.substr(0, semi), params = semi == std::string::npos ? "" : item.substr(semi + 1);
+    coding.erase(std::remove_if(coding.begin(), coding.end(), ::isspace), coding.end());
+    params.erase(std::remove_if(params.begin(), params.end(), ::isspace), params.end());
+    const bool refused = params.rfind("q=0", 0) == 0 && params.find_first_of("123456789", 2) == std::string::npos;
+    if ((coding == "gzip" || coding == "x-gzip" || coding == "*") && !refused) return true;
+  }
+  return false;
+}
+
 // The methods a known route takes (empty: no such route), for 405 + Allow.
 std::string allowed_methods(const std::string& path) {
   static const std::vector<std::pair<std::regex, std::string>> routes = {
@@ -144,6 +162,7 @@ json job_document(const JobView& v) {
     doc["iterations"] = r.iterations;
     doc["solve_seconds"] = r.solve_seconds;
   }
+  if (is_finished(r.status) && r.stored_bytes > 0) doc["stored_bytes"] = r.stored_bytes;
   doc["progress"] = percent;
   const std::string self = job_path(r.id);
   json links = json::array({
@@ -164,7 +183,8 @@ json job_document(const JobView& v) {
 
 struct HttpServer::Impl {
   Impl(JobService& s, HttpOptions o, std::atomic<int>& streams)
-      : service(s), options(std::move(o)), open_streams(streams) {}
+      : service(s), options(std::move(o)), open_streams(streams),
+        budget(options.parse_budget_bytes ? options.parse_budget_bytes : 2 * options.max_body_bytes) {}
 
   JobService& service;
   HttpOptions options;
@@ -173,6 +193,7 @@ struct HttpServer::Impl {
   std::atomic<bool> stopping{false};
   std::atomic<std::int64_t> requests{0};
   int listen_fd = -1;  // the listening socket, seen by the socket-options hook
+  BodyBudget budget;   // submissions' bodies being read and checked
 
   // Registers a handler for every path pattern given.
   template <class F>
@@ -389,6 +410,16 @@ void HttpServer::Impl::submit(const Request& req, Response& res, const httplib::
   // The body is read here: httplib 0.11.4 holds a body to the payload limit only when it has
   // a Content-Length (a chunked one of 100 MB was buffered whole). Past the limit the rest is
   // read and dropped, as httplib does with a long Content-Length, so the client gets its 413.
+  // The body's length of the memory budget, held until the answer is built (destroyed last).
+  const auto declared = parse_count(req.get_header_value("Content-Length"));
+  auto hold = budget.take(std::min<std::size_t>(declared.value_or(options.max_body_bytes), options.max_body_bytes),
+                          std::chrono::seconds(30));
+  if (!hold) {
+    res.set_header("Retry-After", "5");
+    return problem(res, req, 503, "busy", "Busy",
+                   "this server is reading as many scenes as its memory budget allows; nothing was accepted; "
+                   "retry after 5 s");
+  }
   std::string text;
   bool too_large = false;
   const bool complete = reader([&](const char* data, size_t n) {
@@ -459,15 +490,19 @@ void HttpServer::Impl::submit(const Request& req, Response& res, const httplib::
   } catch (const SceneErrors& e) {
     // Listed up to a bound: 8 MB of equal nodes made a million errors, a 99 MB answer and a
     // peak of 1.9 GB.
-    constexpr size_t kMaxListed = 100;
+    // The reader and the validator stop at kMaxSceneIssues (more() then).
+    constexpr size_t kMaxListed = kMaxSceneIssues;
     const auto& issues = e.issues();
     json errors = json::array();
     for (size_t i = 0; i < std::min(issues.size(), kMaxListed); ++i)
       errors.push_back({{"pointer", prefix + (issues[i].pointer == "/" ? "" : issues[i].pointer)},
                         {"detail", issues[i].detail}});
+    const size_t listed = std::min(issues.size(), kMaxListed);
     problem(res, req, 422, "invalid-scene", "Invalid scene",
-            std::to_string(issues.size()) + " problem(s) in the scene" +
-                (issues.size() > kMaxListed ? "; the first " + std::to_string(kMaxListed) + " are listed" : ""),
+            e.more() ? "more than " + std::to_string(listed) + " problems in the scene; the first " +
+                           std::to_string(listed) + " found are listed"
+                     : std::to_string(issues.size()) + " problem(s) in the scene" +
+                           (issues.size() > kMaxListed ? "; the first " + std::to_string(kMaxListed) + " are listed" : ""),
             std::move(errors));
   } catch (const QueueFull& e) {
     res.set_header("Retry-After", std::to_string(e.retry_after_seconds));
@@ -666,11 +701,20 @@ void HttpServer::Impl::result(const Request& req, Response& res) {
     return problem(res, req, 404, "no-result", "No result",
                    "job " + id + " is " + std::string(to_string(view->record.status)) + " and has no result");
   }
+  // Stored gzip-compressed: as stored to a client that accepts gzip, inflated otherwise.
   if (format == "json") {
-    res.set_content(*data, kJson);
+    res.set_header("Vary", "Accept-Encoding");
+    if (is_gzip(*data) && accepts_gzip(req)) {
+      res.set_header("Content-Encoding", "gzip");
+      // httplib compresses a body of exactly "application/json" itself (once more, here): the
+      // charset parameter keeps it from doing so.
+      res.set_content(*data, "application/json; charset=utf-8");
+    } else {
+      res.set_content(is_gzip(*data) ? gunzip(*data) : *data, kJson);
+    }
     return;
   }
-  const json doc = json::parse(*data);
+  const json doc = json::parse(is_gzip(*data) ? gunzip(*data) : *data);
   if (format == "csv") {
     const std::string table = req.has_param("table") ? req.get_param_value("table") : "nodes";
     const auto& tables = result_csv_tables();
@@ -734,13 +778,35 @@ void HttpServer::Impl::metrics(const Request&, Response& res) {
      << "# HELP grip_events_waiting Events not yet stored (the database unreachable or slow).\n"
      << "# TYPE grip_events_waiting gauge\n"
      << "grip_events_waiting " << s.events_waiting << "\n"
-     << "# HELP grip_db_round_trips_total Queries sent to the database by this process.\n"
-     << "# TYPE grip_db_round_trips_total counter\n"
-     << "grip_db_round_trips_total " << s.db_round_trips << "\n"
-     << "# HELP grip_db_bytes_total Bytes sent to and received from the database by this process.\n"
-     << "# TYPE grip_db_bytes_total counter\n"
-     << "grip_db_bytes_total " << s.db_bytes << "\n"
-     << "# HELP grip_http_requests_total HTTP requests received by this process.\n"
+     << "# HELP grip_store_disk_bytes The job database on disk (SQLite: the file; PostgreSQL: grip's tables).\n"
+     << "# TYPE grip_store_disk_bytes gauge\n"
+     << "grip_store_disk_bytes " << s.disk_bytes << "\n"
+     << "# HELP grip_retention_max_jobs Finished jobs kept (0: no bound).\n# TYPE grip_retention_max_jobs gauge\n"
+     << "grip_retention_max_jobs " << s.retention.max_jobs << "\n"
+     << "# HELP grip_retention_max_age_seconds Age of finished jobs kept (0: no bound).\n"
+     << "# TYPE grip_retention_max_age_seconds gauge\n"
+     << "grip_retention_max_age_seconds " << s.retention.max_age_seconds << "\n"
+     << "# HELP grip_retention_max_bytes Stored bytes of finished jobs kept (0: no bound).\n"
+     << "# TYPE grip_retention_max_bytes gauge\n"
+     << "grip_retention_max_bytes " << s.retention.max_bytes << "\n"
+     << "# HELP grip_jobs_pruned_total Finished jobs removed by retention in this process.\n"
+     << "# TYPE grip_jobs_pruned_total counter\n"
+     << "grip_jobs_pruned_total " << s.pruned << "\n"
+     << "# HELP grip_job_stored_bytes Bytes stored per job (scene, events, compressed result) finished by this process.\n"
+     << "# TYPE grip_job_stored_bytes histogram\n";
+  for (const auto& [le, count] : s.stored_bytes_buckets)
+    os << "grip_job_stored_bytes_bucket{le=\"" << (std::isinf(le) ? std::string("+Inf") : std::to_string(static_cast<std::int64_t>(le)))
+       << "\"} " << count << "\n";
+  os << "grip_job_stored_bytes_sum " << s.stored_bytes_sum << "\n"
+     << "grip_job_stored_bytes_count " << s.stored_bytes_count << "\n";
+  if (s.db_traffic)  // only where the store measures them (PostgreSQL)
+    os << "# HELP grip_db_round_trips_total Queries sent to the database by this process.\n"
+       << "# TYPE grip_db_round_trips_total counter\n"
+       << "grip_db_round_trips_total " << s.db_traffic->first << "\n"
+       << "# HELP grip_db_bytes_total Bytes sent to and received from the database by this process.\n"
+       << "# TYPE grip_db_bytes_total counter\n"
+       << "grip_db_bytes_total " << s.db_traffic->second << "\n";
+  os << "# HELP grip_http_requests_total HTTP requests received by this process.\n"
      << "# TYPE grip_http_requests_total counter\n"
      << "grip_http_requests_total " << requests.load() << "\n";
   res.set_content(os.str(), "text/plain; version=0.0.4; charset=utf-8");

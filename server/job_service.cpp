@@ -4,8 +4,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
+#include "server/gzip.hpp"
 #include "server/util.hpp"
 #include "solver/io/result.hpp"
 
@@ -32,6 +34,10 @@ struct JobService::ActiveJob {
 };
 
 namespace {
+
+// Upper bounds of grip_job_stored_bytes' buckets (+Inf last).
+const std::vector<double> kStoredBytesBuckets = {4096, 16384, 65536, 262144, 1048576, 4194304, 16777216,
+                                                 std::numeric_limits<double>::infinity()};
 
 json failed_event(const std::string& reason) {
   return {{"type", "job_failed"}, {"reason", reason}};
@@ -93,6 +99,7 @@ void JobService::start() {
   writer_ = std::thread([this] { writer_loop(); });
   lease_thread_ = std::thread([this] { lease_loop(); });
   for (int i = 0; i < options_.workers; ++i) workers_.emplace_back([this] { worker_loop(); });
+  if (options_.retention.any()) pruner_ = std::make_unique<Pruner>(store_, options_.retention, options_.prune_interval);
   started_ = true;
   spdlog::info("replica {}: lease {} s", options_.replica, options_.lease_seconds);
 }
@@ -317,8 +324,21 @@ ServiceStats JobService::stats() {
     s.events = events_stored_;
     s.events_waiting = pending_.size();
   }
-  std::tie(s.db_round_trips, s.db_bytes) = store_.traffic();
+  s.db_traffic = store_.traffic();
   s.jobs = store_.count_by_status();
+  s.retention = options_.retention;
+  s.pruned = pruner_ ? pruner_->pruned() : 0;
+  s.disk_bytes = store_.disk_bytes();
+  {
+    std::lock_guard lock(mutex_);
+    std::int64_t below = 0;
+    for (size_t b = 0; b < kStoredBytesBuckets.size(); ++b) {
+      below += b < stored_bytes_counts_.size() ? stored_bytes_counts_[b] : 0;
+      s.stored_bytes_buckets.emplace_back(kStoredBytesBuckets[b], below);
+    }
+    s.stored_bytes_sum = stored_bytes_sum_;
+    s.stored_bytes_count = stored_bytes_count_;
+  }
   const auto it = s.jobs.find(JobStatus::accepted);
   s.queue_depth = it == s.jobs.end() ? 0 : static_cast<std::size_t>(it->second);
   return s;
@@ -371,6 +391,7 @@ void JobService::shutdown(std::chrono::milliseconds grace) {
   if (writer_.joinable()) writer_.join();
   lease_cv_.notify_all();
   if (lease_thread_.joinable()) lease_thread_.join();
+  pruner_.reset();
 }
 
 void JobService::worker_loop() {
@@ -565,7 +586,23 @@ void JobService::finish(const std::shared_ptr<ActiveJob>& job, JobOutcome outcom
     spdlog::warn("job {}: run not recorded (fenced: another run holds it)", job->id);
     return;
   }
+  // What the job stores (scene, events, result), as the store counted it.
+  std::optional<JobRecord> stored_job;
+  try {
+    stored_job = store_.job(job->id);
+  } catch (const std::exception&) {
+  }
   std::lock_guard lock(mutex_);
+  if (stored_job && stored_job->stored_bytes > 0) {
+    stored_bytes_counts_.resize(kStoredBytesBuckets.size());
+    for (size_t b = 0; b < kStoredBytesBuckets.size(); ++b)
+      if (stored_job->stored_bytes <= kStoredBytesBuckets[b]) {
+        ++stored_bytes_counts_[b];
+        break;
+      }
+    stored_bytes_sum_ += stored_job->stored_bytes;
+    ++stored_bytes_count_;
+  }
   if (*stored_status != JobStatus::dismissed || outcome.solve_seconds > 0) {
     solve_seconds_ += outcome.solve_seconds;
     iterations_ += outcome.iterations;
@@ -693,7 +730,7 @@ void JobService::run_job(const std::shared_ptr<ActiveJob>& job, const JobRecord&
       // took several times the text's memory and more time than writing it.
       std::ostringstream text;
       write_result(text, *scene, run);
-      outcome.result = std::move(text).str();
+      outcome.result = gzip(std::move(text).str());  // stored and served compressed
     } catch (const std::exception& e) {
       spdlog::error("job {}: cannot build its result: {}", id, e.what());
     }

@@ -28,6 +28,7 @@
 #include <cstdint>
 #include <deque>
 #include <functional>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -37,6 +38,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "server/pruner.hpp"
 #include "server/store.hpp"
 
 namespace grip::server {
@@ -57,6 +59,8 @@ struct ServiceOptions {
   double lease_seconds = 10;  // a run unrenewed this long is taken over by another process
   std::size_t event_buffer = 100000;  // events waiting for the store before runs pause
   JobLimits limits;
+  Retention retention;  // finished jobs kept (server/pruner.hpp)
+  std::chrono::milliseconds prune_interval{60000};
   // Test and benchmark hook, called on the worker thread as each event is produced (before
   // it is stored).
   std::function<void(const std::string& job_id, std::int64_t seq, const nlohmann::json& event)>
@@ -115,9 +119,16 @@ struct ServiceStats {
   std::int64_t iterations = 0;    // contact iterations of finished runs, this process
   std::int64_t events = 0;        // events stored, this process
   std::size_t events_waiting = 0;  // events not yet stored
-  std::int64_t db_round_trips = 0;  // with the database, this process
-  std::int64_t db_bytes = 0;
+  // Round trips and bytes with the database, this process; none where the store does not
+  // measure them.
+  std::optional<std::pair<std::int64_t, std::int64_t>> db_traffic;
   std::map<JobStatus, std::int64_t> jobs;  // by status, from the store
+  Retention retention;
+  std::int64_t pruned = 0;      // finished jobs removed by retention, this process
+  std::int64_t disk_bytes = 0;  // the database on disk
+  // Stored bytes of the jobs this process finished: {upper bound, count} and their sum.
+  std::vector<std::pair<double, std::int64_t>> stored_bytes_buckets;
+  std::int64_t stored_bytes_sum = 0, stored_bytes_count = 0;
 };
 
 bool is_terminal_event(const std::string& type);
@@ -185,6 +196,9 @@ class JobService {
 
   Store& store_;
   ServiceOptions options_;
+  std::unique_ptr<Pruner> pruner_;  // with a retention, while started
+  std::vector<std::int64_t> stored_bytes_counts_;  // per kStoredBytesBuckets (mutex_)
+  std::int64_t stored_bytes_sum_ = 0, stored_bytes_count_ = 0;
   std::atomic<bool> started_{false};
   std::atomic<bool> draining_{false};
 

@@ -73,6 +73,8 @@ const std::vector<Flag>& flags() {
        [](ServeConfig& c, const std::string& v) { c.http.threads = static_cast<int>(integer(v, "--http-threads", 2, 20000)); }},
       {"max-body", "GRIP_MAX_BODY", "BYTES", "largest request body (default 8388608)",
        [](ServeConfig& c, const std::string& v) { c.http.max_body_bytes = static_cast<size_t>(integer(v, "--max-body", 1024, 1LL << 34)); }},
+      {"parse-budget", "GRIP_PARSE_BUDGET", "BYTES", "submitted bodies read and checked at once; more wait (default 2 x max-body)",
+       [](ServeConfig& c, const std::string& v) { c.http.parse_budget_bytes = static_cast<size_t>(integer(v, "--parse-budget", 1024, 1LL << 36)); }},
       {"max-nodes", "GRIP_MAX_NODES", "N", "nodes per job (default 100000)",
        [](ServeConfig& c, const std::string& v) { c.service.limits.max_nodes = static_cast<int>(integer(v, "--max-nodes", 1, 1LL << 30)); }},
       {"max-steps", "GRIP_MAX_STEPS", "N", "load steps per job (default 10000)",
@@ -81,6 +83,16 @@ const std::vector<Flag>& flags() {
        [](ServeConfig& c, const std::string& v) { c.service.limits.max_iterations = integer(v, "--max-iterations", 1, 1LL << 50); }},
       {"max-seconds", "GRIP_MAX_SECONDS", "S", "wall seconds per job run (default 3600)",
        [](ServeConfig& c, const std::string& v) { c.service.limits.max_seconds = real(v, "--max-seconds", 0.001); }},
+      {"retain-jobs", "GRIP_RETAIN_JOBS", "N", "finished jobs kept; older ones are removed, dismissed first (default 10000; 0: all)",
+       [](ServeConfig& c, const std::string& v) { c.service.retention.max_jobs = integer(v, "--retain-jobs", 0, 1LL << 40); }},
+      {"retain-age", "GRIP_RETAIN_AGE", "S", "seconds a finished job is kept (default 0: no age bound)",
+       [](ServeConfig& c, const std::string& v) { c.service.retention.max_age_seconds = real(v, "--retain-age", 0); }},
+      {"retain-bytes", "GRIP_RETAIN_BYTES", "BYTES", "stored bytes of finished jobs kept (default 0: no size bound)",
+       [](ServeConfig& c, const std::string& v) { c.service.retention.max_bytes = integer(v, "--retain-bytes", 0, 1LL << 50); }},
+      {"prune-interval", "GRIP_PRUNE_INTERVAL", "S", "seconds between retention passes (default 60)",
+       [](ServeConfig& c, const std::string& v) {
+         c.service.prune_interval = std::chrono::milliseconds(static_cast<long long>(1000 * real(v, "--prune-interval", 0.05)));
+       }},
       {"replica", "GRIP_REPLICA", "NAME", "this process's name in job leases (default host-pid-random)",
        [](ServeConfig& c, const std::string& v) { c.service.replica = v; }},
       {"lease", "GRIP_LEASE", "S", "a run unrenewed this long is taken over by another replica (default 10)",
@@ -133,6 +145,7 @@ std::string serve_usage() {
 
 ServeConfig read_serve_config(const std::vector<std::string>& args) {
   ServeConfig c;
+  c.service.retention.max_jobs = 10000;  // the disk stays bounded unless asked otherwise
   for (const Flag& f : flags())
     if (const char* v = std::getenv(f.env)) f.set(c, v);
   for (size_t i = 0; i < args.size(); ++i) {
@@ -182,6 +195,10 @@ int serve(const ServeConfig& config) {
   spdlog::info("limits: body {} bytes, {} nodes, {} steps, {} contact iterations, {} s per job",
                c.http.max_body_bytes, c.service.limits.max_nodes, c.service.limits.max_steps,
                c.service.limits.max_iterations, c.service.limits.max_seconds);
+  const Retention& keep = c.service.retention;
+  spdlog::info("retention: {} finished jobs, {} s, {} bytes (0: no bound), every {} s; parse budget {} bytes",
+               keep.max_jobs, keep.max_age_seconds, keep.max_bytes, c.service.prune_interval.count() / 1000.0,
+               c.http.parse_budget_bytes ? c.http.parse_budget_bytes : 2 * c.http.max_body_bytes);
   spdlog::info("token {}, grace {} s, heartbeat {} s, schemas {}, log level {}",
                c.http.token ? "required" : "not required", c.grace_seconds,
                c.http.heartbeat.count() / 1000.0, c.http.schemas_dir, c.log_level);
