@@ -32,12 +32,14 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <ostream>
 #include <stdexcept>
 #include <string>
 #include <thread>
 #include <unordered_map>
 #include <vector>
 
+#include "server/observability.hpp"
 #include "server/pruner.hpp"
 #include "server/store.hpp"
 
@@ -145,8 +147,10 @@ class JobService {
 
   // Validates and stores the scene, then queues it. Throws grip::SceneErrors (invalid scene
   // or over a limit), QueueFull, ShuttingDown, IdempotencyConflict.
+  // `request_id`: the submitting request's, kept with the job.
   SubmitResult submit(const nlohmann::json& scene,
-                      const std::optional<std::string>& idempotency_key = std::nullopt);
+                      const std::optional<std::string>& idempotency_key = std::nullopt,
+                      const std::string& request_id = "");
   std::optional<JobView> job(const std::string& id);
   std::vector<JobView> with_progress(std::vector<JobRecord> records);
   JobPage list(std::optional<JobStatus> status, int limit, std::optional<std::int64_t> before);
@@ -163,6 +167,8 @@ class JobService {
   std::optional<std::string> result(const std::string& id);
 
   ServiceStats stats();
+  // Queue wait and run duration histograms (Prometheus text).
+  void write_job_metrics(std::ostream& os) const;
   // Started, not draining, and the store answers.
   bool ready();
   const std::string& replica() const { return options_.replica; }
@@ -199,6 +205,8 @@ class JobService {
   std::unique_ptr<Pruner> pruner_;  // with a retention, while started
   std::vector<std::int64_t> stored_bytes_counts_;  // per kStoredBytesBuckets (mutex_)
   std::int64_t stored_bytes_sum_ = 0, stored_bytes_count_ = 0;
+  Histogram queue_wait_{seconds_buckets()};                    // accepted -> claimed here
+  std::map<std::string, Histogram> run_seconds_by_outcome_;  // claimed -> stored outcome (mutex_)
   std::atomic<bool> started_{false};
   std::atomic<bool> draining_{false};
 

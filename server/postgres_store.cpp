@@ -55,12 +55,13 @@ CREATE TABLE IF NOT EXISTS grip_results (
 ALTER TABLE grip_results ADD COLUMN IF NOT EXISTS bytes BYTEA;
 ALTER TABLE grip_results ALTER COLUMN data DROP NOT NULL;
 ALTER TABLE grip_jobs ADD COLUMN IF NOT EXISTS stored_bytes BIGINT NOT NULL DEFAULT 0;
+ALTER TABLE grip_jobs ADD COLUMN IF NOT EXISTS request_id TEXT NOT NULL DEFAULT '';
 )sql";
 
 // Columns read by read_job, in this order.
 constexpr const char* kJobColumns =
     "id, ord, status, created, started, finished, updated, message, steps, nodes, "
-    "idempotency_key, last_seq, attempts, solve_seconds, iterations, owner, generation, stored_bytes";
+    "idempotency_key, last_seq, attempts, solve_seconds, iterations, owner, generation, stored_bytes, request_id";
 
 using Param = std::optional<std::string>;
 
@@ -285,7 +286,8 @@ JobRecord read_job(const Result& r, int row, bool with_scene) {
   j.owner = r.text(row, 15);
   j.generation = r.int64(row, 16);
   j.stored_bytes = r.int64(row, 17);
-  if (with_scene) j.scene = r.text(row, 18);
+  j.request_id = r.text(row, 18);
+  if (with_scene) j.scene = r.text(row, 19);
   return j;
 }
 
@@ -431,10 +433,10 @@ void PostgresStore::insert_job(JobRecord& job) {
   Session s(*pool_);
   const Result r = s.query(
       "WITH ins AS (INSERT INTO grip_jobs (id, status, scene, created, updated, message, steps, "
-      "nodes, idempotency_key) VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9) RETURNING ord, id) "
+      "nodes, idempotency_key, request_id) VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10) RETURNING ord, id) "
       "SELECT ord, pg_notify('grip', 'j' || id) FROM ins",
       {job.id, std::string(to_string(job.status)), job.scene, job.created, job.updated, job.message,
-       num(std::int64_t{job.steps}), num(std::int64_t{job.nodes}), job.idempotency_key});
+       num(std::int64_t{job.steps}), num(std::int64_t{job.nodes}), job.idempotency_key, job.request_id});
   job.ord = r.int64(0, 0);
 }
 

@@ -12,6 +12,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "server/observability.hpp"
 #include "server/postgres_store.hpp"
 #include "server/sqlite_store.hpp"
 
@@ -69,8 +70,20 @@ const std::vector<Flag>& flags() {
        [](ServeConfig& c, const std::string& v) { c.service.queue_capacity = static_cast<int>(integer(v, "--queue", 1, 1000000)); }},
       {"streams", "GRIP_STREAMS", "N", "open event streams (default 32)",
        [](ServeConfig& c, const std::string& v) { c.http.max_streams = static_cast<int>(integer(v, "--streams", 1, 10000)); }},
-      {"http-threads", "GRIP_HTTP_THREADS", "N", "HTTP threads (default: streams + 32)",
-       [](ServeConfig& c, const std::string& v) { c.http.threads = static_cast<int>(integer(v, "--http-threads", 2, 20000)); }},
+      {"http-threads", "GRIP_HTTP_THREADS", "N", "connections served at once, a thread each (default 1024)",
+       [](ServeConfig& c, const std::string& v) { c.http.front.max_connections = static_cast<int>(integer(v, "--http-threads", 2, 20000)); }},
+      {"per-client", "GRIP_PER_CLIENT", "N", "open connections from one client address (default 64)",
+       [](ServeConfig& c, const std::string& v) { c.http.front.per_client = static_cast<int>(integer(v, "--per-client", 1, 100000)); }},
+      {"idle-connections", "GRIP_IDLE_CONNECTIONS", "N", "keep-alive connections kept waiting (default 64)",
+       [](ServeConfig& c, const std::string& v) { c.http.front.max_idle = static_cast<int>(integer(v, "--idle-connections", 0, 100000)); }},
+      {"head-timeout", "GRIP_HEAD_TIMEOUT", "S", "seconds for a whole request head (default 5)",
+       [](ServeConfig& c, const std::string& v) {
+         c.http.front.head = std::chrono::milliseconds(static_cast<long long>(1000 * real(v, "--head-timeout", 0.1)));
+       }},
+      {"body-timeout", "GRIP_BODY_TIMEOUT", "S", "seconds for a whole request body (default 10)",
+       [](ServeConfig& c, const std::string& v) {
+         c.http.front.body = std::chrono::milliseconds(static_cast<long long>(1000 * real(v, "--body-timeout", 0.1)));
+       }},
       {"max-body", "GRIP_MAX_BODY", "BYTES", "largest request body (default 8388608)",
        [](ServeConfig& c, const std::string& v) { c.http.max_body_bytes = static_cast<size_t>(integer(v, "--max-body", 1024, 1LL << 34)); }},
       {"parse-budget", "GRIP_PARSE_BUDGET", "BYTES", "submitted bodies read and checked at once; more wait (default 2 x max-body)",
@@ -107,6 +120,11 @@ const std::vector<Flag>& flags() {
        }},
       {"schemas", "GRIP_SCHEMAS", "DIR", "schemas and examples folder (default: found beside the binary)",
        [](ServeConfig& c, const std::string& v) { c.http.schemas_dir = v; }},
+      {"log-format", "GRIP_LOG_FORMAT", "FORMAT", "text or json (one object a line, for log shippers; default text)",
+       [](ServeConfig& c, const std::string& v) {
+         if (v != "text" && v != "json") throw std::invalid_argument("--log-format: '" + v + "' is not text or json");
+         c.log_format = v;
+       }},
       {"log-level", "GRIP_LOG_LEVEL", "LEVEL", "trace, debug, info, warn, error (default info)",
        [](ServeConfig& c, const std::string& v) {
          if (spdlog::level::from_str(v) == spdlog::level::off && v != "off")
@@ -174,9 +192,7 @@ ServeConfig read_serve_config(const std::vector<std::string>& args) {
 }
 
 int serve(const ServeConfig& config) {
-  spdlog::set_pattern("%Y-%m-%dT%H:%M:%S.%e %^%l%$ %v");
-  spdlog::set_level(spdlog::level::from_str(config.log_level));
-  spdlog::flush_on(spdlog::level::info);
+  setup_logging(config.log_format, config.log_level);
 
   // Signals go to one thread only: block them before any thread starts.
   sigset_t signals;
@@ -187,11 +203,13 @@ int serve(const ServeConfig& config) {
   std::signal(SIGPIPE, SIG_IGN);
 
   const ServeConfig& c = config;
-  const int threads = c.http.threads > 0 ? c.http.threads : c.http.max_streams + 32;
+  const FrontLimits& f = c.http.front;
   spdlog::info("grip serve: host {} port {} db {} workers {} queue {} streams {} http-threads {}",
                c.http.host, c.http.port, is_postgresql_url(c.db) ? redacted_url(c.db) : c.db,
                c.service.workers > 0 ? c.service.workers : static_cast<int>(std::thread::hardware_concurrency()),
-               c.service.queue_capacity, c.http.max_streams, threads);
+               c.service.queue_capacity, c.http.max_streams, f.max_connections);
+  spdlog::info("connections: {} per client, {} kept idle, head within {} s, body within {} s",
+               f.per_client, f.max_idle, f.head.count() / 1000.0, f.body.count() / 1000.0);
   spdlog::info("limits: body {} bytes, {} nodes, {} steps, {} contact iterations, {} s per job",
                c.http.max_body_bytes, c.service.limits.max_nodes, c.service.limits.max_steps,
                c.service.limits.max_iterations, c.service.limits.max_seconds);

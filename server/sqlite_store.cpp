@@ -29,7 +29,8 @@ CREATE TABLE IF NOT EXISTS jobs (
   owner TEXT NOT NULL DEFAULT '',
   generation INTEGER NOT NULL DEFAULT 0,
   lease_expires REAL NOT NULL DEFAULT 0,
-  stored_bytes INTEGER NOT NULL DEFAULT 0
+  stored_bytes INTEGER NOT NULL DEFAULT 0,
+  request_id TEXT NOT NULL DEFAULT ''
 );
 CREATE INDEX IF NOT EXISTS jobs_by_status ON jobs (status, ord);
 CREATE TABLE IF NOT EXISTS events (
@@ -53,12 +54,14 @@ ALTER TABLE jobs ADD COLUMN lease_expires REAL NOT NULL DEFAULT 0;
 )sql";
 
 // Schema 2 to 3: the bytes a finished job stores.
-constexpr const char* kUpgrade2to3 = "ALTER TABLE jobs ADD COLUMN stored_bytes INTEGER NOT NULL DEFAULT 0;";
+constexpr const char* kUpgrade2to3 =
+    "ALTER TABLE jobs ADD COLUMN stored_bytes INTEGER NOT NULL DEFAULT 0;"
+    "ALTER TABLE jobs ADD COLUMN request_id TEXT NOT NULL DEFAULT '';";
 
 // Columns read by read_job, in this order.
 constexpr const char* kJobColumns =
     "id, ord, status, created, started, finished, updated, message, steps, nodes, "
-    "idempotency_key, last_seq, attempts, solve_seconds, iterations, owner, generation, stored_bytes";
+    "idempotency_key, last_seq, attempts, solve_seconds, iterations, owner, generation, stored_bytes, request_id";
 
 JobRecord read_job(const Statement& st, bool with_scene) {
   JobRecord j;
@@ -80,7 +83,8 @@ JobRecord read_job(const Statement& st, bool with_scene) {
   j.owner = st.text(15);
   j.generation = st.int64(16);
   j.stored_bytes = st.int64(17);
-  if (with_scene) j.scene = st.text(18);
+  j.request_id = st.text(18);
+  if (with_scene) j.scene = st.text(19);
   return j;
 }
 
@@ -153,10 +157,10 @@ void SqliteStore::insert_job(JobRecord& job) {
     std::lock_guard lock(write_mutex_);
     auto st = writer_->prepare(
         "INSERT INTO jobs (id, status, scene, created, updated, message, steps, nodes, "
-        "idempotency_key) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)");
+        "idempotency_key, request_id) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
     st.bind(1, job.id).bind(2, to_string(job.status)).bind(3, job.scene).bind(4, job.created);
     st.bind(5, job.updated).bind(6, job.message).bind(7, job.steps).bind(8, job.nodes);
-    st.bind(9, job.idempotency_key);
+    st.bind(9, job.idempotency_key).bind(10, job.request_id);
     st.run();
     job.ord = sqlite3_last_insert_rowid(writer_->handle());
   }

@@ -63,6 +63,7 @@ struct JobRecord {
   std::string owner;            // replica holding (or that last held) the lease
   std::int64_t generation = 0;  // lease generation: grows with every claim
   std::int64_t stored_bytes = 0;  // of its scene, events and result, once finished
+  std::string request_id;         // of the request that submitted it (X-Request-Id)
 };
 
 // Which finished jobs the store keeps; 0: no bound of that kind. Beyond a bound the

@@ -475,7 +475,11 @@ std::vector<double> read_step_factors(Reader& r, json& scene) {
 
 // The load path: without stages every case follows `steps`; with stages each stage ramps the
 // factors it names linearly from where the previous stage left them, with its own friction.
-std::vector<LoadStep> read_load_path(Reader& r, json& scene, std::vector<ObstacleInstance>& obstacles) {
+// `cases_known`: the bodies and obstacles, which name the load cases, were read without an
+// error; otherwise a reader that stopped early (at a bad mesh) may not have met a case a stage
+// names, and "names no load case" would be an error of its own making.
+std::vector<LoadStep> read_load_path(Reader& r, json& scene, std::vector<ObstacleInstance>& obstacles,
+                                     bool cases_known) {
   std::vector<double> base_friction;
   std::unordered_map<std::string, size_t> obstacle_index;
   for (const auto& o : obstacles) {
@@ -508,7 +512,8 @@ std::vector<LoadStep> read_load_path(Reader& r, json& scene, std::vector<Obstacl
         const int found = r.find_case(name);
         const size_t k = found < 0 ? cases : static_cast<size_t>(found);
         if (k >= cases) {
-          r.error(sp + "/factors/" + token(name), "names no load case (cases: " + Reader::list(r.cases) + ")");
+          if (cases_known)
+            r.error(sp + "/factors/" + token(name), "names no load case (cases: " + Reader::list(r.cases) + ")");
           continue;
         }
         target[k] = r.number(*f, sp + "/factors", name.c_str());
@@ -629,7 +634,7 @@ Scene read_checked_scene(const nlohmann::json& input) {
     }
   }
   if (several && r.issues.empty()) scene_io::read_contacts(r, e, scene.problem);
-  scene.steps = read_load_path(r, e, scene.problem.obstacles);
+  scene.steps = read_load_path(r, e, scene.problem.obstacles, r.issues.empty());
   scene.load_cases = r.cases;
   scene.problem.case_names = r.cases;
   if (scene.problem.body)

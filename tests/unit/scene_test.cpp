@@ -101,6 +101,24 @@ TEST(SceneReader, StagesNameKnownCasesAndObstacles) {
   EXPECT_TRUE(has(issues, "/stages/1/friction/anvil", "names no obstacle"));
 }
 
+// A body the reader stops at (a bad mesh, a negative thickness) must not drag a "names no
+// load case" error with it for the cases its unread supports would have named (issue 34).
+TEST(SceneReader, ABadBodyDoesNotMakeItsStagesNameUnknownCases) {
+  for (const auto& [pointer, value] : std::vector<std::pair<std::string, json>>{
+           {"/body/mesh/rectangle/divisions", json::array({0, 10})},
+           {"/body/mesh/rectangle/divisions", json::array({2.5, 10})},
+           {"/body/thickness", -1}}) {
+    json j = example_scene("sliding-block");
+    j[json::json_pointer(pointer)] = value;
+    const auto issues = issues_of(j);
+    ASSERT_FALSE(issues.empty()) << pointer;
+    for (const auto& issue : issues) {
+      EXPECT_EQ(issue.pointer.rfind("/body", 0), 0u) << pointer << " = " << value.dump() << " also gave "
+                                                    << issue.pointer << ": " << issue.detail;
+    }
+  }
+}
+
 TEST(SceneReader, StagesRampTheirCasesFromWherePreviousStagesLeftThem) {
   json j = example_scene("beam-on-cylinder");
   j.erase("steps");

@@ -22,7 +22,7 @@ from .client import Client, GripError, Job
 EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
 
 PAPER_SCENES = ("sheet-stretching", "beam-on-cylinder")
-# File stems of the paper's figures (docs: README "Python client").
+# File stems of the paper's figures (documented in clients/python/README.md).
 PAPER_NAMES = {
     "sheet-stretching": {"shapes": "fig4_sheet_shapes", "strain": "fig5_sheet_strain",
                          "contact_normal": "sheet_normal_stress",
