@@ -2,9 +2,9 @@
 // A bound on the memory that submitted scenes take while they are read and checked: each
 // submission holds its body's length of a byte budget from before its body is read until its
 // answer is built, and waits while the budget is spent. Parsing and checking a scene takes
-// about 15 times its text (docs/limits.md#memory), so the process's peak stays near
-// 15 x budget whatever the number of clients; a body larger than the whole budget is let in
-// alone. Each large submission's end hands its freed memory back to the system (malloc_trim),
+// about 30 times its text (its parsed JSON, the reader's copy, the checks; docs/limits.md#memory),
+// so the process's peak stays near 30 x budget whatever the number of clients; a body larger
+// than the whole budget is let in alone. Each large submission's end hands its freed memory back to the system (malloc_trim),
 // where glibc would keep it in its per-thread arenas.
 #include <chrono>
 #include <condition_variable>

@@ -186,7 +186,7 @@ json job_document(const JobView& v) {
 struct HttpServer::Impl {
   Impl(JobService& s, HttpOptions o, std::atomic<int>& streams)
       : service(s), options(std::move(o)), open_streams(streams), svr(options.front),
-        budget(options.parse_budget_bytes ? options.parse_budget_bytes : 2 * options.max_body_bytes) {}
+        budget(options.parse_budget_bytes ? options.parse_budget_bytes : options.max_body_bytes) {}
 
   JobService& service;
   HttpOptions options;
@@ -469,12 +469,12 @@ void HttpServer::Impl::submit(const Request& req, Response& res, const httplib::
   // built (destroyed last).
   const auto declared = parse_count(req.get_header_value("Content-Length"));
   auto hold = budget.take(std::min<std::size_t>(declared.value_or(options.max_body_bytes), options.max_body_bytes),
-                          std::chrono::seconds(30));
+                          std::chrono::seconds(120));
   if (!hold) {
     res.set_header("Retry-After", "5");
     return problem(res, req, 503, "busy", "Busy",
                    "this server is reading as many scenes as its memory budget allows; nothing was accepted; "
-                   "retry after 5 s");
+                   "retry after 5 s");  // after 2 minutes of waiting
   }
   // The body is read here: httplib 0.11.4 holds a body to the payload limit only when it has
   // a Content-Length (a chunked one of 100 MB was buffered whole). Past the limit the rest is

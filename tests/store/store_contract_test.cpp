@@ -408,8 +408,8 @@ TEST_P(StoreContract, RetentionRemovesTheFinishedJobsBeyondItsBoundsDismissedFir
   EXPECT_EQ(ids(), (std::set<std::string>{"a1", "a3", "a4", "a5", "waiting"}));
   EXPECT_FALSE(store->result("a0"));
   EXPECT_TRUE(store->events_after("a0", 0, 100).empty());
-  // Finished more than 3.5 s before 00:00:08: a1 (00:01) and a3 (00:03).
-  EXPECT_EQ(store->prune(Retention{3.5, 0, 0}, "2025-01-01T00:00:08.000Z"), 2);
+  // Finished more than 4.5 s before 00:00:08 (before 00:03.5): a1 (00:01) and a3 (00:03).
+  EXPECT_EQ(store->prune(Retention{4.5, 0, 0}, "2025-01-01T00:00:08.000Z"), 2);
   EXPECT_EQ(ids(), (std::set<std::string>{"a4", "a5", "waiting"}));
   // Room for one job's stored bytes: the newest stays.
   const std::int64_t one = store->job("a5", false)->stored_bytes;
