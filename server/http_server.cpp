@@ -476,6 +476,7 @@ void HttpServer::Impl::submit(const Request& req, Response& res, const httplib::
                    "this server is reading as many scenes as its memory budget allows; nothing was accepted; "
                    "retry after 5 s");  // after 2 minutes of waiting
   }
+  if (ConnectionNote* note = HttpFront::note(); note && note->restart_body_deadline) note->restart_body_deadline();
   // The body is read here: httplib 0.11.4 holds a body to the payload limit only when it has
   // a Content-Length (a chunked one of 100 MB was buffered whole). Past the limit the rest is
   // read and dropped, as httplib does with a long Content-Length, so the client gets its 413.
