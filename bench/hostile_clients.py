@@ -9,7 +9,7 @@ attackers connect from 127.0.1.x (all of 127/8 reaches lo on Linux):
      beyond its solve time.
   2. A POST without Content-Length: seconds until answered, and the status.
   3. 32 event streams opened and dropped on a queued job: ms until a new stream is accepted.
-    python3 bench/hostile_clients.py PORT [DURATION]
+    python3 bench/hostile_clients.py PORT [DURATION [attack|post|streams]]
 The server is best started with --workers 1 (attack 3 needs the worker busy); attack 3 submits
 a long job and dismisses it afterwards.
 """
@@ -125,6 +125,7 @@ def attack_slow_and_idle():
     job = None
     start = time.time()
     submitted = 0.0
+    done_at, doc = None, {}
     while time.time() - start < DURATION:
         t = time.time()
         status, _ = http("GET", "/v1/health", timeout=120)
@@ -134,9 +135,15 @@ def attack_slow_and_idle():
             submitted = time.time()
             status, body = http("POST", "/v1/jobs", json.dumps(small_scene()).encode(), timeout=120)
             job = json.loads(body)["jobID"] if status == 201 else ""
+        elif job and done_at is None:  # the job polled every 10 ms until it ends
+            while time.time() - t < 0.1 and done_at is None:
+                status, body = http("GET", f"/v1/jobs/{job}", timeout=120)
+                doc = json.loads(body) if status == 200 else {}
+                if doc.get("status") in ("successful", "failed"):
+                    done_at = time.time()
+                time.sleep(0.01)
         time.sleep(0.1)
-    done_at, doc = None, {}
-    while job:
+    while job and done_at is None:
         status, body = http("GET", f"/v1/jobs/{job}", timeout=120)
         doc = json.loads(body) if status == 200 else {}
         if doc.get("status") in ("successful", "failed"):
@@ -175,11 +182,8 @@ def post_without_length():
 
 def dropped_streams():
     scene = small_scene()
-    busy = dict(scene, steps=400)
-    busy["body"] = json.loads(json.dumps(scene["body"]))
-    busy["body"]["mesh"]["elements"] = 40
-    for load in busy["body"]["loads"]:
-        load["node"] = 40
+    busy = json.load(open(f"{ROOT}/tests/load/small-job.json"))
+    busy["stages"][-1]["steps"] = 9990  # some 50 s: the worker stays busy, the job queued
     _, b = http("POST", "/v1/jobs", json.dumps(busy).encode())
     busy_id = json.loads(b)["jobID"]
     _, b = http("POST", "/v1/jobs", json.dumps(scene).encode())
@@ -195,8 +199,9 @@ def dropped_streams():
     t = time.time()
     for s in streams:
         s.close()
-    accepted = None
-    while time.time() - t < 30:
+    first = None
+    again = []
+    while len(again) < 32 and time.time() - t < 30:
         s = socket.create_connection(("127.0.0.1", PORT))
         s.sendall(request)
         s.settimeout(2)
@@ -204,18 +209,25 @@ def dropped_streams():
             head = s.recv(100)
         except OSError:
             head = b""
-        s.close()
         if head.startswith(b"HTTP/1.1 200"):
-            accepted = time.time() - t
-            break
-        time.sleep(0.02)
-    print(f"32 streams dropped on a queued job: a new stream accepted after "
-          f"{accepted * 1000:.0f} ms" if accepted is not None else "no new stream within 30 s")
+            again.append(s)
+            first = first or time.time() - t
+        else:
+            s.close()
+            time.sleep(0.02)
+    print(f"32 streams dropped on a queued job: a new stream accepted after {first * 1000:.0f} ms, "
+          f"{len(again)} of 32 new ones after {(time.time() - t) * 1000:.0f} ms")
+    for s in again:
+        s.close()
     http("DELETE", f"/v1/jobs/{busy_id}")
     http("DELETE", f"/v1/jobs/{queued}")
 
 
-attack_slow_and_idle()
-time.sleep(3)
-post_without_length()
-dropped_streams()
+which = sys.argv[3] if len(sys.argv) > 3 else "all"
+if which in ("all", "attack"):
+    attack_slow_and_idle()
+    time.sleep(3)
+if which in ("all", "post"):
+    post_without_length()
+if which in ("all", "streams"):
+    dropped_streams()

@@ -693,12 +693,12 @@ void HttpServer::Impl::events(const Request& req, Response& res) {
         if (state->first && !ndjson) out = "retry: 1000\n\n";
         state->first = false;
         // A client that went away frees its slot now, not at the next write (the heartbeat
-        // 15 s on): the waits are short and each is preceded by a look at the socket.
+        // 15 s on): each wait (at most 500 ms) is preceded by a look at the socket.
         if (!sink.is_writable()) return false;
         const auto now = std::chrono::steady_clock::now();
         const auto until_ping = std::chrono::duration_cast<std::chrono::milliseconds>(
             state->last_write + heartbeat - now);
-        const auto wait = std::clamp(until_ping, std::chrono::milliseconds(0), std::chrono::milliseconds(250));
+        const auto wait = std::clamp(until_ping, std::chrono::milliseconds(0), std::chrono::milliseconds(500));
         const EventBatch batch = service.wait_events(id, state->last, wait);
         if (!batch.found) {
           sink.done();

@@ -5,7 +5,7 @@
 // Connections: a thread each for the connection's life, with deadlines and limits per
 // connection and client (FrontLimits, server/http_front.hpp). Event streams are counted and
 // refused with 503 beyond `max_streams`; a stream's content provider looks at its socket
-// every 250 ms (a closed one frees its slot, stop() finishes promptly) while a heartbeat
+// every 500 ms (a closed one frees its slot, stop() finishes promptly) while a heartbeat
 // comment keeps idle streams alive.
 #include <atomic>
 #include <chrono>

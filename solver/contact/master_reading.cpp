@@ -6,7 +6,7 @@
 #include <map>
 
 #include "solver/contact/contact_error.hpp"
-#include "solver/core/body_set.hpp"
+#include "solver/model/body_set.hpp"
 
 namespace grip {
 

@@ -10,7 +10,7 @@
 // the slave's tangent xi.
 #include <vector>
 
-#include "solver/core/problem.hpp"
+#include "solver/problem/problem.hpp"
 
 namespace grip {
 

@@ -10,7 +10,7 @@
 // on the slip rows), (C P y)_A = -s_A - (C d)_A, a system of the active rows only.
 #include <vector>
 
-#include "solver/solve/equilibrium.hpp"
+#include "solver/equilibrium/equilibrium.hpp"
 
 namespace grip {
 

@@ -6,8 +6,8 @@
 
 #include "solver/contact/acceleration.hpp"
 #include "solver/contact/coulomb_model.hpp"
-#include "solver/solve/friction_limit.hpp"
-#include "solver/solve/rigid_equilibrium.hpp"
+#include "solver/contact/friction_limit.hpp"
+#include "solver/equilibrium/rigid_equilibrium.hpp"
 
 namespace grip {
 namespace {
@@ -506,7 +506,8 @@ void StepSolver::final_check() {
          "the step");
     return;
   }
-  // A free motion that no pressing point resists has no determined amplitude (ALGORITHM.md 7).
+  // A free motion that no pressing point resists has no determined amplitude
+  // (docs/algorithm.md#bodies-held-only-by-contact).
   for (int k = 0; k < problem_.rigid.count(); ++k)
     if (!mode_held(k))
       fail("no contact holds the body's free motion (" + problem_.rigid.names[k] +

@@ -18,7 +18,7 @@
 #include <mutex>
 #include <vector>
 
-#include "solver/core/body.hpp"
+#include "solver/model/body.hpp"
 #include "solver/elements/plane_mesh.hpp"
 
 namespace grip {

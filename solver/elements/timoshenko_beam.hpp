@@ -10,7 +10,7 @@
 // which avoids shear locking. Units are the scene's (consistent) units.
 #include <vector>
 
-#include "solver/core/body.hpp"
+#include "solver/model/body.hpp"
 
 namespace grip {
 

@@ -9,8 +9,8 @@
 
 #include "solver/contact/contact_error.hpp"
 #include "solver/contact/master_reading.hpp"
-#include "solver/core/body_set.hpp"
-#include "solver/solve/rigid_equilibrium.hpp"
+#include "solver/model/body_set.hpp"
+#include "solver/equilibrium/rigid_equilibrium.hpp"
 
 namespace grip {
 
@@ -228,7 +228,8 @@ json effects_json(const Scene& scene) {
           {"contact_unknowns", problem.component_count},
           {"held_by_contact", problem.rigid.names},
           {"unknowns_per_contact_point", tangential > 0 ? 2 : 1}};
-  // How the free motions were held (ALGORITHM.md 7), and that no regularization is left.
+  // How the free motions were held (docs/algorithm.md#bodies-held-only-by-contact), and that no
+  // regularization is left.
   if (problem.rigid.count())
     effects["held_by_contact_by"] =
         scene.params.contact.method == ContactMethod::penalty

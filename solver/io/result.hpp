@@ -1,6 +1,6 @@
 #pragma once
-// Results and events as JSON (DESIGN.md vocabulary). Events are the same objects whether
-// written to an NDJSON file by `grip solve --events` or streamed by the service.
+// Results and events as JSON (docs/design.md#scenes-results-and-events). Events are the same
+// objects whether written to an NDJSON file by `grip solve --events` or streamed by the service.
 #include <functional>
 #include <nlohmann/json.hpp>
 #include <optional>

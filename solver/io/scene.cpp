@@ -11,11 +11,11 @@
 #include <unordered_map>
 #include <unordered_set>
 
-#include "solver/core/body_set.hpp"
+#include "solver/model/body_set.hpp"
 #include "solver/io/json_depth.hpp"
 #include "solver/io/scene_reader.hpp"
 #include "solver/io/schema_validation.hpp"
-#include "solver/solve/rigid_equilibrium.hpp"
+#include "solver/equilibrium/rigid_equilibrium.hpp"
 
 namespace grip {
 namespace {
@@ -79,8 +79,9 @@ std::unique_ptr<Obstacle> read_shape(Reader& r, json& j, const std::string& ptr)
 
 // ---- solver parameters
 
-// solver.start: {"node", "component": "x" | "y", "value", "obstacle"} (ALGORITHM.md section 9):
-// the first step starts from a solve with that displacement prescribed and no contact.
+// solver.start: {"node", "component": "x" | "y", "value", "obstacle"}
+// (docs/algorithm.md#load-stepping-and-cuts): the first step starts from a solve with that
+// displacement prescribed and no contact.
 void read_start(Reader& r, json& scene, Problem& problem) {
   const bool membrane = scene.contains("body") && scene["body"].is_object() &&
                         scene["body"].value("model", "") == "rigid_plastic_membrane";
@@ -233,13 +234,14 @@ std::pair<std::string, int> motion_words(const std::vector<BodyPart>& parts, con
   return {moved > 1 ? "move together (" + words + ")" : words, std::max(first, 0)};
 }
 
-// Free rigid motions are held by contact (ALGORITHM.md section 7) where the model allows it:
-// translations always (internal forces are self-equilibrated at any state), rotations where
-// the tangent is constant (linear kinematics: an infinitesimal rotation is a null mode of K) or
-// where a finite rotation leaves the body's strain unchanged (the continuum with finite
-// kinematics, the von Karman beam, about at most one supported node: its motions then follow its
-// state, rigid_modes_at); a membrane (no reference stiffness) never. Records them in problem.rigid (pins come later);
-// in a scene of several bodies each body's motions on its own dofs.
+// Free rigid motions are held by contact (docs/algorithm.md#bodies-held-only-by-contact) where the
+// model allows it: translations always (internal forces are self-equilibrated at any state),
+// rotations where the tangent is constant (linear kinematics: an infinitesimal rotation is a null
+// mode of K) or where a finite rotation leaves the body's strain unchanged (the continuum with
+// finite kinematics, the von Karman beam, about at most one supported node: its motions then follow
+// its state, rigid_modes_at); a membrane (no reference stiffness) never. Records them in
+// problem.rigid (pins come later); in a scene of several bodies each body's motions on its own
+// dofs.
 void check_rigid_modes(Reader& r, Problem& problem) {
   const std::vector<BodyPart> parts = body_parts(problem);
   for (size_t b = 0; b < parts.size(); ++b) {

@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "solver/core/problem.hpp"
-#include "solver/solve/load_stepping.hpp"
+#include "solver/problem/problem.hpp"
+#include "solver/stepping/load_stepping.hpp"
 
 namespace grip {
 

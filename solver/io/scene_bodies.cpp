@@ -4,7 +4,7 @@
 #include <set>
 #include <unordered_map>
 
-#include "solver/core/body_set.hpp"
+#include "solver/model/body_set.hpp"
 #include "solver/elements/continuum.hpp"
 #include "solver/elements/timoshenko_beam.hpp"
 #include "solver/io/scene_reader.hpp"
@@ -53,7 +53,7 @@ void read_bodies(Reader& r, json& bodies, Problem& problem) {
       r.error(bp + "/model",
               "a rigid_plastic_membrane has no stiffness in its flat reference state: its first step starts from a "
               "prescribed depth of one node pressed by a rigid obstacle (solver.start), whose reaction is the first "
-              "contact force (ALGORITHM.md 9); against a deformable body that depth would be shared with the other "
+              "contact force (docs/algorithm.md#load-stepping-and-cuts); against a deformable body that depth would be shared with the other "
               "body's compliance, which gives no starting force, so a membrane is for one-body scenes (body)");
     if (!r.issues.empty()) continue;
     Problem part;

@@ -8,7 +8,7 @@
 #include <unordered_map>
 #include <vector>
 
-#include "solver/core/problem.hpp"
+#include "solver/problem/problem.hpp"
 #include "solver/io/scene.hpp"
 
 namespace grip::scene_io {

@@ -8,7 +8,7 @@
 #include <Eigen/Core>
 #include <memory>
 
-#include "solver/core/types.hpp"
+#include "solver/model/types.hpp"
 
 namespace grip {
 

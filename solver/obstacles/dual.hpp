@@ -4,7 +4,7 @@
 // derivatives stored (an empty `d`) means a constant. P2 is a plane vector of such values.
 #include <cmath>
 
-#include "solver/core/types.hpp"
+#include "solver/model/types.hpp"
 
 namespace grip {
 

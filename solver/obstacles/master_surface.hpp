@@ -35,7 +35,7 @@
 #include <utility>
 #include <vector>
 
-#include "solver/core/body.hpp"
+#include "solver/model/body.hpp"
 #include "solver/obstacles/obstacle.hpp"
 
 namespace grip {

@@ -40,8 +40,8 @@
 #include "solver/io/scene.hpp"
 #include "tests/support/contact_profile.hpp"
 #include "tests/support/elastica.hpp"
-#include "solver/solve/equilibrium.hpp"
-#include "solver/solve/load_stepping.hpp"
+#include "solver/equilibrium/equilibrium.hpp"
+#include "solver/stepping/load_stepping.hpp"
 
 #ifndef GRIP_SOURCE_DIR
 #define GRIP_SOURCE_DIR "."

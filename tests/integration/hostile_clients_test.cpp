@@ -213,8 +213,10 @@ TEST(HostileClients, SlowAndIdleConnectionsStarveNeitherHealthNorJobs) {
               answered_408, closed_without_408, reopened);
   EXPECT_EQ(health_ok, static_cast<int>(health_ms.size()));
   EXPECT_EQ(doc["status"], "successful");
-  // 7 s of attack against a 2 s head deadline: the first wave of slow heads was cut, with a 408.
-  EXPECT_GE(answered_408, kSlow * 9 / 10);
+  // 7 s of attack against a 2 s head deadline: the first wave of slow heads was cut, most with
+  // a 408 (the rest lose it to the reset that their next byte meets on the closed socket).
+  EXPECT_GE(answered_408 + closed_without_408, kSlow * 9 / 10);
+  EXPECT_GE(answered_408, kSlow / 4);
   EXPECT_EQ(api.get("/v1/health")->status, 200);
 }
 
@@ -259,6 +261,29 @@ TEST(HostileClients, ConnectionsPastTheLimitPerAddressAreRefusedWith503) {
   EXPECT_NE(server.log().find("127.0.2.1: connection refused"), std::string::npos);
 }
 
+// Every connection thread taken (--http-threads 2, both held by slow heads): the reserved
+// threads still answer /v1/health and /v1/ready, and refuse the rest with 503 + Retry-After.
+TEST(HostileClients, HealthIsAnsweredWhenEveryConnectionThreadIsTaken) {
+  TempDir dir;
+  ServerProcess server(dir.path() / "grip.sqlite", {"--http-threads", "2"}, dir.path() / "server.log");
+  std::vector<int> held;
+  for (int i = 0; i < 2; ++i) {
+    held.push_back(connect_from("127.0.2.1", server.port()));
+    send_all(held.back(), "GET /v1/health HTTP/1.1\r\nHost: grip\r\n");  // never ends
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  const Api api(server.port());
+  const auto health = api.client(3).Get("/v1/health");
+  ASSERT_TRUE(health);
+  EXPECT_EQ(health->status, 200);
+  const auto jobs = api.client(3).Get("/v1/jobs");
+  ASSERT_TRUE(jobs);
+  EXPECT_EQ(jobs->status, 503);
+  EXPECT_FALSE(jobs->get_header_value("Retry-After").empty());
+  EXPECT_EQ(json::parse(jobs->body).value("type", std::string()), "urn:grip:problem:server-busy") << jobs->body;
+  for (int fd : held) ::close(fd);
+}
+
 // Oversize heads say which limit they hit.
 TEST(HostileClients, OversizeHeadersAndUrlsNameTheLimitTheyHit) {
   TempDir dir;
@@ -301,7 +326,8 @@ TEST(HostileClients, FaviconIsNoContentNotNotFound) {
 }
 
 // 32 event streams opened and dropped on a queued job (quiet: no event to write) free their
-// slots at once, not at the next heartbeat (15 s here): a new stream is then accepted.
+// slots at once, not at the next heartbeat (15 s here): 32 new streams are then accepted.
+// (cpp-httplib alone freed about 20 of the 32 at once, the others at the heartbeat.)
 TEST(HostileClients, DroppedStreamsOnAQuietJobFreeTheirSlotsAtOnce) {
   TempDir dir;
   ServerProcess server(dir.path() / "grip.sqlite",
@@ -328,24 +354,27 @@ TEST(HostileClients, DroppedStreamsOnAQuietJobFreeTheirSlotsAtOnce) {
   ASSERT_EQ(api.job(queued)["status"], "accepted");
   const auto dropped = Clock::now();
   for (int fd : streams) ::close(fd);
-  // A 33rd stream: refused (503) while the dropped ones still count; accepted once freed.
-  int status = 0;
-  double accepted_ms = 0;
-  while (ms_since(dropped) < 10000) {
+  // 32 new streams, each asked again while refused (503): all are accepted once the dropped
+  // ones are freed, long before the next heartbeat would have found them gone.
+  streams.clear();
+  double all_ms = 0;
+  while (streams.size() < 32 && ms_since(dropped) < 10000) {
     const int fd = connect_from("127.0.0.1", server.port());
     send_all(fd, request);
     const std::string head = read_head(fd, std::chrono::milliseconds(2000));
-    ::close(fd);
-    status = head.rfind("HTTP/1.1 200", 0) == 0 ? 200 : head.rfind("HTTP/1.1 503", 0) == 0 ? 503 : 0;
-    if (status == 200) {
-      accepted_ms = ms_since(dropped);
-      break;
+    if (head.rfind("HTTP/1.1 200", 0) == 0) {
+      streams.push_back(fd);
+      all_ms = ms_since(dropped);
+    } else {
+      EXPECT_EQ(head.rfind("HTTP/1.1 503", 0), 0u) << head;
+      ::close(fd);
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
-  std::printf("[ info ] a new stream accepted %.0f ms after 32 were dropped (heartbeat 15 s)\n", accepted_ms);
-  EXPECT_EQ(status, 200);
+  std::printf("[ info ] 32 new streams accepted within %.0f ms after 32 were dropped (heartbeat 15 s)\n", all_ms);
+  EXPECT_EQ(streams.size(), 32u);
   EXPECT_EQ(api.job(queued)["status"], "accepted");  // still quiet: no write freed the slots
+  for (int fd : streams) ::close(fd);
   api.del("/v1/jobs/" + busy);
   api.del("/v1/jobs/" + queued);
 }

@@ -7,7 +7,7 @@
 #include <sstream>
 
 #include "solver/contact/contact_error.hpp"
-#include "solver/solve/load_stepping.hpp"
+#include "solver/stepping/load_stepping.hpp"
 
 namespace grip::testing {
 

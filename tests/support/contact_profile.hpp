@@ -15,7 +15,7 @@
 
 #include "solver/contact/contact_error.hpp"
 #include "solver/elements/plane_mesh.hpp"
-#include "solver/solve/load_stepping.hpp"
+#include "solver/stepping/load_stepping.hpp"
 #include "tests/support/scenes.hpp"
 
 namespace grip::testing {

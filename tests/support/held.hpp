@@ -9,8 +9,8 @@
 #include <string>
 #include <vector>
 
-#include "solver/core/body_set.hpp"
-#include "solver/solve/rigid_equilibrium.hpp"
+#include "solver/model/body_set.hpp"
+#include "solver/equilibrium/rigid_equilibrium.hpp"
 #include "tests/support/contact_profile.hpp"
 #include "tests/support/result_checks.hpp"
 #include "tests/support/two_bodies.hpp"

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "solver/contact/master_reading.hpp"
-#include "solver/core/body_set.hpp"
+#include "solver/model/body_set.hpp"
 #include "tests/support/contact_profile.hpp"
 #include "tests/support/scenes.hpp"
 

@@ -8,8 +8,8 @@
 #include <atomic>
 
 #include "solver/io/scene.hpp"
-#include "solver/solve/free_block_solver.hpp"
-#include "solver/solve/load_stepping.hpp"
+#include "solver/equilibrium/free_block_solver.hpp"
+#include "solver/stepping/load_stepping.hpp"
 
 namespace grip {
 namespace {

@@ -8,7 +8,7 @@
 
 #include "solver/elements/timoshenko_beam.hpp"
 #include "solver/io/scene.hpp"
-#include "solver/solve/equilibrium.hpp"
+#include "solver/equilibrium/equilibrium.hpp"
 #include "tests/support/scenes.hpp"
 
 namespace grip {

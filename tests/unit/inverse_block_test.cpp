@@ -4,7 +4,7 @@
 
 #include <Eigen/Dense>
 
-#include "solver/solve/free_block_solver.hpp"
+#include "solver/equilibrium/free_block_solver.hpp"
 
 namespace grip {
 namespace {

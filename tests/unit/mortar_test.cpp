@@ -14,8 +14,8 @@
 
 #include <cmath>
 
-#include "solver/core/body_set.hpp"
-#include "solver/solve/equilibrium.hpp"
+#include "solver/model/body_set.hpp"
+#include "solver/equilibrium/equilibrium.hpp"
 #include "tests/support/scenes.hpp"
 
 namespace grip {

@@ -8,7 +8,7 @@
 #include <cmath>
 
 #include "solver/io/scene.hpp"
-#include "solver/solve/rigid_equilibrium.hpp"
+#include "solver/equilibrium/rigid_equilibrium.hpp"
 
 namespace grip {
 namespace {

@@ -9,7 +9,7 @@
 
 #include "solver/contact/newton_rows.hpp"
 #include "solver/io/scene.hpp"
-#include "solver/solve/equilibrium.hpp"
+#include "solver/equilibrium/equilibrium.hpp"
 #include "tests/support/flat_block.hpp"
 
 namespace grip {

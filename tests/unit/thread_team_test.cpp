@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "solver/io/scene.hpp"
-#include "solver/solve/load_stepping.hpp"
+#include "solver/stepping/load_stepping.hpp"
 
 namespace grip {
 namespace {

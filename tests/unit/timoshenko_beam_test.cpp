@@ -6,7 +6,7 @@
 #include <random>
 
 #include "solver/elements/timoshenko_beam.hpp"
-#include "solver/solve/equilibrium.hpp"
+#include "solver/equilibrium/equilibrium.hpp"
 
 namespace grip {
 namespace {

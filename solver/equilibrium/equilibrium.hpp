@@ -1,7 +1,8 @@
 #pragma once
-// SOLVE(U, p) of ALGORITHM.md section 5: equilibrium of eq. 1-2 for given contact forces p,
-// by Newton's method with the pairing, T(u) and the stiffness of the follower contact load
-// d(T(u) p)/du re-evaluated at every iterate. Also the contact compliance C = T^T K^-1 T.
+// SOLVE(U, p) of docs/algorithm.md#equilibrium-for-given-contact-forces: equilibrium of eq. 1-2 for
+// given contact forces p, by Newton's method with the pairing, T(u) and the stiffness of the
+// follower contact load d(T(u) p)/du re-evaluated at every iterate. Also the contact compliance
+// C = T^T K^-1 T.
 #include <Eigen/SparseCore>
 #include <Eigen/SparseLU>
 #include <limits>
@@ -10,14 +11,15 @@
 #include <string>
 #include <vector>
 
-#include "solver/core/parallel.hpp"
-#include "solver/core/problem.hpp"
-#include "solver/solve/free_block_solver.hpp"
+#include "solver/model/parallel.hpp"
+#include "solver/problem/problem.hpp"
+#include "solver/equilibrium/free_block_solver.hpp"
 
 namespace grip {
 
-// Newton's stopping tests, each always reachable in floating point (ALGORITHM.md 9). An
-// iterate is converged when one of them holds:
+// Newton's stopping tests, each always reachable in floating point
+// (docs/algorithm.md#newtons-stopping-tests-and-the-round-off-floor). An iterate is converged when
+// one of them holds:
 // - correction: the largest correction, in length units (rotations times their dof's length
 //   scale), is below `displacement_tolerance` (the contact loop's precision);
 // - residual: the largest free residual, in force units (moments over the length scale), is
@@ -43,7 +45,8 @@ struct NewtonParams {
 
 // Newton's tests as a fraction of the contact tolerance (relative to `length`, the body's
 // characteristic length): the contact error has a floor of about ||K^-1|| x the Newton
-// residual, so Newton must be that much tighter (ALGORITHM.md 9).
+// residual, so Newton must be that much tighter
+// (docs/algorithm.md#newtons-stopping-tests-and-the-round-off-floor).
 inline void couple_newton(NewtonParams& newton, double contact_tolerance, double fraction, double length) {
   newton.displacement_tolerance = fraction * contact_tolerance * length;
   newton.residual_tolerance = fraction * contact_tolerance;
@@ -109,8 +112,8 @@ struct Compliance {
   std::vector<int> position;  // component -> row of `block` (or column of `t`), -1 where not computed
   Matrix block;               // the dense form; empty in the sparse form
   mutable std::shared_ptr<ComplianceFactor> factor;  // reset whenever `block` changes
-  // With the rigid amplitudes' border [C G; G^T 0] (ALGORITHM.md 7): indefinite, no Cholesky.
-  // Dense form only.
+  // With the rigid amplitudes' border [C G; G^T 0] (docs/algorithm.md#bodies-held-only-by-contact):
+  // indefinite, no Cholesky. Dense form only.
   bool bordered = false;
   // The sparse form: `body` is the body's factorization of K (free dofs), `t` is T on the free
   // dofs (free dofs x rows), `diagonal` is C's diagonal.

@@ -1,4 +1,4 @@
-#include "solver/core/body_set.hpp"
+#include "solver/model/body_set.hpp"
 
 #include <algorithm>
 #include <limits>

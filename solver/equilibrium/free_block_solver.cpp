@@ -1,4 +1,4 @@
-#include "solver/solve/free_block_solver.hpp"
+#include "solver/equilibrium/free_block_solver.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "solver/core/body.hpp"
+#include "solver/model/body.hpp"
 
 namespace grip {
 

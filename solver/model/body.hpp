@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "solver/core/types.hpp"
+#include "solver/model/types.hpp"
 
 namespace grip {
 

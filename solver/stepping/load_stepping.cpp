@@ -1,12 +1,12 @@
-#include "solver/solve/load_stepping.hpp"
+#include "solver/stepping/load_stepping.hpp"
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <optional>
 
-#include "solver/solve/friction_limit.hpp"
-#include "solver/solve/rigid_equilibrium.hpp"
+#include "solver/contact/friction_limit.hpp"
+#include "solver/equilibrium/rigid_equilibrium.hpp"
 
 namespace grip {
 namespace {

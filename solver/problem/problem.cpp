@@ -1,4 +1,4 @@
-#include "solver/core/problem.hpp"
+#include "solver/problem/problem.hpp"
 
 #include <algorithm>
 #include <cmath>

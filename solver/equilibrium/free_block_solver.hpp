@@ -12,8 +12,8 @@
 #include <memory>
 #include <vector>
 
-#include "solver/core/body.hpp"
-#include "solver/core/parallel.hpp"
+#include "solver/model/body.hpp"
+#include "solver/model/parallel.hpp"
 
 namespace grip {
 

@@ -1,11 +1,11 @@
-#include "solver/solve/rigid_equilibrium.hpp"
+#include "solver/equilibrium/rigid_equilibrium.hpp"
 
 #include <Eigen/LU>
 #include <Eigen/QR>
 #include <cmath>
 #include <cstdio>
 
-#include "solver/core/body_set.hpp"
+#include "solver/model/body_set.hpp"
 #include "solver/elements/timoshenko_beam.hpp"
 
 namespace grip {

@@ -1,4 +1,4 @@
-#include "solver/solve/equilibrium.hpp"
+#include "solver/equilibrium/equilibrium.hpp"
 
 #include <Eigen/Dense>
 #include <algorithm>
@@ -7,8 +7,8 @@
 #include <limits>
 #include <tuple>
 
-#include "solver/core/body_set.hpp"
-#include "solver/solve/rigid_equilibrium.hpp"
+#include "solver/model/body_set.hpp"
+#include "solver/equilibrium/rigid_equilibrium.hpp"
 
 namespace grip {
 
@@ -805,11 +805,11 @@ Vector Compliance::apply(const Vector& z) const {
   return t.transpose() * body->solve(force);
 }
 
-// The border G = T^T R of the compliance (ALGORITHM.md 7), times the amplitudes' scale: the
-// rigid motion moves every contact point with it, and the amplitudes' s, the whole body's
-// equilibrium, changes with p by G^T. R at the state (rigid_modes_at): for a deformed body free
-// to rotate with finite kinematics, about its current shape, where K R = 0 holds only up to
-// terms in its stresses (K R is the load's own turn); the model is then approximate there and
+// The border G = T^T R of the compliance (docs/algorithm.md#bodies-held-only-by-contact), times the
+// amplitudes' scale: the rigid motion moves every contact point with it, and the amplitudes' s, the
+// whole body's equilibrium, changes with p by G^T. R at the state (rigid_modes_at): for a deformed
+// body free to rotate with finite kinematics, about its current shape, where K R = 0 holds only up
+// to terms in its stresses (K R is the load's own turn); the model is then approximate there and
 // the real solves decide, as for any changing tangent.
 void Equilibrium::add_rigid_border(const EquilibriumState& state) {
   const RigidModes& rigid = problem_.rigid;

@@ -1,12 +1,13 @@
 #pragma once
-// Whether contact can hold a body whose supports leave rigid motions free (ALGORITHM.md 7):
-// the contact forces must balance the applied load on those motions, pressing and inside
-// Coulomb's cone. Checked before a step is solved, so that a load no static equilibrium can
-// carry fails its step with the reason in words instead of a drifting solve.
+// Whether contact can hold a body whose supports leave rigid motions free
+// (docs/algorithm.md#bodies-held-only-by-contact): the contact forces must balance the applied load
+// on those motions, pressing and inside Coulomb's cone. Checked before a step is solved, so that a
+// load no static equilibrium can carry fails its step with the reason in words instead of a
+// drifting solve.
 #include <string>
 #include <vector>
 
-#include "solver/solve/equilibrium.hpp"
+#include "solver/equilibrium/equilibrium.hpp"
 
 namespace grip {
 
@@ -38,9 +39,10 @@ std::string finite_rotation_refusal(const Body& body, const std::vector<int>& fi
 // The free rigid motions of problem.rigid at the state q, 1 at their own pin and 0 at the other
 // pins. For a body with finite kinematics left free to rotate: the translations and the rotation
 // at q (the continuum's about its current shape, the von Karman beam's own: rigid_equilibrium.cpp),
-// zero at its supports (ALGORITHM.md 7): the internal forces of a deformed body do no work along
-// it, so that is where the contact forces and the load must balance too. Elsewhere
-// problem.rigid.modes itself (a constant tangent, or translations only: the same at every state).
+// zero at its supports (docs/algorithm.md#bodies-held-only-by-contact): the internal forces of a
+// deformed body do no work along it, so that is where the contact forces and the load must balance
+// too. Elsewhere problem.rigid.modes itself (a constant tangent, or translations only: the same at
+// every state).
 Matrix rigid_modes_at(const Problem& problem, const Vector& q);
 // Whether rigid_modes_at changes with the state for some body of the problem.
 bool rigid_modes_follow_state(const Problem& problem);

@@ -1,4 +1,4 @@
-#include "solver/solve/friction_limit.hpp"
+#include "solver/contact/friction_limit.hpp"
 
 #include <Eigen/QR>
 #include <cmath>
@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "solver/contact/contact_error.hpp"
-#include "solver/solve/rigid_equilibrium.hpp"
+#include "solver/equilibrium/rigid_equilibrium.hpp"
 
 namespace grip {
 namespace {
