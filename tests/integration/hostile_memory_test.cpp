@@ -87,6 +87,7 @@ TEST(HostileMemory, EightLargeAdversarialScenesAtOnceStayUnder500MbAndMemoryCome
     clients.emplace_back([&, c] {
       const auto& [name, body] = attacks[c % attacks.size()];
       auto cli = api.client(300);
+      cli.set_write_timeout(300);  // the server reads one large body at a time: the others wait
       auto r = cli.Post("/v1/jobs", body, "application/json");
       if (!r) {
         failures[c] = name + ": no answer (" + httplib::to_string(r.error()) + ")";

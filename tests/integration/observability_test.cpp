@@ -81,6 +81,9 @@ TEST(Observability, JsonLogsAreOneObjectALine) {
   ServerProcess server(dir.path() / "grip.sqlite", {"--log-format", "json"}, dir.path() / "serve.log");
   const Api api(server.port());
   ASSERT_EQ(api.get("/v1/jobs/\"quoted\"", {{"X-Request-Id", "r-1"}})->status, 404);
+  // The request's line is written after its answer is sent.
+  for (int i = 0; i < 100 && server.log().find("request r-1") == std::string::npos; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
   std::istringstream lines(server.log());
   std::string line;
   int objects = 0;
