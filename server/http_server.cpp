@@ -149,10 +149,19 @@ json job_document(const JobView& v) {
   if (!r.owner.empty()) doc["replica"] = r.owner;  // the process that runs (or last ran) it
   if (!r.started.empty()) doc["started"] = r.started;
   if (!r.finished.empty()) doc["finished"] = r.finished;
-  int percent = r.status == JobStatus::successful ? 100 : 0;
+  // Converged steps: while running from the run's progress, once finished as stored.
+  int completed = r.status == JobStatus::successful ? r.steps : r.steps_completed;
+  if (v.progress) completed = v.progress->steps_done;
+  doc["steps_completed"] = completed;
+  const int percent = r.steps > 0 ? 100 * completed / r.steps : (r.status == JobStatus::successful ? 100 : 0);
+  if (r.status == JobStatus::dismissed)
+    doc["failure"] = {{"kind", "dismissed"}, {"message", r.message}, {"step", 0}};
+  else if (r.status == JobStatus::failed && !r.failure_kind.empty())  // empty: failed before kinds were kept
+    doc["failure"] = {{"kind", r.failure_kind},
+                      {"message", r.message},
+                      {"step", r.failure_step}};
   if (v.progress) {
     const Progress& p = *v.progress;
-    if (r.steps > 0) percent = 100 * p.steps_done / r.steps;
     doc["step"] = p.step;
     doc["contact_error"] = p.contact_error;
     doc["iterations"] = p.iterations;

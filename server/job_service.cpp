@@ -40,8 +40,20 @@ namespace {
 const std::vector<double> kStoredBytesBuckets = {4096, 16384, 65536, 262144, 1048576, 4194304, 16777216,
                                                  std::numeric_limits<double>::infinity()};
 
-json failed_event(const std::string& reason) {
-  return {{"type", "job_failed"}, {"reason", reason}};
+// A run that did not succeed: its status, message (the result's reason where there is one)
+// and failure kind.
+void failed(JobOutcome& o, FailureKind kind, std::string message, int step = 0) {
+  o.status = kind == FailureKind::dismissed ? JobStatus::dismissed : JobStatus::failed;
+  o.message = std::move(message);
+  o.failure_kind = std::string(to_string(kind));
+  o.failure_step = step;
+}
+
+// The outcome's log line (one format for every end of a run; a failure at warning).
+void log_outcome(const std::string& id, JobStatus status, std::int64_t iterations, const std::string& message,
+                 double seconds) {
+  spdlog::log(status == JobStatus::successful ? spdlog::level::info : spdlog::level::warn,
+              "job {} {} in {:.3f} s: {} contact iterations; {}", id, to_string(status), seconds, iterations, message);
 }
 
 StoredEvent stored(std::int64_t seq, const json& event) {
@@ -443,8 +455,7 @@ void JobService::worker_loop() {
       spdlog::error("job {}: {}", job->id, e.what());
       try {
         JobOutcome o;
-        o.status = JobStatus::failed;
-        o.message = std::string("internal error: ") + e.what();
+        failed(o, FailureKind::exception, std::string("internal error: ") + e.what());
         o.finished = now_iso8601();
         finish(job, std::move(o), job->last_seq);
       } catch (const std::exception& again) {
@@ -598,10 +609,13 @@ void JobService::finish(const std::shared_ptr<ActiveJob>& job, JobOutcome outcom
     return;
   }
   if (outcome.terminal.type.empty()) {
-    const json ev = outcome.status == JobStatus::successful
-                        ? json{{"type", "job_finished"}}
-                        : failed_event(outcome.status == JobStatus::dismissed ? "dismissed"
-                                                                              : outcome.message);
+    const json ev = outcome.status == JobStatus::successful ? json{{"type", "job_finished"}}
+                    : outcome.status == JobStatus::dismissed
+                        ? json::parse(kDismissedEvent)
+                        : json{{"type", "job_failed"},
+                               {"reason", outcome.message},
+                               {"failure",
+                                {{"kind", outcome.failure_kind}, {"message", outcome.message}, {"step", outcome.failure_step}}}};
     outcome.terminal = stored(last + 1, ev);
   }
   std::optional<JobStatus> stored_status;
@@ -652,14 +666,13 @@ void JobService::run_job(const std::shared_ptr<ActiveJob>& job, const JobRecord&
   try {
     scene.emplace(read_scene(json::parse(rec.scene)));
   } catch (const SceneErrors& e) {
-    outcome.status = JobStatus::failed;
-    outcome.message = std::string("invalid scene: ") + e.what();
+    failed(outcome, FailureKind::invalid_scene, std::string("invalid scene: ") + e.what());
   } catch (const std::exception& e) {
-    outcome.status = JobStatus::failed;
-    outcome.message = std::string("cannot read the stored scene: ") + e.what();
+    failed(outcome, FailureKind::invalid_scene, std::string("cannot read the stored scene: ") + e.what());
   }
   if (!scene) {
     outcome.finished = now_iso8601();
+    log_outcome(id, outcome.status, 0, outcome.message, 0.0);
     finish(job, std::move(outcome), seq);
     return;
   }
@@ -667,9 +680,12 @@ void JobService::run_job(const std::shared_ptr<ActiveJob>& job, const JobRecord&
   const int steps = static_cast<int>(scene->steps.size());
   const int nodes = scene->problem.body->node_count();
   if (nodes > lim.max_nodes || steps > lim.max_steps) {
-    outcome.status = JobStatus::failed;
-    outcome.message = "limit: the scene is over this service's node or step limit";
+    failed(outcome, FailureKind::job_limit,
+           "limit: the scene has " + std::to_string(nodes) + " nodes and " + std::to_string(steps) +
+               " steps; this service takes at most " + std::to_string(lim.max_nodes) + " nodes and " +
+               std::to_string(lim.max_steps) + " steps");
     outcome.finished = now_iso8601();
+    log_outcome(id, outcome.status, 0, outcome.message, 0.0);
     finish(job, std::move(outcome), seq);
     return;
   }
@@ -687,8 +703,10 @@ void JobService::run_job(const std::shared_ptr<ActiveJob>& job, const JobRecord&
     std::lock_guard lock(job->progress_mutex);
     job->progress->step = step;
   };
+  // Contact iterations: real solves, the events' trials (the one count: the job document, the
+  // log, /metrics, the limit and the result's summary all read it).
   observer.iteration = [&](const IterationEvent& ev) {
-    ++iterations;
+    iterations += ev.trials;
     emit(job, ++seq, iteration_event(ev));
     std::lock_guard lock(job->progress_mutex);
     job->progress->contact_error = ev.v2;
@@ -708,6 +726,19 @@ void JobService::run_job(const std::shared_ptr<ActiveJob>& job, const JobRecord&
       stop = Stop::seconds;
     return stop != Stop::none;
   };
+  observer.stop_reason = [&]() -> std::pair<FailureKind, std::string> {
+    switch (stop) {
+      case Stop::iterations:
+        return {FailureKind::job_limit, "limit: " + std::to_string(iterations) +
+                                            " contact iterations, this service's limit (--max-iterations " +
+                                            std::to_string(lim.max_iterations) + ")"};
+      case Stop::seconds:
+        return {FailureKind::job_limit, "limit: the run reached this service's wall-time limit (--max-seconds " +
+                                            number_text(lim.max_seconds) + ")"};
+      case Stop::dismissed: return {FailureKind::dismissed, "dismissed"};
+      default: return {FailureKind::stopped, "stopped on request"};  // shutdown or lost: not stored
+    }
+  };
 
   RunResult run;
   try {
@@ -715,6 +746,7 @@ void JobService::run_job(const std::shared_ptr<ActiveJob>& job, const JobRecord&
   } catch (const std::exception& e) {
     run.completed = false;
     run.reason = std::string("solver error: ") + e.what();
+    run.failure = FailureKind::exception;
   }
   const double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
 
@@ -735,21 +767,16 @@ void JobService::run_job(const std::shared_ptr<ActiveJob>& job, const JobRecord&
   outcome.finished = now_iso8601();
   outcome.solve_seconds = run.seconds > 0 ? run.seconds : seconds;
   outcome.iterations = iterations;
+  for (const StepRecord& s : run.steps) outcome.steps_completed += s.converged ? 1 : 0;
   if (job->dismissed) {
-    outcome.status = JobStatus::dismissed;
-    outcome.message = "dismissed";
+    failed(outcome, FailureKind::dismissed, "dismissed");
   } else if (run.completed) {
     outcome.status = JobStatus::successful;
     outcome.message = "solved " + std::to_string(steps) + " steps";
   } else {
-    outcome.status = JobStatus::failed;
-    if (stop == Stop::iterations)
-      outcome.message = "limit: more than " + std::to_string(lim.max_iterations) +
-                        " contact iterations";
-    else if (stop == Stop::seconds)
-      outcome.message = "limit: more than " + std::to_string(lim.max_seconds) + " s of wall time";
-    else
-      outcome.message = run.reason.empty() ? "the run failed" : run.reason;
+    // The result's reason (summary.reason), a job limit's included: the run's stop request
+    // named it (observer.stop_reason).
+    failed(outcome, run.failure, run.reason.empty() ? "the run failed" : run.reason, run.failure_step);
   }
   if (outcome.status != JobStatus::dismissed && !run.steps.empty()) {
     try {
@@ -762,11 +789,10 @@ void JobService::run_job(const std::shared_ptr<ActiveJob>& job, const JobRecord&
       spdlog::error("job {}: cannot build its result: {}", id, e.what());
     }
   }
-  const std::string status(to_string(outcome.status));
+  const JobStatus status = outcome.status;
   const std::string message = outcome.message;
   finish(job, std::move(outcome), seq);
-  spdlog::info("job {} {} in {:.3f} s: {} contact iterations; {}", id, status, seconds, iterations,
-               message);
+  log_outcome(id, status, iterations, message, seconds);
 }
 
 }  // namespace grip::server

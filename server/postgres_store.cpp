@@ -39,6 +39,9 @@ CREATE TABLE IF NOT EXISTS grip_jobs (
   generation BIGINT NOT NULL DEFAULT 0,
   lease_expires TIMESTAMPTZ
 );
+ALTER TABLE grip_jobs ADD COLUMN IF NOT EXISTS failure_kind TEXT NOT NULL DEFAULT '';
+ALTER TABLE grip_jobs ADD COLUMN IF NOT EXISTS failure_step INTEGER NOT NULL DEFAULT 0;
+ALTER TABLE grip_jobs ADD COLUMN IF NOT EXISTS steps_completed INTEGER NOT NULL DEFAULT 0;
 CREATE INDEX IF NOT EXISTS grip_jobs_by_status ON grip_jobs (status, ord);
 CREATE TABLE IF NOT EXISTS grip_events (
   job_id TEXT NOT NULL,
@@ -61,7 +64,8 @@ ALTER TABLE grip_jobs ADD COLUMN IF NOT EXISTS request_id TEXT NOT NULL DEFAULT 
 // Columns read by read_job, in this order.
 constexpr const char* kJobColumns =
     "id, ord, status, created, started, finished, updated, message, steps, nodes, "
-    "idempotency_key, last_seq, attempts, solve_seconds, iterations, owner, generation, stored_bytes, request_id";
+    "idempotency_key, last_seq, attempts, solve_seconds, iterations, owner, generation, failure_kind, "
+    "failure_step, steps_completed, stored_bytes, request_id";
 
 using Param = std::optional<std::string>;
 
@@ -285,9 +289,12 @@ JobRecord read_job(const Result& r, int row, bool with_scene) {
   j.iterations = r.int64(row, 14);
   j.owner = r.text(row, 15);
   j.generation = r.int64(row, 16);
-  j.stored_bytes = r.int64(row, 17);
-  j.request_id = r.text(row, 18);
-  if (with_scene) j.scene = r.text(row, 19);
+  j.failure_kind = r.text(row, 17);
+  j.failure_step = static_cast<int>(r.int64(row, 18));
+  j.steps_completed = static_cast<int>(r.int64(row, 19));
+  j.stored_bytes = r.int64(row, 20);
+  j.request_id = r.text(row, 21);
+  if (with_scene) j.scene = r.text(row, 22);
   return j;
 }
 
@@ -581,7 +588,10 @@ std::optional<JobStatus> PostgresStore::finish_job(const Lease& lease, const Job
       "status = CASE WHEN cur.status = 'dismissed' OR $3::text = 'dismissed' THEN 'dismissed' ELSE $3::text END, "
       "message = CASE WHEN cur.status = 'dismissed' OR $3::text = 'dismissed' THEN 'dismissed' ELSE $4::text END, "
       "finished = $5::text, updated = $5::text, solve_seconds = $6::float8, iterations = $7::bigint, "
-      "last_seq = greatest(j.last_seq, $8::bigint), stored_bytes = octet_length(j.scene) + "
+      "last_seq = greatest(j.last_seq, $8::bigint), "
+      "failure_kind = CASE WHEN cur.status = 'dismissed' OR $3::text = 'dismissed' THEN 'dismissed' ELSE $13::text END, "
+      "failure_step = CASE WHEN cur.status = 'dismissed' OR $3::text = 'dismissed' THEN 0 ELSE $14::integer END, "
+      "steps_completed = $15::integer, stored_bytes = octet_length(j.scene) + "
       "CASE WHEN cur.status = 'dismissed' OR $3::text = 'dismissed' THEN 0 ELSE coalesce(octet_length($9::bytea), 0) END + "
       "octet_length($11::text) + (SELECT coalesce(sum(octet_length(e.data)), 0) FROM grip_events e WHERE e.job_id = j.id) "
       "FROM cur WHERE j.id = cur.id RETURNING j.id, j.status), "
@@ -594,8 +604,8 @@ std::optional<JobStatus> PostgresStore::finish_job(const Lease& lease, const Job
       "SELECT status, pg_notify('grip', 'e' || id) FROM upd",
       {lease.job_id, num(lease.generation), std::string(to_string(o.status)), o.message, o.finished,
        num(o.solve_seconds), num(o.iterations), num(o.terminal.seq), o.result ? Param(bytea(*o.result)) : Param(),
-       o.terminal.type,
-       o.terminal.data, std::string(kDismissedEvent)});
+       o.terminal.type, o.terminal.data, std::string(kDismissedEvent), o.failure_kind,
+       num(std::int64_t{o.failure_step}), num(std::int64_t{o.steps_completed})});
   if (r.rows() == 0) return std::nullopt;
   return parse_job_status(r.text(0, 0));
 }

@@ -29,6 +29,9 @@ CREATE TABLE IF NOT EXISTS jobs (
   owner TEXT NOT NULL DEFAULT '',
   generation INTEGER NOT NULL DEFAULT 0,
   lease_expires REAL NOT NULL DEFAULT 0,
+  failure_kind TEXT NOT NULL DEFAULT '',
+  failure_step INTEGER NOT NULL DEFAULT 0,
+  steps_completed INTEGER NOT NULL DEFAULT 0,
   stored_bytes INTEGER NOT NULL DEFAULT 0,
   request_id TEXT NOT NULL DEFAULT ''
 );
@@ -53,15 +56,23 @@ ALTER TABLE jobs ADD COLUMN generation INTEGER NOT NULL DEFAULT 0;
 ALTER TABLE jobs ADD COLUMN lease_expires REAL NOT NULL DEFAULT 0;
 )sql";
 
-// Schema 2 to 3: the bytes a finished job stores.
-constexpr const char* kUpgrade2to3 =
+// Schema 2 to 3 (failure kinds, converged steps of a finished job).
+constexpr const char* kUpgrade2to3 = R"sql(
+ALTER TABLE jobs ADD COLUMN failure_kind TEXT NOT NULL DEFAULT '';
+ALTER TABLE jobs ADD COLUMN failure_step INTEGER NOT NULL DEFAULT 0;
+ALTER TABLE jobs ADD COLUMN steps_completed INTEGER NOT NULL DEFAULT 0;
+)sql";
+
+// Schema 3 to 4: the bytes a finished job stores, the request that submitted it.
+constexpr const char* kUpgrade3to4 =
     "ALTER TABLE jobs ADD COLUMN stored_bytes INTEGER NOT NULL DEFAULT 0;"
     "ALTER TABLE jobs ADD COLUMN request_id TEXT NOT NULL DEFAULT '';";
 
 // Columns read by read_job, in this order.
 constexpr const char* kJobColumns =
     "id, ord, status, created, started, finished, updated, message, steps, nodes, "
-    "idempotency_key, last_seq, attempts, solve_seconds, iterations, owner, generation, stored_bytes, request_id";
+    "idempotency_key, last_seq, attempts, solve_seconds, iterations, owner, generation, failure_kind, "
+    "failure_step, steps_completed, stored_bytes, request_id";
 
 JobRecord read_job(const Statement& st, bool with_scene) {
   JobRecord j;
@@ -82,9 +93,12 @@ JobRecord read_job(const Statement& st, bool with_scene) {
   j.iterations = st.int64(14);
   j.owner = st.text(15);
   j.generation = st.int64(16);
-  j.stored_bytes = st.int64(17);
-  j.request_id = st.text(18);
-  if (with_scene) j.scene = st.text(19);
+  j.failure_kind = st.text(17);
+  j.failure_step = static_cast<int>(st.int64(18));
+  j.steps_completed = static_cast<int>(st.int64(19));
+  j.stored_bytes = st.int64(20);
+  j.request_id = st.text(21);
+  if (with_scene) j.scene = st.text(22);
   return j;
 }
 
@@ -119,6 +133,7 @@ SqliteStore::SqliteStore(const std::string& path, int busy_timeout_ms) {
     }();
     if (has_jobs && v.int64(0) < 2) writer_->exec(kUpgrade1to2);
     if (has_jobs && v.int64(0) < 3) writer_->exec(kUpgrade2to3);
+    if (has_jobs && v.int64(0) < 4) writer_->exec(kUpgrade3to4);
   }
   // Pages freed by removals go back to the file system at each prune (incremental_vacuum);
   // a file made without it switches once, by a VACUUM that rewrites it.
@@ -132,7 +147,7 @@ SqliteStore::SqliteStore(const std::string& path, int busy_timeout_ms) {
     writer_->exec("VACUUM");
   }
   writer_->exec(kSchema);
-  writer_->exec("PRAGMA user_version = 3");
+  writer_->exec("PRAGMA user_version = 4");
   // The file is this process's alone: whatever a previous process held is free now.
   writer_->exec("UPDATE jobs SET lease_expires = 0 WHERE finished IS NULL");
   reader_ = std::make_unique<Database>(path, busy_timeout_ms);
@@ -380,10 +395,13 @@ std::optional<JobStatus> SqliteStore::finish_job(const Lease& lease, const JobOu
     if (dismissed) terminal = {o.terminal.seq, "job_failed", std::string(kDismissedEvent)};
     writer_->prepare(
                "UPDATE jobs SET status = ?1, message = ?2, finished = ?3, updated = ?3, "
-               "solve_seconds = ?4, iterations = ?5, last_seq = max(last_seq, ?6) WHERE id = ?7")
+               "solve_seconds = ?4, iterations = ?5, last_seq = max(last_seq, ?6), failure_kind = ?8, "
+               "failure_step = ?9, steps_completed = ?10 WHERE id = ?7")
         .bind(1, to_string(final_status)).bind(2, dismissed ? std::string("dismissed") : o.message)
         .bind(3, o.finished).bind(4, o.solve_seconds).bind(5, o.iterations)
-        .bind(6, terminal.seq).bind(7, lease.job_id).run();
+        .bind(6, terminal.seq).bind(7, lease.job_id)
+        .bind(8, dismissed ? std::string("dismissed") : o.failure_kind)
+        .bind(9, dismissed ? 0 : o.failure_step).bind(10, o.steps_completed).run();
     if (o.result && !dismissed)
       writer_->prepare("INSERT OR REPLACE INTO results (job_id, data) VALUES (?, ?)")
           .bind(1, lease.job_id).bind_blob(2, *o.result).run();

@@ -41,7 +41,8 @@ class StoreUnavailable : public std::runtime_error {
 };
 
 // The terminal event of a dismissed job, as the store writes it.
-inline constexpr std::string_view kDismissedEvent = R"({"reason":"dismissed","type":"job_failed"})";
+inline constexpr std::string_view kDismissedEvent =
+    R"({"failure":{"kind":"dismissed","message":"dismissed","step":0},"reason":"dismissed","type":"job_failed"})";
 
 struct JobRecord {
   std::string id;
@@ -62,6 +63,11 @@ struct JobRecord {
   std::int64_t iterations = 0;  // contact iterations of the final run
   std::string owner;            // replica holding (or that last held) the lease
   std::int64_t generation = 0;  // lease generation: grows with every claim
+  // A finished job: why it did not succeed (a FailureKind's name, empty when it did), the step
+  // that failed (0: none), and the steps that converged.
+  std::string failure_kind;
+  int failure_step = 0;
+  int steps_completed = 0;
   std::int64_t stored_bytes = 0;  // of its scene, events and result, once finished
   std::string request_id;         // of the request that submitted it (X-Request-Id)
 };
@@ -114,6 +120,9 @@ struct JobOutcome {
   std::string finished;  // timestamp
   double solve_seconds = 0.0;
   std::int64_t iterations = 0;
+  std::string failure_kind;  // as JobRecord's
+  int failure_step = 0;
+  int steps_completed = 0;
   std::optional<std::string> result;  // the result as stored (gzip of its JSON), when the run produced one
   StoredEvent terminal;                // job_finished | job_failed
 };

@@ -12,6 +12,7 @@
 #include <unordered_set>
 
 #include "solver/model/body_set.hpp"
+#include "solver/model/number_text.hpp"
 #include "solver/io/json_depth.hpp"
 #include "solver/io/scene_reader.hpp"
 #include "solver/io/schema_validation.hpp"
@@ -591,12 +592,41 @@ Scene read_scene(const nlohmann::json& input) {
   throw SceneErrors(std::move(schema_issues), more);
 }
 
+namespace {
+
+// Magnitudes beyond what the arithmetic carries: a modulus or a load of 1e300 overflows the
+// products and squared norms of a solve (a diverging Newton then reported a 300-digit
+// correction). No quantity of a scene comes near 1e30 in any consistent units.
+constexpr double kLargestMagnitude = 1e30;
+
+void refuse_huge_numbers(Reader& r, const json& v, const std::string& pointer) {
+  if (v.is_number_float() || v.is_number_integer()) {
+    const double x = v.get<double>();
+    if (std::abs(x) > kLargestMagnitude)
+      r.error(pointer.empty() ? "/" : pointer,
+              show(v) + " is beyond " + number_text(kLargestMagnitude) +
+                  " in magnitude: the solver's arithmetic would overflow; give the scene in other units");
+  } else if (v.is_object()) {
+    for (const auto& [key, item] : v.items()) {
+      std::string escaped;
+      for (const char c : key) escaped += c == '~' ? "~0" : c == '/' ? "~1" : std::string(1, c);
+      refuse_huge_numbers(r, item, pointer + "/" + escaped);
+    }
+  } else if (v.is_array()) {
+    for (size_t i = 0; i < v.size(); ++i) refuse_huge_numbers(r, v[i], pointer + "/" + std::to_string(i));
+  }
+}
+
+}  // namespace
+
 Scene read_checked_scene(const nlohmann::json& input) {
   Reader r;
   Scene scene;
   scene.effective = input;
   json& e = scene.effective;
   if (!e.is_object()) throw SceneErrors(std::vector<SceneIssue>{{"/", "a scene is a JSON object"}});
+  refuse_huge_numbers(r, e, "");
+  if (!r.issues.empty()) throw SceneErrors(std::move(r.issues));
   const bool several = e.contains("bodies");
   if (several && e.contains("body")) r.error("/body", "cannot be given together with bodies (body is the one-body shorthand)");
   if (!several && e.contains("contacts")) r.error("/contacts", "pairs the surfaces of bodies: give bodies, not body");
