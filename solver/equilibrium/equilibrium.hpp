@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include "solver/model/failure.hpp"
+#include "solver/model/number_text.hpp"
 #include "solver/model/parallel.hpp"
 #include "solver/problem/problem.hpp"
 #include "solver/equilibrium/free_block_solver.hpp"
@@ -76,6 +78,7 @@ struct EquilibriumState {
   double noise = 0.0;
   double relative_residual = 0.0;  // final free residual over the force scale
   std::string reason;              // why Newton failed
+  FailureKind failure = FailureKind::none;  // newton_diverged, or invalid_state (the body refuses q)
 };
 
 struct EquilibriumCounters {

@@ -16,7 +16,11 @@ namespace grip {
 // contact resultant N n + Q t must equal minus the load's resultant on the free translations,
 // with N > 0 where translation along n is free and |Q| < mu N where translation along t is.
 // Other arrangements are left to the solve.
-std::string unreachable_equilibrium(const Problem& problem, const EquilibriumState& paired,
+struct Unreachable {
+  FailureKind kind = FailureKind::none;  // friction_limit (the shear), no_equilibrium (a pull)
+  std::string reason;
+};
+Unreachable unreachable_equilibrium(const Problem& problem, const EquilibriumState& paired,
                                     const LoadFactors& factors);
 
 // "at load factor 1.05", or "at load factors press 1, shear 1.05" (the non-zero ones, named).
