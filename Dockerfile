@@ -7,7 +7,8 @@
 # service takes GRIP_GRACE (5 s) for running jobs, then requeues what is left and exits, well
 # inside those 10 s. A longer GRIP_GRACE needs `docker stop -t` / `--stop-timeout` (compose:
 # stop_grace_period) at least GRIP_GRACE + 5 s.
-# A bind-mounted data folder (-v /srv/grip:/var/lib/grip) must be writable by uid 10001.
+# A bind-mounted data folder (-v /srv/grip:/var/lib/grip) must be writable by user 10001, group
+# 10001 (chown 10001:10001 /srv/grip).
 # Several replicas on one PostgreSQL: GRIP_DB=postgresql://... (deploy/compose.yaml).
 FROM debian:12-slim AS build
 WORKDIR /src
@@ -25,7 +26,8 @@ RUN apt-get update -qq \
  && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
       libcpp-httplib0.11 libspdlog1.10 libfmt9 libsqlite3-0 libpq5 libmetis5 liblapack3 libgomp1 \
  && rm -rf /var/lib/apt/lists/* \
- && useradd --system --uid 10001 --user-group --home-dir /var/lib/grip --create-home grip
+ && groupadd --system --gid 10001 grip \
+ && useradd --system --uid 10001 --gid 10001 --home-dir /var/lib/grip --create-home grip
 # grip serve and grip healthcheck run grip-server from grip's directory (apps/CMakeLists.txt).
 COPY --from=build /build/apps/grip /build/apps/grip-server /usr/local/bin/
 COPY --from=build /src/schemas /usr/local/share/grip/schemas

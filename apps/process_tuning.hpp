@@ -20,7 +20,7 @@ namespace grip {
 // On 2 cores that is 3 threads more than the cores, 5,200 context switches and 26,000 futex
 // calls per refined Hertz run, competing with grip solve's writer thread and the service's
 // workers. Allowing no active parallel level runs each team on its calling thread (the loops
-// are per column: the same numbers), and the solver is single-threaded as DESIGN.md says.
+// are per column: the same numbers), and the solver starts no threads (docs/design.md#principles).
 inline void tune_process() {
   mallopt(M_MMAP_THRESHOLD, 64 << 20);
   mallopt(M_TRIM_THRESHOLD, 256 << 20);

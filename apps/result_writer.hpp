@@ -1,10 +1,10 @@
 #pragma once
 // grip solve's result written to its file while the solve runs (the solver stays
-// single-threaded, DESIGN.md): the head before the solve, each step as the solver's observer
-// hands it over, the tail after the solve (solver/io/result.hpp: result_head_parts,
-// result_step_parts, result_tail_parts). A thread of its own formats the parts into memory
-// and writes each text to the file as soon as it and the ones before it are formatted, so
-// after the solve only the last step and the tail are left. The bytes are write_result's.
+// single-threaded, docs/design.md#principles): the head before the solve, each step as the solver's
+// observer hands it over, the tail after the solve (solver/io/result.hpp: result_head_parts,
+// result_step_parts, result_tail_parts). A thread of its own formats the parts into memory and
+// writes each text to the file as soon as it and the ones before it are formatted, so after the
+// solve only the last step and the tail are left. The bytes are write_result's.
 //
 // The texts are held in anonymous mappings with transparent huge pages asked for, reused once
 // written: on this kind of virtual machine a page fault costs about 10 us, and 28 MB of text

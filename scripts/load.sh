@@ -54,8 +54,10 @@ cleanup() {
 trap cleanup EXIT
 
 server_streams=$((streams + 28))
+# Every load client connects from 127.0.0.1: the limit per client address is raised to let
+# them all in (it stands for clients on many hosts).
 "$grip" serve --host 127.0.0.1 --port 0 --db "$tmp/grip.sqlite" --streams "$server_streams" \
-  "${serve_extra[@]}" >"$tmp/server.log" 2>&1 &
+  --per-client 1000 "${serve_extra[@]}" >"$tmp/server.log" 2>&1 &
 server_pid=$!
 port=
 for _ in $(seq 1 600); do

@@ -1,11 +1,12 @@
 #pragma once
-// The HTTP/JSON API (DESIGN.md) over JobService: thin handlers, problem+json (RFC 9457) for
-// every error, OGC API - Processes aliases. cpp-httplib stays inside http_server.cpp.
+// The HTTP/JSON API (docs/design.md#the-api) over JobService: thin handlers, problem+json (RFC
+// 9457) for every error, OGC API - Processes aliases. cpp-httplib stays inside http_server.cpp.
 //
-// Threads: cpp-httplib serves one connection per pool thread for the connection's life, so
-// event streams are counted and refused with 503 beyond `max_streams`, the pool is sized
-// above that cap, and every stream's content provider returns within about a second (so
-// that stop() finishes) while a heartbeat comment keeps idle streams alive.
+// Connections: a thread each for the connection's life, with deadlines and limits per
+// connection and client (FrontLimits, server/http_front.hpp). Event streams are counted and
+// refused with 503 beyond `max_streams`; a stream's content provider looks at its socket
+// every 500 ms (a closed one frees its slot, stop() finishes promptly) while a heartbeat
+// comment keeps idle streams alive.
 #include <atomic>
 #include <chrono>
 #include <cstddef>
@@ -17,12 +18,24 @@
 
 namespace grip::server {
 
+// What one connection may take (server/http_front.hpp).
+struct FrontLimits {
+  std::chrono::milliseconds head{5000};   // a whole request head, from its first byte
+  std::chrono::milliseconds body{10000};  // a whole request body, from the end of the head
+  int max_connections = 1024;  // connections served at once (a thread each)
+  int per_client = 64;         // open connections from one client address
+  int max_idle = 64;           // keep-alive connections waiting for their next request
+  int keep_alive_seconds = 2;  // how long an idle keep-alive connection is kept
+  int io_seconds = 10;         // one read or write that makes no progress
+};
+
 struct HttpOptions {
   std::string host = "127.0.0.1";
   int port = 8080;                  // 0: any free port (see bound_port())
-  int threads = 0;                  // HTTP pool; 0: max_streams + 32
+  FrontLimits front;
   int max_streams = 32;             // open event streams
   std::size_t max_body_bytes = 8u << 20;
+  std::size_t parse_budget_bytes = 0;  // bodies read and checked at once; 0: max_body_bytes
   std::optional<std::string> token;  // bearer token required on every route but health
   std::chrono::milliseconds heartbeat{15000};
   std::string schemas_dir;          // schemas/*.schema.json and schemas/examples/*.json

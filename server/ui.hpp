@@ -1,5 +1,5 @@
 #pragma once
-// The browser page (DESIGN.md, "The page"): GET /ui and /ui/{file}, and GET / when the
+// The browser page (docs/design.md#the-service): GET /ui and /ui/{file}, and GET / when the
 // Accept header names text/html. Plain HTML, CSS and JavaScript modules from server/ui/,
 // compiled into the binary; no build step, nothing fetched from elsewhere. The page carries
 // no data, so it is served without the bearer token; it sends the token (pasted by the user,

@@ -3,7 +3,8 @@
 // (coulomb_model.hpp), then makes one real solve at the prediction with its line search; the
 // friction bound moves with p_eta, so there are no tau passes. Options: the tau passes of
 // eq. 14 around the same inner loop with eq. 13 on the model (`friction_loop: passes`,
-// ALGORITHM.md section 5), or around the paper's literal loop (`loop: paper`).
+// docs/algorithm.md#friction_loop-passes-the-tau-passes), or around the paper's literal loop
+// (`loop: paper`).
 #include "solver/contact/acceleration.hpp"
 #include "solver/contact/coulomb_model.hpp"
 #include "solver/contact/step.hpp"
@@ -99,6 +100,7 @@ class CevStep : public StepSolver {
     if (!line_search(pl, du, trials)) {
       if (!stale || !budget_left()) return Update::failed;
       out_.reason.clear();
+      out_.failure = FailureKind::none;
       eq_.refresh_compliance();
       return Update::retry;
     }

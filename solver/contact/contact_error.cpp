@@ -54,7 +54,7 @@ Vector project_forces(const Problem& problem, const Vector& p, const Vector& pba
     else  // slipping: stays on the bound, on its side
       out[c.xi] = sign(p[c.xi]) * tau[i];
   }
-  // The rigid amplitudes have no bound (ALGORITHM.md 7).
+  // The rigid amplitudes have no bound (docs/algorithm.md#bodies-held-only-by-contact).
   for (int k = 0; k < problem.rigid.count(); ++k) out[problem.rigid.first + k] = pbar[problem.rigid.first + k];
   return out;
 }

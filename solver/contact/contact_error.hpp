@@ -1,6 +1,6 @@
 #pragma once
 // The contact error vector v (eq. 10) and the Coulomb projection of eq. 13, shared by every
-// strategy. Signs (ALGORITHM.md section 1): p_eta <= 0 presses; s_eta > 0 is penetration;
+// strategy. Signs (docs/algorithm.md#notation): p_eta <= 0 presses; s_eta > 0 is penetration;
 // s_xi is the incremental slip; tau = nu |p*_eta| is the friction bound of the current pass.
 #include <vector>
 

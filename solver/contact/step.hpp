@@ -40,9 +40,9 @@ class StepSolver {
   // The strategy itself: fills out_ (converged, reason, p, tau, state).
   virtual void solve(const Vector& q_guess, const Vector& p_start, const Vector& p_star) = 0;
 
-  // The tau passes of eq. 14 (ALGORITHM.md sections 4, 5): each pass holds tau = mu |p*| and
-  // runs `pass` (a Tresca problem); passes end when p* settles. They start from p_star_in, or
-  // from p_start where the free motions follow the state (step.cpp).
+  // The tau passes of eq. 14 (docs/algorithm.md#friction_loop-passes-the-tau-passes): each pass
+  // holds tau = mu |p*| and runs `pass` (a Tresca problem); passes end when p* settles. They start
+  // from p_star_in, or from p_start where the free motions follow the state (step.cpp).
   void tau_passes(const Vector& q_guess, const Vector& p_start, const Vector& p_star_in,
                   const std::function<bool()>& pass);
 
@@ -70,7 +70,8 @@ class StepSolver {
   Vec2 mode_rates(size_t candidate, int mode) const;
   bool mode_held(int mode) const;
   void accept(EquilibriumState s, const Vector& p);
-  bool fail(std::string reason);
+  // Records the first failure of the step (its kind and reason); false.
+  bool fail(FailureKind kind, std::string reason);
   // False (with the reason) once the step's real-solve budget is spent or a stop is asked.
   bool budget_left();
 

@@ -1,6 +1,6 @@
 #pragma once
 // Contact strategies behind one step contract (solve_contact_step): the paper's accelerated
-// contact error vector scheme `cev` (ALGORITHM.md sections 2-5, 8, 9), `uzawa` (the same
+// contact error vector scheme `cev` (docs/algorithm.md), `uzawa` (the same
 // literal loop with n = 1 and a fixed alpha), and the `penalty` baseline (one Newton solve
 // with a penalty law; its error falls as k grows). Each solves one load step given an
 // equilibrium oracle, and reports every real solve to an observer. One file per strategy
@@ -100,6 +100,7 @@ struct StepOutcome {
   bool converged = false;
   bool stopped = false;  // by the StopRequest, not by the numerics
   std::string reason;
+  FailureKind failure = FailureKind::none;  // the kind of the reason
   Vector p;
   Vector tau;
   EquilibriumState state;

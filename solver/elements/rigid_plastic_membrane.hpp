@@ -5,7 +5,7 @@
 // committed at the end of the previous step.
 //
 // Hill's 1979 yield with r and M; hardening sigma_bar = H (eps_bar + a0)^n. In plane strain
-// (d2 = 0) the effective strain increment of ALGORITHM.md section 6 is c |d1| with
+// (d2 = 0) the effective strain increment (docs/algorithm.md#reading-the-paper) is c |d1| with
 //   c = 0.5 [2(1+r)]^(1/M) [1 + (1+2r)^(-1/(M-1))]^((M-1)/M)   (2/sqrt(3) for r = 1, M = 2),
 // d1 = ln(l / L0) the logarithmic stretch increment of the element. An element with d1 = 0 has
 // an indeterminate stress, so d1 enters through the smooth regularization of section 9,

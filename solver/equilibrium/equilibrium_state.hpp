@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "solver/model/failure.hpp"
 #include "solver/problem/problem.hpp"
 
 namespace grip {
@@ -32,6 +33,7 @@ struct EquilibriumState {
   double noise = 0.0;
   double relative_residual = 0.0;  // final free residual over the force scale
   std::string reason;              // why Newton failed
+  FailureKind failure = FailureKind::none;  // newton_diverged, or invalid_state (the body refuses q)
 };
 
 struct EquilibriumCounters {

@@ -8,6 +8,7 @@
 #include <functional>
 #include <limits>
 
+#include "solver/model/number_text.hpp"
 #include "solver/problem/rigid_modes.hpp"
 
 namespace grip {
@@ -203,6 +204,7 @@ EquilibriumState Equilibrium::newton(const Vector& q_guess, const Vector& p) {
     state.relative_residual = force_scale > 0 ? r_max / force_scale : 0.0;
     if (!std::isfinite(r_max)) {
       state.reason = "Newton produced a non-finite residual";
+      state.failure = FailureKind::newton_diverged;
       return state;
     }
     const bool residual_met = r_max <= params_.residual_tolerance * force_scale;
@@ -231,12 +233,14 @@ EquilibriumState Equilibrium::newton(const Vector& q_guess, const Vector& p) {
     if (reuse) {
       if (!factorize_body_tangent(state.q)) {
         state.reason = "singular stiffness: the supports do not hold the body";
+        state.failure = FailureKind::newton_diverged;
         return state;
       }
     } else {
       ++counters_.factorizations;
       if (!lu_.factorize(triplets, free_index_, free_count_, 1e-4)) {
         state.reason = "singular tangent stiffness in Newton iteration " + std::to_string(it);
+        state.failure = FailureKind::newton_diverged;
         return state;
       }
     }
@@ -254,10 +258,12 @@ EquilibriumState Equilibrium::newton(const Vector& q_guess, const Vector& p) {
     const double step = (dq.array() * length_scales_.array()).abs().maxCoeff();
     if (!std::isfinite(step)) {
       state.reason = "Newton produced a non-finite displacement";
+      state.failure = FailureKind::newton_diverged;
       return state;
     }
     if (step > params_.divergence_lengths * body_length) {
-      state.reason = "Newton diverged (correction of " + std::to_string(step) + " length units)";
+      state.reason = "Newton diverged (correction of " + number_text(step) + " length units)";
+      state.failure = FailureKind::newton_diverged;
       return state;
     }
     last_step = step;
@@ -270,8 +276,9 @@ EquilibriumState Equilibrium::newton(const Vector& q_guess, const Vector& p) {
     stick_branch_.clear();
   }
   pair(state.q, state);
+  state.failure = FailureKind::newton_diverged;
   state.reason = "Newton did not converge in " + std::to_string(params_.max_iterations) +
-                 " iterations (free residual " + std::to_string(state.relative_residual) +
+                 " iterations (free residual " + number_text(state.relative_residual) +
                  " of the force scale)";
   return state;
 }
@@ -279,6 +286,7 @@ EquilibriumState Equilibrium::newton(const Vector& q_guess, const Vector& p) {
 EquilibriumState& Equilibrium::finish(EquilibriumState& state, const Vector& p) const {
   state.reason = problem_.body->inadmissible(state.q);
   state.converged = state.reason.empty();
+  state.failure = state.converged ? FailureKind::none : FailureKind::invalid_state;
   state.p = p;
   const RigidModes& rigid = problem_.rigid;
   if (pins_free_)  // the amplitudes were solved for: they are the pins' displacements

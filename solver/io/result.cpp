@@ -34,9 +34,20 @@ json step_finished_event(const StepRecord& rec) {
             {"converged", rec.converged}, {"tau_passes", rec.passes},
             {"contact_iterations", rec.solves}, {"newton_iterations", rec.newton_iterations},
             {"seconds", rec.seconds}, {"stage", rec.stage}, {"factors", rec.factors}};
-  if (!rec.converged) j["reason"] = rec.reason;
+  if (!rec.converged) {
+    j["reason"] = rec.reason;
+    j["failure"] = failure_json(rec.failure, rec.reason, rec.index);
+  }
   if (!rec.warning.empty()) j["warning"] = rec.warning;
   return j;
+}
+
+json failure_json(FailureKind kind, const std::string& message, int step) {
+  return {{"kind", to_string(kind)}, {"message", message}, {"step", step}};
+}
+
+json job_failed_event(FailureKind kind, const std::string& reason, int step) {
+  return {{"type", "job_failed"}, {"reason", reason}, {"failure", failure_json(kind, reason, step)}};
 }
 
 namespace {
@@ -233,7 +244,8 @@ json effects_json(const Scene& scene) {
           {"contact_unknowns", problem.component_count},
           {"held_by_contact", problem.rigid.names},
           {"unknowns_per_contact_point", tangential > 0 ? 2 : 1}};
-  // How the free motions were held (ALGORITHM.md 7), and that no regularization is left.
+  // How the free motions were held (docs/algorithm.md#bodies-held-only-by-contact), and that no
+  // regularization is left.
   if (problem.rigid.count())
     effects["held_by_contact_by"] =
         scene.params.contact.method == ContactMethod::penalty
@@ -294,10 +306,12 @@ std::optional<json> bodies_json(const Body& body) {
 }
 
 json summary_json(const RunResult& run) {
-  return {{"completed", run.completed}, {"reason", run.reason}, {"steps", run.steps.size()},
-          {"contact_iterations", run.counters.solves},
-          {"newton_iterations", run.counters.newton_iterations},
-          {"factorizations", run.counters.factorizations}, {"seconds", run.seconds}};
+  json j = {{"completed", run.completed}, {"reason", run.reason}, {"steps", run.steps.size()},
+            {"contact_iterations", run.counters.solves},
+            {"newton_iterations", run.counters.newton_iterations},
+            {"factorizations", run.counters.factorizations}, {"seconds", run.seconds}};
+  if (!run.completed) j["failure"] = failure_json(run.failure, run.reason, run.failure_step);
+  return j;
 }
 
 // table_json's rows, written as they are made (no document of the table's size in memory),

@@ -2,6 +2,7 @@
 // [{"slave": "BODY.SET", "master": "BODY.SET" | "OBSTACLE", "friction", "name"}].
 #include <algorithm>
 #include <set>
+#include <unordered_map>
 
 #include "solver/model/body_set.hpp"
 #include "solver/elements/continuum.hpp"
@@ -29,6 +30,7 @@ void read_bodies(Reader& r, json& bodies, Problem& problem) {
   if (bodies.empty()) r.error("/bodies", "needs at least one body");
   std::vector<Problem> parts;
   std::vector<std::string> names;
+  std::set<std::string> named;  // names, for lookup
   for (size_t b = 0; b < bodies.size(); ++b) {
     const std::string bp = "/bodies/" + std::to_string(b);
     json& body = bodies[b];
@@ -45,19 +47,20 @@ void read_bodies(Reader& r, json& bodies, Problem& problem) {
       r.error(bp + "/name", show(name) + " is not a name (a non-empty string without '.')");
       continue;
     }
-    for (const std::string& other : names)
-      if (other == name) r.error(bp + "/name", show(name) + " names another body already");
+    if (named.count(name.get<std::string>()))
+      r.error(bp + "/name", show(name) + " names another body already");
     if (body.value("model", "") == "rigid_plastic_membrane")
       r.error(bp + "/model",
               "a rigid_plastic_membrane has no stiffness in its flat reference state: its first step starts from a "
               "prescribed depth of one node pressed by a rigid obstacle (solver.start), whose reaction is the first "
-              "contact force (ALGORITHM.md 9); against a deformable body that depth would be shared with the other "
+              "contact force (docs/algorithm.md#load-stepping-and-cuts); against a deformable body that depth would be shared with the other "
               "body's compliance, which gives no starting force, so a membrane is for one-body scenes (body)");
     if (!r.issues.empty()) continue;
     Problem part;
     read_body(r, body, part, bp);
     if (!r.issues.empty() || !part.body) continue;
     names.push_back(name.get<std::string>());
+    named.insert(names.back());
     parts.push_back(std::move(part));
   }
   if (!r.issues.empty()) return;
@@ -149,6 +152,9 @@ void read_contacts(Reader& r, json& scene, Problem& problem) {
   const auto& all = static_cast<const BodySet&>(*problem.body);
   const size_t rigid = problem.obstacles.size();
   std::vector<std::vector<int>> obstacle_slaves(rigid);
+  // The obstacles' and the pairs' names (a linear search per contact made reading quadratic).
+  std::unordered_map<std::string, size_t> obstacle_index;
+  for (size_t o = 0; o < rigid; ++o) obstacle_index.emplace(problem.obstacles[o].name, o);
   for (size_t i = 0; i < contacts->size(); ++i) {
     const std::string cp = "/contacts/" + std::to_string(i);
     json& c = (*contacts)[i];
@@ -161,9 +167,9 @@ void read_contacts(Reader& r, json& scene, Problem& problem) {
     if (!r.issues.empty()) continue;
     const auto slave = find_set(r, all, c["slave"].get<std::string>(), cp + "/slave");
     const std::string master = c["master"].get<std::string>();
-    int obstacle = -1;
-    for (size_t o = 0; o < rigid; ++o)
-      if (problem.obstacles[o].name == master) obstacle = static_cast<int>(o);
+    const auto named_master = obstacle_index.find(master);
+    const int obstacle = named_master != obstacle_index.end() && named_master->second < rigid
+                             ? static_cast<int>(named_master->second) : -1;
     if (obstacle >= 0) {
       if (c.contains("friction"))
         r.error(cp + "/friction", "is the obstacle's: give it in /obstacles/" + std::to_string(obstacle) + "/friction");
@@ -184,8 +190,8 @@ void read_contacts(Reader& r, json& scene, Problem& problem) {
     if (!c.contains("name")) c["name"] = c["slave"].get<std::string>() + " on " + master;
     if (!c["name"].is_string()) r.error(cp + "/name", "is not a string");
     else pair.name = c["name"].get<std::string>();
-    for (const auto& other : problem.obstacles)
-      if (other.name == pair.name) r.error(cp + "/name", show(c["name"]) + " names an obstacle or another contact already");
+    if (!pair.name.empty() && !obstacle_index.emplace(pair.name, problem.obstacles.size()).second)
+      r.error(cp + "/name", show(c["name"]) + " names an obstacle or another contact already");
     pair.friction = r.number(c, cp, "friction", 0.0);
     if (pair.friction < 0) r.error(cp + "/friction", show(c["friction"]) + " is negative");
     pair.frictional = pair.friction > 0;

@@ -348,8 +348,8 @@ void read_continuum(Reader& r, json& body, Problem& problem, const std::string& 
   read_continuum_supports(r, body, ptr, checked, problem);
   read_continuum_loads(r, body, ptr, checked, shape, problem, options.thickness);
   if (!r.issues.empty()) return;
-  // ALGORITHM.md section 7: contact holds the free rigid motions of one connected body
-  // (scene.cpp); a mesh of several parts must have each part held by its supports.
+  // docs/algorithm.md#bodies-held-only-by-contact: contact holds the free rigid motions of one
+  // connected body (scene.cpp); a mesh of several parts must have each part held by its supports.
   std::vector<char> fixed(problem.body->dof_count(), 0);
   for (const Constraint& c : problem.constraints) fixed[c.dof] = 1;
   const std::string free = free_rigid_motion(checked, fixed);

@@ -1,7 +1,7 @@
 #pragma once
 // Rigid obstacles: closest-point projection of a query point onto the obstacle surface.
 //
-// Conventions (ALGORITHM.md section 1):
+// Conventions (docs/algorithm.md#notation):
 // - `normal` is the obstacle's outward unit normal at the closest point; the paper's eta = -normal.
 // - `tangent` = rot90(normal): the boundary is traversed with the solid on the LEFT
 //   (counter-clockwise round a convex solid).

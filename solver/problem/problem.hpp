@@ -63,7 +63,8 @@ struct Candidate {
 
 // A body with no stiffness in its reference state (a flat membrane) starts its first step
 // from a preliminary solve with one dof prescribed and no contact; the reaction there is the
-// starting force of the candidate at `site` on `obstacle` (ALGORITHM.md section 9).
+// starting force of the candidate at `site` on `obstacle`
+// (docs/algorithm.md#load-stepping-and-cuts).
 struct StartUp {
   int dof;
   double value;
@@ -71,15 +72,16 @@ struct StartUp {
   int obstacle;
 };
 
-// Rigid motions that the supports leave free and contact holds (ALGORITHM.md section 7). Each
-// equilibrium solve prescribes one pin dof per mode at the mode's amplitude, so the body is held
-// there and q = u + modes alpha, u zero at the pins; the amplitudes alpha join the contact
-// unknowns as the components first.., and the pins' reactions -R^T (F + T p) must vanish: that
-// equilibrium of the whole body is the component's s. In p an amplitude is stored divided by
-// `scale` (length per force: 1 / the largest stiffness), and its s multiplied by it, so the
-// compliance with its border [C, G; G^T, 0] stays symmetric and the error vector in length.
-// In a scene of several bodies each mode moves one body (zero on the others' dofs): its s is that
-// body's equilibrium, with the forces of its pairs on it (the mortar Jacobian moves both sides).
+// Rigid motions that the supports leave free and contact holds
+// (docs/algorithm.md#bodies-held-only-by-contact). Each equilibrium solve prescribes one pin dof
+// per mode at the mode's amplitude, so the body is held there and q = u + modes alpha, u zero at
+// the pins; the amplitudes alpha join the contact unknowns as the components first.., and the pins'
+// reactions -R^T (F + T p) must vanish: that equilibrium of the whole body is the component's s. In
+// p an amplitude is stored divided by `scale` (length per force: 1 / the largest stiffness), and
+// its s multiplied by it, so the compliance with its border [C, G; G^T, 0] stays symmetric and the
+// error vector in length. In a scene of several bodies each mode moves one body (zero on the
+// others' dofs): its s is that body's equilibrium, with the forces of its pairs on it (the mortar
+// Jacobian moves both sides).
 struct RigidModes {
   Matrix modes;                    // dof x count, column k is 1 at pins[k] and 0 at the other pins
   std::vector<int> pins;

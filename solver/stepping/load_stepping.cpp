@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <optional>
+#include <tuple>
 
 #include "solver/contact/friction_limit.hpp"
 #include "solver/contact/held_by_contact.hpp"
@@ -22,7 +23,7 @@ LoadFactors blend(const LoadFactors& from, const LoadFactors& to, double t) {
 // displacement to start the first step's Newton from, and sets the starting contact force.
 std::optional<Vector> start_up(const Problem& problem, const SteppingParams& params,
                                const LoadFactors& factors, const std::vector<double>& zeta,
-                               Vector& p, std::string& reason) {
+                               Vector& p, std::string& reason, FailureKind& failure) {
   const StartUp& st = *problem.start;
   Equilibrium pre(problem, params.newton, {{st.dof, st.value, 0}});
   couple_newton(pre.params(), params.contact.tolerance, params.contact.newton_fraction,
@@ -37,6 +38,7 @@ std::optional<Vector> start_up(const Problem& problem, const SteppingParams& par
   const EquilibriumState s = pre.solve(problem.body->start_guess(prescribed, mask), p);
   if (!s.converged) {
     reason = "the start-up solve failed: " + s.reason;
+    failure = s.failure;
     return std::nullopt;
   }
   const Vector reaction = pre.reactions(s, p);
@@ -115,8 +117,9 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
   std::optional<Vector> start_q;
   double v_first = 0.0;  // the contact error of the last increment's first solve
   if (problem.start) {
-    start_q = start_up(problem, params, current, zeta, p, result.reason);
+    start_q = start_up(problem, params, current, zeta, p, result.reason, result.failure);
     if (!start_q) {
+      result.failure_step = 1;  // the start-up solve is the first step's
       result.counters = eq.counters();
       return;
     }
@@ -157,8 +160,9 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
             amplitudes_following_supports(problem, current, target);
       eq.set_step(target, zeta);
       // A load that no static equilibrium can carry: no cut of the increment can help.
-      if (std::string why = unreachable_equilibrium(problem, eq.evaluate(guess), target); !why.empty()) {
-        rec.reason = std::move(why);
+      if (Unreachable why = unreachable_equilibrium(problem, eq.evaluate(guess), target); !why.reason.empty()) {
+        rec.reason = std::move(why.reason);
+        rec.failure = why.kind;
         break;
       }
       StepOutcome out = solve_contact_step(eq, guess, p_guess, p, params.contact, step,
@@ -189,10 +193,12 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
           if (decided.stopped) {
             out.stopped = result.stopped = true;
             out.reason = decided.reason;
+            out.failure = decided.failure;
           } else if (!decided.converged) {
             if (std::string why = friction_limit_exceeded(problem, decided.state, decided.p, decided.tau, target);
                 !why.empty()) {
               rec.reason = std::move(why);
+              rec.failure = FailureKind::friction_limit;
               rec.p = decided.p;
               rec.tau = decided.tau;
               rec.state = std::move(decided.state);
@@ -208,7 +214,11 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
           continue;
         }
         if (depth >= params.max_cuts || out.stopped) {
-          rec.reason = out.reason + (depth ? " (after " + std::to_string(depth) + " cuts of the increment)" : "");
+          rec.failure = out.failure;
+          rec.reason = out.reason;
+          // A stop names its cause where the caller gives one (the service: a job limit, a dismissal).
+          if (out.stopped && observer.stop_reason) std::tie(rec.failure, rec.reason) = observer.stop_reason();
+          if (depth) rec.reason += " (after " + std::to_string(depth) + " cuts of the increment)";
           rec.p = out.p;
           rec.tau = out.tau;
           rec.state = std::move(out.state);
@@ -249,7 +259,11 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
     }
     rec.seconds = std::chrono::duration<double>(Clock::now() - step_start).count();
     const bool ok = rec.converged;
-    if (!ok) result.reason = "step " + std::to_string(step) + " failed: " + rec.reason;
+    if (!ok) {
+      result.reason = "step " + std::to_string(step) + " failed: " + rec.reason;
+      result.failure = rec.failure;
+      result.failure_step = step;
+    }
     if (observer.step_finished) observer.step_finished(rec);
     result.steps.push_back(std::move(rec));
     if (!ok) break;
@@ -273,7 +287,10 @@ RunResult run_load_steps(Problem& problem, const std::vector<LoadStep>& steps,
     const size_t k = result.steps.size();
     StepRecord rec = step_record(k < steps.size() ? steps[k] : LoadStep{}, static_cast<int>(k) + 1);
     rec.reason = std::string("solver error: ") + e.what();
+    rec.failure = FailureKind::exception;
     result.reason = "step " + std::to_string(rec.index) + " failed: " + rec.reason;
+    result.failure = FailureKind::exception;
+    result.failure_step = rec.index;
     result.completed = false;
     result.steps.push_back(std::move(rec));
     if (observer.step_finished) observer.step_finished(result.steps.back());

@@ -373,7 +373,7 @@ struct Strategy {
 };
 
 // Real solves per load step for the loops that are known to stall (the paper's literal loop
-// and uzawa, ALGORITHM.md sections 8-9): they stop there, recorded as not reaching the
+// and uzawa, docs/algorithm.md#reading-the-paper): they stop there, recorded as not reaching the
 // tolerance, and their increments are not cut.
 constexpr int kCappedIterations = 300;
 

@@ -1,11 +1,11 @@
 // A beam on a deformable foundation (issue 19) at its harder end: slender (10 mm long, 0.1 mm
 // deep: L / d = 100, 200 elements), on a foundation 2000 x softer than the beam (E 100 MPa,
 // 67 x 8 q4, not matching the beam), the foundation's top the slave. The beam has no support
-// but its axial dof at the middle node: contact holds its translation and rotation (ALGORITHM.md
-// section 7). Closed form: a uniform load on a straight beam over a uniformly compressed
-// foundation is a uniform pressure, away from the foundation's free right end, which stretches
-// nu (1 + nu) sigma / E L = 0.044 mm beyond the beam's end and unloads over about the beam's
-// length on its bed, (4 EI / k)^(1/4) = 1.3 mm with k = E / 4 mm.
+// but its axial dof at the middle node: contact holds its translation and rotation
+// (docs/algorithm.md#bodies-held-only-by-contact). Closed form: a uniform load on a straight beam
+// over a uniformly compressed foundation is a uniform pressure, away from the foundation's free
+// right end, which stretches nu (1 + nu) sigma / E L = 0.044 mm beyond the beam's end and unloads
+// over about the beam's length on its bed, (4 EI / k)^(1/4) = 1.3 mm with k = E / 4 mm.
 //
 // With the beam as slave (its 201 nodes on the foundation's 67 segments) node-to-segment does
 // not pass this patch test: the straight, 2000 x stiffer beam meets the faceted surface at every

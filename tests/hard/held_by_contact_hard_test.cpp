@@ -1,10 +1,10 @@
-// Bodies held only by contact at their hardest (ALGORITHM.md section 7): a slender strip
-// (L/t = 100, 400 x 4 elements, 401 contact points, 805 unknowns with the three rigid
-// amplitudes) lying free on a flat (mu 0.3), pressed by 10 MPa and sheared up to 0.99 mu N,
-// where all but a few points slip and the amplitudes of the sideways motion are decided by a
-// handful of sticking points. And uzawa on the disc squeezed between two flats, which needs
-// more real solves than a step's default budget. And a finite-strain disc turned by a couple
-// about its squeezed shape up to the friction limit, by every strategy.
+// Bodies held only by contact at their hardest (docs/algorithm.md#bodies-held-only-by-contact): a
+// slender strip (L/t = 100, 400 x 4 elements, 401 contact points, 805 unknowns with the three rigid
+// amplitudes) lying free on a flat (mu 0.3), pressed by 10 MPa and sheared up to 0.99 mu N, where
+// all but a few points slip and the amplitudes of the sideways motion are decided by a handful of
+// sticking points. And uzawa on the disc squeezed between two flats, which needs more real solves
+// than a step's default budget. And a finite-strain disc turned by a couple about its squeezed
+// shape up to the friction limit, by every strategy.
 #include <gtest/gtest.h>
 
 #include <cstdio>

@@ -59,9 +59,10 @@ TEST(SheetEdges, DrawnOverTheDieShoulderTouchingPunchAndDie) {
   EXPECT_LT(last.p[problem.candidates[joint].eta], 0.0);
 }
 
-// The smallest regularization the documents name (ALGORITHM.md section 9 and the verification
-// test: e0 = 1e-6, a tenth of the default) on the paper's sheet: every step converges and the
-// strains stay within 0.5 % of the default's (ResultsDoNotDependOnTheRegularization).
+// The smallest regularization the documents name (docs/algorithm.md#reading-the-paper and the
+// verification test: e0 = 1e-6, a tenth of the default) on the paper's sheet: every step
+// converges and the strains stay within 0.5 % of the default's
+// (ResultsDoNotDependOnTheRegularization).
 TEST(SheetEdges, SmallestDocumentedRegularization) {
   json j = sheet(30, 0.15);
   const Solved ref = solve_scene(j);

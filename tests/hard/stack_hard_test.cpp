@@ -1,4 +1,4 @@
-// Several bodies held by contact at once (issue 19, ALGORITHM.md section 7): a stack of three
+// Several bodies held by contact (docs/algorithm.md#bodies-held-only-by-contact): three stacked
 // cylinders, plane strain, linear, frictionless. A steel half-disc (R 10 mm) pressed down by a
 // force P on its diameter sits on an aluminium disc (R 10 mm), which sits on a steel half-disc
 // held at its diameter. The upper two are held only by contact along y (x is held on their

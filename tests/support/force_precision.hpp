@@ -1,10 +1,11 @@
 #pragma once
 // What the contact error a converged step reached pins its forces to. The step ends at
 // ||v|| <= tol, not at v = 0: to first order the exact forces (same active set) are p - dp with
-// A dp_E = v_E, A the compliance block at the step's state (ALGORITHM.md 9; the tau passes stop on
-// C_EE^-1 v, StepSolver::force_precision), coupled with the slipping points where the friction
-// bound moves (force_error). A check of forces against a closed form or against another run is
-// then derived as (round-off) + |dp|, never a guessed number.
+// A dp_E = v_E, A the compliance block at the step's state
+// (docs/algorithm.md#friction_loop-passes-the-tau-passes: the tau passes stop on C_EE^-1 v,
+// StepSolver::force_precision), coupled with the slipping points where the friction bound moves
+// (force_error). A check of forces against a closed form or against another run is then derived as
+// (round-off) + |dp|, never a guessed number.
 #include <Eigen/LU>
 #include <limits>
 
@@ -22,14 +23,14 @@ inline constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
 // a slipping point's friction force sign(p_xi) mu |p_eta| moving with its normal force: column
 // eta of A gets -sign(p_xi) mu C_{E,xi}. `own`: r = v, the step's own contact error. `carried`:
 // r = the previous step's position error on E's tangential rows, since this step's slips are
-// measured from that state (ALGORITHM.md 1: s_xi = zeta - zeta_previous). `drift`: the tangential
-// position error this step hands on, C (own + carried) on every tangential component.
+// measured from that state (docs/algorithm.md#notation: s_xi = zeta - zeta_prev). `drift`: the
+// tangential position error this step hands on, C (own + carried) on every tangential component.
 // Measured on the von Karman beam pushed along a flat (tolerance 1e-8 against 1e-12): C_EE^-1 v
-// alone left 3.4e-5 of cev's 9.7e-5 at the first push level (the carried part) and 3.4e-6 of
-// 1.1e-5 at the second (the slipping points' coupling); own + carried leave 2e-8 and 7e-9.
-// `rounding`: what the rounding of s pins the forces to, ||A^-1||_inf (force rows) x 2 eps x the
-// largest coordinate that a gap or slip is a difference of (positions, zeta): on the von Karman
-// beam (zeta up to 100) two runs at tolerance 1e-12 still differed by 1e-8 .. 3e-8.
+// alone left 3.4e-5 of cev's 9.7e-5 at the first push level (the carried part) and 3.4e-6 of 1.1e-5
+// at the second (the slipping points' coupling); own + carried leave 2e-8 and 7e-9. `rounding`:
+// what the rounding of s pins the forces to, ||A^-1||_inf (force rows) x 2 eps x the largest
+// coordinate that a gap or slip is a difference of (positions, zeta): on the von Karman beam (zeta
+// up to 100) two runs at tolerance 1e-12 still differed by 1e-8 .. 3e-8.
 struct ForceError {
   Vector own, carried, drift;
   double rounding = 0.0;

@@ -1,7 +1,7 @@
 #pragma once
-// Bodies held only by contact (ALGORITHM.md section 7), in scenes of one body or several: the
-// balance of load and contact forces on each free rigid motion, the checks of every converged
-// step, and the strategies run on them.
+// Bodies held only by contact (docs/algorithm.md#bodies-held-only-by-contact), in scenes of one
+// body or several: the balance of load and contact forces on each free rigid motion, the checks of
+// every converged step, and the strategies run on them.
 #include <gtest/gtest.h>
 
 #include <algorithm>

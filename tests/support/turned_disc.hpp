@@ -1,8 +1,8 @@
 #pragma once
-// A disc held only by contact with finite kinematics and its rotation left free (ALGORITHM.md
-// section 7): a neo-Hookean disc (radius 10, q4, nu 0.3, no supports) squeezed between two
-// flats (mu 0.3) and turned by a couple from two opposite vertical forces at the ends of its
-// horizontal diameter. Contact alone holds its three motions. Shared by
+// A disc held only by contact with finite kinematics and its rotation left free
+// (docs/algorithm.md#bodies-held-only-by-contact): a neo-Hookean disc (radius 10, q4, nu 0.3, no
+// supports) squeezed between two flats (mu 0.3) and turned by a couple from two opposite vertical
+// forces at the ends of its horizontal diameter. Contact alone holds its three motions. Shared by
 // tests/verification/held_by_contact_finite_test.cpp and tests/hard/held_by_contact_hard_test.cpp:
 // the scene, the balance of force and moment about any point with the deformed positions, each
 // flat's resultant, and the agreement of two runs to what the contact tolerance pins them to.

@@ -67,8 +67,8 @@ TEST(AccelerationLevels, KnownSequenceFromKappa1000) {
     EXPECT_NEAR(kappa[k], expected, 1e-12 * expected) << "level " << k + 1;
   }
   EXPECT_NEAR(kappa[1], 250.50025, 1e-9);  // (1001)^2 / 4000
-  // ALGORITHM.md section 3: "250, 63, 16, 4.6, 1.6, 1.05". The sixth is 1.70, not 1.6
-  // (6 % off); the rest hold within 5 %.
+  // docs/algorithm.md#the-accelerated-multiplier-update quotes 250.5, 63.1, 16.3, 4.59, 1.70,
+  // 1.07; these rounded values hold within 5 %.
   const std::vector<double> approx = {250.0, 63.0, 16.0, 4.6, 1.70, 1.05};
   for (std::size_t k = 0; k < approx.size(); ++k)
     EXPECT_NEAR(kappa[k + 1], approx[k], 0.05 * approx[k]) << "level " << k + 2;
@@ -103,7 +103,7 @@ TEST(AccelerationLevels, AutoLevelPicksSmallestReachingTarget) {
   EXPECT_EQ(auto_level(1.0), 1);
   EXPECT_EQ(auto_level(1e-3), 7);  // 1.0723 <= 1.1 < 1.7012
   EXPECT_EQ(auto_level(1e-12, 1.1, 5), 5);  // capped
-  // ALGORITHM.md section 8: about log4(cond) + 2 levels.
+  // docs/algorithm.md#the-accelerated-multiplier-update: about log4(cond) + 2 levels.
   EXPECT_NEAR(auto_level(1e-7), std::log(1e7) / std::log(4.0) + 2.0, 1.0);
 }
 
@@ -308,7 +308,8 @@ TEST(AccelerationWarmup, KnownRatios) {
 }
 
 // On the linear problem, eq. 30 with n = 1 and alpha = 1.99 bounds the smallest
-// eigenvalue from above (ALGORITHM.md section 8: it overestimates).
+// eigenvalue from above (docs/algorithm.md#the-accelerated-multiplier-update:
+// it overestimates).
 TEST(AccelerationWarmup, OverestimatesOnLinearProblem) {
   const Matrix C1 = normalized(spd_with_spectrum(log_spaced(1e-3, 30), 9));
   const double alpha = 1.99;

@@ -14,6 +14,7 @@
 #include "apps/result_writer.hpp"
 #include "solver/io/json_writer.hpp"
 #include "solver/io/result.hpp"
+#include "solver/io/schema_validation.hpp"
 #include "tests/support/scenes.hpp"
 
 namespace grip {
@@ -99,6 +100,24 @@ TEST(SceneReader, StagesNameKnownCasesAndObstacles) {
   const auto issues = issues_of(j);
   EXPECT_TRUE(has(issues, "/stages/1/factors/shear", "names no load case"));
   EXPECT_TRUE(has(issues, "/stages/1/friction/anvil", "names no obstacle"));
+}
+
+// A body the reader stops at (a bad mesh, a negative thickness) must not drag a "names no
+// load case" error with it for the cases its unread supports would have named (issue 34).
+TEST(SceneReader, ABadBodyDoesNotMakeItsStagesNameUnknownCases) {
+  for (const auto& [pointer, value] : std::vector<std::pair<std::string, json>>{
+           {"/body/mesh/rectangle/divisions", json::array({0, 10})},
+           {"/body/mesh/rectangle/divisions", json::array({2.5, 10})},
+           {"/body/thickness", -1}}) {
+    json j = example_scene("sliding-block");
+    j[json::json_pointer(pointer)] = value;
+    const auto issues = issues_of(j);
+    ASSERT_FALSE(issues.empty()) << pointer;
+    for (const auto& issue : issues) {
+      EXPECT_EQ(issue.pointer.rfind("/body", 0), 0u) << pointer << " = " << value.dump() << " also gave "
+                                                    << issue.pointer << ": " << issue.detail;
+    }
+  }
 }
 
 TEST(SceneReader, StagesRampTheirCasesFromWherePreviousStagesLeftThem) {
@@ -376,6 +395,13 @@ TEST(SceneEffects, AnExceptionDuringAStepFailsThatStepAndKeepsTheStepsBefore) {
   EXPECT_EQ(r, result_json(scene, run));
   EXPECT_EQ(r["steps"].size(), 2u);
   EXPECT_EQ(r["summary"]["completed"], false);
+  // Its kind, for a program (failure_kinds_test.cpp produces the others).
+  EXPECT_EQ(run.failure, FailureKind::exception);
+  EXPECT_EQ(run.failure_step, 2);
+  EXPECT_EQ(r["summary"]["failure"], json({{"kind", "exception"}, {"message", run.reason}, {"step", 2}}));
+  EXPECT_EQ(r["steps"][1]["failure"]["kind"], "exception");
+  const auto issues = validate_against(r, SchemaName::result);
+  EXPECT_TRUE(issues.empty()) << issues.front().pointer << ": " << issues.front().detail;
   std::filesystem::remove(path);
 }
 

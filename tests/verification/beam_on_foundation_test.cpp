@@ -2,10 +2,10 @@
 // (its axis offset by half the depth toward -y, Body::surface_point's side -1) as slave or as
 // master of a pair with a block foundation. The beam has no support but its axial dof at the
 // middle node: contact holds its translation along y and its rotation (linear kinematics,
-// ALGORITHM.md section 7). Closed forms: a uniform load is carried as a uniform pressure (a
-// straight beam on a uniformly compressed q4 foundation), and against a rigid flat the straight
-// beam's contact force at each node is that node's load, which the pair approaches as the
-// foundation stiffens.
+// docs/algorithm.md#bodies-held-only-by-contact). Closed forms: a uniform load is carried as a
+// uniform pressure (a straight beam on a uniformly compressed q4 foundation), and against a rigid
+// flat the straight beam's contact force at each node is that node's load, which the pair
+// approaches as the foundation stiffens.
 #include <gtest/gtest.h>
 
 #include <cstdio>

@@ -1,9 +1,9 @@
-// A body held only by contact with finite kinematics and its rotation left free (ALGORITHM.md
-// section 7): the rotation of a deformed body is taken about its current shape
-// (rigid_modes_at), where its internal forces balance, so the load and the contact forces must
-// balance there too. A disc (finite strain, neo-Hookean, q4) squeezed between two flats and
-// turned by a couple: contact alone holds its three motions. Invariants: the force and the
-// moment balance about any point with the deformed positions, at every converged step; the
+// A body held only by contact with finite kinematics and its rotation left free
+// (docs/algorithm.md#bodies-held-only-by-contact): the rotation of a deformed body is taken about
+// its current shape (rigid_modes_at), where its internal forces balance, so the load and the
+// contact forces must balance there too. A disc (finite strain, neo-Hookean, q4) squeezed between
+// two flats and turned by a couple: contact alone holds its three motions. Invariants: the force
+// and the moment balance about any point with the deformed positions, at every converged step; the
 // small-strain answer at small load; the same state by displacement control.
 #include <gtest/gtest.h>
 
@@ -207,7 +207,8 @@ TEST(HeldByContactFinite, RotationNoContactResistsIsRejected) {
   EXPECT_EQ(read_scene(j).problem.rigid.count(), 3);
 }
 
-// A couple beyond what friction holds (ALGORITHM.md 7; turned_beyond_the_limit): the step fails
+// A couple beyond what friction holds (docs/algorithm.md#the-friction-limit-decision;
+// turned_beyond_the_limit): the step fails
 // at once with the reason in words (friction_limit.hpp: every pressed point slips on its bound
 // against the disc's turn, and the couple's moment exceeds friction's at the normal forces of the
 // state reached), keeps the two steps before it, returns no NaN. Before, cev default cut the

@@ -1,8 +1,8 @@
-// Bodies held only by contact, loaded by forces (ALGORITHM.md section 7): the rigid motions
-// that the supports leave free are held by the contact forces, whose resultant must balance
-// the load. Closed forms: Hertz's line contact under a given force, the reaction of a flat that
-// holds a block under pressure and shear (equal to the load below mu N, no equilibrium above),
-// a disc squeezed between two flats, a block pushed onto a wall.
+// Bodies held only by contact, loaded by forces (docs/algorithm.md#bodies-held-only-by-contact):
+// the rigid motions that the supports leave free are held by the contact forces, whose resultant
+// must balance the load. Closed forms: Hertz's line contact under a given force, the reaction of a
+// flat that holds a block under pressure and shear (equal to the load below mu N, no equilibrium
+// above), a disc squeezed between two flats, a block pushed onto a wall.
 #include <gtest/gtest.h>
 
 #include <algorithm>

@@ -1,6 +1,6 @@
-// ALGORITHM.md section 8: a linear beam pressed onto a slightly inclined rigid flat, one load
-// step, all contacts sliding. Checks the paper's literal loop against the table there and the
-// default loop against it.
+// The dense check of docs/algorithm.md#reading-the-paper: a linear beam pressed onto a slightly
+// inclined rigid flat, one load step, all contacts sliding. Checks the paper's literal loop
+// against the counts quoted there and the default loop against them.
 #include <gtest/gtest.h>
 
 #include "solver/elements/timoshenko_beam.hpp"
@@ -59,7 +59,7 @@ TEST(LinearBeamCheck, PaperLoopCountsAreOfTheOrderOfTheTable) {
   struct Case {
     int n;
     EpsilonSource eps;
-    int table;  // equilibrium solves in ALGORITHM.md's table
+    int table;  // equilibrium solves quoted in docs/algorithm.md#reading-the-paper
   };
   for (const Case& k : {Case{14, EpsilonSource::exact, 59}, Case{kAccelerationInfinity, EpsilonSource::exact, 45},
                         Case{16, EpsilonSource::warmup, 527}}) {

@@ -174,8 +174,8 @@ double largest_relative_change(const std::vector<double>& a, const std::vector<d
   return worst / scale;
 }
 
-// The first step starts from a prescribed pole depth (ALGORITHM.md section 9); from 5 mm of
-// punch travel on, the results do not depend on that depth.
+// The first step starts from a prescribed pole depth (docs/algorithm.md#load-stepping-and-cuts);
+// from 5 mm of punch travel on, the results do not depend on that depth.
 TEST(SheetStretching, ResultsDoNotDependOnTheStartDepth) {
   const auto reference = strains_from(solved(30, 0.15), 5);
   for (const double depth : {-0.5, -2.0}) {

@@ -1,8 +1,9 @@
-// A body held only by contact in a scene of several bodies (issues 16 and 19, ALGORITHM.md
-// section 7): its free rigid amplitudes join the contact unknowns and its whole-body
-// equilibrium, with the forces of its pairs on it, is their condition, as for one body against
-// rigid obstacles. Closed forms: Hertz between two cylinders under a given force (combined
-// radius and modulus), and a free block on a deformable foundation under a uniform pressure.
+// A body held only by contact in a scene of several bodies
+// (docs/algorithm.md#bodies-held-only-by-contact): its free rigid amplitudes join the contact
+// unknowns and its whole-body equilibrium, with the forces of its pairs on it, is their condition,
+// as for one body against rigid obstacles. Closed forms: Hertz between two cylinders under a given
+// force (combined radius and modulus), and a free block on a deformable foundation under a uniform
+// pressure.
 #include <gtest/gtest.h>
 
 #include <cstdio>
