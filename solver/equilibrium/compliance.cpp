@@ -190,7 +190,7 @@ Vector Compliance::apply(const Vector& z) const {
   return t.transpose() * body->solve(force);
 }
 
-// The border G = T^T R of the compliance (ALGORITHM.md 7), times the amplitudes' scale: the
+// The border G = T^T R of the compliance (docs/algorithm.md#bodies-held-only-by-contact), times the amplitudes' scale: the
 // rigid motion moves every contact point with it, and the amplitudes' s, the whole body's
 // equilibrium, changes with p by G^T. R at the state (rigid_modes_at): for a deformed body free
 // to rotate with finite kinematics, about its current shape, where K R = 0 holds only up to

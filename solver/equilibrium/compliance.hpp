@@ -24,7 +24,7 @@ struct Compliance {
   std::vector<int> position;  // component -> row of `block` (or column of `t`), -1 where not computed
   Matrix block;               // the dense form; empty in the sparse form
   mutable std::shared_ptr<ComplianceFactor> factor;  // reset whenever `block` changes
-  // With the rigid amplitudes' border [C G; G^T 0] (ALGORITHM.md 7): indefinite, no Cholesky.
+  // With the rigid amplitudes' border [C G; G^T 0] (docs/algorithm.md#bodies-held-only-by-contact): indefinite, no Cholesky.
   // Dense form only.
   bool bordered = false;
   // The sparse form: `body` is the body's factorization of K (free dofs), `t` is T on the free

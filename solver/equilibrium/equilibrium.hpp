@@ -1,5 +1,5 @@
 #pragma once
-// SOLVE(U, p) of ALGORITHM.md section 5: equilibrium of eq. 1-2 for given contact forces p,
+// SOLVE(U, p) (docs/algorithm.md#equilibrium-for-given-contact-forces): equilibrium of eq. 1-2 for given contact forces p,
 // by Newton's method with the pairing, T(u) and the stiffness of the follower contact load
 // d(T(u) p)/du re-evaluated at every iterate. Also the contact compliance C = T^T K^-1 T.
 #include <Eigen/SparseCore>

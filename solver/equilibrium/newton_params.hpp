@@ -4,7 +4,7 @@
 
 namespace grip {
 
-// Newton's stopping tests, each always reachable in floating point (ALGORITHM.md 9). An
+// Newton's stopping tests, each always reachable in floating point (docs/algorithm.md#newtons-stopping-tests-and-the-round-off-floor). An
 // iterate is converged when one of them holds:
 // - correction: the largest correction, in length units (rotations times their dof's length
 //   scale), is below `displacement_tolerance` (the contact loop's precision);
@@ -31,7 +31,7 @@ struct NewtonParams {
 
 // Newton's tests as a fraction of the contact tolerance (relative to `length`, the body's
 // characteristic length): the contact error has a floor of about ||K^-1|| x the Newton
-// residual, so Newton must be that much tighter (ALGORITHM.md 9).
+// residual, so Newton must be that much tighter (docs/algorithm.md#newtons-stopping-tests-and-the-round-off-floor).
 inline void couple_newton(NewtonParams& newton, double contact_tolerance, double fraction, double length) {
   newton.displacement_tolerance = fraction * contact_tolerance * length;
   newton.residual_tolerance = fraction * contact_tolerance;

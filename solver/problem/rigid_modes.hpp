@@ -26,7 +26,7 @@ std::string finite_rotation_refusal(const Body& body, const std::vector<int>& fi
 // The free rigid motions of problem.rigid at the state q, 1 at their own pin and 0 at the other
 // pins. For a body with finite kinematics left free to rotate: the translations and the rotation
 // at q (the continuum's about its current shape, the von Karman beam's own: rigid_modes.cpp),
-// zero at its supports (ALGORITHM.md 7): the internal forces of a deformed body do no work along
+// zero at its supports (docs/algorithm.md#bodies-held-only-by-contact): the internal forces of a deformed body do no work along
 // it, so that is where the contact forces and the load must balance too. Elsewhere
 // problem.rigid.modes itself (a constant tangent, or translations only: the same at every state).
 Matrix rigid_modes_at(const Problem& problem, const Vector& q);
