@@ -97,7 +97,9 @@ int solve(int argc, char** argv) {
     }
   }
   auto emit = [&](const nlohmann::json& ev) {
-    if (events.is_open()) events << ev.dump() << '\n';
+    // Flushed per event: a reader (tail -f) sees a long step as it runs (two cylinders with
+    // uzawa wrote nothing for over 2 minutes).
+    if (events.is_open()) events << ev.dump() << '\n' << std::flush;
   };
   std::printf("%5s %12s %6s %6s %6s %12s %7s %6s %6s %9s  %s\n", "step", "load_factor", "iters",
               "passes", "newton", "||v||_2", "contact", "stick", "slip", "ms", "status");
@@ -125,7 +127,7 @@ int solve(int argc, char** argv) {
       grip::run_load_steps(scene.problem, scene.steps, scene.params, observer);
   const auto solved = now();
   emit(run.completed ? nlohmann::json{{"type", "job_finished"}}
-                     : nlohmann::json{{"type", "job_failed"}, {"reason", run.reason}});
+                     : grip::job_failed_event(run.failure, run.reason, run.failure_step));
   std::printf("total: %ld contact iterations, %ld Newton iterations, %ld factorizations, %.3f s\n",
               run.counters.solves, run.counters.newton_iterations, run.counters.factorizations,
               run.seconds);

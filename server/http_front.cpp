@@ -394,6 +394,7 @@ void HttpFront::serve(socket_t sock, ConnectionNote& note) {
           // The head is in: the body has its own deadline.
           note.in_body = true;
           stream.set_deadline(Clock::now() + limits_.body);
+          note.restart_body_deadline = [&stream, this] { stream.set_deadline(Clock::now() + limits_.body); };
           // A DELETE (or OPTIONS) with neither length nor chunks has no body: httplib would
           // otherwise read one until the client closes.
           if (!req.has_header("Content-Length") && !req.has_header("Transfer-Encoding") &&

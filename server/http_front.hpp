@@ -21,6 +21,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstddef>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -39,6 +40,9 @@ struct ConnectionNote {
   bool head_too_large = false;   // the head over kMaxHead
   bool overflow = false;         // served by a reserved thread: health and readiness only
   bool close = false;            // close the connection after this response
+  // Starts the body's deadline again: a handler that waited before reading the body (the
+  // memory budget of server/body_budget.hpp) gives the client its whole deadline.
+  std::function<void()> restart_body_deadline;
 };
 
 class HttpFront : public httplib::Server {

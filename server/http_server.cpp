@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -14,6 +15,9 @@
 #include <regex>
 #include <sstream>
 
+#include "server/body_budget.hpp"
+#include "server/gzip.hpp"
+#include "server/observability.hpp"
 #include "server/tar.hpp"
 #include "server/ui.hpp"
 #include "server/util.hpp"
@@ -105,6 +109,21 @@ std::optional<std::int64_t> decode_cursor(const std::string& c) {
 
 std::string job_path(const std::string& id) { return "/v1/jobs/" + id; }
 
+// Accept-Encoding names gzip (or *) without q=0.
+bool accepts_gzip(const Request& req) {
+  std::stringstream list(lower(req.get_header_value("Accept-Encoding")));
+  std::string item;
+  while (std::getline(list, item, ',')) {
+    const size_t semi = item.find(';');
+    std::string coding = item.substr(0, semi), params = semi == std::string::npos ? "" : item.substr(semi + 1);
+    coding.erase(std::remove_if(coding.begin(), coding.end(), ::isspace), coding.end());
+    params.erase(std::remove_if(params.begin(), params.end(), ::isspace), params.end());
+    const bool refused = params.rfind("q=0", 0) == 0 && params.find_first_of("123456789", 2) == std::string::npos;
+    if ((coding == "gzip" || coding == "x-gzip" || coding == "*") && !refused) return true;
+  }
+  return false;
+}
+
 // The methods a known route takes (empty: no such route), for 405 + Allow.
 std::string allowed_methods(const std::string& path) {
   static const std::vector<std::pair<std::regex, std::string>> routes = {
@@ -130,10 +149,19 @@ json job_document(const JobView& v) {
   if (!r.owner.empty()) doc["replica"] = r.owner;  // the process that runs (or last ran) it
   if (!r.started.empty()) doc["started"] = r.started;
   if (!r.finished.empty()) doc["finished"] = r.finished;
-  int percent = r.status == JobStatus::successful ? 100 : 0;
+  // Converged steps: while running from the run's progress, once finished as stored.
+  int completed = r.status == JobStatus::successful ? r.steps : r.steps_completed;
+  if (v.progress) completed = v.progress->steps_done;
+  doc["steps_completed"] = completed;
+  const int percent = r.steps > 0 ? 100 * completed / r.steps : (r.status == JobStatus::successful ? 100 : 0);
+  if (r.status == JobStatus::dismissed)
+    doc["failure"] = {{"kind", "dismissed"}, {"message", r.message}, {"step", 0}};
+  else if (r.status == JobStatus::failed && !r.failure_kind.empty())  // empty: failed before kinds were kept
+    doc["failure"] = {{"kind", r.failure_kind},
+                      {"message", r.message},
+                      {"step", r.failure_step}};
   if (v.progress) {
     const Progress& p = *v.progress;
-    if (r.steps > 0) percent = 100 * p.steps_done / r.steps;
     doc["step"] = p.step;
     doc["contact_error"] = p.contact_error;
     doc["iterations"] = p.iterations;
@@ -144,6 +172,8 @@ json job_document(const JobView& v) {
     doc["iterations"] = r.iterations;
     doc["solve_seconds"] = r.solve_seconds;
   }
+  if (is_finished(r.status) && r.stored_bytes > 0) doc["stored_bytes"] = r.stored_bytes;
+  if (!r.request_id.empty()) doc["request_id"] = r.request_id;
   doc["progress"] = percent;
   const std::string self = job_path(r.id);
   json links = json::array({
@@ -164,15 +194,17 @@ json job_document(const JobView& v) {
 
 struct HttpServer::Impl {
   Impl(JobService& s, HttpOptions o, std::atomic<int>& streams)
-      : service(s), options(std::move(o)), open_streams(streams), svr(options.front) {}
+      : service(s), options(std::move(o)), open_streams(streams), svr(options.front),
+        budget(options.parse_budget_bytes ? options.parse_budget_bytes : options.max_body_bytes) {}
 
   JobService& service;
   HttpOptions options;
   std::atomic<int>& open_streams;
   HttpFront svr;
   std::atomic<bool> stopping{false};
-  std::atomic<std::int64_t> requests{0};
+  RequestMetrics request_metrics;
   int listen_fd = -1;  // the listening socket, seen by the socket-options hook
+  BodyBudget budget;   // submissions' bodies being read and checked
 
   // Registers a handler for every path pattern given.
   template <class F>
@@ -218,7 +250,8 @@ void HttpServer::Impl::hooks() {
 
   svr.set_pre_routing_handler([this](const Request& req, Response& res) {
     request_start = std::chrono::steady_clock::now();
-    ++requests;
+    // Echoed in the answer, logged, and attached to a job it creates.
+    res.set_header("X-Request-Id", request_id_for(req.get_header_value("X-Request-Id")));
     ConnectionNote* note = HttpFront::note();
     if (note && note->overflow && req.path != "/v1/health" && req.path != "/v1/ready") {
       res.set_header("Retry-After", "1");
@@ -309,6 +342,13 @@ void HttpServer::Impl::hooks() {
 
   svr.set_exception_handler([](const Request& req, Response& res, std::exception_ptr ep) {
     std::string what = "unknown exception";
+    struct KeepId {  // the headers are cleared below; the request id stays
+      Response& res;
+      const std::string id = res.get_header_value("X-Request-Id");
+      ~KeepId() {
+        if (!id.empty() && !res.has_header("X-Request-Id")) res.set_header("X-Request-Id", id);
+      }
+    } keep{res};
     try {
       std::rethrow_exception(ep);
     } catch (const StoreUnavailable& e) {
@@ -327,12 +367,14 @@ void HttpServer::Impl::hooks() {
             "the server failed to answer this request; it has been logged");
   });
 
-  svr.set_logger([](const Request& req, const Response& res) {
-    const double ms =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - request_start).count();
+  svr.set_logger([this](const Request& req, const Response& res) {
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - request_start).count();
+    request_metrics.record(req.method, route_template(req.path), res.status, seconds);
     const bool quiet = req.path == "/v1/health" || req.path == "/v1/ready" || req.path == "/v1/metrics";
-    spdlog::log(quiet ? spdlog::level::debug : spdlog::level::info, "{} {} {} {:.1f} ms",
-                req.method, req.path, res.status, ms);
+    const std::string id = res.get_header_value("X-Request-Id");
+    spdlog::log(quiet ? spdlog::level::debug : spdlog::level::info, "{} {} {} {:.1f} ms request {} client {}",
+                req.method, req.path, res.status, 1000 * seconds, id.empty() ? "-" : id, req.remote_addr);
   });
 }
 
@@ -432,6 +474,18 @@ void HttpServer::Impl::routes() {
 
 void HttpServer::Impl::submit(const Request& req, Response& res, const httplib::ContentReader& reader,
                               bool ogc) {
+  // The body's length of the memory budget (server/body_budget.hpp), held until the answer is
+  // built (destroyed last).
+  const auto declared = parse_count(req.get_header_value("Content-Length"));
+  auto hold = budget.take(std::min<std::size_t>(declared.value_or(options.max_body_bytes), options.max_body_bytes),
+                          std::chrono::seconds(120));
+  if (!hold) {
+    res.set_header("Retry-After", "5");
+    return problem(res, req, 503, "busy", "Busy",
+                   "this server is reading as many scenes as its memory budget allows; nothing was accepted; "
+                   "retry after 5 s");  // after 2 minutes of waiting
+  }
+  if (ConnectionNote* note = HttpFront::note(); note && note->restart_body_deadline) note->restart_body_deadline();
   // The body is read here: httplib 0.11.4 holds a body to the payload limit only when it has
   // a Content-Length (a chunked one of 100 MB was buffered whole). Past the limit the rest is
   // read and dropped, as httplib does with a long Content-Length, so the client gets its 413.
@@ -504,22 +558,26 @@ void HttpServer::Impl::submit(const Request& req, Response& res, const httplib::
                      "Idempotency-Key must have 1 to 255 characters");
   }
   try {
-    const SubmitResult r = service.submit(scene, key);
+    const SubmitResult r = service.submit(scene, key, res.get_header_value("X-Request-Id"));
     res.set_header("Location", job_path(r.job.record.id));
     if (r.replayed) res.set_header("Idempotent-Replayed", "true");
     send_json(res, 201, job_document(r.job));
   } catch (const SceneErrors& e) {
     // Listed up to a bound: 8 MB of equal nodes made a million errors, a 99 MB answer and a
     // peak of 1.9 GB.
-    constexpr size_t kMaxListed = 100;
+    // The reader and the validator stop at kMaxSceneIssues (more() then).
+    constexpr size_t kMaxListed = kMaxSceneIssues;
     const auto& issues = e.issues();
     json errors = json::array();
     for (size_t i = 0; i < std::min(issues.size(), kMaxListed); ++i)
       errors.push_back({{"pointer", prefix + (issues[i].pointer == "/" ? "" : issues[i].pointer)},
                         {"detail", issues[i].detail}});
+    const size_t listed = std::min(issues.size(), kMaxListed);
     problem(res, req, 422, "invalid-scene", "Invalid scene",
-            std::to_string(issues.size()) + " problem(s) in the scene" +
-                (issues.size() > kMaxListed ? "; the first " + std::to_string(kMaxListed) + " are listed" : ""),
+            e.more() ? "more than " + std::to_string(listed) + " problems in the scene; the first " +
+                           std::to_string(listed) + " found are listed"
+                     : std::to_string(issues.size()) + " problem(s) in the scene" +
+                           (issues.size() > kMaxListed ? "; the first " + std::to_string(kMaxListed) + " are listed" : ""),
             std::move(errors));
   } catch (const QueueFull& e) {
     res.set_header("Retry-After", std::to_string(e.retry_after_seconds));
@@ -720,11 +778,20 @@ void HttpServer::Impl::result(const Request& req, Response& res) {
     return problem(res, req, 404, "no-result", "No result",
                    "job " + id + " is " + std::string(to_string(view->record.status)) + " and has no result");
   }
+  // Stored gzip-compressed: as stored to a client that accepts gzip, inflated otherwise.
   if (format == "json") {
-    res.set_content(*data, kJson);
+    res.set_header("Vary", "Accept-Encoding");
+    if (is_gzip(*data) && accepts_gzip(req)) {
+      res.set_header("Content-Encoding", "gzip");
+      // httplib compresses a body of exactly "application/json" itself (once more, here): the
+      // charset parameter keeps it from doing so.
+      res.set_content(*data, "application/json; charset=utf-8");
+    } else {
+      res.set_content(is_gzip(*data) ? gunzip(*data) : *data, kJson);
+    }
     return;
   }
-  const json doc = json::parse(*data);
+  const json doc = json::parse(is_gzip(*data) ? gunzip(*data) : *data);
   if (format == "csv") {
     const std::string table = req.has_param("table") ? req.get_param_value("table") : "nodes";
     const auto& tables = result_csv_tables();
@@ -788,15 +855,36 @@ void HttpServer::Impl::metrics(const Request&, Response& res) {
      << "# HELP grip_events_waiting Events not yet stored (the database unreachable or slow).\n"
      << "# TYPE grip_events_waiting gauge\n"
      << "grip_events_waiting " << s.events_waiting << "\n"
-     << "# HELP grip_db_round_trips_total Queries sent to the database by this process.\n"
-     << "# TYPE grip_db_round_trips_total counter\n"
-     << "grip_db_round_trips_total " << s.db_round_trips << "\n"
-     << "# HELP grip_db_bytes_total Bytes sent to and received from the database by this process.\n"
-     << "# TYPE grip_db_bytes_total counter\n"
-     << "grip_db_bytes_total " << s.db_bytes << "\n"
-     << "# HELP grip_http_requests_total HTTP requests received by this process.\n"
-     << "# TYPE grip_http_requests_total counter\n"
-     << "grip_http_requests_total " << requests.load() << "\n";
+     << "# HELP grip_store_disk_bytes The job database on disk (SQLite: the file; PostgreSQL: grip's tables).\n"
+     << "# TYPE grip_store_disk_bytes gauge\n"
+     << "grip_store_disk_bytes " << s.disk_bytes << "\n"
+     << "# HELP grip_retention_max_jobs Finished jobs kept (0: no bound).\n# TYPE grip_retention_max_jobs gauge\n"
+     << "grip_retention_max_jobs " << s.retention.max_jobs << "\n"
+     << "# HELP grip_retention_max_age_seconds Age of finished jobs kept (0: no bound).\n"
+     << "# TYPE grip_retention_max_age_seconds gauge\n"
+     << "grip_retention_max_age_seconds " << s.retention.max_age_seconds << "\n"
+     << "# HELP grip_retention_max_bytes Stored bytes of finished jobs kept (0: no bound).\n"
+     << "# TYPE grip_retention_max_bytes gauge\n"
+     << "grip_retention_max_bytes " << s.retention.max_bytes << "\n"
+     << "# HELP grip_jobs_pruned_total Finished jobs removed by retention in this process.\n"
+     << "# TYPE grip_jobs_pruned_total counter\n"
+     << "grip_jobs_pruned_total " << s.pruned << "\n"
+     << "# HELP grip_job_stored_bytes Bytes stored per job (scene, events, compressed result) finished by this process.\n"
+     << "# TYPE grip_job_stored_bytes histogram\n";
+  for (const auto& [le, count] : s.stored_bytes_buckets)
+    os << "grip_job_stored_bytes_bucket{le=\"" << (std::isinf(le) ? std::string("+Inf") : std::to_string(static_cast<std::int64_t>(le)))
+       << "\"} " << count << "\n";
+  os << "grip_job_stored_bytes_sum " << s.stored_bytes_sum << "\n"
+     << "grip_job_stored_bytes_count " << s.stored_bytes_count << "\n";
+  if (s.db_traffic)  // only where the store measures them (PostgreSQL)
+    os << "# HELP grip_db_round_trips_total Queries sent to the database by this process.\n"
+       << "# TYPE grip_db_round_trips_total counter\n"
+       << "grip_db_round_trips_total " << s.db_traffic->first << "\n"
+       << "# HELP grip_db_bytes_total Bytes sent to and received from the database by this process.\n"
+       << "# TYPE grip_db_bytes_total counter\n"
+       << "grip_db_bytes_total " << s.db_traffic->second << "\n";
+  request_metrics.write(os);
+  service.write_job_metrics(os);
   res.set_content(os.str(), "text/plain; version=0.0.4; charset=utf-8");
 }
 

@@ -4,9 +4,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
+#include "server/gzip.hpp"
 #include "server/util.hpp"
+#include "solver/model/number_text.hpp"
 #include "solver/io/result.hpp"
 
 namespace grip::server {
@@ -34,8 +37,24 @@ struct JobService::ActiveJob {
 
 namespace {
 
-json failed_event(const std::string& reason) {
-  return {{"type", "job_failed"}, {"reason", reason}};
+// Upper bounds of grip_job_stored_bytes' buckets (+Inf last).
+const std::vector<double> kStoredBytesBuckets = {4096, 16384, 65536, 262144, 1048576, 4194304, 16777216,
+                                                 std::numeric_limits<double>::infinity()};
+
+// A run that did not succeed: its status, message (the result's reason where there is one)
+// and failure kind.
+void failed(JobOutcome& o, FailureKind kind, std::string message, int step = 0) {
+  o.status = kind == FailureKind::dismissed ? JobStatus::dismissed : JobStatus::failed;
+  o.message = std::move(message);
+  o.failure_kind = std::string(to_string(kind));
+  o.failure_step = step;
+}
+
+// The outcome's log line (one format for every end of a run; a failure at warning).
+void log_outcome(const std::string& id, JobStatus status, std::int64_t iterations, const std::string& message,
+                 double seconds) {
+  spdlog::log(status == JobStatus::successful ? spdlog::level::info : spdlog::level::warn,
+              "job {} {} in {:.3f} s: {} contact iterations; {}", id, to_string(status), seconds, iterations, message);
 }
 
 StoredEvent stored(std::int64_t seq, const json& event) {
@@ -94,6 +113,7 @@ void JobService::start() {
   writer_ = std::thread([this] { writer_loop(); });
   lease_thread_ = std::thread([this] { lease_loop(); });
   for (int i = 0; i < options_.workers; ++i) workers_.emplace_back([this] { worker_loop(); });
+  if (options_.retention.any()) pruner_ = std::make_unique<Pruner>(store_, options_.retention, options_.prune_interval);
   started_ = true;
   spdlog::info("replica {}: lease {} s", options_.replica, options_.lease_seconds);
 }
@@ -153,7 +173,8 @@ std::optional<SubmitResult> JobService::replay(const std::optional<std::string>&
 }
 
 SubmitResult JobService::submit(const json& scene_json,
-                                const std::optional<std::string>& idempotency_key) {
+                                const std::optional<std::string>& idempotency_key,
+                                const std::string& request_id) {
   if (draining_) throw ShuttingDown();
   const std::string canonical = scene_json.dump();
   if (auto earlier = replay(idempotency_key, canonical)) return *earlier;
@@ -203,6 +224,7 @@ SubmitResult JobService::submit(const json& scene_json,
   rec.steps = size.steps;
   rec.nodes = size.nodes;
   rec.idempotency_key = idempotency_key;
+  rec.request_id = request_id;
   try {
     store_.insert_job(rec);
   } catch (const StoreUnavailable&) {
@@ -212,7 +234,8 @@ SubmitResult JobService::submit(const json& scene_json,
     if (auto earlier = replay(idempotency_key, canonical)) return *earlier;
     throw;
   }
-  spdlog::info("job {} accepted: {} nodes, {} steps", rec.id, size.nodes, size.steps);
+  spdlog::info("job {} accepted: {} nodes, {} steps (request {})", rec.id, size.nodes, size.steps,
+               request_id.empty() ? "-" : request_id);
   rec.scene.clear();
   return {JobView{rec, std::nullopt}, false};
 }
@@ -318,11 +341,35 @@ ServiceStats JobService::stats() {
     s.events = events_stored_;
     s.events_waiting = pending_.size();
   }
-  std::tie(s.db_round_trips, s.db_bytes) = store_.traffic();
+  s.db_traffic = store_.traffic();
   s.jobs = store_.count_by_status();
+  s.retention = options_.retention;
+  s.pruned = pruner_ ? pruner_->pruned() : 0;
+  s.disk_bytes = store_.disk_bytes();
+  {
+    std::lock_guard lock(mutex_);
+    std::int64_t below = 0;
+    for (size_t b = 0; b < kStoredBytesBuckets.size(); ++b) {
+      below += b < stored_bytes_counts_.size() ? stored_bytes_counts_[b] : 0;
+      s.stored_bytes_buckets.emplace_back(kStoredBytesBuckets[b], below);
+    }
+    s.stored_bytes_sum = stored_bytes_sum_;
+    s.stored_bytes_count = stored_bytes_count_;
+  }
   const auto it = s.jobs.find(JobStatus::accepted);
   s.queue_depth = it == s.jobs.end() ? 0 : static_cast<std::size_t>(it->second);
   return s;
+}
+
+void JobService::write_job_metrics(std::ostream& os) const {
+  os << "# HELP grip_job_queue_wait_seconds From a job's acceptance to its first claim, for jobs claimed here.\n"
+     << "# TYPE grip_job_queue_wait_seconds histogram\n";
+  queue_wait_.write(os, "grip_job_queue_wait_seconds", "");
+  os << "# HELP grip_job_run_seconds From a job's claim to its stored outcome, by outcome, for runs here.\n"
+     << "# TYPE grip_job_run_seconds histogram\n";
+  std::lock_guard lock(mutex_);
+  for (const auto& [outcome, h] : run_seconds_by_outcome_)
+    h.write(os, "grip_job_run_seconds", "outcome=\"" + outcome + "\"");
 }
 
 int JobService::retry_after_seconds() const {
@@ -372,6 +419,7 @@ void JobService::shutdown(std::chrono::milliseconds grace) {
   if (writer_.joinable()) writer_.join();
   lease_cv_.notify_all();
   if (lease_thread_.joinable()) lease_thread_.join();
+  pruner_.reset();
 }
 
 void JobService::worker_loop() {
@@ -392,6 +440,8 @@ void JobService::worker_loop() {
       continue;
     }
     if (!claimed) continue;
+    if (const auto created = parse_iso8601(claimed->created); created && claimed->attempts == 1)
+      queue_wait_.observe(std::max(0.0, std::chrono::duration<double>(std::chrono::system_clock::now() - *created).count()));
     auto job = std::make_shared<ActiveJob>(Lease{claimed->id, claimed->generation});
     {
       std::lock_guard lock(mutex_);
@@ -406,8 +456,7 @@ void JobService::worker_loop() {
       spdlog::error("job {}: {}", job->id, e.what());
       try {
         JobOutcome o;
-        o.status = JobStatus::failed;
-        o.message = std::string("internal error: ") + e.what();
+        failed(o, FailureKind::exception, std::string("internal error: ") + e.what());
         o.finished = now_iso8601();
         finish(job, std::move(o), job->last_seq);
       } catch (const std::exception& again) {
@@ -561,10 +610,13 @@ void JobService::finish(const std::shared_ptr<ActiveJob>& job, JobOutcome outcom
     return;
   }
   if (outcome.terminal.type.empty()) {
-    const json ev = outcome.status == JobStatus::successful
-                        ? json{{"type", "job_finished"}}
-                        : failed_event(outcome.status == JobStatus::dismissed ? "dismissed"
-                                                                              : outcome.message);
+    const json ev = outcome.status == JobStatus::successful ? json{{"type", "job_finished"}}
+                    : outcome.status == JobStatus::dismissed
+                        ? json::parse(kDismissedEvent)
+                        : json{{"type", "job_failed"},
+                               {"reason", outcome.message},
+                               {"failure",
+                                {{"kind", outcome.failure_kind}, {"message", outcome.message}, {"step", outcome.failure_step}}}};
     outcome.terminal = stored(last + 1, ev);
   }
   std::optional<JobStatus> stored_status;
@@ -574,7 +626,25 @@ void JobService::finish(const std::shared_ptr<ActiveJob>& job, JobOutcome outcom
     spdlog::warn("job {}: run not recorded (fenced: another run holds it)", job->id);
     return;
   }
+  // What the job stores (scene, events, result), as the store counted it.
+  std::optional<JobRecord> stored_job;
+  try {
+    stored_job = store_.job(job->id);
+  } catch (const std::exception&) {
+  }
   std::lock_guard lock(mutex_);
+  run_seconds_by_outcome_.try_emplace(std::string(to_string(*stored_status)), seconds_buckets())
+      .first->second.observe(std::chrono::duration<double>(Clock::now() - job->started).count());
+  if (stored_job && stored_job->stored_bytes > 0) {
+    stored_bytes_counts_.resize(kStoredBytesBuckets.size());
+    for (size_t b = 0; b < kStoredBytesBuckets.size(); ++b)
+      if (stored_job->stored_bytes <= kStoredBytesBuckets[b]) {
+        ++stored_bytes_counts_[b];
+        break;
+      }
+    stored_bytes_sum_ += stored_job->stored_bytes;
+    ++stored_bytes_count_;
+  }
   if (*stored_status != JobStatus::dismissed || outcome.solve_seconds > 0) {
     solve_seconds_ += outcome.solve_seconds;
     iterations_ += outcome.iterations;
@@ -597,14 +667,13 @@ void JobService::run_job(const std::shared_ptr<ActiveJob>& job, const JobRecord&
   try {
     scene.emplace(read_scene(json::parse(rec.scene)));
   } catch (const SceneErrors& e) {
-    outcome.status = JobStatus::failed;
-    outcome.message = std::string("invalid scene: ") + e.what();
+    failed(outcome, FailureKind::invalid_scene, std::string("invalid scene: ") + e.what());
   } catch (const std::exception& e) {
-    outcome.status = JobStatus::failed;
-    outcome.message = std::string("cannot read the stored scene: ") + e.what();
+    failed(outcome, FailureKind::invalid_scene, std::string("cannot read the stored scene: ") + e.what());
   }
   if (!scene) {
     outcome.finished = now_iso8601();
+    log_outcome(id, outcome.status, 0, outcome.message, 0.0);
     finish(job, std::move(outcome), seq);
     return;
   }
@@ -612,9 +681,12 @@ void JobService::run_job(const std::shared_ptr<ActiveJob>& job, const JobRecord&
   const int steps = static_cast<int>(scene->steps.size());
   const int nodes = scene->problem.body->node_count();
   if (nodes > lim.max_nodes || steps > lim.max_steps) {
-    outcome.status = JobStatus::failed;
-    outcome.message = "limit: the scene is over this service's node or step limit";
+    failed(outcome, FailureKind::job_limit,
+           "limit: the scene has " + std::to_string(nodes) + " nodes and " + std::to_string(steps) +
+               " steps; this service takes at most " + std::to_string(lim.max_nodes) + " nodes and " +
+               std::to_string(lim.max_steps) + " steps");
     outcome.finished = now_iso8601();
+    log_outcome(id, outcome.status, 0, outcome.message, 0.0);
     finish(job, std::move(outcome), seq);
     return;
   }
@@ -632,8 +704,10 @@ void JobService::run_job(const std::shared_ptr<ActiveJob>& job, const JobRecord&
     std::lock_guard lock(job->progress_mutex);
     job->progress->step = step;
   };
+  // Contact iterations: real solves, the events' trials (the one count: the job document, the
+  // log, /metrics, the limit and the result's summary all read it).
   observer.iteration = [&](const IterationEvent& ev) {
-    ++iterations;
+    iterations += ev.trials;
     emit(job, ++seq, iteration_event(ev));
     std::lock_guard lock(job->progress_mutex);
     job->progress->contact_error = ev.v2;
@@ -653,6 +727,19 @@ void JobService::run_job(const std::shared_ptr<ActiveJob>& job, const JobRecord&
       stop = Stop::seconds;
     return stop != Stop::none;
   };
+  observer.stop_reason = [&]() -> std::pair<FailureKind, std::string> {
+    switch (stop) {
+      case Stop::iterations:
+        return {FailureKind::job_limit, "limit: " + std::to_string(iterations) +
+                                            " contact iterations, this service's limit (--max-iterations " +
+                                            std::to_string(lim.max_iterations) + ")"};
+      case Stop::seconds:
+        return {FailureKind::job_limit, "limit: the run reached this service's wall-time limit (--max-seconds " +
+                                            number_text(lim.max_seconds) + ")"};
+      case Stop::dismissed: return {FailureKind::dismissed, "dismissed"};
+      default: return {FailureKind::stopped, "stopped on request"};  // shutdown or lost: not stored
+    }
+  };
 
   RunResult run;
   try {
@@ -660,6 +747,7 @@ void JobService::run_job(const std::shared_ptr<ActiveJob>& job, const JobRecord&
   } catch (const std::exception& e) {
     run.completed = false;
     run.reason = std::string("solver error: ") + e.what();
+    run.failure = FailureKind::exception;
   }
   const double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
 
@@ -680,21 +768,16 @@ void JobService::run_job(const std::shared_ptr<ActiveJob>& job, const JobRecord&
   outcome.finished = now_iso8601();
   outcome.solve_seconds = run.seconds > 0 ? run.seconds : seconds;
   outcome.iterations = iterations;
+  for (const StepRecord& s : run.steps) outcome.steps_completed += s.converged ? 1 : 0;
   if (job->dismissed) {
-    outcome.status = JobStatus::dismissed;
-    outcome.message = "dismissed";
+    failed(outcome, FailureKind::dismissed, "dismissed");
   } else if (run.completed) {
     outcome.status = JobStatus::successful;
     outcome.message = "solved " + std::to_string(steps) + " steps";
   } else {
-    outcome.status = JobStatus::failed;
-    if (stop == Stop::iterations)
-      outcome.message = "limit: more than " + std::to_string(lim.max_iterations) +
-                        " contact iterations";
-    else if (stop == Stop::seconds)
-      outcome.message = "limit: more than " + std::to_string(lim.max_seconds) + " s of wall time";
-    else
-      outcome.message = run.reason.empty() ? "the run failed" : run.reason;
+    // The result's reason (summary.reason), a job limit's included: the run's stop request
+    // named it (observer.stop_reason).
+    failed(outcome, run.failure, run.reason.empty() ? "the run failed" : run.reason, run.failure_step);
   }
   if (outcome.status != JobStatus::dismissed && !run.steps.empty()) {
     try {
@@ -702,16 +785,15 @@ void JobService::run_job(const std::shared_ptr<ActiveJob>& job, const JobRecord&
       // took several times the text's memory and more time than writing it.
       std::ostringstream text;
       write_result(text, *scene, run);
-      outcome.result = std::move(text).str();
+      outcome.result = gzip(std::move(text).str());  // stored and served compressed
     } catch (const std::exception& e) {
       spdlog::error("job {}: cannot build its result: {}", id, e.what());
     }
   }
-  const std::string status(to_string(outcome.status));
+  const JobStatus status = outcome.status;
   const std::string message = outcome.message;
   finish(job, std::move(outcome), seq);
-  spdlog::info("job {} {} in {:.3f} s: {} contact iterations; {}", id, status, seconds, iterations,
-               message);
+  log_outcome(id, status, iterations, message, seconds);
 }
 
 }  // namespace grip::server

@@ -28,15 +28,19 @@
 #include <cstdint>
 #include <deque>
 #include <functional>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <ostream>
 #include <stdexcept>
 #include <string>
 #include <thread>
 #include <unordered_map>
 #include <vector>
 
+#include "server/observability.hpp"
+#include "server/pruner.hpp"
 #include "server/store.hpp"
 
 namespace grip::server {
@@ -57,6 +61,8 @@ struct ServiceOptions {
   double lease_seconds = 10;  // a run unrenewed this long is taken over by another process
   std::size_t event_buffer = 100000;  // events waiting for the store before runs pause
   JobLimits limits;
+  Retention retention;  // finished jobs kept (server/pruner.hpp)
+  std::chrono::milliseconds prune_interval{60000};
   // Test and benchmark hook, called on the worker thread as each event is produced (before
   // it is stored).
   std::function<void(const std::string& job_id, std::int64_t seq, const nlohmann::json& event)>
@@ -115,9 +121,16 @@ struct ServiceStats {
   std::int64_t iterations = 0;    // contact iterations of finished runs, this process
   std::int64_t events = 0;        // events stored, this process
   std::size_t events_waiting = 0;  // events not yet stored
-  std::int64_t db_round_trips = 0;  // with the database, this process
-  std::int64_t db_bytes = 0;
+  // Round trips and bytes with the database, this process; none where the store does not
+  // measure them.
+  std::optional<std::pair<std::int64_t, std::int64_t>> db_traffic;
   std::map<JobStatus, std::int64_t> jobs;  // by status, from the store
+  Retention retention;
+  std::int64_t pruned = 0;      // finished jobs removed by retention, this process
+  std::int64_t disk_bytes = 0;  // the database on disk
+  // Stored bytes of the jobs this process finished: {upper bound, count} and their sum.
+  std::vector<std::pair<double, std::int64_t>> stored_bytes_buckets;
+  std::int64_t stored_bytes_sum = 0, stored_bytes_count = 0;
 };
 
 bool is_terminal_event(const std::string& type);
@@ -134,8 +147,10 @@ class JobService {
 
   // Validates and stores the scene, then queues it. Throws grip::SceneErrors (invalid scene
   // or over a limit), QueueFull, ShuttingDown, IdempotencyConflict.
+  // `request_id`: the submitting request's, kept with the job.
   SubmitResult submit(const nlohmann::json& scene,
-                      const std::optional<std::string>& idempotency_key = std::nullopt);
+                      const std::optional<std::string>& idempotency_key = std::nullopt,
+                      const std::string& request_id = "");
   std::optional<JobView> job(const std::string& id);
   std::vector<JobView> with_progress(std::vector<JobRecord> records);
   JobPage list(std::optional<JobStatus> status, int limit, std::optional<std::int64_t> before);
@@ -152,6 +167,8 @@ class JobService {
   std::optional<std::string> result(const std::string& id);
 
   ServiceStats stats();
+  // Queue wait and run duration histograms (Prometheus text).
+  void write_job_metrics(std::ostream& os) const;
   // Started, not draining, and the store answers.
   bool ready();
   const std::string& replica() const { return options_.replica; }
@@ -185,6 +202,11 @@ class JobService {
 
   Store& store_;
   ServiceOptions options_;
+  std::unique_ptr<Pruner> pruner_;  // with a retention, while started
+  std::vector<std::int64_t> stored_bytes_counts_;  // per kStoredBytesBuckets (mutex_)
+  std::int64_t stored_bytes_sum_ = 0, stored_bytes_count_ = 0;
+  Histogram queue_wait_{seconds_buckets()};                    // accepted -> claimed here
+  std::map<std::string, Histogram> run_seconds_by_outcome_;  // claimed -> stored outcome (mutex_)
   std::atomic<bool> started_{false};
   std::atomic<bool> draining_{false};
 

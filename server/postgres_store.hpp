@@ -50,9 +50,11 @@ class PostgresStore final : public Store {
   std::vector<StoredEvent> events_after(const std::string& id, std::int64_t after, int limit,
                                         std::string_view type) override;
   std::optional<std::string> result(const std::string& id) override;
+  std::int64_t prune(const Retention& retention, const std::string& now) override;
+  std::int64_t disk_bytes() override;
   bool ping() override;
   void set_listener(std::function<void(const StoreChange&)> listener) override;
-  std::pair<std::int64_t, std::int64_t> traffic() const override;
+  std::optional<std::pair<std::int64_t, std::int64_t>> traffic() const override;
 
   struct Connection;
   struct Pool;

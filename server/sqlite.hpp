@@ -53,6 +53,8 @@ class Statement {
   Statement& bind(int index, const std::string& value) { return bind(index, std::string_view(value)); }
   Statement& bind(int index, const std::optional<std::string>& value);
   Statement& bind_null(int index);
+  // Bytes as a BLOB (a TEXT binding would claim they are UTF-8).
+  Statement& bind_blob(int index, std::string_view bytes);
 
   // Steps once: true while a row is available, false when done.
   bool step();
@@ -63,6 +65,7 @@ class Statement {
   std::int64_t int64(int column) const;
   double real(int column) const;
   std::string text(int column) const;
+  std::string blob(int column) const;  // a BLOB's bytes (a TEXT value's too)
   std::optional<std::string> optional_text(int column) const;
   bool is_null(int column) const;
 

@@ -28,7 +28,12 @@ CREATE TABLE IF NOT EXISTS jobs (
   iterations INTEGER NOT NULL DEFAULT 0,
   owner TEXT NOT NULL DEFAULT '',
   generation INTEGER NOT NULL DEFAULT 0,
-  lease_expires REAL NOT NULL DEFAULT 0
+  lease_expires REAL NOT NULL DEFAULT 0,
+  failure_kind TEXT NOT NULL DEFAULT '',
+  failure_step INTEGER NOT NULL DEFAULT 0,
+  steps_completed INTEGER NOT NULL DEFAULT 0,
+  stored_bytes INTEGER NOT NULL DEFAULT 0,
+  request_id TEXT NOT NULL DEFAULT ''
 );
 CREATE INDEX IF NOT EXISTS jobs_by_status ON jobs (status, ord);
 CREATE TABLE IF NOT EXISTS events (
@@ -51,10 +56,23 @@ ALTER TABLE jobs ADD COLUMN generation INTEGER NOT NULL DEFAULT 0;
 ALTER TABLE jobs ADD COLUMN lease_expires REAL NOT NULL DEFAULT 0;
 )sql";
 
+// Schema 2 to 3 (failure kinds, converged steps of a finished job).
+constexpr const char* kUpgrade2to3 = R"sql(
+ALTER TABLE jobs ADD COLUMN failure_kind TEXT NOT NULL DEFAULT '';
+ALTER TABLE jobs ADD COLUMN failure_step INTEGER NOT NULL DEFAULT 0;
+ALTER TABLE jobs ADD COLUMN steps_completed INTEGER NOT NULL DEFAULT 0;
+)sql";
+
+// Schema 3 to 4: the bytes a finished job stores, the request that submitted it.
+constexpr const char* kUpgrade3to4 =
+    "ALTER TABLE jobs ADD COLUMN stored_bytes INTEGER NOT NULL DEFAULT 0;"
+    "ALTER TABLE jobs ADD COLUMN request_id TEXT NOT NULL DEFAULT '';";
+
 // Columns read by read_job, in this order.
 constexpr const char* kJobColumns =
     "id, ord, status, created, started, finished, updated, message, steps, nodes, "
-    "idempotency_key, last_seq, attempts, solve_seconds, iterations, owner, generation";
+    "idempotency_key, last_seq, attempts, solve_seconds, iterations, owner, generation, failure_kind, "
+    "failure_step, steps_completed, stored_bytes, request_id";
 
 JobRecord read_job(const Statement& st, bool with_scene) {
   JobRecord j;
@@ -75,7 +93,12 @@ JobRecord read_job(const Statement& st, bool with_scene) {
   j.iterations = st.int64(14);
   j.owner = st.text(15);
   j.generation = st.int64(16);
-  if (with_scene) j.scene = st.text(17);
+  j.failure_kind = st.text(17);
+  j.failure_step = static_cast<int>(st.int64(18));
+  j.steps_completed = static_cast<int>(st.int64(19));
+  j.stored_bytes = st.int64(20);
+  j.request_id = st.text(21);
+  if (with_scene) j.scene = st.text(22);
   return j;
 }
 
@@ -109,9 +132,22 @@ SqliteStore::SqliteStore(const std::string& path, int busy_timeout_ms) {
       return t.int64(0) > 0;
     }();
     if (has_jobs && v.int64(0) < 2) writer_->exec(kUpgrade1to2);
+    if (has_jobs && v.int64(0) < 3) writer_->exec(kUpgrade2to3);
+    if (has_jobs && v.int64(0) < 4) writer_->exec(kUpgrade3to4);
+  }
+  // Pages freed by removals go back to the file system at each prune (incremental_vacuum);
+  // a file made without it switches once, by a VACUUM that rewrites it.
+  const std::int64_t vacuum_mode = [&] {
+    auto mode = writer_->prepare("PRAGMA auto_vacuum");
+    mode.step();
+    return mode.int64(0);
+  }();
+  if (vacuum_mode != 2) {
+    writer_->exec("PRAGMA auto_vacuum = INCREMENTAL");
+    writer_->exec("VACUUM");
   }
   writer_->exec(kSchema);
-  writer_->exec("PRAGMA user_version = 2");
+  writer_->exec("PRAGMA user_version = 4");
   // The file is this process's alone: whatever a previous process held is free now.
   writer_->exec("UPDATE jobs SET lease_expires = 0 WHERE finished IS NULL");
   reader_ = std::make_unique<Database>(path, busy_timeout_ms);
@@ -136,10 +172,10 @@ void SqliteStore::insert_job(JobRecord& job) {
     std::lock_guard lock(write_mutex_);
     auto st = writer_->prepare(
         "INSERT INTO jobs (id, status, scene, created, updated, message, steps, nodes, "
-        "idempotency_key) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?)");
+        "idempotency_key, request_id) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
     st.bind(1, job.id).bind(2, to_string(job.status)).bind(3, job.scene).bind(4, job.created);
     st.bind(5, job.updated).bind(6, job.message).bind(7, job.steps).bind(8, job.nodes);
-    st.bind(9, job.idempotency_key);
+    st.bind(9, job.idempotency_key).bind(10, job.request_id);
     st.run();
     job.ord = sqlite3_last_insert_rowid(writer_->handle());
   }
@@ -359,14 +395,22 @@ std::optional<JobStatus> SqliteStore::finish_job(const Lease& lease, const JobOu
     if (dismissed) terminal = {o.terminal.seq, "job_failed", std::string(kDismissedEvent)};
     writer_->prepare(
                "UPDATE jobs SET status = ?1, message = ?2, finished = ?3, updated = ?3, "
-               "solve_seconds = ?4, iterations = ?5, last_seq = max(last_seq, ?6) WHERE id = ?7")
+               "solve_seconds = ?4, iterations = ?5, last_seq = max(last_seq, ?6), failure_kind = ?8, "
+               "failure_step = ?9, steps_completed = ?10 WHERE id = ?7")
         .bind(1, to_string(final_status)).bind(2, dismissed ? std::string("dismissed") : o.message)
         .bind(3, o.finished).bind(4, o.solve_seconds).bind(5, o.iterations)
-        .bind(6, terminal.seq).bind(7, lease.job_id).run();
+        .bind(6, terminal.seq).bind(7, lease.job_id)
+        .bind(8, dismissed ? std::string("dismissed") : o.failure_kind)
+        .bind(9, dismissed ? 0 : o.failure_step).bind(10, o.steps_completed).run();
     if (o.result && !dismissed)
       writer_->prepare("INSERT OR REPLACE INTO results (job_id, data) VALUES (?, ?)")
-          .bind(1, lease.job_id).bind(2, *o.result).run();
+          .bind(1, lease.job_id).bind_blob(2, *o.result).run();
     insert_event(*writer_, lease.job_id, terminal);
+    writer_->prepare(
+               "UPDATE jobs SET stored_bytes = length(CAST(scene AS BLOB)) + "
+               "coalesce((SELECT length(CAST(data AS BLOB)) FROM results WHERE job_id = ?1), 0) + "
+               "coalesce((SELECT sum(length(CAST(data AS BLOB))) FROM events WHERE job_id = ?1), 0) WHERE id = ?1")
+        .bind(1, lease.job_id).run();
     tx.commit();
   }
   announce(StoreChange::events, lease.job_id);
@@ -446,7 +490,43 @@ std::optional<std::string> SqliteStore::result(const std::string& id) {
   auto st = reader_->prepare("SELECT data FROM results WHERE job_id = ?");
   st.bind(1, id);
   if (!st.step()) return std::nullopt;
-  return st.text(0);
+  return st.blob(0);
+}
+
+std::int64_t SqliteStore::prune(const Retention& retention, const std::string& now) {
+  if (!retention.any()) return 0;
+  std::vector<FinishedJob> finished;
+  {
+    std::lock_guard lock(read_mutex_);
+    auto st = reader_->prepare(
+        "SELECT id, status, finished, stored_bytes FROM jobs WHERE finished IS NOT NULL AND "
+        "status IN ('successful', 'failed', 'dismissed') ORDER BY status = 'dismissed', ord DESC");
+    while (st.step()) finished.push_back({st.text(0), st.text(1) == "dismissed", st.text(2), st.int64(3)});
+  }
+  const std::vector<std::string> gone = beyond_retention(finished, retention, retention_cutoff(retention, now));
+  if (gone.empty()) return 0;
+  {
+    std::lock_guard lock(write_mutex_);
+    Transaction tx(*writer_);
+    auto events = writer_->prepare("DELETE FROM events WHERE job_id = ?");
+    auto results = writer_->prepare("DELETE FROM results WHERE job_id = ?");
+    auto jobs = writer_->prepare("DELETE FROM jobs WHERE id = ? AND finished IS NOT NULL");
+    for (const std::string& id : gone)
+      for (Statement* st : {&events, &results, &jobs}) {
+        st->reset();
+        st->bind(1, id).run();
+      }
+    tx.commit();
+    writer_->exec("PRAGMA incremental_vacuum");
+  }
+  announce(StoreChange::job, "");
+  return static_cast<std::int64_t>(gone.size());
+}
+
+std::int64_t SqliteStore::disk_bytes() {
+  std::lock_guard lock(read_mutex_);
+  auto st = reader_->prepare("SELECT page_count * page_size FROM pragma_page_count(), pragma_page_size()");
+  return st.step() ? st.int64(0) : 0;
 }
 
 }  // namespace grip::server

@@ -42,6 +42,8 @@ class SqliteStore final : public Store {
   std::vector<StoredEvent> events_after(const std::string& id, std::int64_t after, int limit,
                                         std::string_view type) override;
   std::optional<std::string> result(const std::string& id) override;
+  std::int64_t prune(const Retention& retention, const std::string& now) override;
+  std::int64_t disk_bytes() override;
   bool ping() override { return true; }
   void set_listener(std::function<void(const StoreChange&)> listener) override;
 

@@ -41,7 +41,8 @@ class StoreUnavailable : public std::runtime_error {
 };
 
 // The terminal event of a dismissed job, as the store writes it.
-inline constexpr std::string_view kDismissedEvent = R"({"reason":"dismissed","type":"job_failed"})";
+inline constexpr std::string_view kDismissedEvent =
+    R"({"failure":{"kind":"dismissed","message":"dismissed","step":0},"reason":"dismissed","type":"job_failed"})";
 
 struct JobRecord {
   std::string id;
@@ -62,7 +63,39 @@ struct JobRecord {
   std::int64_t iterations = 0;  // contact iterations of the final run
   std::string owner;            // replica holding (or that last held) the lease
   std::int64_t generation = 0;  // lease generation: grows with every claim
+  // A finished job: why it did not succeed (a FailureKind's name, empty when it did), the step
+  // that failed (0: none), and the steps that converged.
+  std::string failure_kind;
+  int failure_step = 0;
+  int steps_completed = 0;
+  std::int64_t stored_bytes = 0;  // of its scene, events and result, once finished
+  std::string request_id;         // of the request that submitted it (X-Request-Id)
 };
+
+// Which finished jobs the store keeps; 0: no bound of that kind. Beyond a bound the
+// dismissed jobs go first, then the oldest.
+struct Retention {
+  double max_age_seconds = 0;  // finished longer ago than this
+  std::int64_t max_jobs = 0;   // finished jobs
+  std::int64_t max_bytes = 0;  // stored bytes of finished jobs
+  bool any() const { return max_age_seconds > 0 || max_jobs > 0 || max_bytes > 0; }
+};
+
+// A finished job as retention sees it, in the order it keeps them: the ones it keeps first.
+struct FinishedJob {
+  std::string id;
+  bool dismissed = false;
+  std::string finished;
+  std::int64_t stored_bytes = 0;
+};
+
+// The time (ISO 8601) before which a job finished is too old at `now`; empty: no age bound.
+std::string retention_cutoff(const Retention& r, const std::string& now);
+
+// The ids of `jobs` (ordered as FinishedJob says) that `r` removes at `cutoff` (the ISO 8601
+// time before which finished jobs are too old; empty: no age bound).
+std::vector<std::string> beyond_retention(const std::vector<FinishedJob>& jobs, const Retention& r,
+                                          const std::string& cutoff);
 
 // A run's hold on a job (fencing token).
 struct Lease {
@@ -87,7 +120,10 @@ struct JobOutcome {
   std::string finished;  // timestamp
   double solve_seconds = 0.0;
   std::int64_t iterations = 0;
-  std::optional<std::string> result;  // result JSON, when the run produced one
+  std::string failure_kind;  // as JobRecord's
+  int failure_step = 0;
+  int steps_completed = 0;
+  std::optional<std::string> result;  // the result as stored (gzip of its JSON), when the run produced one
   StoredEvent terminal;                // job_finished | job_failed
 };
 
@@ -158,14 +194,22 @@ class Store {
   // Events with seq > after, in order, at most `limit`; only of `type` when given.
   virtual std::vector<StoredEvent> events_after(const std::string& id, std::int64_t after,
                                                 int limit, std::string_view type = {}) = 0;
+  // The result as stored: bytes (gzip, or the JSON text of a result stored before compression).
   virtual std::optional<std::string> result(const std::string& id) = 0;
+
+  // Removes the finished jobs beyond `retention` at `now` (ISO 8601), with their events and
+  // results, and hands their space back (SQLite: incremental vacuum). Returns how many.
+  virtual std::int64_t prune(const Retention& retention, const std::string& now) = 0;
+  // Bytes the database takes on disk (SQLite: the file; PostgreSQL: grip's tables).
+  virtual std::int64_t disk_bytes() = 0;
 
   // True when the database answers now.
   virtual bool ping() = 0;
   // Called (on a store thread) for every change on the database, from any store instance.
   virtual void set_listener(std::function<void(const StoreChange&)> listener) = 0;
-  // Round trips and bytes exchanged with the database so far (benchmarks; 0 when embedded).
-  virtual std::pair<std::int64_t, std::int64_t> traffic() const { return {0, 0}; }
+  // Round trips and bytes exchanged with the database so far (benchmarks); none when the
+  // store does not measure them (embedded).
+  virtual std::optional<std::pair<std::int64_t, std::int64_t>> traffic() const { return std::nullopt; }
 };
 
 }  // namespace grip::server

@@ -100,6 +100,7 @@ class CevStep : public StepSolver {
     if (!line_search(pl, du, trials)) {
       if (!stale || !budget_left()) return Update::failed;
       out_.reason.clear();
+      out_.failure = FailureKind::none;
       eq_.refresh_compliance();
       return Update::retry;
     }

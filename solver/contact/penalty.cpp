@@ -29,11 +29,11 @@ class PenaltyStep : public StepSolver {
     const double pin_scale = problem_.rigid.count() ? eq_.stiffness_scale(q_guess) : 0.0;
     int solves = 0;
     EquilibriumState s = levels(law, pin_scale, q0, p_start, 1.0, solves);
-    if (!s.converged) s = levels(law, pin_scale, q0, p_start, kRamp, solves);
+    if (!s.converged && !out_.stopped) s = levels(law, pin_scale, q0, p_start, kRamp, solves);
     eq_.set_penalty(std::nullopt);
     pass_ = out_.passes = 1;
     if (!s.converged) {
-      fail("equilibrium solve failed: " + s.reason);
+      if (!out_.stopped) fail(s.failure, "equilibrium solve failed: " + s.reason);
       return;
     }
     Vector p_star = Vector::Zero(problem_.component_count);
@@ -58,12 +58,20 @@ class PenaltyStep : public StepSolver {
     const int count = held || ramp < 1.0 ? kLevels : 1;
     EquilibriumState s;
     s.reason = "no level solved";
+    s.failure = FailureKind::newton_diverged;
     for (int level = 0; level < count; ++level) {
       PenaltyLaw at = law;
       const double stiffer = std::pow(ramp, static_cast<double>(count - 1 - level) / std::max(1, count - 1));
       at.normal *= stiffer;
       at.tangential *= stiffer;
       at.pin_spring = held && level + 1 < count ? kPinSpring * std::pow(1e-2, level) * pin_scale : 0.0;
+      // A stop (a dismissal, a job limit) is heard before every real solve, as by the others.
+      if (stop_ && stop_()) {
+        out_.stopped = true;
+        fail(FailureKind::stopped, "stopped on request");
+        s.converged = false;
+        return s;
+      }
       eq_.set_penalty(at);
       s = eq_.solve(q, p_start);
       ++solves;

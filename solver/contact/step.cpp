@@ -7,7 +7,8 @@
 #include "solver/contact/acceleration.hpp"
 #include "solver/contact/coulomb_model.hpp"
 #include "solver/contact/friction_limit.hpp"
-#include "solver/equilibrium/rigid_equilibrium.hpp"
+#include "solver/model/number_text.hpp"
+#include "solver/problem/rigid_modes.hpp"
 
 namespace grip {
 namespace {
@@ -59,6 +60,16 @@ StepOutcome StepSolver::run(const Vector& q_guess, const Vector& p_start, const 
   solves_at_start_ = solves0;
   solve(q_guess, p_start, p_star);
   out_.solves = static_cast<int>(eq_.counters().solves - solves0);
+  // One count of contact iterations: the real solves, each reported in an event's trials. The
+  // trials that a failure cut short before their update was accepted (a line search or an
+  // alpha halving without a decrease, a stop) go in one closing event, at the state the
+  // attempt ended on: a cut step's attempts and the job's limit count them as well.
+  int reported = 0;
+  for (const IterationEvent& ev : out_.history) reported += ev.trials;
+  if (out_.solves > reported) {
+    m_ = 0;  // no update: like a pass's starting solve, it is no step of the pass's descent
+    emit(out_.solves - reported, 0, 0, 0, 0.0);
+  }
   out_.newton_iterations =
       static_cast<int>(eq_.counters().newton_iterations - newton0 + own_newton_iterations_);
   out_.v2 = error_.norm2;
@@ -130,7 +141,7 @@ void StepSolver::tau_passes(const Vector& q_guess, const Vector& p_start, const 
     if (literal_ && change <= force_precision()) pin_forces_ = 0.1 * settled;
     for (const Candidate& c : problem_.candidates) p_star[c.eta] = out_.p[c.eta];
     if (!passes_to_budget_ && pass_index == params_.max_tau_passes)
-      fail("the friction bound did not settle in " + std::to_string(pass_index) + " tau passes");
+      fail(FailureKind::contact_budget, "the friction bound did not settle in " + std::to_string(pass_index) + " tau passes");
   }
   if (no_friction && out_.reason.empty()) out_.converged = true;
   if (out_.converged) final_check();
@@ -155,7 +166,7 @@ bool StepSolver::bound_from_model(Vector& p_star) {
   const Compliance& C = eq_.compliance(out_.state, relevant_components());
   const CoulombModelSolution model = solve_model(C, 0.1 * tol_);
   out_.inner_iterations += model.iterations;
-  if (!presses(model.p)) return fail("the linear model at the step's first state presses no point");
+  if (!presses(model.p)) return fail(FailureKind::no_equilibrium, "the linear model at the step's first state presses no point");
   for (const Candidate& c : problem_.candidates) p_star[c.eta] = model.p[c.eta];
   out_.tau = friction_bounds(problem_, p_star);
   return true;
@@ -166,7 +177,7 @@ bool StepSolver::fresh_solve(const Vector& q, double v_scale) {
   const bool loose = loosen_newton(v_scale);
   EquilibriumState s = eq_.solve(q, out_.p);
   tighten_newton();
-  if (!s.converged) return fail("equilibrium solve failed: " + s.reason);
+  if (!s.converged) return fail(s.failure, "equilibrium solve failed: " + s.reason);
   if (loose) {
     // v_scale was another state's error. Newton is finished to the precision this state's
     // error asks for where that one is within the tolerance (the full precision), or far below
@@ -177,7 +188,7 @@ bool StepSolver::fresh_solve(const Vector& q, double v_scale) {
       if (v > tol_) loosen_newton(v);
       eq_.continue_solve(s, out_.p);
       tighten_newton();
-      if (!s.converged) return fail("equilibrium solve failed: " + s.reason);
+      if (!s.converged) return fail(s.failure, "equilibrium solve failed: " + s.reason);
     }
   }
   accept(std::move(s), out_.p);
@@ -262,24 +273,28 @@ void StepSolver::accept(EquilibriumState s, const Vector& p) {
   }
 }
 
-bool StepSolver::fail(std::string reason) {
+bool StepSolver::fail(FailureKind kind, std::string reason) {
   out_.converged = false;
-  if (out_.reason.empty()) out_.reason = std::move(reason);
+  if (out_.reason.empty()) {
+    out_.reason = std::move(reason);
+    out_.failure = kind;
+  }
   return false;
 }
 
 bool StepSolver::budget_left() {
   if (stop_ && stop_()) {
     out_.stopped = true;
-    return fail("stopped on request");
+    return fail(FailureKind::stopped, "stopped on request");
   }
-  if (!friction_limit_.empty()) return fail(friction_limit_);
+  if (!friction_limit_.empty()) return fail(FailureKind::friction_limit, friction_limit_);
   if (eq_.counters().solves < solves_at_start_ + params_.max_iterations) return true;
   if (error_met(error_))  // what is left is the tau passes' p*
-    return fail("the friction bound did not settle in " + std::to_string(params_.max_iterations) +
+    return fail(FailureKind::contact_budget,
+                "the friction bound did not settle in " + std::to_string(params_.max_iterations) +
                 " contact iterations (" + std::to_string(pass_) + " tau passes; ||v|| within the tolerance)");
-  return fail("contact error " + std::to_string(error_.norm2) + " above tolerance " +
-              std::to_string(tol_) + " after " + std::to_string(params_.max_iterations) +
+  return fail(FailureKind::contact_budget, "contact error " + number_text(error_.norm2) + " above tolerance " +
+              number_text(tol_) + " after " + std::to_string(params_.max_iterations) +
               " contact iterations");
 }
 
@@ -308,8 +323,8 @@ bool StepSolver::line_search(const Vector& pl, const Vector& du, int& trials) {
       return true;
     }
   }
-  return fail("no decrease of the contact error along the predicted force change (||v|| = " +
-              std::to_string(v0) + ")");
+  return fail(FailureKind::contact_stalled,
+              "no decrease of the contact error along the predicted force change (||v|| = " + number_text(v0) + ")");
 }
 
 bool StepSolver::loosen_newton(double v_ref) {
@@ -388,7 +403,7 @@ bool StepSolver::literal_pass(int first_level, double alpha_fixed) {
     while (true) {
       Vector pbar, asked;
       const Direction dir = held_direction(C, e, level, alpha_fixed, a, pbar, asked);
-      if (!dir.ok) return fail("the active block of the compliance is not positive definite");
+      if (!dir.ok) return fail(FailureKind::contact_stalled, "the active block of the compliance is not positive definite");
       if (!budget_left()) return false;
       const Vector pt = project(C, out_.p, pbar, e, out_.tau, &asked);
       ++trials;
@@ -409,7 +424,7 @@ bool StepSolver::literal_pass(int first_level, double alpha_fixed) {
         a = 1.0;
       }
       if (halvings > params_.max_halvings)
-        return fail("alpha halved " + std::to_string(params_.max_halvings) +
+        return fail(FailureKind::contact_stalled, "alpha halved " + std::to_string(params_.max_halvings) +
                     " times without a decrease of the contact error");
     }
   }
@@ -498,11 +513,12 @@ double StepSolver::force_precision() {
 
 void StepSolver::final_check() {
   if (error_.norm2 > tol_) {
-    fail("contact error above tolerance at the end of the step");
+    fail(FailureKind::contact_stalled, "contact error above tolerance at the end of the step");
     return;
   }
   if (!error_met(error_)) {
-    fail("the load and the contact forces do not balance on the body's free motions to the tolerance at the end of "
+    fail(FailureKind::contact_stalled,
+         "the load and the contact forces do not balance on the body's free motions to the tolerance at the end of "
          "the step");
     return;
   }
@@ -510,21 +526,21 @@ void StepSolver::final_check() {
   // (docs/algorithm.md#bodies-held-only-by-contact).
   for (int k = 0; k < problem_.rigid.count(); ++k)
     if (!mode_held(k))
-      fail("no contact holds the body's free motion (" + problem_.rigid.names[k] +
+      fail(FailureKind::no_equilibrium, "no contact holds the body's free motion (" + problem_.rigid.names[k] +
            "): no point presses against an obstacle in that direction, so its position is not determined; "
            "no static equilibrium fixes it");
   for (size_t i = 0; i < problem_.candidates.size(); ++i) {
     const Candidate& c = problem_.candidates[i];
-    if (out_.p[c.eta] > 0) fail("a normal contact force pulls");
+    if (out_.p[c.eta] > 0) fail(FailureKind::contact_stalled, "a normal contact force pulls");
     if (c.xi >= 0 && std::abs(out_.p[c.xi]) > out_.tau[i] * (1 + 1e-9) + 1e-300)
-      fail("a friction force exceeds its Coulomb bound");
+      fail(FailureKind::contact_stalled, "a friction force exceeds its Coulomb bound");
   }
 }
 
 void StepSolver::emit(int trials, int inner, int halvings, int n, double alpha, int own_newton) {
   IterationEvent ev;
   ev.step = step_;
-  ev.pass = pass_;
+  ev.pass = std::max(pass_, 1);  // 1 also for a closing event before the first pass began
   ev.m = m_;
   ev.trials = trials;
   ev.inner_iterations = inner;
@@ -533,7 +549,9 @@ void StepSolver::emit(int trials, int inner, int halvings, int n, double alpha, 
   ev.alpha = alpha;
   ev.v2 = error_.norm2;
   ev.v_inf = error_.norm_inf;
-  for (size_t i = 0; i < problem_.candidates.size(); ++i) {
+  const bool forces = out_.p.size() == problem_.component_count &&
+                      static_cast<size_t>(out_.tau.size()) == problem_.candidates.size();
+  for (size_t i = 0; forces && i < problem_.candidates.size(); ++i) {
     switch (contact_state(problem_, i, out_.p, out_.tau)) {
       case ContactState::open: ++ev.open; break;
       case ContactState::stick: ++ev.stick; break;

@@ -70,7 +70,8 @@ class StepSolver {
   Vec2 mode_rates(size_t candidate, int mode) const;
   bool mode_held(int mode) const;
   void accept(EquilibriumState s, const Vector& p);
-  bool fail(std::string reason);
+  // Records the first failure of the step (its kind and reason); false.
+  bool fail(FailureKind kind, std::string reason);
   // False (with the reason) once the step's real-solve budget is spent or a stop is asked.
   bool budget_left();
 

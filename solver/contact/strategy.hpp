@@ -100,6 +100,7 @@ struct StepOutcome {
   bool converged = false;
   bool stopped = false;  // by the StopRequest, not by the numerics
   std::string reason;
+  FailureKind failure = FailureKind::none;  // the kind of the reason
   Vector p;
   Vector tau;
   EquilibriumState state;

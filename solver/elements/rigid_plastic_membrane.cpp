@@ -4,6 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "solver/model/number_text.hpp"
+
 namespace grip {
 
 double HillMaterial::plane_strain_factor() const {
@@ -186,7 +188,7 @@ std::string RigidPlasticMembrane::inadmissible(const Vector& q) const {
     const ElementState s = element_state(q, e);
     if (s.d1 < -10 * material_.regularization)
       return "membrane element " + std::to_string(e) + " is compressed (stretch increment " +
-             std::to_string(s.d1) + "): the sheet would wrinkle";
+             number_text(s.d1) + "): the sheet would wrinkle";
   }
   return {};
 }

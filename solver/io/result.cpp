@@ -10,7 +10,7 @@
 #include "solver/contact/contact_error.hpp"
 #include "solver/contact/master_reading.hpp"
 #include "solver/model/body_set.hpp"
-#include "solver/equilibrium/rigid_equilibrium.hpp"
+#include "solver/problem/rigid_modes.hpp"
 
 namespace grip {
 
@@ -34,12 +34,28 @@ json step_finished_event(const StepRecord& rec) {
             {"converged", rec.converged}, {"tau_passes", rec.passes},
             {"contact_iterations", rec.solves}, {"newton_iterations", rec.newton_iterations},
             {"seconds", rec.seconds}, {"stage", rec.stage}, {"factors", rec.factors}};
-  if (!rec.converged) j["reason"] = rec.reason;
+  if (!rec.converged) {
+    j["reason"] = rec.reason;
+    j["failure"] = failure_json(rec.failure, rec.reason, rec.index);
+  }
   if (!rec.warning.empty()) j["warning"] = rec.warning;
   return j;
 }
 
+json failure_json(FailureKind kind, const std::string& message, int step) {
+  return {{"kind", to_string(kind)}, {"message", message}, {"step", step}};
+}
+
+json job_failed_event(FailureKind kind, const std::string& reason, int step) {
+  return {{"type", "job_failed"}, {"reason", reason}, {"failure", failure_json(kind, reason, step)}};
+}
+
 namespace {
+
+// The scene's bodies where it has several (the BodySet that the scene reader built for
+// "bodies"), null for a scene of one body: the result takes the scene's form ("bodies",
+// "rigid_motions", "master_points"), so io asks for the type it built (docs/design.md).
+const BodySet* body_set_of(const Body& body) { return dynamic_cast<const BodySet*>(&body); }
 
 json table_json(const FieldTable& t, const char* index_name) {
   json rows = json::array();
@@ -57,7 +73,7 @@ json table_json(const FieldTable& t, const char* index_name) {
 // The contact points' numbers, read from the problem and the record.
 std::vector<ContactPointRow> contact_point_rows(const Problem& problem, const StepRecord& rec) {
   const Body& body = *problem.body;
-  const auto* all = dynamic_cast<const BodySet*>(&body);
+  const auto* all = body_set_of(body);
   std::vector<ContactPointRow> rows;
   rows.reserve(problem.candidates.size());
   for (size_t i = 0; i < problem.candidates.size(); ++i) {
@@ -129,9 +145,9 @@ json step_json(const Problem& problem, const StepRecord& rec, const OutputOption
       if (a.size() > 2) m["rotation"] = a[2];
       return m;
     };
-    if (const auto* all = dynamic_cast<const BodySet*>(&body)) {
+    if (const auto* all = body_set_of(body)) {
       json motions = json::array();
-      for (int b = 0; b < all->count(); ++b) {
+      for (int b = 0; b < all->part_count(); ++b) {
         if (std::find(problem.rigid.body.begin(), problem.rigid.body.end(), b) == problem.rigid.body.end()) continue;
         json m = motion(all->part(b), all->part_q(rec.state.q, b));
         m["body"] = all->name(b);
@@ -172,7 +188,7 @@ json step_json(const Problem& problem, const StepRecord& rec, const OutputOption
   std::vector<ContactPointRow> points = contact_point_rows(problem, rec);
   if (rows) *rows = std::move(points);
   else j["contact_points"] = contact_points_json(points);
-  if (const auto* all = dynamic_cast<const BodySet*>(&body)) {  // each pair's field read on its master
+  if (const auto* all = body_set_of(body)) {  // each pair's field read on its master
     json readings = json::array();
     for (size_t o = 0; o < problem.obstacles.size(); ++o) {
       const ObstacleInstance& pair = problem.obstacles[o];
@@ -248,10 +264,10 @@ json effects_json(const Scene& scene) {
               "forces, the whole body's equilibrium their rows; no regularization"
             : "the contact forces: the rigid amplitudes are contact unknowns and the whole body's equilibrium "
               "their condition; no regularization";
-  if (const auto* all = dynamic_cast<const BodySet*>(problem.body.get())) {
+  if (const auto* all = body_set_of(*problem.body)) {
     // Per body what it simulates, and per contact pair its candidates.
     json bodies = json::array(), pairs = json::array();
-    for (int b = 0; b < all->count(); ++b) {
+    for (int b = 0; b < all->part_count(); ++b) {
       const Body::Traits t = all->part(b).traits();
       json held = json::array();  // its motions held by contact, without the "BODY: " of the scene's list
       for (int k = 0; k < problem.rigid.count(); ++k)
@@ -283,11 +299,11 @@ namespace {
 
 // Each body's rows of the nodes and elements tables and of mesh.cells (several bodies only).
 std::optional<json> bodies_json(const Body& body) {
-  const auto* all = dynamic_cast<const BodySet*>(&body);
+  const auto* all = body_set_of(body);
   if (!all) return std::nullopt;
   json bodies = json::array();
   int first_element = 0;
-  for (int b = 0; b < all->count(); ++b) {
+  for (int b = 0; b < all->part_count(); ++b) {
     const int elements = static_cast<int>(all->part(b).cells().size());
     bodies.push_back({{"name", all->name(b)}, {"first_node", all->node_offset(b)}, {"nodes", all->part(b).node_count()},
                       {"first_element", first_element}, {"elements", elements}});
@@ -297,10 +313,12 @@ std::optional<json> bodies_json(const Body& body) {
 }
 
 json summary_json(const RunResult& run) {
-  return {{"completed", run.completed}, {"reason", run.reason}, {"steps", run.steps.size()},
-          {"contact_iterations", run.counters.solves},
-          {"newton_iterations", run.counters.newton_iterations},
-          {"factorizations", run.counters.factorizations}, {"seconds", run.seconds}};
+  json j = {{"completed", run.completed}, {"reason", run.reason}, {"steps", run.steps.size()},
+            {"contact_iterations", run.counters.solves},
+            {"newton_iterations", run.counters.newton_iterations},
+            {"factorizations", run.counters.factorizations}, {"seconds", run.seconds}};
+  if (!run.completed) j["failure"] = failure_json(run.failure, run.reason, run.failure_step);
+  return j;
 }
 
 // table_json's rows, written as they are made (no document of the table's size in memory),

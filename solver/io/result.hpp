@@ -16,6 +16,11 @@ namespace grip {
 nlohmann::json iteration_event(const IterationEvent& ev);
 nlohmann::json step_started_event(int step, double load_factor);
 nlohmann::json step_finished_event(const StepRecord& rec);
+// The failure member of a failed step, run or job: {kind, message, step}; step 0 where the
+// failure is no step's (a dismissal, an invalid scene, a node or step limit).
+nlohmann::json failure_json(FailureKind kind, const std::string& message, int step);
+// The terminal event of a job that did not solve every step.
+nlohmann::json job_failed_event(FailureKind kind, const std::string& reason, int step);
 
 // One step's fields: nodes, elements, reactions, contact points, obstacle positions.
 // Fields only where the step was recorded (see SteppingParams::record_fields) and wanted.

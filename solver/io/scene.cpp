@@ -8,12 +8,15 @@
 #include <numbers>
 #include <optional>
 #include <sstream>
+#include <unordered_map>
+#include <unordered_set>
 
 #include "solver/model/body_set.hpp"
+#include "solver/model/number_text.hpp"
 #include "solver/io/json_depth.hpp"
 #include "solver/io/scene_reader.hpp"
 #include "solver/io/schema_validation.hpp"
-#include "solver/equilibrium/rigid_equilibrium.hpp"
+#include "solver/problem/rigid_modes.hpp"
 
 namespace grip {
 namespace {
@@ -203,10 +206,11 @@ struct BodyPart {
 };
 
 std::vector<BodyPart> body_parts(const Problem& problem) {
+  // The BodySet that scene_bodies.cpp built for "bodies": its names and pointers are the scene's.
   const auto* all = dynamic_cast<const BodySet*>(problem.body.get());
   if (!all) return {{problem.body.get(), 0, "/body/supports", ""}};
   std::vector<BodyPart> parts;
-  for (int b = 0; b < all->count(); ++b)
+  for (int b = 0; b < all->part_count(); ++b)
     parts.push_back({&all->part(b), all->dof_offset(b), "/bodies/" + std::to_string(b) + "/supports", all->name(b) + ": "});
   return parts;
 }
@@ -482,7 +486,11 @@ std::vector<double> read_step_factors(Reader& r, json& scene) {
 std::vector<LoadStep> read_load_path(Reader& r, json& scene, std::vector<ObstacleInstance>& obstacles,
                                      bool cases_known) {
   std::vector<double> base_friction;
-  for (const auto& o : obstacles) base_friction.push_back(o.friction);
+  std::unordered_map<std::string, size_t> obstacle_index;
+  for (const auto& o : obstacles) {
+    obstacle_index.emplace(o.name, base_friction.size());
+    base_friction.push_back(o.friction);
+  }
   const size_t cases = r.cases.size();
   std::vector<LoadStep> path;
   if (!scene.contains("stages")) {
@@ -506,9 +514,9 @@ std::vector<LoadStep> read_load_path(Reader& r, json& scene, std::vector<Obstacl
     LoadFactors target = current;
     if (json* f = r.object(st, sp, "factors", true))
       for (auto& [name, v] : f->items()) {
-        size_t k = 0;
-        while (k < cases && r.cases[k] != name) ++k;
-        if (k == cases) {
+        const int found = r.find_case(name);
+        const size_t k = found < 0 ? cases : static_cast<size_t>(found);
+        if (k >= cases) {
           if (cases_known)
             r.error(sp + "/factors/" + token(name), "names no load case (cases: " + Reader::list(r.cases) + ")");
           continue;
@@ -518,8 +526,8 @@ std::vector<LoadStep> read_load_path(Reader& r, json& scene, std::vector<Obstacl
     std::vector<double> friction = base_friction;
     if (json* fr = r.object(st, sp, "friction", false))
       for (auto& [name, v] : fr->items()) {
-        size_t o = 0;
-        while (o < obstacles.size() && obstacles[o].name != name) ++o;
+        const auto named = obstacle_index.find(name);
+        const size_t o = named == obstacle_index.end() ? obstacles.size() : named->second;
         if (o == obstacles.size()) {
           r.error(sp + "/friction/" + token(name), "names no obstacle");
           continue;
@@ -547,34 +555,71 @@ std::vector<LoadStep> read_load_path(Reader& r, json& scene, std::vector<Obstacl
 
 Scene read_checked_scene(const nlohmann::json& input);
 
-SceneErrors::SceneErrors(std::vector<SceneIssue> issues)
-    : std::runtime_error(join(issues)), issues_(std::move(issues)) {}
+SceneErrors::SceneErrors(std::vector<SceneIssue> issues, bool more)
+    : std::runtime_error(join(issues)), issues_(std::move(issues)), more_(more) {}
 
 Scene read_scene(const nlohmann::json& input) {
   // Stage 1: the schema (types, ranges, unknown keys); stage 2: the readers' own checks
   // (references, meshes, rigid motions). Both run, so every error is reported at once; a
   // reader error under a value the schema already rejected is left out. The readers run
   // first: a caller may build the schema's validator meanwhile (prepare_schema, grip solve).
+  // Each stage lists at most kMaxSceneIssues problems, and so does the whole.
   std::optional<Scene> scene;
   std::vector<SceneIssue> reader_issues;
+  bool more = false;
   try {
     scene.emplace(read_checked_scene(input));
   } catch (const SceneErrors& e) {
     reader_issues = e.issues();
+    more = e.more();
   }
-  std::vector<SceneIssue> schema_issues = validate_against(input, SchemaName::scene);
+  bool schema_more = false;
+  std::vector<SceneIssue> schema_issues = validate_against(input, SchemaName::scene, &schema_more);
   if (schema_issues.empty()) {
     if (scene) return std::move(*scene);
-    throw SceneErrors(std::move(reader_issues));
+    throw SceneErrors(std::move(reader_issues), more);
   }
+  more |= schema_more;
   for (const SceneIssue& issue : reader_issues) {
     bool covered = false;
     for (const SceneIssue& s : schema_issues)
       covered |= issue.pointer == s.pointer || issue.pointer.rfind(s.pointer + "/", 0) == 0 || s.pointer == "/";
-    if (!covered) schema_issues.push_back(issue);
+    if (covered) continue;
+    if (schema_issues.size() >= kMaxSceneIssues) {
+      more = true;
+      break;
+    }
+    schema_issues.push_back(issue);
   }
-  throw SceneErrors(std::move(schema_issues));
+  throw SceneErrors(std::move(schema_issues), more);
 }
+
+namespace {
+
+// Magnitudes beyond what the arithmetic carries: a modulus or a load of 1e300 overflows the
+// products and squared norms of a solve (a diverging Newton then reported a 300-digit
+// correction). No quantity of a scene comes near 1e30 in any consistent units.
+constexpr double kLargestMagnitude = 1e30;
+
+void refuse_huge_numbers(Reader& r, const json& v, const std::string& pointer) {
+  if (v.is_number_float() || v.is_number_integer()) {
+    const double x = v.get<double>();
+    if (std::abs(x) > kLargestMagnitude)
+      r.error(pointer.empty() ? "/" : pointer,
+              show(v) + " is beyond " + number_text(kLargestMagnitude) +
+                  " in magnitude: the solver's arithmetic would overflow; give the scene in other units");
+  } else if (v.is_object()) {
+    for (const auto& [key, item] : v.items()) {
+      std::string escaped;
+      for (const char c : key) escaped += c == '~' ? "~0" : c == '/' ? "~1" : std::string(1, c);
+      refuse_huge_numbers(r, item, pointer + "/" + escaped);
+    }
+  } else if (v.is_array()) {
+    for (size_t i = 0; i < v.size(); ++i) refuse_huge_numbers(r, v[i], pointer + "/" + std::to_string(i));
+  }
+}
+
+}  // namespace
 
 Scene read_checked_scene(const nlohmann::json& input) {
   Reader r;
@@ -582,6 +627,8 @@ Scene read_checked_scene(const nlohmann::json& input) {
   scene.effective = input;
   json& e = scene.effective;
   if (!e.is_object()) throw SceneErrors(std::vector<SceneIssue>{{"/", "a scene is a JSON object"}});
+  refuse_huge_numbers(r, e, "");
+  if (!r.issues.empty()) throw SceneErrors(std::move(r.issues));
   const bool several = e.contains("bodies");
   if (several && e.contains("body")) r.error("/body", "cannot be given together with bodies (body is the one-body shorthand)");
   if (!several && e.contains("contacts")) r.error("/contacts", "pairs the surfaces of bodies: give bodies, not body");
@@ -593,6 +640,7 @@ Scene read_checked_scene(const nlohmann::json& input) {
   json* obs = several && !e.contains("obstacles") ? nullptr : r.array(e, "", "obstacles", !several);
   if (obs) {
     if (obs->empty() && !several) r.error("/obstacles", "needs at least one obstacle");
+    std::unordered_set<std::string> obstacle_names;
     for (size_t i = 0; i < obs->size(); ++i) {
       const std::string op = "/obstacles/" + std::to_string(i);
       json& o = (*obs)[i];
@@ -604,9 +652,8 @@ Scene read_checked_scene(const nlohmann::json& input) {
       if (!o.contains("name")) o["name"] = "obstacle" + std::to_string(i);
       if (!o["name"].is_string()) r.error(op + "/name", "is not a string");
       else inst.name = o["name"].get<std::string>();
-      for (const auto& other : scene.problem.obstacles)
-        if (!inst.name.empty() && other.name == inst.name)
-          r.error(op + "/name", "\"" + inst.name + "\" names another obstacle already");
+      if (!inst.name.empty() && !obstacle_names.insert(inst.name).second)
+        r.error(op + "/name", "\"" + inst.name + "\" names another obstacle already");
       if (json* shape = r.object(o, op, "shape", true)) inst.shape = read_shape(r, *shape, op + "/shape");
       inst.friction = r.number(o, op, "friction", 0.0);
       if (inst.friction < 0) r.error(op + "/friction", show(o["friction"]) + " is negative");

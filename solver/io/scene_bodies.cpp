@@ -2,6 +2,7 @@
 // [{"slave": "BODY.SET", "master": "BODY.SET" | "OBSTACLE", "friction", "name"}].
 #include <algorithm>
 #include <set>
+#include <unordered_map>
 
 #include "solver/model/body_set.hpp"
 #include "solver/elements/continuum.hpp"
@@ -29,6 +30,7 @@ void read_bodies(Reader& r, json& bodies, Problem& problem) {
   if (bodies.empty()) r.error("/bodies", "needs at least one body");
   std::vector<Problem> parts;
   std::vector<std::string> names;
+  std::set<std::string> named;  // names, for lookup
   for (size_t b = 0; b < bodies.size(); ++b) {
     const std::string bp = "/bodies/" + std::to_string(b);
     json& body = bodies[b];
@@ -45,8 +47,8 @@ void read_bodies(Reader& r, json& bodies, Problem& problem) {
       r.error(bp + "/name", show(name) + " is not a name (a non-empty string without '.')");
       continue;
     }
-    for (const std::string& other : names)
-      if (other == name) r.error(bp + "/name", show(name) + " names another body already");
+    if (named.count(name.get<std::string>()))
+      r.error(bp + "/name", show(name) + " names another body already");
     if (body.value("model", "") == "rigid_plastic_membrane")
       r.error(bp + "/model",
               "a rigid_plastic_membrane has no stiffness in its flat reference state: its first step starts from a "
@@ -58,6 +60,7 @@ void read_bodies(Reader& r, json& bodies, Problem& problem) {
     read_body(r, body, part, bp);
     if (!r.issues.empty() || !part.body) continue;
     names.push_back(name.get<std::string>());
+    named.insert(names.back());
     parts.push_back(std::move(part));
   }
   if (!r.issues.empty()) return;
@@ -66,7 +69,7 @@ void read_bodies(Reader& r, json& bodies, Problem& problem) {
   auto set = std::make_unique<BodySet>(std::move(bodies_owned), names);
   problem.body = std::move(set);
   const BodySet& all = static_cast<const BodySet&>(*problem.body);
-  for (int b = 0; b < all.count(); ++b) {
+  for (int b = 0; b < all.part_count(); ++b) {
     const int offset = all.dof_offset(b), n = all.part(b).dof_count();
     for (Constraint c : parts[b].constraints) {
       c.dof += offset;
@@ -92,9 +95,11 @@ struct SetRef {
 std::optional<SetRef> find_set(Reader& r, const BodySet& all, const std::string& text, const std::string& ptr) {
   const size_t dot = text.find('.');
   const std::string body = text.substr(0, dot), set = dot == std::string::npos ? "" : text.substr(dot + 1);
-  for (int b = 0; b < all.count(); ++b) {
+  for (int b = 0; b < all.part_count(); ++b) {
     if (all.name(b) != body) continue;
     const int first = all.site_offset(b), count = all.part(b).site_count();
+    // The body that read_body built from this scene: a set names a beam's surface or a node set
+    // of the continuum's mesh, so io asks for the type it built (docs/design.md).
     if (dynamic_cast<const TimoshenkoBeam*>(&all.part(b))) {
       if (set != "upper" && set != "lower") {
         r.error(ptr, "\"" + set + "\" names no surface of the beam \"" + body + "\" (surfaces: upper, lower: its axis "
@@ -134,7 +139,7 @@ std::optional<SetRef> find_set(Reader& r, const BodySet& all, const std::string&
     return ref;
   }
   std::vector<std::string> names;
-  for (int b = 0; b < all.count(); ++b) names.push_back(all.name(b));
+  for (int b = 0; b < all.part_count(); ++b) names.push_back(all.name(b));
   r.error(ptr, show(text) + " names no body (\"BODY.SET\", bodies: " + Reader::list(names) + ")");
   return std::nullopt;
 }
@@ -147,6 +152,9 @@ void read_contacts(Reader& r, json& scene, Problem& problem) {
   const auto& all = static_cast<const BodySet&>(*problem.body);
   const size_t rigid = problem.obstacles.size();
   std::vector<std::vector<int>> obstacle_slaves(rigid);
+  // The obstacles' and the pairs' names (a linear search per contact made reading quadratic).
+  std::unordered_map<std::string, size_t> obstacle_index;
+  for (size_t o = 0; o < rigid; ++o) obstacle_index.emplace(problem.obstacles[o].name, o);
   for (size_t i = 0; i < contacts->size(); ++i) {
     const std::string cp = "/contacts/" + std::to_string(i);
     json& c = (*contacts)[i];
@@ -159,9 +167,9 @@ void read_contacts(Reader& r, json& scene, Problem& problem) {
     if (!r.issues.empty()) continue;
     const auto slave = find_set(r, all, c["slave"].get<std::string>(), cp + "/slave");
     const std::string master = c["master"].get<std::string>();
-    int obstacle = -1;
-    for (size_t o = 0; o < rigid; ++o)
-      if (problem.obstacles[o].name == master) obstacle = static_cast<int>(o);
+    const auto named_master = obstacle_index.find(master);
+    const int obstacle = named_master != obstacle_index.end() && named_master->second < rigid
+                             ? static_cast<int>(named_master->second) : -1;
     if (obstacle >= 0) {
       if (c.contains("friction"))
         r.error(cp + "/friction", "is the obstacle's: give it in /obstacles/" + std::to_string(obstacle) + "/friction");
@@ -182,8 +190,8 @@ void read_contacts(Reader& r, json& scene, Problem& problem) {
     if (!c.contains("name")) c["name"] = c["slave"].get<std::string>() + " on " + master;
     if (!c["name"].is_string()) r.error(cp + "/name", "is not a string");
     else pair.name = c["name"].get<std::string>();
-    for (const auto& other : problem.obstacles)
-      if (other.name == pair.name) r.error(cp + "/name", show(c["name"]) + " names an obstacle or another contact already");
+    if (!pair.name.empty() && !obstacle_index.emplace(pair.name, problem.obstacles.size()).second)
+      r.error(cp + "/name", show(c["name"]) + " names an obstacle or another contact already");
     pair.friction = r.number(c, cp, "friction", 0.0);
     if (pair.friction < 0) r.error(cp + "/friction", show(c["friction"]) + " is negative");
     pair.frictional = pair.friction > 0;

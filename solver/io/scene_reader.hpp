@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "solver/problem/problem.hpp"
@@ -28,12 +29,14 @@ inline std::string show(const json& j) {
 }
 
 // Reads values out of the (mutable) effective scene, writing defaults in and collecting
-// every problem with its JSON pointer.
+// every problem with its JSON pointer, up to kMaxSceneIssues: the next one ends the reading
+// (SceneErrors with more()), so a scene's problems cost at most that many.
 class Reader {
  public:
   std::vector<SceneIssue> issues;
 
   void error(const std::string& pointer, std::string detail) {
+    if (issues.size() >= kMaxSceneIssues) throw SceneErrors(std::move(issues), true);
     issues.push_back({pointer.empty() ? "/" : pointer, std::move(detail)});
   }
 
@@ -186,18 +189,30 @@ class Reader {
       error(ptr + "/case", show(obj["case"]) + " is not a string");
       return 0;
     }
-    const std::string name = obj["case"].get<std::string>();
-    for (size_t k = 0; k < cases.size(); ++k)
-      if (cases[k] == name) return static_cast<int>(k);
-    cases.push_back(name);
-    return static_cast<int>(cases.size()) - 1;
+    const std::string& name = obj["case"].get_ref<const std::string&>();
+    const auto [it, added] = case_index_.try_emplace(name, static_cast<int>(cases.size()));
+    if (added) cases.push_back(name);
+    return it->second;
   }
 
+  // The index of a registered load case; -1 for none.
+  int find_case(const std::string& name) const {
+    const auto it = case_index_.find(name);
+    return it == case_index_.end() ? -1 : it->second;
+  }
+
+  // "\"a\", \"b\"": the first 20, then how many more (a scene may name thousands).
   static std::string list(const std::vector<std::string>& options) {
+    constexpr size_t kShown = 20;
     std::string s;
-    for (size_t i = 0; i < options.size(); ++i) s += (i ? ", " : "") + ("\"" + options[i] + "\"");
+    for (size_t i = 0; i < std::min(options.size(), kShown); ++i) s += (i ? ", " : "") + ("\"" + options[i] + "\"");
+    if (options.size() > kShown) s += " and " + std::to_string(options.size() - kShown) + " more";
     return s;
   }
+
+ private:
+  // cases by name: a scene may name thousands (a linear search made reading quadratic).
+  std::unordered_map<std::string, int> case_index_{{"main", 0}};
 };
 
 

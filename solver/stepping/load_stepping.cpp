@@ -5,9 +5,11 @@
 #include <cmath>
 #include <memory>
 #include <optional>
+#include <tuple>
 
 #include "solver/contact/friction_limit.hpp"
-#include "solver/equilibrium/rigid_equilibrium.hpp"
+#include "solver/contact/held_by_contact.hpp"
+#include "solver/problem/rigid_modes.hpp"
 #include "solver/stepping/candidate_growth.hpp"
 
 namespace grip {
@@ -23,7 +25,7 @@ LoadFactors blend(const LoadFactors& from, const LoadFactors& to, double t) {
 // displacement to start the first step's Newton from, and sets the starting contact force.
 std::optional<Vector> start_up(const Problem& problem, const SteppingParams& params,
                                const LoadFactors& factors, const std::vector<double>& zeta,
-                               Vector& p, std::string& reason) {
+                               Vector& p, std::string& reason, FailureKind& failure) {
   const StartUp& st = *problem.start;
   Equilibrium pre(problem, params.newton, {{st.dof, st.value, 0}});
   couple_newton(pre.params(), params.contact.tolerance, params.contact.newton_fraction,
@@ -38,6 +40,7 @@ std::optional<Vector> start_up(const Problem& problem, const SteppingParams& par
   const EquilibriumState s = pre.solve(problem.body->start_guess(prescribed, mask), p);
   if (!s.converged) {
     reason = "the start-up solve failed: " + s.reason;
+    failure = s.failure;
     return std::nullopt;
   }
   const Vector reaction = pre.reactions(s, p);
@@ -117,8 +120,9 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
   std::optional<Vector> start_q;
   double v_first = 0.0;  // the contact error of the last increment's first solve
   if (problem.start) {
-    start_q = start_up(problem, params, current, zeta, p, result.reason);
+    start_q = start_up(problem, params, current, zeta, p, result.reason, result.failure);
     if (!start_q) {
+      result.failure_step = 1;  // the start-up solve is the first step's
       result.counters = eq->counters();
       return;
     }
@@ -161,8 +165,9 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
             amplitudes_following_supports(problem, current, target);
       eq->set_step(target, zeta);
       // A load that no static equilibrium can carry: no cut of the increment can help.
-      if (std::string why = unreachable_equilibrium(problem, eq->evaluate(guess), target); !why.empty()) {
-        rec.reason = std::move(why);
+      if (Unreachable why = unreachable_equilibrium(problem, eq->evaluate(guess), target); !why.reason.empty()) {
+        rec.reason = std::move(why.reason);
+        rec.failure = why.kind;
         break;
       }
       // An obstacle that moves farther than the body's element size or its own radius in one
@@ -177,6 +182,7 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
       if (const double parts = std::ceil(travel - 1e-9); !too_far.empty()) {
         if (parts * (1.0 / increment) > std::ldexp(1.0, params.max_cuts)) {
           rec.checks.worst_of(attempt);
+          rec.failure = FailureKind::check_failed;
           rec.reason = "refused by the step checks: " + too_far + " (more than " +
                        std::to_string(1 << params.max_cuts) + " parts of the step would be needed)";
           break;
@@ -225,6 +231,7 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
             if (o.entered && nodes.size() < 200) nodes += (nodes.empty() ? "" : ", ") + std::to_string(o.node);
           if (!nodes.empty()) {
             rec.checks.worst_of(attempt);
+            rec.failure = FailureKind::missed_contact;
             rec.reason = "nodes " + nodes + " entered an obstacle outside the contact candidates" +
                          (params.fail_outside_candidates ? " (solver.contact.outside_candidates: fail)" : "");
             break;
@@ -234,6 +241,7 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
           rec.checks.worst_of(attempt);
           out.converged = false;
           out.reason = "refused by the step checks: " + why;
+          out.failure = FailureKind::check_failed;
           refused = true;
         }
       }
@@ -262,10 +270,12 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
           if (decided.stopped) {
             out.stopped = result.stopped = true;
             out.reason = decided.reason;
+            out.failure = decided.failure;
           } else if (!decided.converged) {
             if (std::string why = friction_limit_exceeded(problem, decided.state, decided.p, decided.tau, target);
                 !why.empty()) {
               rec.reason = std::move(why);
+              rec.failure = FailureKind::friction_limit;
               rec.p = decided.p;
               rec.tau = decided.tau;
               rec.state = std::move(decided.state);
@@ -281,7 +291,11 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
           continue;
         }
         if (depth >= params.max_cuts || out.stopped) {
-          rec.reason = out.reason + (depth ? " (after " + std::to_string(depth) + " cuts of the increment)" : "");
+          rec.failure = out.failure;
+          rec.reason = out.reason;
+          // A stop names its cause where the caller gives one (the service: a job limit, a dismissal).
+          if (out.stopped && observer.stop_reason) std::tie(rec.failure, rec.reason) = observer.stop_reason();
+          if (depth) rec.reason += " (after " + std::to_string(depth) + " cuts of the increment)";
           rec.p = out.p;
           rec.tau = out.tau;
           rec.state = std::move(out.state);
@@ -324,7 +338,11 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
     }
     rec.seconds = std::chrono::duration<double>(Clock::now() - step_start).count();
     const bool ok = rec.converged;
-    if (!ok) result.reason = "step " + std::to_string(step) + " failed: " + rec.reason;
+    if (!ok) {
+      result.reason = "step " + std::to_string(step) + " failed: " + rec.reason;
+      result.failure = rec.failure;
+      result.failure_step = step;
+    }
     if (observer.step_finished) observer.step_finished(rec);
     result.steps.push_back(std::move(rec));
     if (!ok) break;
@@ -353,7 +371,10 @@ RunResult run_load_steps(Problem& problem, const std::vector<LoadStep>& steps,
     const size_t k = result.steps.size();
     StepRecord rec = step_record(k < steps.size() ? steps[k] : LoadStep{}, static_cast<int>(k) + 1);
     rec.reason = std::string("solver error: ") + e.what();
+    rec.failure = FailureKind::exception;
     result.reason = "step " + std::to_string(rec.index) + " failed: " + rec.reason;
+    result.failure = FailureKind::exception;
+    result.failure_step = rec.index;
     result.completed = false;
     result.steps.push_back(std::move(rec));
     if (observer.step_finished) observer.step_finished(result.steps.back());

@@ -33,6 +33,7 @@ struct StepRecord {
   LoadFactors factors;         // every load case's factor
   bool converged = false;
   std::string reason;
+  FailureKind failure = FailureKind::none;  // the kind of the reason
   std::string warning;         // the converged state lies beyond the model's accurate range
   std::vector<std::string> notes;  // what the step changed in the problem (candidates added)
   StepChecks checks;           // the step checks' worst values (step_checks.hpp)
@@ -51,6 +52,9 @@ struct SteppingObserver {
   std::function<void(int step, double load_factor)> step_started;
   IterationObserver iteration;
   StopRequest stop_requested;  // checked before every real solve
+  // After a stop: its kind and reason (a job limit, a dismissal), which the stopped step
+  // records instead of "stopped on request".
+  std::function<std::pair<FailureKind, std::string>()> stop_reason;
   std::function<void(const StepRecord&)> step_finished;
 };
 
@@ -59,6 +63,8 @@ struct RunResult {
   bool completed = false;
   bool stopped = false;  // by the observer's stop request
   std::string reason;
+  FailureKind failure = FailureKind::none;  // the kind of the reason
+  int failure_step = 0;                     // the step that failed, from 1
   EquilibriumCounters counters;
   double seconds = 0.0;
   double check_seconds = 0.0;  // spent in the step checks (bench/results/robustness.md)

@@ -91,6 +91,9 @@ class StepChecker {
   std::vector<Pairing> outside_sites_;    // (site, rigid obstacle) not among the candidates
   std::vector<int> nodes_without_site_;   // held against every rigid obstacle
   double element_size_ = 0.0;             // the largest spacing of neighbouring sites
+  // The largest force a checked state carried in this run: the scale of round-off where a
+  // state carries almost nothing (a punch lifted off).
+  mutable double force_level_ = 0.0;
 };
 
 }  // namespace grip

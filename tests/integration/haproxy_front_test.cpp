@@ -208,8 +208,13 @@ TEST(HaproxyFront, RetriesSafeRequestsAnswersProblemJson503LogsAndStopsAtOnce) {
   EXPECT_EQ(retry_after, "5");
   EXPECT_EQ(json::parse(body, nullptr, false).value("type", std::string()), "urn:grip:problem:no-replica-ready");
 
-  // Logged: one line per request, with its method, path and status.
-  const std::string log = read_text(dir.path() / "haproxy.log");
+  // Logged: one line per request, with its method, path and status. HAProxy writes its log
+  // line after the response has gone out, so the last one may land a moment later.
+  std::string log = read_text(dir.path() / "haproxy.log");
+  for (int i = 0; i < 100 && log.find(" 503 ") == std::string::npos; ++i) {
+    std::this_thread::sleep_for(50ms);
+    log = read_text(dir.path() / "haproxy.log");
+  }
   EXPECT_NE(log.find("\"GET /v1/health HTTP/1.1\""), std::string::npos) << log.substr(0, 2000);
   EXPECT_NE(log.find(" 503 "), std::string::npos) << log;
 

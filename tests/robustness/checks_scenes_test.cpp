@@ -48,9 +48,10 @@ size_t node_row_at(const StepRecord& rec, const Vec2& x) {
   return best;
 }
 
-// A run that failed: with a reason that names `what`, and a failed last step saying the same.
-void expect_failure_naming(const Solved& s, const std::string& what) {
+// A run that failed with `kind`: with a reason that names `what`, and a failed last step.
+void expect_failure_naming(const Solved& s, FailureKind kind, const std::string& what) {
   EXPECT_FALSE(s.run.completed);
+  EXPECT_EQ(to_string(s.run.failure), to_string(kind));
   ASSERT_FALSE(s.run.steps.empty());
   EXPECT_FALSE(s.run.steps.back().converged);
   EXPECT_NE(s.run.reason.find(what), std::string::npos) << s.run.reason;
@@ -85,7 +86,7 @@ TEST(RobustnessPassThrough, IndenterInOneStepIsCutToTheAnswerOfFiveSteps) {
 // 32 parts of the element size.
 TEST(RobustnessPassThrough, SheetPunchTimes100FailsWithTheReason) {
   const Solved s = solve_scene(robustness_scene("sheet-stretching__disp100"));
-  expect_failure_naming(s, "the obstacle 'punch' moves by 100 in one increment");
+  expect_failure_naming(s, FailureKind::check_failed, "the obstacle 'punch' moves by 100 in one increment");
   EXPECT_EQ(s.run.steps.size(), 1u);
   EXPECT_EQ(s.run.counters.solves, 0);
   EXPECT_GT(s.run.steps.front().checks.obstacle_motion, 32.0);
@@ -115,7 +116,7 @@ TEST(RobustnessCandidates, HertzAtTenTimesTheIndentationFindsTheNodesOutsideTheS
   }
   nlohmann::json strict = j;
   strict["solver"]["contact"]["outside_candidates"] = "fail";
-  expect_failure_naming(solve_scene(strict), "entered an obstacle outside the contact candidates");
+  expect_failure_naming(solve_scene(strict), FailureKind::missed_contact, "entered an obstacle outside the contact candidates");
 }
 
 // A floor 1.5 below the strip, beyond the default reach (the body's length, 1): the tip once

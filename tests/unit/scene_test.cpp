@@ -14,6 +14,7 @@
 #include "apps/result_writer.hpp"
 #include "solver/io/json_writer.hpp"
 #include "solver/io/result.hpp"
+#include "solver/io/schema_validation.hpp"
 #include "tests/support/scenes.hpp"
 
 namespace grip {
@@ -394,6 +395,13 @@ TEST(SceneEffects, AnExceptionDuringAStepFailsThatStepAndKeepsTheStepsBefore) {
   EXPECT_EQ(r, result_json(scene, run));
   EXPECT_EQ(r["steps"].size(), 2u);
   EXPECT_EQ(r["summary"]["completed"], false);
+  // Its kind, for a program (failure_kinds_test.cpp produces the others).
+  EXPECT_EQ(run.failure, FailureKind::exception);
+  EXPECT_EQ(run.failure_step, 2);
+  EXPECT_EQ(r["summary"]["failure"], json({{"kind", "exception"}, {"message", run.reason}, {"step", 2}}));
+  EXPECT_EQ(r["steps"][1]["failure"]["kind"], "exception");
+  const auto issues = validate_against(r, SchemaName::result);
+  EXPECT_TRUE(issues.empty()) << issues.front().pointer << ": " << issues.front().detail;
   std::filesystem::remove(path);
 }
 

@@ -497,7 +497,8 @@ Produced solve_with_events(json scene) {
   observer.step_finished = [&](const StepRecord& rec) { out.events.push_back(step_finished_event(rec)); };
   const RunResult run = run_load_steps(s.problem, s.steps, s.params, observer);
   // The terminal event as `grip solve --events` and the service write it.
-  out.events.push_back(run.completed ? json{{"type", "job_finished"}} : json{{"type", "job_failed"}, {"reason", run.reason}});
+  out.events.push_back(run.completed ? json{{"type", "job_finished"}}
+                                     : job_failed_event(run.failure, run.reason, run.failure_step));
   out.result = result_json(s, run);
   return out;
 }
@@ -535,7 +536,7 @@ TEST(SchemaEvents, FailedStepsAndJobsValidate) {
   ASSERT_EQ(p.events.back()["type"], "job_failed") << p.events.back();
   for (const json& ev : p.events) expect_valid(ev, SchemaName::event);
   expect_valid(p.result, SchemaName::result);
-  expect_valid(json{{"type", "job_failed"}, {"reason", "dismissed"}}, SchemaName::event);
+  expect_valid(job_failed_event(FailureKind::dismissed, "dismissed", 0), SchemaName::event);
 }
 
 TEST(SchemaEvents, TheMembraneAndContinuumResultsValidate) {
@@ -577,24 +578,25 @@ const InvalidDocument kInvalidDocuments[] = {
      "/v2", "is required"},
     {"a failed step without its reason", SchemaName::event,
      R"({"type": "step_finished", "step": 1, "load_factor": 1, "converged": false, "tau_passes": 1,
-         "contact_iterations": 3, "newton_iterations": 9, "seconds": 0.1, "stage": 0, "factors": [1]})",
+         "contact_iterations": 3, "newton_iterations": 9, "seconds": 0.1, "stage": 0, "factors": [1],
+         "failure": {"kind": "contact_budget", "message": "x", "step": 1}})",
      "/reason", "is required"},
     {"a finished step without converged (and no rule about the reason fires)", SchemaName::event,
      R"({"type": "step_finished", "step": 1, "load_factor": 1, "tau_passes": 1,
          "contact_iterations": 3, "newton_iterations": 9, "seconds": 0.1, "stage": 0, "factors": [1]})",
      "/converged", "is required"},
-    {"a job failure without its reason", SchemaName::event, R"({"type": "job_failed"})", "/reason", "is required"},
+    {"a job failure without its reason", SchemaName::event, R"({"type": "job_failed", "failure": {"kind": "dismissed", "message": "x", "step": 0}})", "/reason", "is required"},
     {"an extra field in an event", SchemaName::event, R"({"type": "job_finished", "seconds": 1})", "/seconds",
      "is not a known key"},
     {"an unknown job status", SchemaName::job,
      R"({"jobID": "x", "processID": "contact2d", "type": "process", "status": "done", "message": "",
          "created": "2024-05-01T10:00:00.000Z", "updated": "2024-05-01T10:00:00.000Z", "progress": 0,
-         "nodes": 41, "steps": 20, "attempts": 1, "links": []})",
+         "nodes": 41, "steps": 20, "steps_completed": 0, "attempts": 1, "links": []})",
      "/status", "is not one of \"accepted\", \"running\", \"successful\", \"failed\", \"dismissed\""},
     {"progress above 100", SchemaName::job,
      R"({"jobID": "x", "processID": "contact2d", "type": "process", "status": "running", "message": "",
          "created": "2024-05-01T10:00:00.000Z", "updated": "2024-05-01T10:00:00.000Z", "progress": 101,
-         "nodes": 41, "steps": 20, "attempts": 1, "links": []})",
+         "nodes": 41, "steps": 20, "steps_completed": 0, "attempts": 1, "links": []})",
      "/progress", "101 is above 100"},
 };
 
@@ -613,7 +615,7 @@ TEST(SchemaJob, JobDocumentsOfEveryStateValidate) {
     "jobID": "0f8e2a52-4d0e-4c9a-9b3e-6f2d1c0b7a11", "processID": "contact2d", "type": "process",
     "status": "running", "message": "step 3 of 20, ||v||_2 = 1.234e-06",
     "created": "2024-05-01T10:00:00.000Z", "started": "2024-05-01T10:00:00.120Z",
-    "updated": "2024-05-01T10:00:00.120Z", "nodes": 41, "steps": 20, "attempts": 1,
+    "updated": "2024-05-01T10:00:00.120Z", "nodes": 41, "steps": 20, "steps_completed": 0, "attempts": 1,
     "step": 3, "contact_error": 1.234e-06, "iterations": 17, "progress": 10,
     "links": [
       {"href": "/v1/jobs/0f8e2a52-4d0e-4c9a-9b3e-6f2d1c0b7a11", "rel": "self", "type": "application/json", "title": "this job"},
