@@ -16,7 +16,7 @@
 #include <sstream>
 
 #include "server/body_budget.hpp"
-#include "server/gzip.hpp"
+#include "server/compression.hpp"
 #include "server/observability.hpp"
 #include "server/tar.hpp"
 #include "server/ui.hpp"
@@ -109,8 +109,8 @@ std::optional<std::int64_t> decode_cursor(const std::string& c) {
 
 std::string job_path(const std::string& id) { return "/v1/jobs/" + id; }
 
-// Accept-Encoding names gzip (or *) without q=0.
-bool accepts_gzip(const Request& req) {
+// Accept-Encoding names zstd (or *) without q=0.
+bool accepts_zstd(const Request& req) {
   std::stringstream list(lower(req.get_header_value("Accept-Encoding")));
   std::string item;
   while (std::getline(list, item, ',')) {
@@ -119,7 +119,7 @@ bool accepts_gzip(const Request& req) {
     coding.erase(std::remove_if(coding.begin(), coding.end(), ::isspace), coding.end());
     params.erase(std::remove_if(params.begin(), params.end(), ::isspace), params.end());
     const bool refused = params.rfind("q=0", 0) == 0 && params.find_first_of("123456789", 2) == std::string::npos;
-    if ((coding == "gzip" || coding == "x-gzip" || coding == "*") && !refused) return true;
+    if ((coding == "zstd" || coding == "*") && !refused) return true;
   }
   return false;
 }
@@ -778,20 +778,21 @@ void HttpServer::Impl::result(const Request& req, Response& res) {
     return problem(res, req, 404, "no-result", "No result",
                    "job " + id + " is " + std::string(to_string(view->record.status)) + " and has no result");
   }
-  // Stored gzip-compressed: as stored to a client that accepts gzip, inflated otherwise.
+  // Stored zstd-compressed: as stored to a client that accepts zstd, as JSON text otherwise
+  // (which httplib gzip-compresses for a client that accepts gzip).
   if (format == "json") {
     res.set_header("Vary", "Accept-Encoding");
-    if (is_gzip(*data) && accepts_gzip(req)) {
-      res.set_header("Content-Encoding", "gzip");
+    if (is_zstd(*data) && accepts_zstd(req)) {
+      res.set_header("Content-Encoding", "zstd");
       // httplib compresses a body of exactly "application/json" itself (once more, here): the
       // charset parameter keeps it from doing so.
       res.set_content(*data, "application/json; charset=utf-8");
     } else {
-      res.set_content(is_gzip(*data) ? gunzip(*data) : *data, kJson);
+      res.set_content(stored_text(*data), kJson);
     }
     return;
   }
-  const json doc = json::parse(is_gzip(*data) ? gunzip(*data) : *data);
+  const json doc = json::parse(stored_text(*data));
   if (format == "csv") {
     const std::string table = req.has_param("table") ? req.get_param_value("table") : "nodes";
     const auto& tables = result_csv_tables();

@@ -7,7 +7,7 @@
 #include <limits>
 #include <sstream>
 
-#include "server/gzip.hpp"
+#include "server/compression.hpp"
 #include "server/util.hpp"
 #include "solver/io/result.hpp"
 
@@ -784,7 +784,7 @@ void JobService::run_job(const std::shared_ptr<ActiveJob>& job, const JobRecord&
       // took several times the text's memory and more time than writing it.
       std::ostringstream text;
       write_result(text, *scene, run);
-      outcome.result = gzip(std::move(text).str());  // stored and served compressed
+      outcome.result = zstd(std::move(text).str());  // stored and served compressed
     } catch (const std::exception& e) {
       spdlog::error("job {}: cannot build its result: {}", id, e.what());
     }

@@ -7,7 +7,7 @@
 #include <thread>
 
 // Eigen (through the solver) before httplib.h, whose <resolv.h> defines `_res`.
-#include "server/gzip.hpp"
+#include "server/compression.hpp"
 #include "server/job_service.hpp"
 #include "server/sqlite_store.hpp"
 #include "solver/io/scene.hpp"
@@ -103,7 +103,7 @@ nlohmann::json failed_job_result(const nlohmann::json& scene, const std::string&
     ADD_FAILURE() << "no result stored for the failed job";
     return nlohmann::json::object();
   }
-  return nlohmann::json::parse(server::gunzip(*result));  // stored gzip-compressed
+  return nlohmann::json::parse(server::stored_text(*result));  // stored compressed
 }
 
 // A body held only by contact under a shear load above mu N

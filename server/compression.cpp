@@ -1,0 +1,63 @@
+#include "server/compression.hpp"
+
+#include <zlib.h>
+#include <zstd.h>
+
+#include <stdexcept>
+
+namespace grip::server {
+
+namespace {
+
+constexpr int kZstdLevel = 16;
+constexpr int kGzipWindow = 15 + 16;  // 32 KB window, gzip header and trailer
+
+// ZSTD_compress writes the text's size in the frame's header.
+std::string unzstd(std::string_view data) {
+  const unsigned long long size = ZSTD_getFrameContentSize(data.data(), data.size());
+  if (size == ZSTD_CONTENTSIZE_ERROR || size == ZSTD_CONTENTSIZE_UNKNOWN)
+    throw std::runtime_error("zstd: the data is not a zstd frame with its size");
+  std::string out(size, '\0');
+  const size_t n = ZSTD_decompress(out.data(), out.size(), data.data(), data.size());
+  if (ZSTD_isError(n)) throw std::runtime_error(std::string("zstd: ") + ZSTD_getErrorName(n));
+  if (n != size) throw std::runtime_error("zstd: the frame is shorter than its header says");
+  return out;
+}
+
+std::string gunzip(std::string_view data) {
+  z_stream z{};
+  if (inflateInit2(&z, kGzipWindow) != Z_OK) throw std::runtime_error("gunzip: cannot start zlib");
+  z.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(data.data()));
+  z.avail_in = static_cast<uInt>(data.size());
+  std::string out;
+  char buffer[1 << 16];
+  int rc = Z_OK;
+  while (rc == Z_OK) {
+    z.next_out = reinterpret_cast<Bytef*>(buffer);
+    z.avail_out = sizeof buffer;
+    rc = inflate(&z, Z_NO_FLUSH);
+    out.append(buffer, sizeof buffer - z.avail_out);
+    if (rc == Z_BUF_ERROR && z.avail_in == 0) break;  // truncated
+  }
+  inflateEnd(&z);
+  if (rc != Z_STREAM_END) throw std::runtime_error("gunzip: the data is not a whole gzip member");
+  return out;
+}
+
+}  // namespace
+
+std::string zstd(std::string_view text) {
+  std::string out(ZSTD_compressBound(text.size()), '\0');
+  const size_t n = ZSTD_compress(out.data(), out.size(), text.data(), text.size(), kZstdLevel);
+  if (ZSTD_isError(n)) throw std::runtime_error(std::string("zstd: ") + ZSTD_getErrorName(n));
+  out.resize(n);
+  return out;
+}
+
+std::string stored_text(std::string_view stored) {
+  if (is_zstd(stored)) return unzstd(stored);
+  if (is_gzip(stored)) return gunzip(stored);
+  return std::string(stored);
+}
+
+}  // namespace grip::server
