@@ -14,6 +14,7 @@ import json
 import sys
 import threading
 import time
+import uuid
 from datetime import datetime
 
 PORT = int(sys.argv[1])
@@ -27,23 +28,44 @@ lock = threading.Lock()
 taken = 0
 rows = []  # (beyond solve s, attempts, solve s)
 problems = []
+reconnects = 0  # keep-alive connections found closed by the server
 
 
 def when(text):
     return datetime.strptime(text, "%Y-%m-%dT%H:%M:%S.%fZ").timestamp()
 
 
+class Api:
+    """A keep-alive connection, opened again when the server has closed it (the request is
+    sent again: GETs, and POSTs with an Idempotency-Key)."""
+
+    def __init__(self):
+        self.c = http.client.HTTPConnection("127.0.0.1", PORT, timeout=120)
+
+    def call(self, method, path, body=None, headers=None):
+        for attempt in range(3):
+            try:
+                self.c.request(method, path, body, headers or {})
+                r = self.c.getresponse()
+                return r, r.read()
+            except (http.client.HTTPException, ConnectionError):
+                global reconnects
+                reconnects += 1
+                self.c.close()
+                self.c = http.client.HTTPConnection("127.0.0.1", PORT, timeout=120)
+        raise RuntimeError(f"{method} {path}: no answer in 3 connections")
+
+
 def client():
     global taken
-    api = http.client.HTTPConnection("127.0.0.1", PORT, timeout=120)
+    api = Api()
     while True:
         with lock:
             if taken >= JOBS:
                 return
             taken += 1
-        api.request("POST", "/v1/jobs", SCENE, {"Content-Type": "application/json"})
-        r = api.getresponse()
-        body = r.read()
+        headers = {"Content-Type": "application/json", "Idempotency-Key": str(uuid.uuid4())}
+        r, body = api.call("POST", "/v1/jobs", SCENE, headers)
         if r.status == 503:
             with lock:
                 taken -= 1
@@ -53,16 +75,18 @@ def client():
             problems.append(f"submit: {r.status} {body[:200]!r}")
             continue
         job = json.loads(body)["jobID"]
-        stream = http.client.HTTPConnection("127.0.0.1", PORT, timeout=120)
-        stream.request("GET", f"/v1/jobs/{job}/events")
-        s = stream.getresponse()
-        for line in s:
-            if line.startswith(b"event: job_"):  # job_finished or job_failed
-                break
-        stream.close()
-        api.request("GET", f"/v1/jobs/{job}")
-        r = api.getresponse()
-        doc = json.loads(r.read())
+        for attempt in range(3):  # the stream to the terminal event (replayed from the start)
+            stream = http.client.HTTPConnection("127.0.0.1", PORT, timeout=120)
+            try:
+                stream.request("GET", f"/v1/jobs/{job}/events")
+                if any(line.startswith(b"event: job_") for line in stream.getresponse()):
+                    break  # job_finished or job_failed
+            except (http.client.HTTPException, ConnectionError):
+                pass
+            finally:
+                stream.close()
+        _, body = api.call("GET", f"/v1/jobs/{job}")
+        doc = json.loads(body)
         if doc.get("status") != "successful":
             problems.append(f"{job}: {doc.get('status')} {doc.get('message')}")
             continue
@@ -87,5 +111,6 @@ print(f"created to finished beyond the solve: p50 {pick(beyond, 0.5) * 1000:.1f}
       f"p99 {pick(beyond, 0.99) * 1000:.1f} ms, p99.9 {pick(beyond, 0.999) * 1000:.1f} ms, max {beyond[-1] * 1000:.1f} ms")
 print(f"jobs over 1 s beyond their solve: {sum(b > 1 for b in beyond)}; run more than once: "
       f"{sum(r[1] != 1 for r in rows)}")
+print(f"keep-alive connections found closed and opened again: {reconnects}")
 for p in problems[:20]:
     print("problem:", p)

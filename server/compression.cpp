@@ -54,6 +54,22 @@ std::string zstd(std::string_view text) {
   return out;
 }
 
+std::string gzip_fast(std::string_view text) {
+  z_stream z{};
+  if (deflateInit2(&z, Z_BEST_SPEED, Z_DEFLATED, kGzipWindow, 8, Z_DEFAULT_STRATEGY) != Z_OK)
+    throw std::runtime_error("gzip: cannot start zlib");
+  std::string out(deflateBound(&z, static_cast<uLong>(text.size())), '\0');
+  z.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(text.data()));
+  z.avail_in = static_cast<uInt>(text.size());
+  z.next_out = reinterpret_cast<Bytef*>(out.data());
+  z.avail_out = static_cast<uInt>(out.size());
+  const int rc = deflate(&z, Z_FINISH);
+  out.resize(z.total_out);
+  deflateEnd(&z);
+  if (rc != Z_STREAM_END) throw std::runtime_error("gzip: zlib did not finish");
+  return out;
+}
+
 std::string stored_text(std::string_view stored) {
   if (is_zstd(stored)) return unzstd(stored);
   if (is_gzip(stored)) return gunzip(stored);

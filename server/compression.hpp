@@ -10,6 +10,9 @@ namespace grip::server {
 // zstd at level 16 (its optimal parser): a result's steps repeat one another's numbers at
 // distances gzip's 32 KB window cannot reach; 16 takes about what gzip -9 took.
 std::string zstd(std::string_view text);
+// gzip (RFC 1952) at zlib's fastest level: a stored result sent to a client that accepts gzip
+// but not zstd (httplib's own compression would pick brotli at its slowest quality).
+std::string gzip_fast(std::string_view text);
 // The JSON text of a stored result, whichever of the three forms it has; std::runtime_error
 // when compressed data is not whole.
 std::string stored_text(std::string_view stored);

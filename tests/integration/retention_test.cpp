@@ -1,7 +1,9 @@
 // Disk bounded (issue 34.3): results are stored zstd-compressed and served as stored to a
-// client that accepts zstd (as JSON text to one that does not), each finished job's stored
-// bytes are reported, and retention keeps the store at its bounds while jobs keep coming.
+// client that accepts zstd (gzipped to one that accepts gzip, as JSON text to any other), each
+// finished job's stored bytes are reported, and retention keeps the store at its bounds while
+// jobs keep coming.
 #include <gtest/gtest.h>
+#include <zlib.h>
 
 #include <filesystem>
 
@@ -10,6 +12,25 @@
 
 namespace grip::testing {
 namespace {
+
+std::string inflate_gzip(const std::string& data) {
+  z_stream z{};
+  EXPECT_EQ(inflateInit2(&z, 15 + 16), Z_OK);
+  z.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(data.data()));
+  z.avail_in = static_cast<uInt>(data.size());
+  std::string out;
+  char buffer[65536];
+  int rc = Z_OK;
+  while (rc == Z_OK) {
+    z.next_out = reinterpret_cast<Bytef*>(buffer);
+    z.avail_out = sizeof buffer;
+    rc = inflate(&z, Z_NO_FLUSH);
+    out.append(buffer, sizeof buffer - z.avail_out);
+  }
+  inflateEnd(&z);
+  EXPECT_EQ(rc, Z_STREAM_END);
+  return out;
+}
 
 // The value of an unlabelled sample in /v1/metrics.
 double metric(const Api& api, const std::string& name) {
@@ -55,6 +76,12 @@ TEST(Retention, TheSlidingBlocksResultIsStoredCompressedAndServedAsStoredOrAsTex
   EXPECT_LT(static_cast<std::int64_t>(packed->body.size()), stored);
   EXPECT_LT(10 * packed->body.size(), json_text->body.size());
   EXPECT_EQ(server::stored_text(packed->body), json_text->body);
+  // One that accepts gzip (and br, as httplib's client does) but not zstd gets it gzipped.
+  const auto gz = plain.Get("/v1/jobs/" + id + "/result", {{"Accept-Encoding", "br, gzip, deflate"}});
+  ASSERT_TRUE(gz);
+  ASSERT_EQ(gz->status, 200);
+  EXPECT_EQ(gz->get_header_value("Content-Encoding"), "gzip");
+  EXPECT_EQ(inflate_gzip(gz->body), json_text->body);
   // The other formats read the stored result too.
   const auto csv = plain.Get("/v1/jobs/" + id + "/result?format=csv", {{"Accept-Encoding", "identity"}});
   ASSERT_TRUE(csv);
