@@ -9,6 +9,7 @@
 
 #include "server/compression.hpp"
 #include "server/util.hpp"
+#include "solver/model/number_text.hpp"
 #include "solver/io/result.hpp"
 
 namespace grip::server {

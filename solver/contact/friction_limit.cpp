@@ -6,7 +6,8 @@
 #include <vector>
 
 #include "solver/contact/contact_error.hpp"
-#include "solver/equilibrium/rigid_equilibrium.hpp"
+#include "solver/contact/held_by_contact.hpp"
+#include "solver/problem/rigid_modes.hpp"
 
 namespace grip {
 namespace {

@@ -20,6 +20,7 @@
 
 #include "solver/contact/coulomb_model.hpp"
 #include "solver/contact/step.hpp"
+#include "solver/model/number_text.hpp"
 
 namespace grip {
 namespace {

@@ -7,7 +7,8 @@
 #include "solver/contact/acceleration.hpp"
 #include "solver/contact/coulomb_model.hpp"
 #include "solver/contact/friction_limit.hpp"
-#include "solver/equilibrium/rigid_equilibrium.hpp"
+#include "solver/model/number_text.hpp"
+#include "solver/problem/rigid_modes.hpp"
 
 namespace grip {
 namespace {

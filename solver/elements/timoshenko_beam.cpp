@@ -148,6 +148,13 @@ Vector TimoshenkoBeam::rigid_rotation() const {
   return q;
 }
 
+Vector TimoshenkoBeam::own_rotation_at(const Vector& q) const {
+  Vector rot = rigid_rotation();
+  for (int k = 0; k < node_count(); ++k) rot[node_dof(k, 0)] -= q[node_dof(k, 1)];
+  for (int e = 0; e < element_count(); ++e) rot[mid_dof(e, 0)] -= q[mid_dof(e, 1)];
+  return rot;
+}
+
 Body::Traits TimoshenkoBeam::traits() const {
   const bool linear = kinematics_ == Kinematics::linear;
   return {!linear, false, linear};

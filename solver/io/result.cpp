@@ -12,7 +12,7 @@
 #include "solver/contact/contact_error.hpp"
 #include "solver/contact/master_reading.hpp"
 #include "solver/model/body_set.hpp"
-#include "solver/equilibrium/rigid_equilibrium.hpp"
+#include "solver/problem/rigid_modes.hpp"
 
 namespace grip {
 
@@ -63,6 +63,11 @@ double field_value(double v) {
 
 namespace {
 
+// The scene's bodies where it has several (the BodySet that the scene reader built for
+// "bodies"), null for a scene of one body: the result takes the scene's form ("bodies",
+// "rigid_motions", "master_points"), so io asks for the type it built (docs/design.md).
+const BodySet* body_set_of(const Body& body) { return dynamic_cast<const BodySet*>(&body); }
+
 json table_json(const FieldTable& t, const char* index_name) {
   json rows = json::array();
   for (size_t i = 0; i < t.rows.size(); ++i) {
@@ -79,7 +84,7 @@ json table_json(const FieldTable& t, const char* index_name) {
 // The contact points' numbers, read from the problem and the record.
 std::vector<ContactPointRow> contact_point_rows(const Problem& problem, const StepRecord& rec) {
   const Body& body = *problem.body;
-  const auto* all = dynamic_cast<const BodySet*>(&body);
+  const auto* all = body_set_of(body);
   std::vector<ContactPointRow> rows;
   rows.reserve(problem.candidates.size());
   for (size_t i = 0; i < problem.candidates.size(); ++i) {
@@ -145,9 +150,9 @@ json step_json(const Problem& problem, const StepRecord& rec, const OutputOption
       if (a.size() > 2) m["rotation"] = a[2];
       return m;
     };
-    if (const auto* all = dynamic_cast<const BodySet*>(&body)) {
+    if (const auto* all = body_set_of(body)) {
       json motions = json::array();
-      for (int b = 0; b < all->count(); ++b) {
+      for (int b = 0; b < all->part_count(); ++b) {
         if (std::find(problem.rigid.body.begin(), problem.rigid.body.end(), b) == problem.rigid.body.end()) continue;
         json m = motion(all->part(b), all->part_q(rec.state.q, b));
         m["body"] = all->name(b);
@@ -188,7 +193,7 @@ json step_json(const Problem& problem, const StepRecord& rec, const OutputOption
   std::vector<ContactPointRow> points = contact_point_rows(problem, rec);
   if (rows) *rows = std::move(points);
   else j["contact_points"] = contact_points_json(points);
-  if (const auto* all = dynamic_cast<const BodySet*>(&body)) {  // each pair's field read on its master
+  if (const auto* all = body_set_of(body)) {  // each pair's field read on its master
     json readings = json::array();
     for (size_t o = 0; o < problem.obstacles.size(); ++o) {
       const ObstacleInstance& pair = problem.obstacles[o];
@@ -265,10 +270,10 @@ json effects_json(const Scene& scene) {
               "forces, the whole body's equilibrium their rows; no regularization"
             : "the contact forces: the rigid amplitudes are contact unknowns and the whole body's equilibrium "
               "their condition; no regularization";
-  if (const auto* all = dynamic_cast<const BodySet*>(problem.body.get())) {
+  if (const auto* all = body_set_of(*problem.body)) {
     // Per body what it simulates, and per contact pair its candidates.
     json bodies = json::array(), pairs = json::array();
-    for (int b = 0; b < all->count(); ++b) {
+    for (int b = 0; b < all->part_count(); ++b) {
       const Body::Traits t = all->part(b).traits();
       json held = json::array();  // its motions held by contact, without the "BODY: " of the scene's list
       for (int k = 0; k < problem.rigid.count(); ++k)
@@ -300,11 +305,11 @@ namespace {
 
 // Each body's rows of the nodes and elements tables and of mesh.cells (several bodies only).
 std::optional<json> bodies_json(const Body& body) {
-  const auto* all = dynamic_cast<const BodySet*>(&body);
+  const auto* all = body_set_of(body);
   if (!all) return std::nullopt;
   json bodies = json::array();
   int first_element = 0;
-  for (int b = 0; b < all->count(); ++b) {
+  for (int b = 0; b < all->part_count(); ++b) {
     const int elements = static_cast<int>(all->part(b).cells().size());
     bodies.push_back({{"name", all->name(b)}, {"first_node", all->node_offset(b)}, {"nodes", all->part(b).node_count()},
                       {"first_element", first_element}, {"elements", elements}});

@@ -16,7 +16,7 @@
 #include "solver/io/json_depth.hpp"
 #include "solver/io/scene_reader.hpp"
 #include "solver/io/schema_validation.hpp"
-#include "solver/equilibrium/rigid_equilibrium.hpp"
+#include "solver/problem/rigid_modes.hpp"
 
 namespace grip {
 namespace {
@@ -206,10 +206,11 @@ struct BodyPart {
 };
 
 std::vector<BodyPart> body_parts(const Problem& problem) {
+  // The BodySet that scene_bodies.cpp built for "bodies": its names and pointers are the scene's.
   const auto* all = dynamic_cast<const BodySet*>(problem.body.get());
   if (!all) return {{problem.body.get(), 0, "/body/supports", ""}};
   std::vector<BodyPart> parts;
-  for (int b = 0; b < all->count(); ++b)
+  for (int b = 0; b < all->part_count(); ++b)
     parts.push_back({&all->part(b), all->dof_offset(b), "/bodies/" + std::to_string(b) + "/supports", all->name(b) + ": "});
   return parts;
 }

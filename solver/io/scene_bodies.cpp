@@ -69,7 +69,7 @@ void read_bodies(Reader& r, json& bodies, Problem& problem) {
   auto set = std::make_unique<BodySet>(std::move(bodies_owned), names);
   problem.body = std::move(set);
   const BodySet& all = static_cast<const BodySet&>(*problem.body);
-  for (int b = 0; b < all.count(); ++b) {
+  for (int b = 0; b < all.part_count(); ++b) {
     const int offset = all.dof_offset(b), n = all.part(b).dof_count();
     for (Constraint c : parts[b].constraints) {
       c.dof += offset;
@@ -95,9 +95,11 @@ struct SetRef {
 std::optional<SetRef> find_set(Reader& r, const BodySet& all, const std::string& text, const std::string& ptr) {
   const size_t dot = text.find('.');
   const std::string body = text.substr(0, dot), set = dot == std::string::npos ? "" : text.substr(dot + 1);
-  for (int b = 0; b < all.count(); ++b) {
+  for (int b = 0; b < all.part_count(); ++b) {
     if (all.name(b) != body) continue;
     const int first = all.site_offset(b), count = all.part(b).site_count();
+    // The body that read_body built from this scene: a set names a beam's surface or a node set
+    // of the continuum's mesh, so io asks for the type it built (docs/design.md).
     if (dynamic_cast<const TimoshenkoBeam*>(&all.part(b))) {
       if (set != "upper" && set != "lower") {
         r.error(ptr, "\"" + set + "\" names no surface of the beam \"" + body + "\" (surfaces: upper, lower: its axis "
@@ -137,7 +139,7 @@ std::optional<SetRef> find_set(Reader& r, const BodySet& all, const std::string&
     return ref;
   }
   std::vector<std::string> names;
-  for (int b = 0; b < all.count(); ++b) names.push_back(all.name(b));
+  for (int b = 0; b < all.part_count(); ++b) names.push_back(all.name(b));
   r.error(ptr, show(text) + " names no body (\"BODY.SET\", bodies: " + Reader::list(names) + ")");
   return std::nullopt;
 }

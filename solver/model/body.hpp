@@ -74,6 +74,20 @@ class Body {
   // An infinitesimal rigid rotation by one radian about the origin (empty if the model has
   // none): with the translations, the motions that supports must remove.
   virtual Vector rigid_rotation() const { return {}; }
+  // For a model with a changing tangent whose own finite rotation is not the turn of its current
+  // positions (the von Karman beam): the rate of that rotation at q, by one radian about the
+  // origin. Empty (default): the model has none of its own (solver/problem/rigid_modes.cpp).
+  virtual Vector own_rotation_at(const Vector& /*q*/) const { return {}; }
+  // The node that a dof moves (default: two dofs a node, x and y).
+  virtual int dof_node(int dof) const { return dof / 2; }
+
+  // A body made of several (BodySet: a scene of several bodies) answers for its parts: their
+  // number, each part, and the dof and the site each part starts at (b = part_count(): the
+  // totals). A single body is not made of parts (part_count() 0) and is its own part 0.
+  virtual int part_count() const { return 0; }
+  virtual const Body& part(int /*b*/) const { return *this; }
+  virtual int dof_offset(int b) const { return b == 0 ? 0 : dof_count(); }
+  virtual int site_offset(int b) const { return b == 0 ? 0 : site_count(); }
 
   // What the model simulates, for the result's effects block; a constant tangent lets one
   // factorization serve every solve.

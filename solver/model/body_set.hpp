@@ -15,11 +15,11 @@ class BodySet final : public Body {
  public:
   BodySet(std::vector<std::unique_ptr<Body>> parts, std::vector<std::string> names);
 
-  int count() const { return static_cast<int>(parts_.size()); }
-  const Body& part(int b) const { return *parts_[b]; }
+  int part_count() const override { return static_cast<int>(parts_.size()); }
+  const Body& part(int b) const override { return *parts_[b]; }
   const std::string& name(int b) const { return names_[b]; }
-  int dof_offset(int b) const { return dof_offset_[b]; }
-  int site_offset(int b) const { return site_offset_[b]; }
+  int dof_offset(int b) const override { return dof_offset_[b]; }
+  int site_offset(int b) const override { return site_offset_[b]; }
   int node_offset(int b) const { return node_offset_[b]; }
   // The body a site (or a node) of the set belongs to.
   int body_of_site(int site) const;

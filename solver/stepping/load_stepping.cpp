@@ -7,7 +7,8 @@
 #include <tuple>
 
 #include "solver/contact/friction_limit.hpp"
-#include "solver/equilibrium/rigid_equilibrium.hpp"
+#include "solver/contact/held_by_contact.hpp"
+#include "solver/problem/rigid_modes.hpp"
 
 namespace grip {
 namespace {

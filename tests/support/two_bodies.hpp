@@ -103,7 +103,7 @@ inline void expect_pairs_balanced(const Solved& s, const StepRecord& rec) {
   double scale = 0.0;
   for (size_t i = 0; i < problem.candidates.size(); ++i) scale += std::abs(rec.p[problem.candidates[i].eta]);
   Vec2 total = Vec2::Zero();
-  for (int b = 0; b < body_set(problem).count(); ++b) {
+  for (int b = 0; b < body_set(problem).part_count(); ++b) {
     const Vec2 on_body = body_resultant(problem, b, f);
     total += on_body;
     const Vec2 reaction = body_resultant(problem, b, rec.reactions) + body_resultant(problem, b, problem.load(rec.factors));

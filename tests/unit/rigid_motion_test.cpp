@@ -8,7 +8,7 @@
 #include <cmath>
 
 #include "solver/io/scene.hpp"
-#include "solver/equilibrium/rigid_equilibrium.hpp"
+#include "solver/problem/rigid_modes.hpp"
 
 namespace grip {
 namespace {
