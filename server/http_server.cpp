@@ -780,8 +780,8 @@ void HttpServer::Impl::result(const Request& req, Response& res) {
   }
   // Stored zstd-compressed: as stored to a client that accepts zstd, gzip-compressed (fast) to
   // one that accepts gzip, as JSON text otherwise. The charset parameter keeps httplib from
-  // compressing the body itself (it does so for exactly "application/json", with brotli at
-  // its slowest quality where the client accepts br).
+  // compressing a compressed body again (it compresses exactly "application/json", with
+  // brotli at its slowest quality where the client accepts br).
   if (format == "json") {
     res.set_header("Vary", "Accept-Encoding");
     const char* type = "application/json; charset=utf-8";
@@ -792,7 +792,7 @@ void HttpServer::Impl::result(const Request& req, Response& res) {
       res.set_header("Content-Encoding", "gzip");
       res.set_content(gzip_fast(stored_text(*data)), type);
     } else {
-      res.set_content(stored_text(*data), type);
+      res.set_content(stored_text(*data), kJson);
     }
     return;
   }
