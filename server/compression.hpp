@@ -7,7 +7,7 @@
 
 namespace grip::server {
 
-// zstd at level 9, or 16 (its optimal parser) for a text of 256 KiB or more: a result's steps
+// zstd at level 3, or 16 (its optimal parser) for a text of 256 KiB or more: a result's steps
 // repeat one another's numbers at distances gzip's 32 KB window cannot reach.
 std::string zstd(std::string_view text);
 // gzip (RFC 1952) at zlib's fastest level: a stored result sent to a client that accepts gzip
