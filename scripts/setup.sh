@@ -8,7 +8,8 @@ service=(
   libeigen3-dev nlohmann-json3-dev libspdlog-dev libgtest-dev
   libcpp-httplib-dev libvalijson-dev libsqlite3-dev
   libpq-dev  # the shared job store (grip serve --db postgresql://...)
-  zlib1g-dev  # results stored gzip-compressed
+  zlib1g-dev  # results stored gzip-compressed by earlier versions (read still)
+  libzstd-dev  # results stored zstd-compressed
   libsuitesparse-dev  # CHOLMOD: sparse Cholesky of symmetric tangents; UMFPACK: LU of large contact zones' saddle-point systems
 )
 extras=(

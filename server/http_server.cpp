@@ -16,7 +16,7 @@
 #include <sstream>
 
 #include "server/body_budget.hpp"
-#include "server/gzip.hpp"
+#include "server/compression.hpp"
 #include "server/observability.hpp"
 #include "server/tar.hpp"
 #include "server/ui.hpp"
@@ -109,17 +109,17 @@ std::optional<std::int64_t> decode_cursor(const std::string& c) {
 
 std::string job_path(const std::string& id) { return "/v1/jobs/" + id; }
 
-// Accept-Encoding names gzip (or *) without q=0.
-bool accepts_gzip(const Request& req) {
+// Accept-Encoding names `coding` (or *) without q=0.
+bool accepts(const Request& req, std::string_view coding) {
   std::stringstream list(lower(req.get_header_value("Accept-Encoding")));
   std::string item;
   while (std::getline(list, item, ',')) {
     const size_t semi = item.find(';');
-    std::string coding = item.substr(0, semi), params = semi == std::string::npos ? "" : item.substr(semi + 1);
-    coding.erase(std::remove_if(coding.begin(), coding.end(), ::isspace), coding.end());
+    std::string c = item.substr(0, semi), params = semi == std::string::npos ? "" : item.substr(semi + 1);
+    c.erase(std::remove_if(c.begin(), c.end(), ::isspace), c.end());
     params.erase(std::remove_if(params.begin(), params.end(), ::isspace), params.end());
     const bool refused = params.rfind("q=0", 0) == 0 && params.find_first_of("123456789", 2) == std::string::npos;
-    if ((coding == "gzip" || coding == "x-gzip" || coding == "*") && !refused) return true;
+    if ((c == coding || c == "*") && !refused) return true;
   }
   return false;
 }
@@ -778,20 +778,25 @@ void HttpServer::Impl::result(const Request& req, Response& res) {
     return problem(res, req, 404, "no-result", "No result",
                    "job " + id + " is " + std::string(to_string(view->record.status)) + " and has no result");
   }
-  // Stored gzip-compressed: as stored to a client that accepts gzip, inflated otherwise.
+  // Stored zstd-compressed: as stored to a client that accepts zstd, gzip-compressed (fast) to
+  // one that accepts gzip, as JSON text otherwise. The charset parameter keeps httplib from
+  // compressing a compressed body again (it compresses exactly "application/json", with
+  // brotli at its slowest quality where the client accepts br).
   if (format == "json") {
     res.set_header("Vary", "Accept-Encoding");
-    if (is_gzip(*data) && accepts_gzip(req)) {
+    const char* type = "application/json; charset=utf-8";
+    if (is_zstd(*data) && accepts(req, "zstd")) {
+      res.set_header("Content-Encoding", "zstd");
+      res.set_content(*data, type);
+    } else if (accepts(req, "gzip")) {
       res.set_header("Content-Encoding", "gzip");
-      // httplib compresses a body of exactly "application/json" itself (once more, here): the
-      // charset parameter keeps it from doing so.
-      res.set_content(*data, "application/json; charset=utf-8");
+      res.set_content(gzip_fast(stored_text(*data)), type);
     } else {
-      res.set_content(is_gzip(*data) ? gunzip(*data) : *data, kJson);
+      res.set_content(stored_text(*data), kJson);
     }
     return;
   }
-  const json doc = json::parse(is_gzip(*data) ? gunzip(*data) : *data);
+  const json doc = json::parse(stored_text(*data));
   if (format == "csv") {
     const std::string table = req.has_param("table") ? req.get_param_value("table") : "nodes";
     const auto& tables = result_csv_tables();

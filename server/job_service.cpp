@@ -7,7 +7,7 @@
 #include <limits>
 #include <sstream>
 
-#include "server/gzip.hpp"
+#include "server/compression.hpp"
 #include "server/util.hpp"
 #include "solver/model/number_text.hpp"
 #include "solver/io/result.hpp"
@@ -135,14 +135,16 @@ void JobService::on_change(const StoreChange& change) {
     }
     if (job) hear_dismissal(*job, "notification");
   }
-  {
-    std::lock_guard lock(events_mutex_);
-    if (changes_.size() > 100000) changes_.clear();  // waiters then wake once, harmlessly
-    ++changes_[change.job_id];
-    if (change.job_id.empty())
-      for (auto& [id, n] : changes_) ++n;
+  std::lock_guard lock(events_mutex_);
+  auto wake = [](Watch& w) {
+    ++w.changes;
+    w.cv.notify_all();
+  };
+  if (change.job_id.empty()) {
+    for (auto& [id, w] : watches_) wake(*w);
+  } else if (const auto it = watches_.find(change.job_id); it != watches_.end()) {
+    wake(*it->second);
   }
-  stored_cv_.notify_all();
 }
 
 void JobService::hear_dismissal(ActiveJob& job, const char* how) {
@@ -285,11 +287,25 @@ std::pair<DismissOutcome, std::optional<JobView>> JobService::dismiss(const std:
 EventBatch JobService::wait_events(const std::string& id, std::int64_t after,
                                    std::chrono::milliseconds wait, int limit) {
   const auto deadline = Clock::now() + wait;
+  std::shared_ptr<Watch> watch;
+  {
+    std::lock_guard lock(events_mutex_);
+    auto& w = watches_[id];
+    if (!w) w = std::make_shared<Watch>();
+    watch = w;
+    ++watch->waiters;
+  }
+  const auto unwatch = [&](void*) {
+    std::lock_guard lock(events_mutex_);
+    const auto it = watches_.find(id);
+    if (--watch->waiters == 0 && it != watches_.end() && it->second == watch) watches_.erase(it);
+  };
+  const std::unique_ptr<void, decltype(unwatch)> watching(watch.get(), unwatch);
   while (true) {
     std::uint64_t seen = 0;
     {
       std::lock_guard lock(events_mutex_);
-      seen = changes_[id];
+      seen = watch->changes;
     }
     try {
       EventBatch batch;
@@ -314,8 +330,8 @@ EventBatch JobService::wait_events(const std::string& id, std::int64_t after,
       return {};
     }
     std::unique_lock lock(events_mutex_);
-    const bool woke = stored_cv_.wait_until(
-        lock, deadline, [&] { return changes_[id] != seen || draining_.load(); });
+    const bool woke =
+        watch->cv.wait_until(lock, deadline, [&] { return watch->changes != seen || draining_.load(); });
     if (!woke || draining_) return {};
   }
 }
@@ -388,6 +404,7 @@ void JobService::begin_drain() {
   draining_ = true;
   std::lock_guard lock(events_mutex_);
   stored_cv_.notify_all();
+  for (auto& [id, w] : watches_) w->cv.notify_all();
 }
 
 void JobService::shutdown(std::chrono::milliseconds grace) {
@@ -785,7 +802,7 @@ void JobService::run_job(const std::shared_ptr<ActiveJob>& job, const JobRecord&
       // took several times the text's memory and more time than writing it.
       std::ostringstream text;
       write_result(text, *scene, run);
-      outcome.result = gzip(std::move(text).str());  // stored and served compressed
+      outcome.result = zstd(std::move(text).str());  // stored and served compressed
     } catch (const std::exception& e) {
       spdlog::error("job {}: cannot build its result: {}", id, e.what());
     }

@@ -54,7 +54,7 @@ CREATE TABLE IF NOT EXISTS grip_results (
   job_id TEXT PRIMARY KEY,
   data TEXT NOT NULL
 );
--- Results as stored bytes (gzip) in `bytes`; `data` holds those stored before as JSON text.
+-- Results as stored bytes (zstd; gzip from earlier versions) in `bytes`; `data` holds those stored before as JSON text.
 ALTER TABLE grip_results ADD COLUMN IF NOT EXISTS bytes BYTEA;
 ALTER TABLE grip_results ALTER COLUMN data DROP NOT NULL;
 ALTER TABLE grip_jobs ADD COLUMN IF NOT EXISTS stored_bytes BIGINT NOT NULL DEFAULT 0;

@@ -123,7 +123,7 @@ struct JobOutcome {
   std::string failure_kind;  // as JobRecord's
   int failure_step = 0;
   int steps_completed = 0;
-  std::optional<std::string> result;  // the result as stored (gzip of its JSON), when the run produced one
+  std::optional<std::string> result;  // the result as stored (zstd of its JSON), when the run produced one
   StoredEvent terminal;                // job_finished | job_failed
 };
 
@@ -194,7 +194,7 @@ class Store {
   // Events with seq > after, in order, at most `limit`; only of `type` when given.
   virtual std::vector<StoredEvent> events_after(const std::string& id, std::int64_t after,
                                                 int limit, std::string_view type = {}) = 0;
-  // The result as stored: bytes (gzip, or the JSON text of a result stored before compression).
+  // The result as stored: bytes (zstd; gzip or JSON text if stored by an earlier version).
   virtual std::optional<std::string> result(const std::string& id) = 0;
 
   // Removes the finished jobs beyond `retention` at `now` (ISO 8601), with their events and

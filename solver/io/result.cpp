@@ -3,6 +3,8 @@
 #include "solver/io/json_writer.hpp"
 
 #include <algorithm>
+#include <charconv>
+#include <cmath>
 #include <functional>
 #include <memory>
 #include <stdexcept>
@@ -50,6 +52,15 @@ json job_failed_event(FailureKind kind, const std::string& reason, int step) {
   return {{"type", "job_failed"}, {"reason", reason}, {"failure", failure_json(kind, reason, step)}};
 }
 
+double field_value(double v) {
+  if (!std::isfinite(v) || v == 0) return v;
+  char text[32];
+  const char* end = std::to_chars(text, text + sizeof text, v, std::chars_format::scientific, kFieldDigits - 1).ptr;
+  double rounded = v;
+  std::from_chars(text, end, rounded);
+  return rounded;
+}
+
 namespace {
 
 // The scene's bodies where it has several (the BodySet that the scene reader built for
@@ -61,8 +72,8 @@ json table_json(const FieldTable& t, const char* index_name) {
   json rows = json::array();
   for (size_t i = 0; i < t.rows.size(); ++i) {
     json row = {{index_name, i}};
-    for (size_t c = 0; c < t.names.size(); ++c)
-      if (!std::isnan(t.rows[i][c])) row[t.names[c]] = t.rows[i][c];  // NaN: a column the row's body lacks
+    for (size_t c = 0; c < t.names.size(); ++c)  // NaN: a column the row's body lacks
+      if (!std::isnan(t.rows[i][c])) row[t.names[c]] = field_value(t.rows[i][c]);
     rows.push_back(row);
   }
   return rows;
@@ -100,12 +111,13 @@ std::vector<ContactPointRow> contact_point_rows(const Problem& problem, const St
 json contact_points_json(const std::vector<ContactPointRow>& rows) {
   json points = json::array();
   for (const ContactPointRow& r : rows) {
+    const auto f = field_value;
     json point = {{"node", r.node}, {"obstacle", r.obstacle},
-                  {"x", r.x.x()}, {"y", r.x.y()},
-                  {"pair", {r.pair.x(), r.pair.y()}},
-                  {"normal", {r.normal.x(), r.normal.y()}},
-                  {"p_n", r.p_n}, {"p_t", r.p_t}, {"sigma_n", r.sigma_n}, {"sigma_t", r.sigma_t},
-                  {"gap", r.gap}, {"slip", r.slip}, {"state", r.state}};
+                  {"x", f(r.x.x())}, {"y", f(r.x.y())},
+                  {"pair", {f(r.pair.x()), f(r.pair.y())}},
+                  {"normal", {f(r.normal.x()), f(r.normal.y())}},
+                  {"p_n", f(r.p_n)}, {"p_t", f(r.p_t)}, {"sigma_n", f(r.sigma_n)}, {"sigma_t", f(r.sigma_t)},
+                  {"gap", f(r.gap)}, {"slip", f(r.slip)}, {"state", r.state}};
     if (r.several_bodies) {
       point["body"] = r.body;
       point["master"] = r.master;
@@ -181,7 +193,7 @@ json step_json(const Problem& problem, const StepRecord& rec, const OutputOption
   if (rec.reactions.size() && output.wants("reactions")) {
     json reactions = json::array();
     for (const Constraint& c : problem.constraints)
-      reactions.push_back({{"dof", c.dof}, {"force", rec.reactions[c.dof]}});
+      reactions.push_back({{"dof", c.dof}, {"force", field_value(rec.reactions[c.dof])}});
     j["reactions"] = reactions;
   }
   if (!output.wants("contact_points")) return j;
@@ -197,9 +209,10 @@ json step_json(const Problem& problem, const StepRecord& rec, const OutputOption
         const double area = body.tributary_area(r.site);
         const Vec2 x = body.surface_point(rec.state.q, r.site, 0).x;
         readings.push_back({{"node", body.site_node(r.site)}, {"obstacle", pair.name},
-                            {"body", all->name(pair.master->body)}, {"x", x.x()}, {"y", x.y()},
-                            {"p_n", r.sigma_n * area}, {"p_t", r.sigma_t * area},
-                            {"sigma_n", r.sigma_n}, {"sigma_t", r.sigma_t}});
+                            {"body", all->name(pair.master->body)}, {"x", field_value(x.x())},
+                            {"y", field_value(x.y())}, {"p_n", field_value(r.sigma_n * area)},
+                            {"p_t", field_value(r.sigma_t * area)}, {"sigma_n", field_value(r.sigma_n)},
+                            {"sigma_t", field_value(r.sigma_t)}});
       }
     }
     j["master_points"] = readings;
@@ -371,7 +384,7 @@ FlatTable flat_table(const FieldTable& t) {
   f.values.reserve(t.rows.size() * t.names.size());
   for (const auto& row : t.rows) {
     if (row.size() != t.names.size()) throw std::logic_error("a field table's row is not as wide as its names");
-    f.values.insert(f.values.end(), row.begin(), row.end());
+    for (double v : row) f.values.push_back(field_value(v));  // NaN stays: a column the row's body lacks
   }
   return f;
 }

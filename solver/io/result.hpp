@@ -22,6 +22,16 @@ nlohmann::json failure_json(FailureKind kind, const std::string& message, int st
 // The terminal event of a job that did not solve every step.
 nlohmann::json job_failed_event(FailureKind kind, const std::string& reason, int step);
 
+// The digits a step's fields (nodes, elements, reactions, contact and master points) are
+// written with: single precision's, within 5e-7 of the value, far below any mesh's discretisation
+// error; full doubles' 17 digits, which no mesh resolves, took most of a stored result's
+// bytes (docs/design.md#scenes-results-and-events). Summaries, histories, events and
+// the scene keep the shortest round-trip form of their doubles.
+constexpr int kFieldDigits = 7;
+// v rounded to kFieldDigits significant digits (written as at most that many); 0, infinities
+// and NaN as they are.
+double field_value(double v);
+
 // One step's fields: nodes, elements, reactions, contact points, obstacle positions.
 // Fields only where the step was recorded (see SteppingParams::record_fields) and wanted.
 nlohmann::json step_json(const Problem& problem, const StepRecord& rec, const OutputOptions& output = {});

@@ -30,14 +30,13 @@ TEST(Observability, RequestsAreCountedByMethodRouteAndStatusWithLatencyAndJobHis
   ASSERT_EQ(api.get("/v1/jobs/no-such-job")->status, 404);
   ASSERT_EQ(api.post_json("/v1/jobs", R"({"body": {}})")->status, 422);
   ASSERT_EQ(api.get("/no/such/route")->status, 404);
-  // A request is counted once its answer has gone out, and a job's duration once its status is
-  // stored: the last of each may land a moment after the client has seen it.
+  // A request is counted by httplib's logger, which runs once its answer has gone out: the
+  // client may ask for the metrics first (a parallel test run did). Read until the last one
+  // is in.
   std::string m;
-  for (int i = 0; i < 100; ++i) {
+  for (int tries = 0; tries < 100; ++tries) {
     m = api.get("/v1/metrics")->body;
-    if (sample(m, R"(grip_http_requests_total{method="GET",route="other",status="404"})") == 1 &&
-        sample(m, R"(grip_job_run_seconds_count{outcome="successful"})") == 1)
-      break;
+    if (sample(m, R"(grip_http_requests_total{method="GET",route="other",status="404"})") >= 0) break;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
 
