@@ -413,7 +413,8 @@ test("with a bearer token: the page asks for it, keeps it in sessionStorage, and
     await tab.waitForFunction(() => document.getElementById("scene").value.includes("beam-on-cylinder"));
     await tab.click("#submit");
     await tab.waitForFunction(() => document.getElementById("job-panel").dataset.state === "result", { timeout: 60000 });
-    assert.ok(await tab.$$eval("#conv-plot circle.pt", (els) => els.length) > 20);
+    // The result can be shown before the last iteration events are drawn: wait for them.
+    await tab.waitForFunction(() => document.querySelectorAll("#conv-plot circle.pt").length > 20, { timeout: 10000 });
     // A reload keeps the token (same tab).
     await tab.reload();
     await tab.waitForFunction(() => document.querySelectorAll("#jobs-table tbody tr").length === 1);
