@@ -17,8 +17,9 @@ std::string gzip_fast(std::string_view text);
 // when compressed data is not whole.
 std::string stored_text(std::string_view stored);
 inline bool is_zstd(std::string_view data) {
-  return data.size() >= 4 && static_cast<unsigned char>(data[0]) == 0x28 && static_cast<unsigned char>(data[1]) == 0xb5 &&
-         static_cast<unsigned char>(data[2]) == 0x2f && static_cast<unsigned char>(data[3]) == 0xfd;
+  return data.size() >= 4 && static_cast<unsigned char>(data[0]) == 0x28 &&
+         static_cast<unsigned char>(data[1]) == 0xb5 && static_cast<unsigned char>(data[2]) == 0x2f &&
+         static_cast<unsigned char>(data[3]) == 0xfd;
 }
 // Starts with gzip's magic number (JSON text never does).
 inline bool is_gzip(std::string_view data) {

@@ -33,7 +33,7 @@ namespace grip::server {
 
 // What the request on this thread's connection ran into; read by the error handler.
 struct ConnectionNote {
-  std::string client;  // the peer's address
+  std::string client;            // the peer's address
   bool in_body = false;          // the head has been read
   bool deadline_missed = false;  // in the head or, with in_body, the body
   bool line_too_long = false;    // a line of the head over kMaxLine

@@ -9,17 +9,15 @@
 
 #include "server/compression.hpp"
 #include "server/util.hpp"
-#include "solver/model/number_text.hpp"
 #include "solver/io/result.hpp"
+#include "solver/model/number_text.hpp"
 
 namespace grip::server {
 
 using nlohmann::json;
 using Clock = std::chrono::steady_clock;
 
-bool is_terminal_event(const std::string& type) {
-  return type == "job_finished" || type == "job_failed";
-}
+bool is_terminal_event(const std::string& type) { return type == "job_finished" || type == "job_failed"; }
 
 struct JobService::ActiveJob {
   explicit ActiveJob(Lease l) : lease(std::move(l)), id(lease.job_id) {}
@@ -38,8 +36,8 @@ struct JobService::ActiveJob {
 namespace {
 
 // Upper bounds of grip_job_stored_bytes' buckets (+Inf last).
-const std::vector<double> kStoredBytesBuckets = {4096, 16384, 65536, 262144, 1048576, 4194304, 16777216,
-                                                 std::numeric_limits<double>::infinity()};
+const std::vector<double> kStoredBytesBuckets = {4096,    16384,   65536,    262144,
+                                                 1048576, 4194304, 16777216, std::numeric_limits<double>::infinity()};
 
 // A run that did not succeed: its status, message (the result's reason where there is one)
 // and failure kind.
@@ -86,10 +84,8 @@ std::optional<std::int64_t> least_generated_nodes(const json& scene) {
 
 }  // namespace
 
-JobService::JobService(Store& store, ServiceOptions options)
-    : store_(store), options_(std::move(options)) {
-  if (options_.workers <= 0)
-    options_.workers = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+JobService::JobService(Store& store, ServiceOptions options) : store_(store), options_(std::move(options)) {
+  if (options_.workers <= 0) options_.workers = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
   options_.queue_capacity = std::max(1, options_.queue_capacity);
   options_.event_buffer = std::max<std::size_t>(16, options_.event_buffer);
   if (!(options_.lease_seconds > 0)) options_.lease_seconds = 10;
@@ -163,8 +159,7 @@ bool JobService::ready() {
   return store_.ping();
 }
 
-std::optional<SubmitResult> JobService::replay(const std::optional<std::string>& key,
-                                              const std::string& scene) {
+std::optional<SubmitResult> JobService::replay(const std::optional<std::string>& key, const std::string& scene) {
   if (!key) return std::nullopt;
   auto existing = store_.job_by_idempotency_key(*key);
   if (!existing) return std::nullopt;
@@ -174,17 +169,16 @@ std::optional<SubmitResult> JobService::replay(const std::optional<std::string>&
   return SubmitResult{JobView{*existing, std::nullopt}, true};
 }
 
-SubmitResult JobService::submit(const json& scene_json,
-                                const std::optional<std::string>& idempotency_key,
+SubmitResult JobService::submit(const json& scene_json, const std::optional<std::string>& idempotency_key,
                                 const std::string& request_id) {
   if (draining_) throw ShuttingDown();
   const std::string canonical = scene_json.dump();
   if (auto earlier = replay(idempotency_key, canonical)) return *earlier;
   const JobLimits& lim = options_.limits;
   if (const auto least = least_generated_nodes(scene_json); least && *least > lim.max_nodes)
-    throw SceneErrors(std::vector<SceneIssue>{
-        {"/body/mesh", "the body has at least " + std::to_string(*least) +
-                           " nodes; this service takes at most " + std::to_string(lim.max_nodes)}});
+    throw SceneErrors(std::vector<SceneIssue>{{"/body/mesh", "the body has at least " + std::to_string(*least) +
+                                                                 " nodes; this service takes at most " +
+                                                                 std::to_string(lim.max_nodes)}});
   struct {
     int nodes, steps;
   } size;
@@ -195,12 +189,10 @@ SubmitResult JobService::submit(const json& scene_json,
   std::vector<SceneIssue> issues;
   if (size.nodes > lim.max_nodes)
     issues.push_back({"/body/mesh", "the body has " + std::to_string(size.nodes) +
-                                        " nodes; this service takes at most " +
-                                        std::to_string(lim.max_nodes)});
+                                        " nodes; this service takes at most " + std::to_string(lim.max_nodes)});
   if (size.steps > lim.max_steps)
     issues.push_back({scene_json.contains("stages") ? "/stages" : "/steps",
-                      "the scene has " + std::to_string(size.steps) +
-                          " load steps; this service takes at most " +
+                      "the scene has " + std::to_string(size.steps) + " load steps; this service takes at most " +
                           std::to_string(lim.max_steps)});
   if (!issues.empty()) throw SceneErrors(std::move(issues));
 
@@ -270,8 +262,7 @@ std::optional<JobView> JobService::job(const std::string& id) {
   return with_progress({std::move(*rec)}).front();
 }
 
-JobPage JobService::list(std::optional<JobStatus> status, int limit,
-                         std::optional<std::int64_t> before) {
+JobPage JobService::list(std::optional<JobStatus> status, int limit, std::optional<std::int64_t> before) {
   return store_.list_jobs(status, limit, before);
 }
 
@@ -284,8 +275,8 @@ std::pair<DismissOutcome, std::optional<JobView>> JobService::dismiss(const std:
   return {outcome, JobView{std::move(*rec), std::nullopt}};
 }
 
-EventBatch JobService::wait_events(const std::string& id, std::int64_t after,
-                                   std::chrono::milliseconds wait, int limit) {
+EventBatch JobService::wait_events(const std::string& id, std::int64_t after, std::chrono::milliseconds wait,
+                                   int limit) {
   const auto deadline = Clock::now() + wait;
   std::shared_ptr<Watch> watch;
   {
@@ -330,8 +321,7 @@ EventBatch JobService::wait_events(const std::string& id, std::int64_t after,
       return {};
     }
     std::unique_lock lock(events_mutex_);
-    const bool woke =
-        watch->cv.wait_until(lock, deadline, [&] { return watch->changes != seen || draining_.load(); });
+    const bool woke = watch->cv.wait_until(lock, deadline, [&] { return watch->changes != seen || draining_.load(); });
     if (!woke || draining_) return {};
   }
 }
@@ -414,8 +404,7 @@ void JobService::shutdown(std::chrono::milliseconds grace) {
     std::unique_lock lock(mutex_);
     stop_workers_ = true;
     work_cv_.notify_all();
-    if (running_ > 0)
-      spdlog::info("waiting up to {:.1f} s for {} running job(s)", grace.count() / 1000.0, running_);
+    if (running_ > 0) spdlog::info("waiting up to {:.1f} s for {} running job(s)", grace.count() / 1000.0, running_);
     if (!idle_cv_.wait_for(lock, grace, [&] { return running_ == 0; })) {
       spdlog::warn("grace period over: stopping {} running job(s); they run again later", running_);
       abort_runs_ = true;
@@ -458,7 +447,8 @@ void JobService::worker_loop() {
     }
     if (!claimed) continue;
     if (const auto created = parse_iso8601(claimed->created); created && claimed->attempts == 1)
-      queue_wait_.observe(std::max(0.0, std::chrono::duration<double>(std::chrono::system_clock::now() - *created).count()));
+      queue_wait_.observe(
+          std::max(0.0, std::chrono::duration<double>(std::chrono::system_clock::now() - *created).count()));
     auto job = std::make_shared<ActiveJob>(Lease{claimed->id, claimed->generation});
     {
       std::lock_guard lock(mutex_);
@@ -515,8 +505,7 @@ void JobService::writer_loop() {
       std::unique_lock lock(events_mutex_);
       writer_cv_.wait(lock, [&] { return stop_writer_ || !pending_.empty() || !batch.empty(); });
       if (stop_writer_ && pending_.empty() && batch.empty()) return;
-      batch.insert(batch.end(), std::make_move_iterator(pending_.begin()),
-                   std::make_move_iterator(pending_.end()));
+      batch.insert(batch.end(), std::make_move_iterator(pending_.begin()), std::make_move_iterator(pending_.end()));
       pending_.clear();
     }
     room_cv_.notify_all();
@@ -527,15 +516,13 @@ void JobService::writer_loop() {
       failures = 0;
     } catch (const std::exception& e) {
       // Kept and retried: an acknowledged job's events are not dropped while this process runs.
-      if (failures++ % 20 == 0)
-        spdlog::error("storing {} event(s) failed, retrying: {}", batch.size(), e.what());
+      if (failures++ % 20 == 0) spdlog::error("storing {} event(s) failed, retrying: {}", batch.size(), e.what());
       std::unique_lock lock(events_mutex_);
       if (stop_writer_) {
         spdlog::warn("stopping with {} event(s) unstored; their runs are taken over", batch.size());
         return;
       }
-      writer_cv_.wait_for(lock, std::chrono::milliseconds(std::min(2000, 50 * failures)),
-                          [&] { return stop_writer_; });
+      writer_cv_.wait_for(lock, std::chrono::milliseconds(std::min(2000, 50 * failures)), [&] { return stop_writer_; });
       continue;
     }
     std::vector<std::shared_ptr<ActiveJob>> jobs;
@@ -543,8 +530,7 @@ void JobService::writer_loop() {
       std::lock_guard lock(mutex_);
       for (const NewEvent& e : batch) {
         const auto it = active_.find(e.lease.job_id);
-        if (it != active_.end() && it->second->lease.generation == e.lease.generation)
-          jobs.push_back(it->second);
+        if (it != active_.end() && it->second->lease.generation == e.lease.generation) jobs.push_back(it->second);
       }
     }
     {
@@ -619,21 +605,21 @@ bool JobService::retry_store(const std::shared_ptr<ActiveJob>& job, const std::f
   }
 }
 
-void JobService::finish(const std::shared_ptr<ActiveJob>& job, JobOutcome outcome,
-                        std::int64_t last) {
+void JobService::finish(const std::shared_ptr<ActiveJob>& job, JobOutcome outcome, std::int64_t last) {
   flush(job, last);  // the job's events come first
   if (job->lost) {
     spdlog::warn("job {}: run not recorded (its lease went to another run)", job->id);
     return;
   }
   if (outcome.terminal.type.empty()) {
-    const json ev = outcome.status == JobStatus::successful ? json{{"type", "job_finished"}}
-                    : outcome.status == JobStatus::dismissed
-                        ? json::parse(kDismissedEvent)
-                        : json{{"type", "job_failed"},
-                               {"reason", outcome.message},
-                               {"failure",
-                                {{"kind", outcome.failure_kind}, {"message", outcome.message}, {"step", outcome.failure_step}}}};
+    const json ev =
+        outcome.status == JobStatus::successful ? json{{"type", "job_finished"}}
+        : outcome.status == JobStatus::dismissed
+            ? json::parse(kDismissedEvent)
+            : json{{"type", "job_failed"},
+                   {"reason", outcome.message},
+                   {"failure",
+                    {{"kind", outcome.failure_kind}, {"message", outcome.message}, {"step", outcome.failure_step}}}};
     outcome.terminal = stored(last + 1, ev);
   }
   std::optional<JobStatus> stored_status;
@@ -740,8 +726,7 @@ void JobService::run_job(const std::shared_ptr<ActiveJob>& job, const JobRecord&
     else if (job->lost) stop = Stop::lost;
     else if (abort_runs_) stop = Stop::shutdown;
     else if (iterations >= lim.max_iterations) stop = Stop::iterations;
-    else if (std::chrono::duration<double>(Clock::now() - t0).count() > lim.max_seconds)
-      stop = Stop::seconds;
+    else if (std::chrono::duration<double>(Clock::now() - t0).count() > lim.max_seconds) stop = Stop::seconds;
     return stop != Stop::none;
   };
   observer.stop_reason = [&]() -> std::pair<FailureKind, std::string> {
@@ -753,8 +738,10 @@ void JobService::run_job(const std::shared_ptr<ActiveJob>& job, const JobRecord&
       case Stop::seconds:
         return {FailureKind::job_limit, "limit: the run reached this service's wall-time limit (--max-seconds " +
                                             number_text(lim.max_seconds) + ")"};
-      case Stop::dismissed: return {FailureKind::dismissed, "dismissed"};
-      default: return {FailureKind::stopped, "stopped on request"};  // shutdown or lost: not stored
+      case Stop::dismissed:
+        return {FailureKind::dismissed, "dismissed"};
+      default:
+        return {FailureKind::stopped, "stopped on request"};  // shutdown or lost: not stored
     }
   };
 

@@ -1,9 +1,9 @@
 #include "server/postgres_store.hpp"
 
 #include <libpq-fe.h>
-#include <nlohmann/json.hpp>
 #include <poll.h>
 #include <spdlog/spdlog.h>
+#include <nlohmann/json.hpp>
 
 #include <chrono>
 #include <condition_variable>
@@ -211,8 +211,8 @@ class Session {
       values.push_back(p ? p->c_str() : nullptr);
       if (p) sent += static_cast<std::int64_t>(p->size());
     }
-    PGresult* raw = PQexecParams(c_->conn, sql, static_cast<int>(values.size()), nullptr,
-                                 values.data(), nullptr, nullptr, 0);
+    PGresult* raw =
+        PQexecParams(c_->conn, sql, static_cast<int>(values.size()), nullptr, values.data(), nullptr, nullptr, 0);
     // A pooled connection that the database dropped while idle (it restarted) fails its first
     // statement: connect again and send that statement once more. Statements whose reply
     // could have been lost with a commit are safe to repeat (events: ON CONFLICT DO NOTHING;
@@ -222,8 +222,7 @@ class Session {
       PQfinish(c_->conn);
       c_->conn = nullptr;
       c_->conn = pool_.reconnect();
-      raw = PQexecParams(c_->conn, sql, static_cast<int>(values.size()), nullptr, values.data(),
-                         nullptr, nullptr, 0);
+      raw = PQexecParams(c_->conn, sql, static_cast<int>(values.size()), nullptr, values.data(), nullptr, nullptr, 0);
     }
     first_ = false;
     Result r(raw);
@@ -299,8 +298,7 @@ JobRecord read_job(const Result& r, int row, bool with_scene) {
 }
 
 std::string select_job(bool with_scene, const std::string& where) {
-  return std::string("SELECT ") + kJobColumns + (with_scene ? ", scene" : "") +
-         " FROM grip_jobs WHERE " + where;
+  return std::string("SELECT ") + kJobColumns + (with_scene ? ", scene" : "") + " FROM grip_jobs WHERE " + where;
 }
 
 // Bytes as a bytea literal in text form (\x and hex digits): parameters are sent as text.
@@ -461,8 +459,7 @@ std::optional<JobRecord> PostgresStore::job_by_idempotency_key(const std::string
   return read_job(r, 0, true);
 }
 
-JobPage PostgresStore::list_jobs(std::optional<JobStatus> status, int limit,
-                                 std::optional<std::int64_t> before) {
+JobPage PostgresStore::list_jobs(std::optional<JobStatus> status, int limit, std::optional<std::int64_t> before) {
   Session s(*pool_);
   const std::string sql = select_job(false, status ? "ord < $1 AND status = $3" : "ord < $1 AND $3::text IS NULL") +
                           " ORDER BY ord DESC LIMIT $2";
@@ -589,11 +586,14 @@ std::optional<JobStatus> PostgresStore::finish_job(const Lease& lease, const Job
       "message = CASE WHEN cur.status = 'dismissed' OR $3::text = 'dismissed' THEN 'dismissed' ELSE $4::text END, "
       "finished = $5::text, updated = $5::text, solve_seconds = $6::float8, iterations = $7::bigint, "
       "last_seq = greatest(j.last_seq, $8::bigint), "
-      "failure_kind = CASE WHEN cur.status = 'dismissed' OR $3::text = 'dismissed' THEN 'dismissed' ELSE $13::text END, "
+      "failure_kind = CASE WHEN cur.status = 'dismissed' OR $3::text = 'dismissed' THEN 'dismissed' ELSE $13::text "
+      "END, "
       "failure_step = CASE WHEN cur.status = 'dismissed' OR $3::text = 'dismissed' THEN 0 ELSE $14::integer END, "
       "steps_completed = $15::integer, stored_bytes = octet_length(j.scene) + "
-      "CASE WHEN cur.status = 'dismissed' OR $3::text = 'dismissed' THEN 0 ELSE coalesce(octet_length($9::bytea), 0) END + "
-      "octet_length($11::text) + (SELECT coalesce(sum(octet_length(e.data)), 0) FROM grip_events e WHERE e.job_id = j.id) "
+      "CASE WHEN cur.status = 'dismissed' OR $3::text = 'dismissed' THEN 0 ELSE coalesce(octet_length($9::bytea), 0) "
+      "END + "
+      "octet_length($11::text) + (SELECT coalesce(sum(octet_length(e.data)), 0) FROM grip_events e WHERE e.job_id = "
+      "j.id) "
       "FROM cur WHERE j.id = cur.id RETURNING j.id, j.status), "
       "res AS (INSERT INTO grip_results (job_id, bytes) SELECT id, $9::bytea FROM upd WHERE "
       "upd.status <> 'dismissed' AND $9::bytea IS NOT NULL ON CONFLICT (job_id) DO UPDATE SET bytes = EXCLUDED.bytes, "
@@ -633,15 +633,15 @@ std::pair<DismissOutcome, std::optional<JobRecord>> PostgresStore::dismiss_job(c
   DismissOutcome outcome = DismissOutcome::dismissed;
   if (rec.status == JobStatus::accepted) {
     const std::string seq = num(rec.last_seq + 1);
-    s.query("UPDATE grip_jobs SET status = 'dismissed', message = 'dismissed before it started', "
-            "finished = $2, updated = $2, last_seq = $3 WHERE id = $1",
-            {id, now, seq});
+    s.query(
+        "UPDATE grip_jobs SET status = 'dismissed', message = 'dismissed before it started', "
+        "finished = $2, updated = $2, last_seq = $3 WHERE id = $1",
+        {id, now, seq});
     s.query("INSERT INTO grip_events (job_id, seq, type, data) VALUES ($1, $2, 'job_failed', $3)",
             {id, seq, std::string(kDismissedEvent)});
     s.query("SELECT pg_notify('grip', 'e' || $1::text)", {id});
   } else if (!is_finished(rec.status) || rec.finished.empty()) {
-    s.query("UPDATE grip_jobs SET status = 'dismissed', message = 'dismissed', updated = $2 WHERE id = $1",
-            {id, now});
+    s.query("UPDATE grip_jobs SET status = 'dismissed', message = 'dismissed', updated = $2 WHERE id = $1", {id, now});
     s.query("SELECT pg_notify('grip', 'd' || $1::text)", {id});
   } else {
     s.query("DELETE FROM grip_events WHERE job_id = $1", {id});
@@ -659,8 +659,8 @@ std::pair<DismissOutcome, std::optional<JobRecord>> PostgresStore::dismiss_job(c
   return {outcome, after};
 }
 
-std::vector<StoredEvent> PostgresStore::events_after(const std::string& id, std::int64_t after,
-                                                     int limit, std::string_view type) {
+std::vector<StoredEvent> PostgresStore::events_after(const std::string& id, std::int64_t after, int limit,
+                                                     std::string_view type) {
   Session s(*pool_);
   const Result r = s.query(
       "SELECT seq, type, data FROM grip_events WHERE job_id = $1 AND seq > $2 AND "

@@ -48,14 +48,14 @@ struct JobRecord {
   std::string id;
   std::int64_t ord = 0;  // creation order, assigned by the store
   JobStatus status = JobStatus::accepted;
-  std::string scene;     // compact JSON as accepted (only filled when asked for)
-  std::string created;   // ISO 8601 UTC timestamps; empty: not yet
+  std::string scene;    // compact JSON as accepted (only filled when asked for)
+  std::string created;  // ISO 8601 UTC timestamps; empty: not yet
   std::string started;
   std::string finished;
   std::string updated;
   std::string message;
-  int steps = 0;         // load steps of the scene
-  int nodes = 0;         // nodes of the body's mesh
+  int steps = 0;  // load steps of the scene
+  int nodes = 0;  // nodes of the body's mesh
   std::optional<std::string> idempotency_key;
   std::int64_t last_seq = 0;  // highest event sequence number ever given out
   int attempts = 0;           // runs started; above 1 after an interrupted run
@@ -124,7 +124,7 @@ struct JobOutcome {
   int failure_step = 0;
   int steps_completed = 0;
   std::optional<std::string> result;  // the result as stored (zstd of its JSON), when the run produced one
-  StoredEvent terminal;                // job_finished | job_failed
+  StoredEvent terminal;               // job_finished | job_failed
 };
 
 struct JobPage {
@@ -136,8 +136,8 @@ enum class DismissOutcome { not_found, dismissed, removed };
 
 // What renew_leases found about the owner's jobs.
 struct LeaseRenewal {
-  std::vector<Lease> held;                // leases still this owner's (renewed)
-  std::vector<std::string> dismissed;     // among them: jobs dismissed meanwhile
+  std::vector<Lease> held;             // leases still this owner's (renewed)
+  std::vector<std::string> dismissed;  // among them: jobs dismissed meanwhile
 };
 
 // A change announced to listeners.
@@ -156,8 +156,7 @@ class Store {
   virtual std::optional<JobRecord> job(const std::string& id, bool with_scene = false) = 0;
   virtual std::optional<JobRecord> job_by_idempotency_key(const std::string& key) = 0;
   // Newest first; `before`: only jobs with a smaller ord.
-  virtual JobPage list_jobs(std::optional<JobStatus> status, int limit,
-                            std::optional<std::int64_t> before) = 0;
+  virtual JobPage list_jobs(std::optional<JobStatus> status, int limit, std::optional<std::int64_t> before) = 0;
   virtual std::map<JobStatus, std::int64_t> count_by_status() = 0;
   virtual std::int64_t count_accepted() = 0;
 
@@ -188,12 +187,12 @@ class Store {
   // Atomically: an accepted job is finished as dismissed (with the dismissed event), a running
   // one marked dismissed (its runner finishes it), a finished one removed with its events and
   // result. Returns the job as it is afterwards (removed: as it was).
-  virtual std::pair<DismissOutcome, std::optional<JobRecord>> dismiss_job(
-      const std::string& id, const std::string& now) = 0;
+  virtual std::pair<DismissOutcome, std::optional<JobRecord>> dismiss_job(const std::string& id,
+                                                                          const std::string& now) = 0;
 
   // Events with seq > after, in order, at most `limit`; only of `type` when given.
-  virtual std::vector<StoredEvent> events_after(const std::string& id, std::int64_t after,
-                                                int limit, std::string_view type = {}) = 0;
+  virtual std::vector<StoredEvent> events_after(const std::string& id, std::int64_t after, int limit,
+                                                std::string_view type = {}) = 0;
   // The result as stored: bytes (zstd; gzip or JSON text if stored by an earlier version).
   virtual std::optional<std::string> result(const std::string& id) = 0;
 

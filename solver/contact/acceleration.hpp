@@ -59,7 +59,6 @@ double smallest_eigenvalue(const Matrix& C1);
 // >= 1 (no contraction seen) makes the min non-positive and so gives the floor, the
 // conservative bound. Throws std::invalid_argument unless alpha > 0,
 // 1 <= first <= last and v_norms reaches index first.
-double warmup_epsilon(const std::vector<double>& v_norms, double alpha, int first = 3,
-                      int last = 10);
+double warmup_epsilon(const std::vector<double>& v_norms, double alpha, int first = 3, int last = 10);
 
 }  // namespace grip

@@ -19,8 +19,7 @@
 
 namespace grip {
 
-Direction StepSolver::bordered_direction(const Compliance& C, const ContactError& err, int level,
-                                         double alpha_fixed) {
+Direction StepSolver::bordered_direction(const Compliance& C, const ContactError& err, int level, double alpha_fixed) {
   Direction dir;
   dir.d = Vector::Zero(err.v.size());
   std::vector<int> contact, amplitude;

@@ -115,8 +115,7 @@ class Model {
   Vector x0_, s0_;
 };
 
-ContactError coulomb_error(const Problem& problem, const Vector& p, const Vector& s,
-                           const std::vector<char>& enabled) {
+ContactError coulomb_error(const Problem& problem, const Vector& p, const Vector& s, const std::vector<char>& enabled) {
   return contact_error(problem, p, s, friction_bounds(problem, p), enabled);
 }
 

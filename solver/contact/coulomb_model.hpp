@@ -23,12 +23,12 @@ struct CoulombModelParams {
 };
 
 struct CoulombModelSolution {
-  Vector p, s;             // full component vectors; p in the cone exactly
-  ContactError error;      // on the model, with tau = mu |p_eta|
-  int iterations = 0;      // Newton iterations on the model
+  Vector p, s;         // full component vectors; p in the cone exactly
+  ContactError error;  // on the model, with tau = mu |p_eta|
+  int iterations = 0;  // Newton iterations on the model
   int halvings = 0;
-  int factorizations = 0;   // of reduced Newton systems or of C's active block (newton_rows.hpp)
-  int capacitances = 0;     // low-rank corrections of a kept factorization
+  int factorizations = 0;  // of reduced Newton systems or of C's active block (newton_rows.hpp)
+  int capacitances = 0;    // low-rank corrections of a kept factorization
   bool converged = false;  // error.norm2 <= target
 };
 

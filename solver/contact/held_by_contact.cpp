@@ -40,8 +40,7 @@ Unreachable unreachable_equilibrium(const Problem& problem, const EquilibriumSta
   const Vec2 n = -paired.points.front().eta;
   const double mu = problem.obstacles[problem.candidates.front().obstacle].friction;
   for (size_t i = 0; i < problem.candidates.size(); ++i)
-    if ((-paired.points[i].eta - n).norm() > 1e-9 ||
-        problem.obstacles[problem.candidates[i].obstacle].friction != mu)
+    if ((-paired.points[i].eta - n).norm() > 1e-9 || problem.obstacles[problem.candidates[i].obstacle].friction != mu)
       return {};
   const Vec2 t(-n.y(), n.x());
   const Vector load = problem.load(factors);
@@ -55,15 +54,16 @@ Unreachable unreachable_equilibrium(const Problem& problem, const EquilibriumSta
   if (translation_free(problem, n) && N <= 1e-12 * scale)
     return {FailureKind::no_equilibrium,
             "the load pulls the body off every obstacle: contact can only push, and the load's resultant (" +
-                number_text(resultant.x()) + ", " + number_text(resultant.y()) + ") points away from the obstacles " + at +
-                "; no static equilibrium exists"};
+                number_text(resultant.x()) + ", " + number_text(resultant.y()) + ") points away from the obstacles " +
+                at + "; no static equilibrium exists"};
   if (translation_free(problem, t) && Q > 0 && N > 0 && Q >= mu * N * (1 - 1e-12)) {
     return {FailureKind::friction_limit,
             std::string(Q > mu * N * (1 + 1e-12) ? "the shear load exceeds what friction can hold"
                                                  : "the shear load reaches what friction can hold, so nothing "
                                                    "fixes how far the body slides") +
-                ": Q / (mu N) = " + number_text(mu > 0 ? Q / (mu * N) : INFINITY) + " " + at + " (Q = " +
-                number_text(Q) + ", N = " + number_text(N) + ", mu = " + number_text(mu) + "); no static equilibrium exists"};
+                ": Q / (mu N) = " + number_text(mu > 0 ? Q / (mu * N) : INFINITY) + " " + at +
+                " (Q = " + number_text(Q) + ", N = " + number_text(N) + ", mu = " + number_text(mu) +
+                "); no static equilibrium exists"};
   }
   return {};
 }

@@ -21,8 +21,7 @@ struct Unreachable {
   FailureKind kind = FailureKind::none;  // friction_limit (the shear), no_equilibrium (a pull)
   std::string reason;
 };
-Unreachable unreachable_equilibrium(const Problem& problem, const EquilibriumState& paired,
-                                    const LoadFactors& factors);
+Unreachable unreachable_equilibrium(const Problem& problem, const EquilibriumState& paired, const LoadFactors& factors);
 
 // "at load factor 1.05", or "at load factors press 1, shear 1.05" (the non-zero ones, named).
 std::string load_factors_text(const Problem& problem, const LoadFactors& factors);

@@ -9,8 +9,8 @@
 
 namespace grip {
 
-std::vector<MasterReading> master_readings(const Problem& problem, const Vector& q, const Vector& p,
-                                           const Vector& tau, int obstacle) {
+std::vector<MasterReading> master_readings(const Problem& problem, const Vector& q, const Vector& p, const Vector& tau,
+                                           int obstacle) {
   const Body& all = *problem.body;
   const ObstacleInstance& pair = problem.obstacles.at(obstacle);
   std::map<int, std::array<double, 3>> slave;  // site -> sigma_n, sigma_t, pressing

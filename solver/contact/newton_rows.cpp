@@ -18,7 +18,7 @@ namespace grip {
 // Z = Q^-1 A_E (Woodbury).
 struct ComplianceFactor {
   std::vector<int> base;
-  Matrix l;                                       // C_BB, then its factor in place
+  Matrix l;  // C_BB, then its factor in place
   std::optional<Eigen::LLT<Eigen::Ref<Matrix>>> llt;
   bool ok = false;
   // The last system's capacitance.

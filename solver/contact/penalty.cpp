@@ -20,8 +20,8 @@ class PenaltyStep : public StepSolver {
  private:
   void solve(const Vector& q_guess, const Vector& p_start, const Vector& p_previous) override {
     PenaltyLaw law;
-    law.normal = params_.penalty_normal > 0 ? params_.penalty_normal
-                                            : params_.penalty_factor * eq_.stiffness_scale(q_guess);
+    law.normal =
+        params_.penalty_normal > 0 ? params_.penalty_normal : params_.penalty_factor * eq_.stiffness_scale(q_guess);
     law.tangential = params_.penalty_tangential > 0 ? params_.penalty_tangential : law.normal;
     law.previous = p_previous;  // the springs start from the last step's force
     Vector q0 = q_guess;
@@ -92,7 +92,8 @@ class PenaltyStep : public StepSolver {
     out_.p = p_start;
     out_.state = eq_.evaluate(q);
     const Vector applied = eq_.applied_forces(out_.state, p_start);
-    for (int k = 0; k < rigid.count(); ++k) out_.state.s[rigid.first + k] = rigid.scale * rigid.modes.col(k).dot(applied);
+    for (int k = 0; k < rigid.count(); ++k)
+      out_.state.s[rigid.first + k] = rigid.scale * rigid.modes.col(k).dot(applied);
     Vector dq;
     if (approach_motion(dq)) q += dq;
   }
@@ -108,9 +109,9 @@ class PenaltyStep : public StepSolver {
 
 }  // namespace
 
-StepOutcome solve_penalty_step(Equilibrium& eq, const Vector& q_guess, const Vector& p_start,
-                               const Vector& p_star, const ContactParams& params, int step,
-                               const IterationObserver& observer, const StopRequest& stop) {
+StepOutcome solve_penalty_step(Equilibrium& eq, const Vector& q_guess, const Vector& p_start, const Vector& p_star,
+                               const ContactParams& params, int step, const IterationObserver& observer,
+                               const StopRequest& stop) {
   return PenaltyStep(eq, params, step, observer, stop).run(q_guess, p_start, p_star);
 }
 

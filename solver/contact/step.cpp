@@ -27,9 +27,7 @@ using Clock = std::chrono::steady_clock;
 // instead of 6 and its run cost more instructions than with exact solves.
 constexpr double kInexactNewton = 0.05;
 
-double inf_norm(const Matrix& A) {
-  return A.size() ? A.cwiseAbs().rowwise().sum().maxCoeff() : 0.0;
-}
+double inf_norm(const Matrix& A) { return A.size() ? A.cwiseAbs().rowwise().sum().maxCoeff() : 0.0; }
 
 }  // namespace
 
@@ -40,10 +38,10 @@ std::vector<int> active_indices(const ContactError& e) {
   return idx;
 }
 
-StepSolver::StepSolver(Equilibrium& eq, const ContactParams& params, int step,
-                       const IterationObserver& obs, const StopRequest& stop)
-    : eq_(eq), problem_(eq.problem()), params_(params), step_(step), observer_(obs), stop_(stop),
-      start_(Clock::now()), newton_emitted_(eq.counters().newton_iterations) {
+StepSolver::StepSolver(Equilibrium& eq, const ContactParams& params, int step, const IterationObserver& obs,
+                       const StopRequest& stop)
+    : eq_(eq), problem_(eq.problem()), params_(params), step_(step), observer_(obs), stop_(stop), start_(Clock::now()),
+      newton_emitted_(eq.counters().newton_iterations) {
   tol_ = params.tolerance * problem_.body->characteristic_length();
   strict_balance_ = rigid_modes_follow_state(problem_);
   is_normal_.assign(problem_.component_count, 0);
@@ -51,8 +49,7 @@ StepSolver::StepSolver(Equilibrium& eq, const ContactParams& params, int step,
 }
 
 StepOutcome StepSolver::run(const Vector& q_guess, const Vector& p_start, const Vector& p_star) {
-  couple_newton(eq_.params(), params_.tolerance, params_.newton_fraction,
-                problem_.body->characteristic_length());
+  couple_newton(eq_.params(), params_.tolerance, params_.newton_fraction, problem_.body->characteristic_length());
   newton_base_ = eq_.params();
   eq_.set_compliance_reuse(params_.reuse_compliance && params_.method == ContactMethod::cev &&
                            params_.loop == ContactLoop::inner);
@@ -70,8 +67,7 @@ StepOutcome StepSolver::run(const Vector& q_guess, const Vector& p_start, const 
     m_ = 0;  // no update: like a pass's starting solve, it is no step of the pass's descent
     emit(out_.solves - reported, 0, 0, 0, 0.0);
   }
-  out_.newton_iterations =
-      static_cast<int>(eq_.counters().newton_iterations - newton0 + own_newton_iterations_);
+  out_.newton_iterations = static_cast<int>(eq_.counters().newton_iterations - newton0 + own_newton_iterations_);
   out_.v2 = error_.norm2;
   return std::move(out_);
 }
@@ -141,7 +137,8 @@ void StepSolver::tau_passes(const Vector& q_guess, const Vector& p_start, const 
     if (literal_ && change <= force_precision()) pin_forces_ = 0.1 * settled;
     for (const Candidate& c : problem_.candidates) p_star[c.eta] = out_.p[c.eta];
     if (!passes_to_budget_ && pass_index == params_.max_tau_passes)
-      fail(FailureKind::contact_budget, "the friction bound did not settle in " + std::to_string(pass_index) + " tau passes");
+      fail(FailureKind::contact_budget,
+           "the friction bound did not settle in " + std::to_string(pass_index) + " tau passes");
   }
   if (no_friction && out_.reason.empty()) out_.converged = true;
   if (out_.converged) final_check();
@@ -166,7 +163,8 @@ bool StepSolver::bound_from_model(Vector& p_star) {
   const Compliance& C = eq_.compliance(out_.state, relevant_components());
   const CoulombModelSolution model = solve_model(C, 0.1 * tol_);
   out_.inner_iterations += model.iterations;
-  if (!presses(model.p)) return fail(FailureKind::no_equilibrium, "the linear model at the step's first state presses no point");
+  if (!presses(model.p))
+    return fail(FailureKind::no_equilibrium, "the linear model at the step's first state presses no point");
   for (const Candidate& c : problem_.candidates) p_star[c.eta] = model.p[c.eta];
   out_.tau = friction_bounds(problem_, p_star);
   return true;
@@ -267,8 +265,7 @@ void StepSolver::accept(EquilibriumState s, const Vector& p) {
     // Newton's share of the tolerance of the size of the forces (the sum of the load's and the
     // contact forces' magnitudes), in the amplitudes' unit (s = scale R^T (F + T p)).
     double size = problem_.load(eq_.factors()).cwiseAbs().sum();
-    for (const Candidate& c : problem_.candidates)
-      size += std::hypot(p[c.eta], c.xi >= 0 ? p[c.xi] : 0.0);
+    for (const Candidate& c : problem_.candidates) size += std::hypot(p[c.eta], c.xi >= 0 ? p[c.xi] : 0.0);
     balance_tol_ = problem_.rigid.scale * params_.newton_fraction * params_.tolerance * size;
   }
 }
@@ -290,12 +287,12 @@ bool StepSolver::budget_left() {
   if (!friction_limit_.empty()) return fail(FailureKind::friction_limit, friction_limit_);
   if (eq_.counters().solves < solves_at_start_ + params_.max_iterations) return true;
   if (error_met(error_))  // what is left is the tau passes' p*
-    return fail(FailureKind::contact_budget,
-                "the friction bound did not settle in " + std::to_string(params_.max_iterations) +
-                " contact iterations (" + std::to_string(pass_) + " tau passes; ||v|| within the tolerance)");
+    return fail(FailureKind::contact_budget, "the friction bound did not settle in " +
+                                                 std::to_string(params_.max_iterations) + " contact iterations (" +
+                                                 std::to_string(pass_) + " tau passes; ||v|| within the tolerance)");
   return fail(FailureKind::contact_budget, "contact error " + number_text(error_.norm2) + " above tolerance " +
-              number_text(tol_) + " after " + std::to_string(params_.max_iterations) +
-              " contact iterations");
+                                               number_text(tol_) + " after " + std::to_string(params_.max_iterations) +
+                                               " contact iterations");
 }
 
 bool StepSolver::line_search(const Vector& pl, const Vector& du, int& trials) {
@@ -334,12 +331,9 @@ bool StepSolver::loosen_newton(double v_ref) {
   return true;
 }
 
-void StepSolver::tighten_newton() {
-  eq_.params().displacement_tolerance = newton_base_.displacement_tolerance;
-}
+void StepSolver::tighten_newton() { eq_.params().displacement_tolerance = newton_base_.displacement_tolerance; }
 
-Direction StepSolver::direction(const Compliance& C, const ContactError& err, int level,
-                                double alpha_fixed) {
+Direction StepSolver::direction(const Compliance& C, const ContactError& err, int level, double alpha_fixed) {
   if (C.bordered) return bordered_direction(C, err, level, alpha_fixed);
   Direction dir;
   const std::vector<int> idx = active_indices(err);
@@ -403,7 +397,8 @@ bool StepSolver::literal_pass(int first_level, double alpha_fixed) {
     while (true) {
       Vector pbar, asked;
       const Direction dir = held_direction(C, e, level, alpha_fixed, a, pbar, asked);
-      if (!dir.ok) return fail(FailureKind::contact_stalled, "the active block of the compliance is not positive definite");
+      if (!dir.ok)
+        return fail(FailureKind::contact_stalled, "the active block of the compliance is not positive definite");
       if (!budget_left()) return false;
       const Vector pt = project(C, out_.p, pbar, e, out_.tau, &asked);
       ++trials;
@@ -425,7 +420,7 @@ bool StepSolver::literal_pass(int first_level, double alpha_fixed) {
       }
       if (halvings > params_.max_halvings)
         return fail(FailureKind::contact_stalled, "alpha halved " + std::to_string(params_.max_halvings) +
-                    " times without a decrease of the contact error");
+                                                      " times without a decrease of the contact error");
     }
   }
   return true;
@@ -526,9 +521,10 @@ void StepSolver::final_check() {
   // (docs/algorithm.md#bodies-held-only-by-contact).
   for (int k = 0; k < problem_.rigid.count(); ++k)
     if (!mode_held(k))
-      fail(FailureKind::no_equilibrium, "no contact holds the body's free motion (" + problem_.rigid.names[k] +
-           "): no point presses against an obstacle in that direction, so its position is not determined; "
-           "no static equilibrium fixes it");
+      fail(FailureKind::no_equilibrium,
+           "no contact holds the body's free motion (" + problem_.rigid.names[k] +
+               "): no point presses against an obstacle in that direction, so its position is not determined; "
+               "no static equilibrium fixes it");
   for (size_t i = 0; i < problem_.candidates.size(); ++i) {
     const Candidate& c = problem_.candidates[i];
     if (out_.p[c.eta] > 0) fail(FailureKind::contact_stalled, "a normal contact force pulls");
@@ -549,19 +545,24 @@ void StepSolver::emit(int trials, int inner, int halvings, int n, double alpha, 
   ev.alpha = alpha;
   ev.v2 = error_.norm2;
   ev.v_inf = error_.norm_inf;
-  const bool forces = out_.p.size() == problem_.component_count &&
-                      static_cast<size_t>(out_.tau.size()) == problem_.candidates.size();
+  const bool forces =
+      out_.p.size() == problem_.component_count && static_cast<size_t>(out_.tau.size()) == problem_.candidates.size();
   for (size_t i = 0; forces && i < problem_.candidates.size(); ++i) {
     switch (contact_state(problem_, i, out_.p, out_.tau)) {
-      case ContactState::open: ++ev.open; break;
-      case ContactState::stick: ++ev.stick; break;
-      case ContactState::slip: ++ev.slip; break;
+      case ContactState::open:
+        ++ev.open;
+        break;
+      case ContactState::stick:
+        ++ev.stick;
+        break;
+      case ContactState::slip:
+        ++ev.slip;
+        break;
     }
   }
   // Every Newton iteration since the last event, rejected line-search trials' included, so
   // that the events of a step add up to its count (plus those made outside the oracle: ssn).
-  ev.newton_iterations = static_cast<int>(eq_.counters().newton_iterations - newton_emitted_) +
-                         own_newton;
+  ev.newton_iterations = static_cast<int>(eq_.counters().newton_iterations - newton_emitted_) + own_newton;
   newton_emitted_ = eq_.counters().newton_iterations;
   ev.elapsed_ms = std::chrono::duration<double, std::milli>(Clock::now() - start_).count();
   out_.history.push_back(ev);

@@ -95,8 +95,8 @@ class StepSolver {
   // eq. 13's projection of pbar (project_forces), keeping a held body's equilibrium rows met.
   // `asked` (if given): the forces the direction's step assumed, where they differ from pbar
   // (held_direction's forces put on their bound): the rows are kept against those.
-  Vector project(const Compliance& C, const Vector& p, const Vector& pbar, const ContactError& e,
-                 const Vector& tau, const Vector* asked = nullptr) const;
+  Vector project(const Compliance& C, const Vector& p, const Vector& pbar, const ContactError& e, const Vector& tau,
+                 const Vector* asked = nullptr) const;
 
   // eq. 13's direction for the literal loop, on the components that eq. 13's projection lets
   // move: a force on its bound (|p_xi| = tau, or p_eta = 0) that the direction pushes beyond it
@@ -152,35 +152,35 @@ class StepSolver {
   double tol_ = 0.0;
   bool strict_balance_ = false;  // error_met tests the amplitudes' rows
   double balance_tol_ = 0.0;     // their bound, at the accepted state (accept)
-  NewtonParams newton_base_;  // Newton's tests at the contact tolerance (couple_newton)
+  NewtonParams newton_base_;     // Newton's tests at the contact tolerance (couple_newton)
   int pass_ = 0, m_ = 0;
   long solves_at_start_ = 0;
   long newton_emitted_ = 0;  // the Newton counter at the last event
   double warmup_eps_ = 0.0;
-  bool coulomb_ = false;  // the friction bound moves with p (no tau passes)
-  bool literal_ = false;  // the passes run the literal loop (literal_pass)
-  double pin_forces_ = 0.0;  // > 0: the literal loop's passes pin p_eta to this (tau_passes)
-  bool passes_to_budget_ = false;  // the tau passes end at the budget, not max_tau_passes (uzawa)
+  bool coulomb_ = false;            // the friction bound moves with p (no tau passes)
+  bool literal_ = false;            // the passes run the literal loop (literal_pass)
+  double pin_forces_ = 0.0;         // > 0: the literal loop's passes pin p_eta to this (tau_passes)
+  bool passes_to_budget_ = false;   // the tau passes end at the budget, not max_tau_passes (uzawa)
   long own_newton_iterations_ = 0;  // Newton iterations made outside the oracle (ssn)
   std::vector<char> is_normal_;
-  int beyond_friction_ = 0;    // accepted states in a row beyond what friction holds (accept)
+  int beyond_friction_ = 0;     // accepted states in a row beyond what friction holds (accept)
   std::string friction_limit_;  // why, once shown: budget_left ends the step with it
   ContactError error_;
   StepOutcome out_;
 };
 
 // One entry per strategy file.
-StepOutcome solve_cev_step(Equilibrium& eq, const Vector& q_guess, const Vector& p_start,
-                           const Vector& p_star, const ContactParams& params, int step,
-                           const IterationObserver& observer, const StopRequest& stop, double v_previous);
-StepOutcome solve_uzawa_step(Equilibrium& eq, const Vector& q_guess, const Vector& p_start,
-                             const Vector& p_star, const ContactParams& params, int step,
-                             const IterationObserver& observer, const StopRequest& stop);
-StepOutcome solve_ssn_step(Equilibrium& eq, const Vector& q_guess, const Vector& p_start,
-                           const Vector& p_star, const ContactParams& params, int step,
-                           const IterationObserver& observer, const StopRequest& stop);
-StepOutcome solve_penalty_step(Equilibrium& eq, const Vector& q_guess, const Vector& p_start,
-                               const Vector& p_star, const ContactParams& params, int step,
-                               const IterationObserver& observer, const StopRequest& stop);
+StepOutcome solve_cev_step(Equilibrium& eq, const Vector& q_guess, const Vector& p_start, const Vector& p_star,
+                           const ContactParams& params, int step, const IterationObserver& observer,
+                           const StopRequest& stop, double v_previous);
+StepOutcome solve_uzawa_step(Equilibrium& eq, const Vector& q_guess, const Vector& p_start, const Vector& p_star,
+                             const ContactParams& params, int step, const IterationObserver& observer,
+                             const StopRequest& stop);
+StepOutcome solve_ssn_step(Equilibrium& eq, const Vector& q_guess, const Vector& p_start, const Vector& p_star,
+                           const ContactParams& params, int step, const IterationObserver& observer,
+                           const StopRequest& stop);
+StepOutcome solve_penalty_step(Equilibrium& eq, const Vector& q_guess, const Vector& p_start, const Vector& p_star,
+                               const ContactParams& params, int step, const IterationObserver& observer,
+                               const StopRequest& stop);
 
 }  // namespace grip

@@ -42,9 +42,9 @@ struct ContactParams {
   // r_i = augmentation / C_ii (each component's own contact stiffness), ssn r = augmentation x
   // the largest diagonal entry of the body's stiffness. It changes the path, not the answer.
   double augmentation = 1.0;
-  int max_halvings = 40;  // halvings of the step inside the inner loop, or of alpha (paper)
+  int max_halvings = 40;             // halvings of the step inside the inner loop, or of alpha (paper)
   int halvings_before_fallback = 4;  // paper loop: then n -> n - 1
-  int line_search_steps = 10;  // H of the line search along p -> prediction
+  int line_search_steps = 10;        // H of the line search along p -> prediction
   int max_tau_passes = 30;
   // Passes end when max |p_eta - p*| <= tau_tolerance * max |p_eta| (section 9: 1e-5 settles
   // in a few passes; much tighter makes p* cycle at the precision ||v|| pins p to).
@@ -79,13 +79,13 @@ struct ContactParams {
 };
 
 struct IterationEvent {
-  int step = 0;           // load step, 1-based
-  int pass = 0;           // tau pass, 1-based
-  int m = 0;              // accepted update in this pass (0: the pass's starting solve)
-  int trials = 1;         // real solves this update took (rejected line-search trials too)
+  int step = 0;    // load step, 1-based
+  int pass = 0;    // tau pass, 1-based
+  int m = 0;       // accepted update in this pass (0: the pass's starting solve)
+  int trials = 1;  // real solves this update took (rejected line-search trials too)
   int inner_iterations = 0;
   int halvings = 0;
-  int n = 0;              // acceleration level (0 = infinity)
+  int n = 0;  // acceleration level (0 = infinity)
   double alpha = 0.0;
   double v2 = 0.0, v_inf = 0.0;
   int open = 0, stick = 0, slip = 0;
@@ -118,9 +118,8 @@ struct StepOutcome {
 // step's force (the first pass's friction bound, penalty's springs). v_previous: the contact
 // error of the previous step's first solve (0: none), which cev's first solve of this step
 // takes as the scale of its own (its Newton tolerance, StepSolver::fresh_solve).
-StepOutcome solve_contact_step(Equilibrium& equilibrium, const Vector& q_guess,
-                               const Vector& p_start, const Vector& p_star,
-                               const ContactParams& params, int step,
+StepOutcome solve_contact_step(Equilibrium& equilibrium, const Vector& q_guess, const Vector& p_start,
+                               const Vector& p_star, const ContactParams& params, int step,
                                const IterationObserver& observer, const StopRequest& stop = {},
                                double v_previous = 0.0);
 

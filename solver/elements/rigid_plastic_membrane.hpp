@@ -24,11 +24,11 @@
 namespace grip {
 
 struct HillMaterial {
-  double r = 1.0;        // normal anisotropy
-  double M = 2.0;        // yield-surface exponent, > 1
-  double H = 0.0;        // hardening coefficient (stress)
-  double a0 = 1e-4;      // pre-strain
-  double n = 0.2;        // hardening exponent
+  double r = 1.0;                // normal anisotropy
+  double M = 2.0;                // yield-surface exponent, > 1
+  double H = 0.0;                // hardening coefficient (stress)
+  double a0 = 1e-4;              // pre-strain
+  double n = 0.2;                // hardening exponent
   double regularization = 1e-5;  // e0: strain-increment scale of the smooth cut-off
   // The plane-strain factor c of d_eps_bar = c |d1|.
   double plane_strain_factor() const;
@@ -39,8 +39,7 @@ struct HillMaterial {
 class RigidPlasticMembrane final : public Body {
  public:
   // Nodes in order along the sheet; `thickness` initial; `width` out of plane.
-  RigidPlasticMembrane(std::vector<Vec2> nodes, double thickness, HillMaterial material,
-                       double width = 1.0);
+  RigidPlasticMembrane(std::vector<Vec2> nodes, double thickness, HillMaterial material, double width = 1.0);
 
   int dof_count() const override { return 2 * node_count(); }
   Vector dof_length_scales() const override { return Vector::Ones(dof_count()); }
@@ -68,12 +67,12 @@ class RigidPlasticMembrane final : public Body {
 
   // The element's kinematics and stress at state q, from the committed state.
   struct ElementState {
-    Vec2 e;             // unit vector node a -> node b
-    double l = 0.0;     // current length
-    double d1 = 0.0;    // logarithmic stretch increment of the step
-    double deps = 0.0;  // regularized effective strain increment
-    double sigma = 0.0; // flow stress at eps_bar + deps
-    double tension = 0.0;    // per unit width
+    Vec2 e;                // unit vector node a -> node b
+    double l = 0.0;        // current length
+    double d1 = 0.0;       // logarithmic stretch increment of the step
+    double deps = 0.0;     // regularized effective strain increment
+    double sigma = 0.0;    // flow stress at eps_bar + deps
+    double tension = 0.0;  // per unit width
     double dtension_dl = 0.0;
     double thickness = 0.0;  // current
   };
@@ -83,7 +82,7 @@ class RigidPlasticMembrane final : public Body {
   std::vector<Vec2> nodes_;
   double width_;
   HillMaterial material_;
-  double c_;                        // plane-strain factor
+  double c_;  // plane-strain factor
   double initial_thickness_;
   std::vector<double> initial_length_;
   // Committed state (end of the last converged step).

@@ -55,8 +55,8 @@ bool same_sparse(const Eigen::SparseMatrix<double>& a, const Eigen::SparseMatrix
 // T on the given components (columns at `position`), one row per free dof as `row` numbers it.
 template <class Row>
 Eigen::SparseMatrix<double> contact_map(const Problem& problem, const EquilibriumState& state,
-                                        const std::vector<int>& position, const std::vector<int>& free_index,
-                                        int rows, int cols, Row row) {
+                                        const std::vector<int>& position, const std::vector<int>& free_index, int rows,
+                                        int cols, Row row) {
   Triplets ts;
   for (size_t i = 0; i < problem.candidates.size(); ++i) {
     const Candidate& c = problem.candidates[i];
@@ -117,8 +117,8 @@ const Compliance& Equilibrium::compliance(const EquilibriumState& state, const s
     extend_surface_compliance(added);
     ++g_version_;
   }
-  Eigen::SparseMatrix<double> t_surface = contact_map(problem_, state, c_.position, free_index_, g_.rows(), k,
-                                                      [&](int f) { return surface_row_[f]; });
+  Eigen::SparseMatrix<double> t_surface =
+      contact_map(problem_, state, c_.position, free_index_, g_.rows(), k, [&](int f) { return surface_row_[f]; });
   // The same G, components and T_s (a constant tangent, a pairing that did not move): the same
   // C, and the inner solver keeps its factorizations.
   if (same_components && c_version_ == g_version_ && same_sparse(t_surface, t_surface_)) return c_;
@@ -160,8 +160,7 @@ bool Equilibrium::compliance_tangent(const EquilibriumState& state) {
   return true;
 }
 
-const Compliance& Equilibrium::sparse_compliance(const EquilibriumState& state,
-                                                 const std::vector<int>& components) {
+const Compliance& Equilibrium::sparse_compliance(const EquilibriumState& state, const std::vector<int>& components) {
   const int k = static_cast<int>(components.size());
   std::vector<int> position(problem_.component_count, -1);
   for (int a = 0; a < k; ++a) position[components[a]] = a;

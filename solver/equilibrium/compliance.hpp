@@ -32,7 +32,7 @@ struct Compliance {
   const FreeBlockSolver* body = nullptr;
   Eigen::SparseMatrix<double> t;
   Vector diagonal_entries;
-  std::vector<int> normal_of;  // row -> the row of its candidate's normal (tangent rows), else -1
+  std::vector<int> normal_of;                    // row -> the row of its candidate's normal (tangent rows), else -1
   mutable std::shared_ptr<SaddleFactor> saddle;  // reset whenever `t` or `body` changes
 
   bool sparse() const { return body != nullptr; }

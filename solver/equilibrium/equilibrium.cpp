@@ -55,8 +55,8 @@ double Equilibrium::stiffness_scale(const Vector& q) const {
   return diagonal.cwiseAbs().maxCoeff();
 }
 
-Vector Equilibrium::residual(const Vector& q, const EquilibriumState& paired, const Vector& p_given,
-                             Triplets* tangent, double* force_scale, bool body_tangent) const {
+Vector Equilibrium::residual(const Vector& q, const EquilibriumState& paired, const Vector& p_given, Triplets* tangent,
+                             double* force_scale, bool body_tangent) const {
   const Vector p = penalty_ ? penalty_forces(q, paired, tangent) : p_given;
   Vector r = Vector::Zero(q.size());
   problem_.body->internal_force(q, r, body_tangent ? tangent : nullptr);
@@ -78,8 +78,7 @@ Vector Equilibrium::residual(const Vector& q, const EquilibriumState& paired, co
     R << 0, -1, 1, 0;
     const Mat2 df_dx = (-p_eta * Mat2::Identity() + p_xi * R) * pp.projection.dnormal_dx;
     for (const auto& a : pp.point.jacobian)
-      for (const auto& b : pp.point.jacobian)
-        tangent->emplace_back(a.dof, b.dof, -a.dx.dot(df_dx * b.dx));
+      for (const auto& b : pp.point.jacobian) tangent->emplace_back(a.dof, b.dof, -a.dx.dot(df_dx * b.dx));
     // The pair's stiffness at the iterate's forces, both bodies (the penalty law's change of p
     // with the positions, the gradients of the gap and zeta, is in penalty_forces): the whole
     // consistent tangent, given forces or the law's. These terms scale with p (p / element size):

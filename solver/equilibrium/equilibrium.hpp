@@ -10,13 +10,13 @@
 #include <string>
 #include <vector>
 
-#include "solver/model/parallel.hpp"
-#include "solver/problem/problem.hpp"
-#include "solver/equilibrium/free_block_solver.hpp"
 #include "solver/equilibrium/compliance.hpp"
 #include "solver/equilibrium/equilibrium_state.hpp"
+#include "solver/equilibrium/free_block_solver.hpp"
 #include "solver/equilibrium/newton_params.hpp"
 #include "solver/equilibrium/penalty_law.hpp"
+#include "solver/model/parallel.hpp"
+#include "solver/problem/problem.hpp"
 
 namespace grip {
 
@@ -92,8 +92,8 @@ class Equilibrium {
   // force_scale (if asked): the largest of |A(q)|, |lambda F| and |T p| over all dofs, in
   // force units (the scale Newton's residual test is relative to). Without body_tangent, the
   // tangent's contact terms only.
-  Vector residual(const Vector& q, const EquilibriumState& paired, const Vector& p,
-                  Triplets* tangent, double* force_scale = nullptr, bool body_tangent = true) const;
+  Vector residual(const Vector& q, const EquilibriumState& paired, const Vector& p, Triplets* tangent,
+                  double* force_scale = nullptr, bool body_tangent = true) const;
   // Newton's step K_t^-1 rhs for the constant body tangent plus the pair's stiffness (the
   // `contact` triplets): the body's factorization and a Krylov solve on the pair's dofs.
   Vector low_rank_step(const Triplets& contact, const Vector& rhs) const;
@@ -154,15 +154,15 @@ class Equilibrium {
   // dofs afresh at every iterate (13 such G's cost 6x one factorization, two cylinders).
   FreeBlockSolver lu_;
   double body_tangent_norm_ = 0.0;  // |K|_inf of the constant body tangent (round-off scale)
-  std::vector<int> surface_free_;  // surface row of G -> free index
-  std::vector<int> surface_row_;   // free index -> surface row of G, -1 off the surface
-  Matrix g_;                       // G = K^-1 on the surface dofs
+  std::vector<int> surface_free_;   // surface row of G -> free index
+  std::vector<int> surface_row_;    // free index -> surface row of G, -1 off the surface
+  Matrix g_;                        // G = K^-1 on the surface dofs
   bool g_valid_ = false;
   bool compliance_reuse_ = false, compliance_reused_ = false;
   Eigen::SparseMatrix<double> t_surface_;  // the last compliance's T_s (surface rows x block)
   Compliance c_;
-  long g_version_ = 0, c_version_ = -1;  // G's content; the G that c_ was formed from
-  Compliance sparse_;                     // the sparse form
+  long g_version_ = 0, c_version_ = -1;             // G's content; the G that c_ was formed from
+  Compliance sparse_;                               // the sparse form
   long tangent_version_ = 0, sparse_version_ = -1;  // body_lu_'s content; the one sparse_ uses
 };
 

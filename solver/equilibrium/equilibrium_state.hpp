@@ -18,8 +18,8 @@ struct PairedPoint {
 
 struct EquilibriumState {
   Vector q;
-  Vector p;                   // the contact forces in equilibrium (given, or from the penalty law)
-  Vector s;                   // (s_eta, s_xi) per component
+  Vector p;  // the contact forces in equilibrium (given, or from the penalty law)
+  Vector s;  // (s_eta, s_xi) per component
   std::vector<PairedPoint> points;
   // Per obstacle: the master surface of a pair of bodies in this state's configuration (null
   // for a rigid obstacle); its force_derivative() is the pair's stiffness.
@@ -31,13 +31,13 @@ struct EquilibriumState {
   // last correction (length units) is the noise of the displacements.
   bool at_floor = false;
   double noise = 0.0;
-  double relative_residual = 0.0;  // final free residual over the force scale
-  std::string reason;              // why Newton failed
+  double relative_residual = 0.0;           // final free residual over the force scale
+  std::string reason;                       // why Newton failed
   FailureKind failure = FailureKind::none;  // newton_diverged, or invalid_state (the body refuses q)
 };
 
 struct EquilibriumCounters {
-  long solves = 0;            // calls of solve(): real equilibrium solves
+  long solves = 0;  // calls of solve(): real equilibrium solves
   long newton_iterations = 0;
   long factorizations = 0;
   long compliance_forms = 0;    // G formed afresh (each on a factorization of its own)

@@ -127,8 +127,8 @@ Vector Equilibrium::low_rank_step(const Triplets& contact, const Vector& rhs) co
   // is formed for small contact zones anyway): m^2 a product instead of a body solve (the
   // refined two cylinders: 2.5e9 -> 3.5e9 instructions with the solves).
   const bool from_g = g_valid_ && std::all_of(rows.begin(), rows.end(), [&](int f) {
-    return f < static_cast<int>(surface_row_.size()) && surface_row_[f] >= 0;
-  });
+                        return f < static_cast<int>(surface_row_.size()) && surface_row_[f] >= 0;
+                      });
   Matrix g;
   if (from_g) {
     g.resize(m, m);
@@ -278,8 +278,7 @@ EquilibriumState Equilibrium::newton(const Vector& q_guess, const Vector& p) {
   pair(state.q, state);
   state.failure = FailureKind::newton_diverged;
   state.reason = "Newton did not converge in " + std::to_string(params_.max_iterations) +
-                 " iterations (free residual " + number_text(state.relative_residual) +
-                 " of the force scale)";
+                 " iterations (free residual " + number_text(state.relative_residual) + " of the force scale)";
   return state;
 }
 

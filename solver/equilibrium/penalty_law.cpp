@@ -113,7 +113,8 @@ EquilibriumState& Equilibrium::finish_penalty(EquilibriumState& state) {
   Triplets tangent;
   const Vector r = residual(state.q, state, state.p, &tangent);
   ++counters_.factorizations;
-  if (!lu_.factorize(tangent, free_index_, free_count_, 1e-4)) return finish(state, penalty_forces(state.q, state, nullptr));
+  if (!lu_.factorize(tangent, free_index_, free_count_, 1e-4))
+    return finish(state, penalty_forces(state.q, state, nullptr));
   Vector r_free(free_count_);
   for (int i = 0; i < r.size(); ++i)
     if (free_index_[i] >= 0) r_free[free_index_[i]] = -r[i];

@@ -19,11 +19,21 @@ namespace grip {
 using nlohmann::json;
 
 json iteration_event(const IterationEvent& ev) {
-  return {{"type", "iteration"}, {"step", ev.step}, {"pass", ev.pass}, {"m", ev.m},
-          {"trials", ev.trials}, {"inner_iterations", ev.inner_iterations},
-          {"halvings", ev.halvings}, {"n", ev.n == 0 ? json("inf") : json(ev.n)},
-          {"alpha", ev.alpha}, {"v2", ev.v2}, {"v_inf", ev.v_inf}, {"open", ev.open},
-          {"stick", ev.stick}, {"slip", ev.slip}, {"newton_iterations", ev.newton_iterations},
+  return {{"type", "iteration"},
+          {"step", ev.step},
+          {"pass", ev.pass},
+          {"m", ev.m},
+          {"trials", ev.trials},
+          {"inner_iterations", ev.inner_iterations},
+          {"halvings", ev.halvings},
+          {"n", ev.n == 0 ? json("inf") : json(ev.n)},
+          {"alpha", ev.alpha},
+          {"v2", ev.v2},
+          {"v_inf", ev.v_inf},
+          {"open", ev.open},
+          {"stick", ev.stick},
+          {"slip", ev.slip},
+          {"newton_iterations", ev.newton_iterations},
           {"elapsed_ms", ev.elapsed_ms}};
 }
 
@@ -32,10 +42,16 @@ json step_started_event(int step, double load_factor) {
 }
 
 json step_finished_event(const StepRecord& rec) {
-  json j = {{"type", "step_finished"}, {"step", rec.index}, {"load_factor", rec.load_factor},
-            {"converged", rec.converged}, {"tau_passes", rec.passes},
-            {"contact_iterations", rec.solves}, {"newton_iterations", rec.newton_iterations},
-            {"seconds", rec.seconds}, {"stage", rec.stage}, {"factors", rec.factors}};
+  json j = {{"type", "step_finished"},
+            {"step", rec.index},
+            {"load_factor", rec.load_factor},
+            {"converged", rec.converged},
+            {"tau_passes", rec.passes},
+            {"contact_iterations", rec.solves},
+            {"newton_iterations", rec.newton_iterations},
+            {"seconds", rec.seconds},
+            {"stage", rec.stage},
+            {"factors", rec.factors}};
   if (!rec.converged) {
     j["reason"] = rec.reason;
     j["failure"] = failure_json(rec.failure, rec.reason, rec.index);
@@ -92,10 +108,19 @@ std::vector<ContactPointRow> contact_point_rows(const Problem& problem, const St
     const PairedPoint& pp = rec.state.points[i];
     const double area = body.tributary_area(c.site);
     const double p_n = rec.p[c.eta], p_t = c.xi >= 0 ? rec.p[c.xi] : 0.0;
-    ContactPointRow r{body.site_node(c.site), problem.obstacles[c.obstacle].name,
-                      to_string(contact_state(problem, i, rec.p, rec.tau)), {}, {},
-                      pp.point.x, pp.projection.point, pp.projection.normal,
-                      p_n, p_t, p_n / area, p_t / area, pp.projection.gap,
+    ContactPointRow r{body.site_node(c.site),
+                      problem.obstacles[c.obstacle].name,
+                      to_string(contact_state(problem, i, rec.p, rec.tau)),
+                      {},
+                      {},
+                      pp.point.x,
+                      pp.projection.point,
+                      pp.projection.normal,
+                      p_n,
+                      p_t,
+                      p_n / area,
+                      p_t / area,
+                      pp.projection.gap,
                       c.xi >= 0 ? rec.state.s[c.xi] : 0.0};
     if (all) {  // several bodies: who touches whom
       const ObstacleInstance& o = problem.obstacles[c.obstacle];
@@ -112,12 +137,19 @@ json contact_points_json(const std::vector<ContactPointRow>& rows) {
   json points = json::array();
   for (const ContactPointRow& r : rows) {
     const auto f = field_value;
-    json point = {{"node", r.node}, {"obstacle", r.obstacle},
-                  {"x", f(r.x.x())}, {"y", f(r.x.y())},
+    json point = {{"node", r.node},
+                  {"obstacle", r.obstacle},
+                  {"x", f(r.x.x())},
+                  {"y", f(r.x.y())},
                   {"pair", {f(r.pair.x()), f(r.pair.y())}},
                   {"normal", {f(r.normal.x()), f(r.normal.y())}},
-                  {"p_n", f(r.p_n)}, {"p_t", f(r.p_t)}, {"sigma_n", f(r.sigma_n)}, {"sigma_t", f(r.sigma_t)},
-                  {"gap", f(r.gap)}, {"slip", f(r.slip)}, {"state", r.state}};
+                  {"p_n", f(r.p_n)},
+                  {"p_t", f(r.p_t)},
+                  {"sigma_n", f(r.sigma_n)},
+                  {"sigma_t", f(r.sigma_t)},
+                  {"gap", f(r.gap)},
+                  {"slip", f(r.slip)},
+                  {"state", r.state}};
     if (r.several_bodies) {
       point["body"] = r.body;
       point["master"] = r.master;
@@ -139,14 +171,16 @@ json step_json(const Problem& problem, const StepRecord& rec, const OutputOption
   j["cuts"] = rec.cuts;
   // The step checks (solver/stepping/step_checks.hpp): the worst value of each over the step.
   const StepChecks& c = rec.checks;
-  j["checks"] = {{"balance", c.balance},         {"tension", c.tension},
-                 {"cone", c.cone},               {"penetration", c.penetration},
-                 {"normal_turn", c.normal_turn}, {"obstacle_motion", c.obstacle_motion},
+  j["checks"] = {{"balance", c.balance},
+                 {"tension", c.tension},
+                 {"cone", c.cone},
+                 {"penetration", c.penetration},
+                 {"normal_turn", c.normal_turn},
+                 {"obstacle_motion", c.obstacle_motion},
                  {"boundary_points", c.boundary_points}};
   if (!rec.notes.empty()) j["notes"] = rec.notes;
   if (rec.converged)
-    j["equilibrium"] = {{"relative_residual", rec.state.relative_residual},
-                        {"at_round_off_floor", rec.state.at_floor}};
+    j["equilibrium"] = {{"relative_residual", rec.state.relative_residual}, {"at_round_off_floor", rec.state.at_floor}};
   if (!rec.epsilon_used.empty()) j["epsilon"] = rec.epsilon_used;
   if (problem.rigid.count() && rec.converged) {
     // The rigid motion fitted to the displacement (translation of the point at the origin);
@@ -208,10 +242,14 @@ json step_json(const Problem& problem, const StepRecord& rec, const OutputOption
       for (const MasterReading& r : master_readings(problem, rec.state.q, rec.p, rec.tau, static_cast<int>(o))) {
         const double area = body.tributary_area(r.site);
         const Vec2 x = body.surface_point(rec.state.q, r.site, 0).x;
-        readings.push_back({{"node", body.site_node(r.site)}, {"obstacle", pair.name},
-                            {"body", all->name(pair.master->body)}, {"x", field_value(x.x())},
-                            {"y", field_value(x.y())}, {"p_n", field_value(r.sigma_n * area)},
-                            {"p_t", field_value(r.sigma_t * area)}, {"sigma_n", field_value(r.sigma_n)},
+        readings.push_back({{"node", body.site_node(r.site)},
+                            {"obstacle", pair.name},
+                            {"body", all->name(pair.master->body)},
+                            {"x", field_value(x.x())},
+                            {"y", field_value(x.y())},
+                            {"p_n", field_value(r.sigma_n * area)},
+                            {"p_t", field_value(r.sigma_t * area)},
+                            {"sigma_n", field_value(r.sigma_n)},
                             {"sigma_t", field_value(r.sigma_t)}});
       }
     }
@@ -256,14 +294,14 @@ json effects_json(const Scene& scene) {
   }
   for (const Candidate& c : problem.candidates) tangential += c.xi >= 0;
   json effects = {{"friction", friction},
-          {"geometric_nonlinearity", traits.geometric_nonlinearity},
-          {"plasticity", traits.plasticity},
-          {"moving_obstacles", moving},
-          {"constant_tangent", traits.constant_tangent},
-          {"contact_candidates", problem.candidates.size()},
-          {"contact_unknowns", problem.component_count},
-          {"held_by_contact", problem.rigid.names},
-          {"unknowns_per_contact_point", tangential > 0 ? 2 : 1}};
+                  {"geometric_nonlinearity", traits.geometric_nonlinearity},
+                  {"plasticity", traits.plasticity},
+                  {"moving_obstacles", moving},
+                  {"constant_tangent", traits.constant_tangent},
+                  {"contact_candidates", problem.candidates.size()},
+                  {"contact_unknowns", problem.component_count},
+                  {"held_by_contact", problem.rigid.names},
+                  {"unknowns_per_contact_point", tangential > 0 ? 2 : 1}};
   // How the free motions were held (docs/algorithm.md#bodies-held-only-by-contact), and that no
   // regularization is left.
   if (problem.rigid.count())
@@ -285,17 +323,23 @@ json effects_json(const Scene& scene) {
       json held = json::array();  // its motions held by contact, without the "BODY: " of the scene's list
       for (int k = 0; k < problem.rigid.count(); ++k)
         if (problem.rigid.body[k] == b) held.push_back(problem.rigid.names[k].substr(all->name(b).size() + 2));
-      bodies.push_back({{"name", all->name(b)}, {"geometric_nonlinearity", t.geometric_nonlinearity},
-                        {"plasticity", t.plasticity}, {"constant_tangent", t.constant_tangent},
-                        {"dofs", all->part(b).dof_count()}, {"held_by_contact", held}});
+      bodies.push_back({{"name", all->name(b)},
+                        {"geometric_nonlinearity", t.geometric_nonlinearity},
+                        {"plasticity", t.plasticity},
+                        {"constant_tangent", t.constant_tangent},
+                        {"dofs", all->part(b).dof_count()},
+                        {"held_by_contact", held}});
     }
     for (size_t o = 0; o < problem.obstacles.size(); ++o) {
       const ObstacleInstance& pair = problem.obstacles[o];
       if (!pair.master) continue;
       int candidates = 0;
       for (const Candidate& c : problem.candidates) candidates += c.obstacle == static_cast<int>(o);
-      pairs.push_back({{"name", pair.name}, {"slave", all->name(pair.slave_body)}, {"master", all->name(pair.master->body)},
-                       {"friction", pair.frictional}, {"contact_candidates", candidates}});
+      pairs.push_back({{"name", pair.name},
+                       {"slave", all->name(pair.slave_body)},
+                       {"master", all->name(pair.master->body)},
+                       {"friction", pair.frictional},
+                       {"contact_candidates", candidates}});
     }
     effects["bodies"] = bodies;
     effects["contacts"] = pairs;
@@ -318,18 +362,24 @@ std::optional<json> bodies_json(const Body& body) {
   int first_element = 0;
   for (int b = 0; b < all->part_count(); ++b) {
     const int elements = static_cast<int>(all->part(b).cells().size());
-    bodies.push_back({{"name", all->name(b)}, {"first_node", all->node_offset(b)}, {"nodes", all->part(b).node_count()},
-                      {"first_element", first_element}, {"elements", elements}});
+    bodies.push_back({{"name", all->name(b)},
+                      {"first_node", all->node_offset(b)},
+                      {"nodes", all->part(b).node_count()},
+                      {"first_element", first_element},
+                      {"elements", elements}});
     first_element += elements;
   }
   return bodies;
 }
 
 json summary_json(const RunResult& run) {
-  json j = {{"completed", run.completed}, {"reason", run.reason}, {"steps", run.steps.size()},
+  json j = {{"completed", run.completed},
+            {"reason", run.reason},
+            {"steps", run.steps.size()},
             {"contact_iterations", run.counters.solves},
             {"newton_iterations", run.counters.newton_iterations},
-            {"factorizations", run.counters.factorizations}, {"seconds", run.seconds}};
+            {"factorizations", run.counters.factorizations},
+            {"seconds", run.seconds}};
   if (!run.completed) j["failure"] = failure_json(run.failure, run.reason, run.failure_step);
   return j;
 }
@@ -338,7 +388,7 @@ json summary_json(const RunResult& run) {
 // kRowsPerPart rows a part.
 std::vector<ResultPart> table_parts(const FlatTable& t, const std::string& index_name) {
   struct Columns {
-    std::vector<int> column;  // of each key in nlohmann's order (sorted); -1: the row index
+    std::vector<int> column;          // of each key in nlohmann's order (sorted); -1: the row index
     std::vector<std::string> quoted;  // "key":
   };
   std::vector<std::pair<std::string, int>> keys{{index_name, -1}};
@@ -366,10 +416,8 @@ std::vector<ResultPart> table_parts(const FlatTable& t, const std::string& index
           if (!first) w.put(',');
           first = false;
           w.raw(columns->quoted[k]);
-          if (c < 0)
-            w.integer(static_cast<long long>(i));
-          else
-            w.number(row[c]);
+          if (c < 0) w.integer(static_cast<long long>(i));
+          else w.number(row[c]);
         }
         w.put('}');
       }

@@ -74,8 +74,8 @@ struct ContactPointRow {
 std::vector<ContactPointRow> contact_point_rows(const Problem& problem, const StepRecord& rec);
 nlohmann::json contact_points_json(const std::vector<ContactPointRow>& rows);
 struct StepOutput {
-  nlohmann::json summary;  // step_json without the tables and the contact points
-  std::optional<FlatTable> nodes, elements;  // where recorded and wanted
+  nlohmann::json summary;                                      // step_json without the tables and the contact points
+  std::optional<FlatTable> nodes, elements;                    // where recorded and wanted
   std::optional<std::vector<ContactPointRow>> contact_points;  // as JSON on the writer's thread
 };
 StepOutput step_output(const Problem& problem, const StepRecord& rec, const OutputOptions& output);

@@ -11,11 +11,11 @@
 #include <unordered_map>
 #include <unordered_set>
 
-#include "solver/model/body_set.hpp"
-#include "solver/model/number_text.hpp"
 #include "solver/io/json_depth.hpp"
 #include "solver/io/scene_reader.hpp"
 #include "solver/io/schema_validation.hpp"
+#include "solver/model/body_set.hpp"
+#include "solver/model/number_text.hpp"
 #include "solver/problem/rigid_modes.hpp"
 
 namespace grip {
@@ -28,8 +28,7 @@ using scene_io::token;
 
 std::string join(const std::vector<SceneIssue>& issues) {
   std::ostringstream os;
-  for (size_t i = 0; i < issues.size(); ++i)
-    os << (i ? "\n" : "") << issues[i].pointer << ": " << issues[i].detail;
+  for (size_t i = 0; i < issues.size(); ++i) os << (i ? "\n" : "") << issues[i].pointer << ": " << issues[i].detail;
   return os.str();
 }
 
@@ -39,13 +38,12 @@ ProfilePiece read_piece(Reader& r, json& j, const std::string& ptr) {
   const std::string type = r.choice(j, ptr, "type", {"segment", "arc"}, std::nullopt);
   if (type == "segment") return SegmentPiece{r.vec2(j, ptr, "from"), r.vec2(j, ptr, "to")};
   const double deg = std::numbers::pi / 180;
-  return ArcPiece{r.vec2(j, ptr, "centre"), r.positive(j, ptr, "radius"),
-                  r.number(j, ptr, "start_angle") * deg, r.number(j, ptr, "end_angle") * deg};
+  return ArcPiece{r.vec2(j, ptr, "centre"), r.positive(j, ptr, "radius"), r.number(j, ptr, "start_angle") * deg,
+                  r.number(j, ptr, "end_angle") * deg};
 }
 
 std::unique_ptr<Obstacle> read_shape(Reader& r, json& j, const std::string& ptr) {
-  const std::string type =
-      r.choice(j, ptr, "type", {"circle", "segment", "arc", "profile"}, std::nullopt);
+  const std::string type = r.choice(j, ptr, "type", {"circle", "segment", "arc", "profile"}, std::nullopt);
   const size_t before = r.issues.size();
   std::vector<ProfilePiece> pieces;
   if (type == "circle") {
@@ -90,9 +88,10 @@ void read_start(Reader& r, json& scene, Problem& problem) {
   if (!solver) return;
   if (!solver->contains("start")) {
     if (membrane)
-      r.error("/solver/start", "is required for a rigid_plastic_membrane: a flat sheet has no transverse "
-                                "stiffness, so its first step starts from a prescribed depth of one node "
-                                "(e.g. {\"node\": 0, \"component\": \"y\", \"value\": -1, \"obstacle\": \"punch\"})");
+      r.error("/solver/start",
+              "is required for a rigid_plastic_membrane: a flat sheet has no transverse "
+              "stiffness, so its first step starts from a prescribed depth of one node "
+              "(e.g. {\"node\": 0, \"component\": \"y\", \"value\": -1, \"obstacle\": \"punch\"})");
     return;
   }
   json* st = r.object(*solver, "/solver", "start", true);
@@ -144,8 +143,9 @@ std::string motion_name(const Vector& coefficients, double L) {
   const double omega = c.size() > 2 ? c[2] / L : 0.0;
   if (std::abs(omega) * L < 1e-9) {
     const Vec2 d = Vec2(c[0], c[1]).normalized();
-    return std::abs(d.y()) < 1e-9 ? "translate along x" : std::abs(d.x()) < 1e-9 ? "translate along y"
-                                                                                : "translate along " + format_point(d);
+    return std::abs(d.y()) < 1e-9   ? "translate along x"
+           : std::abs(d.x()) < 1e-9 ? "translate along y"
+                                    : "translate along " + format_point(d);
   }
   Vec2 pivot(-c[1] / omega, c[0] / omega);
   for (int d = 0; d < 2; ++d)
@@ -211,7 +211,8 @@ std::vector<BodyPart> body_parts(const Problem& problem) {
   if (!all) return {{problem.body.get(), 0, "/body/supports", ""}};
   std::vector<BodyPart> parts;
   for (int b = 0; b < all->part_count(); ++b)
-    parts.push_back({&all->part(b), all->dof_offset(b), "/bodies/" + std::to_string(b) + "/supports", all->name(b) + ": "});
+    parts.push_back(
+        {&all->part(b), all->dof_offset(b), "/bodies/" + std::to_string(b) + "/supports", all->name(b) + ": "});
   return parts;
 }
 
@@ -258,10 +259,8 @@ void check_rigid_modes(Reader& r, Problem& problem) {
     for (const Vector& c : free) {
       const bool rotates = c.size() > 2 && std::abs(c[2]) > 1e-9;
       std::string why;
-      if (problem.start)
-        why = "a membrane has no stiffness of its own to carry a load to its contacts";
-      else if (rotates && !body.traits().constant_tangent)
-        why = finite_rotation_refusal(body, fixed);
+      if (problem.start) why = "a membrane has no stiffness of its own to carry a load to its contacts";
+      else if (rotates && !body.traits().constant_tangent) why = finite_rotation_refusal(body, fixed);
       if (!why.empty()) {
         r.error(parts[b].supports, "leave the body free to " + motion_name(c, L) + ": " + why +
                                        "; fix a component that this motion moves, or drive the body by a "
@@ -322,7 +321,7 @@ void hold_rigid_modes(Reader& r, Problem& problem) {
     // The motion that no contact point resists, in words, at the first body it moves.
     const auto [words, b] = motion_words(parts, Vector(rigid.modes * svd.matrixV().col(k)));
     r.error(parts[b].supports, std::string(words.rfind("move together", 0) == 0 ? "leave the bodies free to "
-                                                                                 : "leave the body free to ") +
+                                                                                : "leave the body free to ") +
                                    words + unstoppable);
   }
   if (!r.issues.empty()) return;
@@ -394,20 +393,17 @@ void read_solver(Reader& r, json& scene, SteppingParams& params) {
       const std::string ap = cp + "/acceleration";
       if (!acc->contains("n")) (*acc)["n"] = "inf";
       const json& n = (*acc)["n"];
-      if (n.is_string() && n == "inf")
-        c.acceleration = kAccelerationInfinity;
-      else if (n.is_string() && n == "auto")
-        c.acceleration = kAccelerationAuto;
-      else if (n.is_number_integer())
-        c.acceleration = r.integer_value(n, ap + "/n", 1, 64);
-      else
-        r.error(ap + "/n", show(n) + " is not \"inf\", \"auto\" or an integer from 1 to 64");
+      if (n.is_string() && n == "inf") c.acceleration = kAccelerationInfinity;
+      else if (n.is_string() && n == "auto") c.acceleration = kAccelerationAuto;
+      else if (n.is_number_integer()) c.acceleration = r.integer_value(n, ap + "/n", 1, 64);
+      else r.error(ap + "/n", show(n) + " is not \"inf\", \"auto\" or an integer from 1 to 64");
       const std::string eps = r.choice(*acc, ap, "epsilon", {"exact", "warmup"}, "exact");
       c.epsilon = eps == "warmup" ? EpsilonSource::warmup : EpsilonSource::exact;
     }
   }
   if (json* newton = r.object(*solver, sp, "newton", false))
-    params.newton.max_iterations = r.integer(*newton, sp + "/newton", "max_iterations", 1, 1000, params.newton.max_iterations);
+    params.newton.max_iterations =
+        r.integer(*newton, sp + "/newton", "max_iterations", 1, 1000, params.newton.max_iterations);
   params.max_cuts = r.integer(*solver, sp, "max_cuts", 0, 30, params.max_cuts);
 }
 
@@ -426,7 +422,8 @@ void read_output(Reader& r, json& scene, Scene& out) {
   } else if (steps.is_array()) {
     out.params.record_fields.assign(n, 0);
     for (size_t i = 0; i < steps.size(); ++i) {
-      const int k = r.integer_value(steps[i], "/output/steps/" + std::to_string(i), 1, static_cast<int>(std::max<size_t>(n, 1)));
+      const int k =
+          r.integer_value(steps[i], "/output/steps/" + std::to_string(i), 1, static_cast<int>(std::max<size_t>(n, 1)));
       if (n) out.params.record_fields[k - 1] = 1;
     }
   } else {
@@ -438,10 +435,12 @@ void read_output(Reader& r, json& scene, Scene& out) {
   out.output.fields.clear();
   for (size_t i = 0; i < fields->size(); ++i) {
     const json& f = (*fields)[i];
-    if (f.is_string() && std::find(OutputOptions::kAllFields.begin(), OutputOptions::kAllFields.end(), f.get<std::string>()) != OutputOptions::kAllFields.end())
+    if (f.is_string() && std::find(OutputOptions::kAllFields.begin(), OutputOptions::kAllFields.end(),
+                                   f.get<std::string>()) != OutputOptions::kAllFields.end())
       out.output.fields.push_back(f.get<std::string>());
     else
-      r.error("/output/fields/" + std::to_string(i), show(f) + " is not one of " + Reader::list(OutputOptions::kAllFields));
+      r.error("/output/fields/" + std::to_string(i),
+              show(f) + " is not one of " + Reader::list(OutputOptions::kAllFields));
   }
 }
 
@@ -469,8 +468,7 @@ std::vector<double> read_step_factors(Reader& r, json& scene) {
     for (size_t i = 0; i < s.size(); ++i) {
       if (!s[i].is_number() || !std::isfinite(s[i].get<double>()))
         r.error("/steps/" + std::to_string(i), show(s[i]) + " is not a finite number");
-      else
-        factors.push_back(s[i].get<double>());
+      else factors.push_back(s[i].get<double>());
     }
   } else {
     r.error("/steps", show(s) + " is neither a step count nor a list of load factors");
@@ -630,7 +628,8 @@ Scene read_checked_scene(const nlohmann::json& input) {
   refuse_huge_numbers(r, e, "");
   if (!r.issues.empty()) throw SceneErrors(std::move(r.issues));
   const bool several = e.contains("bodies");
-  if (several && e.contains("body")) r.error("/body", "cannot be given together with bodies (body is the one-body shorthand)");
+  if (several && e.contains("body"))
+    r.error("/body", "cannot be given together with bodies (body is the one-body shorthand)");
   if (!several && e.contains("contacts")) r.error("/contacts", "pairs the surfaces of bodies: give bodies, not body");
   if (several) {
     if (json* bodies = r.array(e, "", "bodies", true)) scene_io::read_bodies(r, *bodies, scene.problem);
@@ -662,8 +661,7 @@ Scene read_checked_scene(const nlohmann::json& input) {
       if (o["motion"].is_array())
         for (size_t m = 0; m < o["motion"].size(); ++m)
           read_motion(r, o["motion"][m], op + "/motion/" + std::to_string(m), inst);
-      else
-        read_motion(r, o["motion"], op + "/motion", inst);
+      else read_motion(r, o["motion"], op + "/motion", inst);
       scene.problem.obstacles.push_back(std::move(inst));
     }
   }
@@ -678,8 +676,8 @@ Scene read_checked_scene(const nlohmann::json& input) {
   if (r.issues.empty() && scene.problem.body) check_rigid_modes(r, scene.problem);
   if (r.issues.empty()) read_start(r, e, scene.problem);
   if (!r.issues.empty()) throw SceneErrors(std::move(r.issues));
-  const double reach = scene.params.contact_reach > 0 ? scene.params.contact_reach
-                                                      : scene.problem.body->characteristic_length();
+  const double reach =
+      scene.params.contact_reach > 0 ? scene.params.contact_reach : scene.problem.body->characteristic_length();
   add_candidates(scene.problem, scene.steps, reach);
   hold_rigid_modes(r, scene.problem);
   if (!r.issues.empty()) throw SceneErrors(std::move(r.issues));
@@ -692,8 +690,8 @@ Scene read_scene_file(const std::string& path) {
   std::ostringstream text;
   text << in.rdbuf();
   if (nested_deeper_than(text.str(), kMaxJsonDepth))
-    throw SceneErrors(std::vector<SceneIssue>{
-        {"/", "malformed JSON: arrays and objects are nested deeper than " + std::to_string(kMaxJsonDepth) + " levels"}});
+    throw SceneErrors(std::vector<SceneIssue>{{"/", "malformed JSON: arrays and objects are nested deeper than " +
+                                                        std::to_string(kMaxJsonDepth) + " levels"}});
   json j;
   try {
     j = json::parse(text.str());

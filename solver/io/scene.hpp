@@ -2,9 +2,9 @@
 // Scene JSON -> typed problem: the one place where a scene's names become types. Every error
 // names the JSON pointer of the offending value; all errors are collected, not only the first,
 // up to kMaxSceneIssues.
-#include <nlohmann/json.hpp>
 #include <algorithm>
 #include <cstddef>
+#include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -37,12 +37,10 @@ class SceneErrors : public std::runtime_error {
 
 // What the result keeps: fields only for the chosen steps, and only the chosen kinds.
 struct OutputOptions {
-  static inline const std::vector<std::string> kAllFields = {"nodes", "elements", "contact_points",
-                                                             "reactions", "history"};
+  static inline const std::vector<std::string> kAllFields = {"nodes", "elements", "contact_points", "reactions",
+                                                             "history"};
   std::vector<std::string> fields = kAllFields;
-  bool wants(const std::string& field) const {
-    return std::find(fields.begin(), fields.end(), field) != fields.end();
-  }
+  bool wants(const std::string& field) const { return std::find(fields.begin(), fields.end(), field) != fields.end(); }
 };
 
 struct Scene {

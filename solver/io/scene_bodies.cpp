@@ -4,10 +4,10 @@
 #include <set>
 #include <unordered_map>
 
-#include "solver/model/body_set.hpp"
 #include "solver/elements/continuum.hpp"
 #include "solver/elements/timoshenko_beam.hpp"
 #include "solver/io/scene_reader.hpp"
+#include "solver/model/body_set.hpp"
 
 namespace grip::scene_io {
 
@@ -43,17 +43,18 @@ void read_bodies(Reader& r, json& bodies, Problem& problem) {
       continue;
     }
     const json& name = body["name"];
-    if (!name.is_string() || name.get<std::string>().empty() || name.get<std::string>().find('.') != std::string::npos) {
+    if (!name.is_string() || name.get<std::string>().empty() ||
+        name.get<std::string>().find('.') != std::string::npos) {
       r.error(bp + "/name", show(name) + " is not a name (a non-empty string without '.')");
       continue;
     }
-    if (named.count(name.get<std::string>()))
-      r.error(bp + "/name", show(name) + " names another body already");
+    if (named.count(name.get<std::string>())) r.error(bp + "/name", show(name) + " names another body already");
     if (body.value("model", "") == "rigid_plastic_membrane")
       r.error(bp + "/model",
               "a rigid_plastic_membrane has no stiffness in its flat reference state: its first step starts from a "
               "prescribed depth of one node pressed by a rigid obstacle (solver.start), whose reaction is the first "
-              "contact force (docs/algorithm.md#load-stepping-and-cuts); against a deformable body that depth would be shared with the other "
+              "contact force (docs/algorithm.md#load-stepping-and-cuts); against a deformable body that depth would be "
+              "shared with the other "
               "body's compliance, which gives no starting force, so a membrane is for one-body scenes (body)");
     if (!r.issues.empty()) continue;
     Problem part;
@@ -75,7 +76,8 @@ void read_bodies(Reader& r, json& bodies, Problem& problem) {
       c.dof += offset;
       problem.constraints.push_back(c);
     }
-    for (size_t k = 0; k < parts[b].loads.size(); ++k) case_load(problem, static_cast<int>(k)).segment(offset, n) += parts[b].loads[k];
+    for (size_t k = 0; k < parts[b].loads.size(); ++k)
+      case_load(problem, static_cast<int>(k)).segment(offset, n) += parts[b].loads[k];
   }
 }
 
@@ -87,9 +89,9 @@ namespace {
 // half the depth toward +y or -y (Body::surface_point's side), through every node.
 struct SetRef {
   int body = -1;
-  std::vector<int> sites;                      // sites of the BodySet
-  std::vector<std::array<int, 2>> segments;    // its surface pieces, body on the left of a -> b
-  int side = 0;                                // a beam's surface side; 0 for a continuum
+  std::vector<int> sites;                    // sites of the BodySet
+  std::vector<std::array<int, 2>> segments;  // its surface pieces, body on the left of a -> b
+  int side = 0;                              // a beam's surface side; 0 for a continuum
 };
 
 std::optional<SetRef> find_set(Reader& r, const BodySet& all, const std::string& text, const std::string& ptr) {
@@ -102,8 +104,9 @@ std::optional<SetRef> find_set(Reader& r, const BodySet& all, const std::string&
     // of the continuum's mesh, so io asks for the type it built (docs/design.md).
     if (dynamic_cast<const TimoshenkoBeam*>(&all.part(b))) {
       if (set != "upper" && set != "lower") {
-        r.error(ptr, "\"" + set + "\" names no surface of the beam \"" + body + "\" (surfaces: upper, lower: its axis "
-                     "offset by half the depth toward +y or -y)");
+        r.error(ptr, "\"" + set + "\" names no surface of the beam \"" + body +
+                         "\" (surfaces: upper, lower: its axis "
+                         "offset by half the depth toward +y or -y)");
         return std::nullopt;
       }
       SetRef ref{b, {}, {}, set == "upper" ? +1 : -1};
@@ -114,7 +117,8 @@ std::optional<SetRef> find_set(Reader& r, const BodySet& all, const std::string&
     }
     const auto* continuum = dynamic_cast<const ContinuumBody*>(&all.part(b));
     if (!continuum) {
-      r.error(ptr, "body \"" + body + "\" has no surface that pairs with another body's (continuum and beam bodies do)");
+      r.error(ptr,
+              "body \"" + body + "\" has no surface that pairs with another body's (continuum and beam bodies do)");
       return std::nullopt;
     }
     const auto& sets = continuum->mesh().sets;
@@ -163,17 +167,20 @@ void read_contacts(Reader& r, json& scene, Problem& problem) {
       continue;
     }
     if (!c.contains("slave") || !c["slave"].is_string()) r.error(cp + "/slave", "is required: \"BODY.SET\"");
-    if (!c.contains("master") || !c["master"].is_string()) r.error(cp + "/master", "is required: \"BODY.SET\" or an obstacle's name");
+    if (!c.contains("master") || !c["master"].is_string())
+      r.error(cp + "/master", "is required: \"BODY.SET\" or an obstacle's name");
     if (!r.issues.empty()) continue;
     const auto slave = find_set(r, all, c["slave"].get<std::string>(), cp + "/slave");
     const std::string master = c["master"].get<std::string>();
     const auto named_master = obstacle_index.find(master);
     const int obstacle = named_master != obstacle_index.end() && named_master->second < rigid
-                             ? static_cast<int>(named_master->second) : -1;
+                             ? static_cast<int>(named_master->second)
+                             : -1;
     if (obstacle >= 0) {
       if (c.contains("friction"))
         r.error(cp + "/friction", "is the obstacle's: give it in /obstacles/" + std::to_string(obstacle) + "/friction");
-      if (slave) obstacle_slaves[obstacle].insert(obstacle_slaves[obstacle].end(), slave->sites.begin(), slave->sites.end());
+      if (slave)
+        obstacle_slaves[obstacle].insert(obstacle_slaves[obstacle].end(), slave->sites.begin(), slave->sites.end());
       continue;
     }
     const auto master_set = find_set(r, all, master, cp + "/master");

@@ -8,8 +8,8 @@
 #include <unordered_map>
 #include <vector>
 
-#include "solver/problem/problem.hpp"
 #include "solver/io/scene.hpp"
+#include "solver/problem/problem.hpp"
 
 namespace grip::scene_io {
 
@@ -76,8 +76,7 @@ class Reader {
   }
 
   // A finite number; `fallback` fills it in when absent (required when no fallback).
-  double number(json& obj, const std::string& ptr, const char* key,
-                std::optional<double> fallback = std::nullopt) {
+  double number(json& obj, const std::string& ptr, const char* key, std::optional<double> fallback = std::nullopt) {
     const std::string p = ptr + "/" + token(key);
     if (!obj.is_object()) return fallback.value_or(0.0);
     if (!obj.contains(key)) {
@@ -101,8 +100,7 @@ class Reader {
     return d;
   }
 
-  double positive(json& obj, const std::string& ptr, const char* key,
-                  std::optional<double> fallback = std::nullopt) {
+  double positive(json& obj, const std::string& ptr, const char* key, std::optional<double> fallback = std::nullopt) {
     const double d = number(obj, ptr, key, fallback);
     if (obj.is_object() && obj.contains(key) && obj[key].is_number() && !(d > 0))
       error(ptr + "/" + token(key), show(obj[key]) + " is not positive");
@@ -137,8 +135,8 @@ class Reader {
     return static_cast<int>(i);
   }
 
-  std::string choice(json& obj, const std::string& ptr, const char* key,
-                     const std::vector<std::string>& options, std::optional<std::string> fallback) {
+  std::string choice(json& obj, const std::string& ptr, const char* key, const std::vector<std::string>& options,
+                     std::optional<std::string> fallback) {
     const std::string p = ptr + "/" + token(key);
     if (!obj.is_object()) return fallback.value_or(options.front());
     if (!obj.contains(key)) {
@@ -157,8 +155,7 @@ class Reader {
     return fallback.value_or(options.front());
   }
 
-  Vec2 vec2(json& obj, const std::string& ptr, const char* key,
-            std::optional<Vec2> fallback = std::nullopt) {
+  Vec2 vec2(json& obj, const std::string& ptr, const char* key, std::optional<Vec2> fallback = std::nullopt) {
     const std::string p = ptr + "/" + token(key);
     if (!obj.is_object()) return Vec2::Zero();
     if (!obj.contains(key)) {
@@ -215,7 +212,6 @@ class Reader {
   std::unordered_map<std::string, int> case_index_{{"main", 0}};
 };
 
-
 // The load vector of a case, created (zero) on first use.
 inline Vector& case_load(Problem& problem, int load_case) {
   while (static_cast<int>(problem.loads.size()) <= load_case)
@@ -225,9 +221,8 @@ inline Vector& case_load(Problem& problem, int load_case) {
 
 // body.supports: [{"node", "fix": [component names], "values": {name: value}, "case"}];
 // `dof(node, component index)` maps to the global dof.
-void read_supports(Reader& r, json& body, const std::string& ptr, int nodes,
-                   const std::vector<std::string>& components, int (*dof)(int, int),
-                   Problem& problem);
+void read_supports(Reader& r, json& body, const std::string& ptr, int nodes, const std::vector<std::string>& components,
+                   int (*dof)(int, int), Problem& problem);
 
 // Body model readers: fill problem.body, constraints and load from the body at `ptr`
 // (scene["body"], or an entry of scene["bodies"]).

@@ -10,9 +10,9 @@
 
 #include <algorithm>
 #include <map>
-#include <new>
 #include <memory>
 #include <mutex>
+#include <new>
 #include <optional>
 #include <regex>
 #include <set>
@@ -89,8 +89,8 @@ class Rewriter {
     if (!s.is_object()) return s;
     // Each subschema with keywords of its own checks the collected errors' count (kEnough).
     if (!s.empty() && !s.contains("$ref")) s[kEnoughKeyword] = true;
-    for (const char* key : {"additionalProperties", "additionalItems", "contains", "propertyNames", "not",
-                            "if", "then", "else"})
+    for (const char* key :
+         {"additionalProperties", "additionalItems", "contains", "propertyNames", "not", "if", "then", "else"})
       if (s.contains(key)) s[key] = schema(std::move(s[key]));
     for (const char* key : {"properties", "patternProperties", "definitions"})
       if (s.contains(key) && s[key].is_object())
@@ -98,7 +98,8 @@ class Rewriter {
     if (s.contains("dependencies") && s["dependencies"].is_object())
       for (json& sub : s["dependencies"])
         if (!sub.is_array()) sub = schema(std::move(sub));
-    if (s.contains("items")) s["items"] = s["items"].is_array() ? list(std::move(s["items"])) : schema(std::move(s["items"]));
+    if (s.contains("items"))
+      s["items"] = s["items"].is_array() ? list(std::move(s["items"])) : schema(std::move(s["items"]));
     for (const char* key : {"allOf", "anyOf", "oneOf"})
       if (s.contains(key) && s[key].is_array()) s[key] = list(std::move(s[key]));
     if (s.contains("oneOf")) split_discriminated(s);
@@ -148,8 +149,8 @@ class Rewriter {
     json all = s.value("allOf", json::array());
     all.push_back({{"required", {*key}}, {"properties", {{*key, {{"enum", values}}}}}});
     for (size_t i = 0; i < branches.size(); ++i)
-      all.push_back({{"if", {{"required", {*key}}, {"properties", {{*key, {{"const", values[i]}}}}}}},
-                     {"then", branches[i]}});
+      all.push_back(
+          {{"if", {{"required", {*key}}, {"properties", {{*key, {{"const", values[i]}}}}}}}, {"then", branches[i]}});
     s.erase("oneOf");
     s["allOf"] = all;
   }
@@ -187,7 +188,8 @@ struct Registry {
 
   const Loaded& get(std::string_view stem) const {
     const auto it = by_stem.find(stem);
-    if (it == by_stem.end()) throw std::logic_error("no schema schemas/" + std::string(stem) + ".schema.json was embedded");
+    if (it == by_stem.end())
+      throw std::logic_error("no schema schemas/" + std::string(stem) + ".schema.json was embedded");
     return it->second;
   }
 };
@@ -355,9 +357,8 @@ class Walker {
       return r == false;
     };
     for (const auto& [key, arg] : s->items()) {
-      if (key == "description" || key == "title" || key == "$comment" || key == "errorMessage" ||
-          key == "default" || key == "examples" || key == "definitions" || key == "$schema" ||
-          key == kEnoughKeyword) {
+      if (key == "description" || key == "title" || key == "$comment" || key == "errorMessage" || key == "default" ||
+          key == "examples" || key == "definitions" || key == "$schema" || key == kEnoughKeyword) {
         continue;
       } else if (key == "const") {
         if (value != arg) return false;
@@ -443,9 +444,29 @@ std::string pointer_of(const Tokens& tokens) {
 
 // What valijson's description says failed.
 enum class Failure {
-  wrapper, required, unknown_key, not_, type, enum_, const_, minimum, exclusive_minimum, maximum,
-  exclusive_maximum, min_items, max_items, min_length, max_length, min_properties, max_properties,
-  pattern, multiple_of, unique_items, one_of, format, other
+  wrapper,
+  required,
+  unknown_key,
+  not_,
+  type,
+  enum_,
+  const_,
+  minimum,
+  exclusive_minimum,
+  maximum,
+  exclusive_maximum,
+  min_items,
+  max_items,
+  min_length,
+  max_length,
+  min_properties,
+  max_properties,
+  pattern,
+  multiple_of,
+  unique_items,
+  one_of,
+  format,
+  other
 };
 
 struct Classified {
@@ -548,8 +569,7 @@ class Describer {
       for (const Located& l : here)
         if (l.schema->contains(c.keyword) && keyword_fails(c, *l.schema, subject, walker_, l.root)) {
           // Prefer the subschema that explains itself.
-          if (!chosen || (!chosen->schema->contains("errorMessage") && l.schema->contains("errorMessage")))
-            chosen = &l;
+          if (!chosen || (!chosen->schema->contains("errorMessage") && l.schema->contains("errorMessage"))) chosen = &l;
         }
     }
     if (chosen && chosen->schema->contains("errorMessage") && (*chosen->schema)["errorMessage"].is_string())
@@ -597,7 +617,8 @@ class Describer {
       case Failure::required:
         return "is required";
       case Failure::not_:
-        if (arg && arg->empty()) return tokens.empty() ? "is not allowed" : unknown_key({tokens.begin(), tokens.end() - 1}, tokens.back());
+        if (arg && arg->empty())
+          return tokens.empty() ? "is not allowed" : unknown_key({tokens.begin(), tokens.end() - 1}, tokens.back());
         if (arg && arg->contains("const")) return "must not be " + (*arg)["const"].dump();
         if (arg && arg->contains("enum")) return "must not be " + list_values((*arg)["enum"]);
         return v + " has a form that is not allowed here";
@@ -681,10 +702,14 @@ Tokens tokens_of(const std::vector<std::string>& context) {
 
 std::string_view schema_file_stem(SchemaName which) {
   switch (which) {
-    case SchemaName::scene: return "scene";
-    case SchemaName::event: return "event";
-    case SchemaName::result: return "result";
-    case SchemaName::job: return "job";
+    case SchemaName::scene:
+      return "scene";
+    case SchemaName::event:
+      return "event";
+    case SchemaName::result:
+      return "result";
+    case SchemaName::job:
+      return "job";
   }
   throw std::invalid_argument("unknown SchemaName");
 }
@@ -735,7 +760,7 @@ std::vector<SceneIssue> validate_against(const nlohmann::json& document, SchemaN
   }
 
   struct Raw {
-    Tokens tokens;  // of the issue's pointer, for sorting
+    Tokens tokens;         // of the issue's pointer, for sorting
     Tokens object_tokens;  // of the value the schema applies to (the object, for a key)
     std::string description;
   };

@@ -28,8 +28,7 @@ std::string_view schema_text(SchemaName which);
 // collecting stops at a bound, and `more` (when given) tells whether it did. Thread-safe; the
 // schemas are parsed once, on first use (std::logic_error if one was not embedded or does not
 // parse).
-std::vector<SceneIssue> validate_against(const nlohmann::json& document, SchemaName which,
-                                         bool* more = nullptr);
+std::vector<SceneIssue> validate_against(const nlohmann::json& document, SchemaName which, bool* more = nullptr);
 
 // Builds the schema's validator now, as the first validate_against would: for a caller that
 // does it on a thread of its own while it reads the document (grip solve: 5 ms of a refined

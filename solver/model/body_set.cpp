@@ -27,7 +27,8 @@ int BodySet::body_of_node(int node) const { return find_part(node_offset_, node)
 
 Vector BodySet::dof_length_scales() const {
   Vector s(dof_count());
-  for (int b = 0; b < part_count(); ++b) s.segment(dof_offset_[b], parts_[b]->dof_count()) = parts_[b]->dof_length_scales();
+  for (int b = 0; b < part_count(); ++b)
+    s.segment(dof_offset_[b], parts_[b]->dof_count()) = parts_[b]->dof_length_scales();
   return s;
 }
 
@@ -69,7 +70,8 @@ SurfacePoint BodySet::surface_point(const VectorRef& q, int site, int side) cons
   const int b = body_of_site(site);
   // A view of the body's part of q: a copy of it per point made pairing quadratic (12 % of the
   // 1501-point interface's time).
-  SurfacePoint p = parts_[b]->surface_point(q.segment(dof_offset_[b], parts_[b]->dof_count()), site - site_offset_[b], side);
+  SurfacePoint p =
+      parts_[b]->surface_point(q.segment(dof_offset_[b], parts_[b]->dof_count()), site - site_offset_[b], side);
   for (auto& j : p.jacobian) j.dof += dof_offset_[b];
   return p;
 }
@@ -94,7 +96,8 @@ double BodySet::characteristic_length() const {
 
 Vector BodySet::rigid_translation(const Vec2& d) const {
   Vector t(dof_count());
-  for (int b = 0; b < part_count(); ++b) t.segment(dof_offset_[b], parts_[b]->dof_count()) = parts_[b]->rigid_translation(d);
+  for (int b = 0; b < part_count(); ++b)
+    t.segment(dof_offset_[b], parts_[b]->dof_count()) = parts_[b]->rigid_translation(d);
   return t;
 }
 

@@ -25,20 +25,34 @@ enum class FailureKind {
 
 constexpr std::string_view to_string(FailureKind kind) {
   switch (kind) {
-    case FailureKind::none: return "none";
-    case FailureKind::friction_limit: return "friction_limit";
-    case FailureKind::no_equilibrium: return "no_equilibrium";
-    case FailureKind::newton_diverged: return "newton_diverged";
-    case FailureKind::invalid_state: return "invalid_state";
-    case FailureKind::contact_budget: return "contact_budget";
-    case FailureKind::contact_stalled: return "contact_stalled";
-    case FailureKind::check_failed: return "check_failed";
-    case FailureKind::missed_contact: return "missed_contact";
-    case FailureKind::stopped: return "stopped";
-    case FailureKind::job_limit: return "job_limit";
-    case FailureKind::dismissed: return "dismissed";
-    case FailureKind::invalid_scene: return "invalid_scene";
-    case FailureKind::exception: return "exception";
+    case FailureKind::none:
+      return "none";
+    case FailureKind::friction_limit:
+      return "friction_limit";
+    case FailureKind::no_equilibrium:
+      return "no_equilibrium";
+    case FailureKind::newton_diverged:
+      return "newton_diverged";
+    case FailureKind::invalid_state:
+      return "invalid_state";
+    case FailureKind::contact_budget:
+      return "contact_budget";
+    case FailureKind::contact_stalled:
+      return "contact_stalled";
+    case FailureKind::check_failed:
+      return "check_failed";
+    case FailureKind::missed_contact:
+      return "missed_contact";
+    case FailureKind::stopped:
+      return "stopped";
+    case FailureKind::job_limit:
+      return "job_limit";
+    case FailureKind::dismissed:
+      return "dismissed";
+    case FailureKind::invalid_scene:
+      return "invalid_scene";
+    case FailureKind::exception:
+      return "exception";
   }
   return "none";
 }

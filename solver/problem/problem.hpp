@@ -24,8 +24,8 @@ struct ObstacleInstance {
   // Coulomb coefficient (the paper's nu) in force at the current step: the load stepping
   // sets it from the step's stage.
   double friction = 0.0;
-  bool frictional = false;            // friction > 0 in some stage: tangential unknowns exist
-  std::vector<Vec2> translations;     // prescribed translation per load case at factor 1
+  bool frictional = false;         // friction > 0 in some stage: tangential unknowns exist
+  std::vector<Vec2> translations;  // prescribed translation per load case at factor 1
   std::optional<MasterSurface> master;
   // The sites that pair with it (a contact's slave set); empty: every site of the body.
   std::vector<int> slaves;
@@ -83,7 +83,7 @@ struct StartUp {
 // others' dofs): its s is that body's equilibrium, with the forces of its pairs on it (the mortar
 // Jacobian moves both sides).
 struct RigidModes {
-  Matrix modes;                    // dof x count, column k is 1 at pins[k] and 0 at the other pins
+  Matrix modes;  // dof x count, column k is 1 at pins[k] and 0 at the other pins
   std::vector<int> pins;
   std::vector<std::string> names;  // "translate along x", ...; "BODY: ..." in a scene of several bodies
   std::vector<int> body;           // the body each mode moves (index into the scene's bodies; 0 for one body)
@@ -97,7 +97,7 @@ struct Problem {
   std::unique_ptr<Body> body;
   std::vector<ObstacleInstance> obstacles;
   std::vector<Constraint> constraints;
-  std::vector<Vector> loads;  // generalized external force per load case at factor 1
+  std::vector<Vector> loads;            // generalized external force per load case at factor 1
   std::vector<std::string> case_names;  // the load cases' names, in the order of the factors
   // The generalized external force at the given factors.
   Vector load(const LoadFactors& factors) const {

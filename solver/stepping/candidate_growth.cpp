@@ -65,11 +65,11 @@ CandidateGrowth add_candidates_for(Problem& problem, const std::vector<OutsidePo
   for (const auto& [o, lists] : by_obstacle) {
     const std::string& name = problem.obstacles[o].name;
     if (!lists.first.empty())
-      note += (note.empty() ? "" : "; ") + std::string("nodes ") + list(lists.first) + " entered the obstacle '" + name +
-              "' outside the contact candidates";
+      note += (note.empty() ? "" : "; ") + std::string("nodes ") + list(lists.first) + " entered the obstacle '" +
+              name + "' outside the contact candidates";
     if (!lists.second.empty())
-      note += (note.empty() ? "" : "; ") + std::string("nodes ") + list(lists.second) + " came within reach of the obstacle '" +
-              name + "'";
+      note += (note.empty() ? "" : "; ") + std::string("nodes ") + list(lists.second) +
+              " came within reach of the obstacle '" + name + "'";
   }
   g.note = note + ": contact candidates from this step on (" + std::to_string(added.size()) + " added)";
   return g;

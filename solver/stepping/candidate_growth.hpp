@@ -18,7 +18,7 @@ struct CandidateGrowth {
   int old_first = 0;       // problem.rigid.first before
   int old_candidates = 0;  // problem.candidates.size() before
   int added_components = 0;
-  std::string note;        // for the step's notes; empty if nothing was added
+  std::string note;  // for the step's notes; empty if nothing was added
   bool grew() const { return added_components > 0; }
 };
 

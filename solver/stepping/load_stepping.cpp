@@ -23,9 +23,8 @@ LoadFactors blend(const LoadFactors& from, const LoadFactors& to, double t) {
 
 // The start-up solve of a body without reference stiffness (Problem::start): returns the
 // displacement to start the first step's Newton from, and sets the starting contact force.
-std::optional<Vector> start_up(const Problem& problem, const SteppingParams& params,
-                               const LoadFactors& factors, const std::vector<double>& zeta,
-                               Vector& p, std::string& reason, FailureKind& failure) {
+std::optional<Vector> start_up(const Problem& problem, const SteppingParams& params, const LoadFactors& factors,
+                               const std::vector<double>& zeta, Vector& p, std::string& reason, FailureKind& failure) {
   const StartUp& st = *problem.start;
   Equilibrium pre(problem, params.newton, {{st.dof, st.value, 0}});
   couple_newton(pre.params(), params.contact.tolerance, params.contact.newton_fraction,
@@ -112,8 +111,8 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
   // Node-to-segment pairs start from the last force: from the extrapolated one, the slave
   // nodes' forces land on other master segments and the loop wanders (two cylinders of
   // unequal materials, step 2: 59 real solves and 1958 Newton iterations instead of 4 and 24).
-  const bool extrapolate_forces =
-      std::none_of(problem.obstacles.begin(), problem.obstacles.end(), [](const ObstacleInstance& o) { return o.master.has_value(); });
+  const bool extrapolate_forces = std::none_of(problem.obstacles.begin(), problem.obstacles.end(),
+                                               [](const ObstacleInstance& o) { return o.master.has_value(); });
   LoadFactors current(cases, 0.0), before = current;
   eq->set_step(current, std::vector<double>(problem.candidates.size(), 0.0));
   std::vector<double> zeta = eq->zetas(eq->evaluate(q));
@@ -191,8 +190,8 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
         ++rec.cuts;
         continue;
       }
-      StepOutcome out = solve_contact_step(*eq, guess, p_guess, p, params.contact, step,
-                                           observer.iteration, observer.stop_requested, v_first);
+      StepOutcome out = solve_contact_step(*eq, guess, p_guess, p, params.contact, step, observer.iteration,
+                                           observer.stop_requested, v_first);
       count_attempt(rec, out);
       bool refused = false;  // converged, but the step checks refused the state
       if (out.converged) {
@@ -200,10 +199,10 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
         check_start = Clock::now();
         std::string why = checker->state(*eq, out.state, out.p, accepted, attempt, outside);
         result.check_seconds += std::chrono::duration<double>(Clock::now() - check_start).count();
-        if (params.fail_outside_candidates)
-          std::erase_if(outside, [](const OutsidePoint& o) { return !o.entered; });
+        if (params.fail_outside_candidates) std::erase_if(outside, [](const OutsidePoint& o) { return !o.entered; });
         if (!outside.empty()) {
-          const CandidateGrowth g = params.fail_outside_candidates ? CandidateGrowth{} : add_candidates_for(problem, outside);
+          const CandidateGrowth g =
+              params.fail_outside_candidates ? CandidateGrowth{} : add_candidates_for(problem, outside);
           if (g.grew()) {
             // The same increment again with the new candidates, from the last accepted state.
             rec.notes.push_back(g.note);
@@ -218,9 +217,11 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
             zeta.resize(problem.candidates.size(), 0.0);
             eq->set_step(current, zeta);
             const EquilibriumState now = eq->evaluate(q);
-            for (size_t i = g.old_candidates; i < problem.candidates.size(); ++i) zeta[i] = now.points[i].projection.zeta;
+            for (size_t i = g.old_candidates; i < problem.candidates.size(); ++i)
+              zeta[i] = now.points[i].projection.zeta;
             accepted.p = grown_components(accepted.p, g, problem);
-            for (size_t i = g.old_candidates; i < problem.candidates.size(); ++i) accepted.eta.push_back(now.points[i].eta);
+            for (size_t i = g.old_candidates; i < problem.candidates.size(); ++i)
+              accepted.eta.push_back(now.points[i].eta);
             for (StepRecord& done_step : result.steps) grow_record(done_step, g, problem);
             grow_record(rec, g, problem);
             checker = std::make_unique<StepChecker>(problem, params.contact, params.contact_reach);
@@ -358,8 +359,8 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
 
 }  // namespace
 
-RunResult run_load_steps(Problem& problem, const std::vector<LoadStep>& steps,
-                         const SteppingParams& params, const SteppingObserver& observer) {
+RunResult run_load_steps(Problem& problem, const std::vector<LoadStep>& steps, const SteppingParams& params,
+                         const SteppingObserver& observer) {
   const auto run_start = Clock::now();
   RunResult result;
   try {

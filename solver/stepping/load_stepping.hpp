@@ -27,18 +27,18 @@ struct SteppingParams {
 };
 
 struct StepRecord {
-  int index = 0;               // 1-based output step
+  int index = 0;  // 1-based output step
   int stage = 0;
-  double load_factor = 0.0;    // the first load case's factor
-  LoadFactors factors;         // every load case's factor
+  double load_factor = 0.0;  // the first load case's factor
+  LoadFactors factors;       // every load case's factor
   bool converged = false;
   std::string reason;
   FailureKind failure = FailureKind::none;  // the kind of the reason
-  std::string warning;         // the converged state lies beyond the model's accurate range
-  std::vector<std::string> notes;  // what the step changed in the problem (candidates added)
-  StepChecks checks;           // the step checks' worst values (step_checks.hpp)
-  int cuts = 0;                // sub-increments this step needed beyond one
-  int restarts = 0;            // attempts from the extrapolated force retried from the last one
+  std::string warning;                      // the converged state lies beyond the model's accurate range
+  std::vector<std::string> notes;           // what the step changed in the problem (candidates added)
+  StepChecks checks;                        // the step checks' worst values (step_checks.hpp)
+  int cuts = 0;                             // sub-increments this step needed beyond one
+  int restarts = 0;                         // attempts from the extrapolated force retried from the last one
   int passes = 0, solves = 0, newton_iterations = 0, inner_iterations = 0;
   double seconds = 0.0;
   std::string epsilon_used;
@@ -70,7 +70,7 @@ struct RunResult {
   double check_seconds = 0.0;  // spent in the step checks (bench/results/robustness.md)
 };
 
-RunResult run_load_steps(Problem& problem, const std::vector<LoadStep>& steps,
-                         const SteppingParams& params, const SteppingObserver& observer = {});
+RunResult run_load_steps(Problem& problem, const std::vector<LoadStep>& steps, const SteppingParams& params,
+                         const SteppingObserver& observer = {});
 
 }  // namespace grip

@@ -111,7 +111,8 @@ StepChecker::StepChecker(const Problem& problem, const ContactParams& contact, d
   if (!(element_size_ > 0)) element_size_ = body.characteristic_length();
 }
 
-double StepChecker::increment(const LoadFactors& from, const LoadFactors& to, StepChecks& worst, std::string& why) const {
+double StepChecker::increment(const LoadFactors& from, const LoadFactors& to, StepChecks& worst,
+                              std::string& why) const {
   double worst_ratio = 0.0;
   for (const ObstacleInstance& o : problem_.obstacles) {
     if (!o.shape || o.translations.empty()) continue;
@@ -172,7 +173,8 @@ std::string StepChecker::state(const Equilibrium& eq, const EquilibriumState& s,
     }
   }
   if (c.balance > limits_.balance)
-    fail("a body is out of balance by " + num(c.balance) + " of the forces it carries (limit " + num(limits_.balance) + ")");
+    fail("a body is out of balance by " + num(c.balance) + " of the forces it carries (limit " + num(limits_.balance) +
+         ")");
 
   // Contact forces: no tension, the cone; candidates inside an obstacle; the normal's turn.
   double max_pn = 0.0;
@@ -212,8 +214,8 @@ std::string StepChecker::state(const Equilibrium& eq, const EquilibriumState& s,
     fail("the contact point at node " + node_of(worst_tension) + " pulls (p_n = " + num(c.tension) +
          " of the largest pressure)");
   if (c.cone > limits_.cone)
-    fail("the contact point at node " + node_of(worst_cone) + " lies outside Coulomb's cone (|p_t| - mu |p_n| = " +
-         num(c.cone) + " of the largest pressure)");
+    fail("the contact point at node " + node_of(worst_cone) +
+         " lies outside Coulomb's cone (|p_t| - mu |p_n| = " + num(c.cone) + " of the largest pressure)");
   if (c.normal_turn > limits_.normal_turn)
     fail("the contact normal at node " + node_of(worst_turn) + " turned by " + num(c.normal_turn) +
          " degrees since the last accepted state: the obstacle passed through the body");
@@ -247,7 +249,8 @@ std::string StepChecker::state(const Equilibrium& eq, const EquilibriumState& s,
     if (!penalty_)
       for (const PairedPoint& pp : s.points) among_candidates |= -pp.projection.gap > limits_.penetration;
     if (among_candidates)
-      fail("a contact point lies " + num(c.penetration) + " inside an obstacle (limit " + num(limits_.penetration) + ")");
+      fail("a contact point lies " + num(c.penetration) + " inside an obstacle (limit " + num(limits_.penetration) +
+           ")");
   }
   worst.worst_of(c);
   return why;

@@ -73,8 +73,8 @@ class StepChecker {
   // A converged state with forces p (after the strategy's stopping test): why it cannot be
   // accepted (empty if it can); `outside` gets the boundary points outside the candidates that
   // entered an obstacle or came within reach (not a failure by itself: the caller decides).
-  std::string state(const Equilibrium& eq, const EquilibriumState& s, const Vector& p,
-                    const AcceptedContact& before, StepChecks& worst, std::vector<OutsidePoint>& outside) const;
+  std::string state(const Equilibrium& eq, const EquilibriumState& s, const Vector& p, const AcceptedContact& before,
+                    StepChecks& worst, std::vector<OutsidePoint>& outside) const;
 
   const StepCheckLimits& limits() const { return limits_; }
 
@@ -88,9 +88,9 @@ class StepChecker {
   bool penalty_;
   double reach_;
   StepCheckLimits limits_;
-  std::vector<Pairing> outside_sites_;    // (site, rigid obstacle) not among the candidates
-  std::vector<int> nodes_without_site_;   // held against every rigid obstacle
-  double element_size_ = 0.0;             // the largest spacing of neighbouring sites
+  std::vector<Pairing> outside_sites_;   // (site, rigid obstacle) not among the candidates
+  std::vector<int> nodes_without_site_;  // held against every rigid obstacle
+  double element_size_ = 0.0;            // the largest spacing of neighbouring sites
   // The largest force a checked state carried in this run: the scale of round-off where a
   // state carries almost nothing (a punch lifted off).
   mutable double force_level_ = 0.0;

@@ -27,10 +27,11 @@ json example(const std::string& name) { return json::parse(read_text(examples_di
 void expect_solve_fails_with(const json& scene, const std::string& kind) {
   SCOPED_TRACE(kind);
   TempDir dir;
-  const fs::path in = dir.path() / "scene.json", out = dir.path() / "result.json", events = dir.path() / "events.ndjson";
+  const fs::path in = dir.path() / "scene.json", out = dir.path() / "result.json",
+                 events = dir.path() / "events.ndjson";
   std::ofstream(in) << scene.dump();
-  const std::string cmd = std::string(GRIP_BINARY) + " solve " + in.string() + " --out " + out.string() +
-                          " --events " + events.string() + " > /dev/null 2>&1";
+  const std::string cmd = std::string(GRIP_BINARY) + " solve " + in.string() + " --out " + out.string() + " --events " +
+                          events.string() + " > /dev/null 2>&1";
   const int status = std::system(cmd.c_str());
   ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 1) << "grip solve should fail (exit 1)";
   const json result = json::parse(read_text(out));
@@ -57,7 +58,8 @@ void expect_solve_fails_with(const json& scene, const std::string& kind) {
 }
 
 TEST(FailureKinds, FrictionLimit) {
-  expect_solve_fails_with(json::parse(read_text(source_dir() / "tests" / "golden" / "friction-limit.json")), "friction_limit");
+  expect_solve_fails_with(json::parse(read_text(source_dir() / "tests" / "golden" / "friction-limit.json")),
+                          "friction_limit");
 }
 
 TEST(FailureKinds, NoEquilibriumWhenTheLoadPullsTheBodyOff) {
@@ -163,9 +165,10 @@ TEST(FailureKinds, EveryKindOfTheSchemaHasItsTest) {
   const json schema = json::parse(read_text(schemas_dir() / "result.schema.json"));
   std::set<std::string> listed;
   for (const json& k : schema["definitions"]["failure"]["properties"]["kind"]["enum"]) listed.insert(k);
-  const std::set<std::string> tested = {"friction_limit", "no_equilibrium", "newton_diverged", "invalid_state",
-                                        "contact_budget", "contact_stalled", "check_failed", "missed_contact", "job_limit",      "dismissed",
-                                        "invalid_scene",  "exception",       "stopped"};
+  const std::set<std::string> tested = {"friction_limit", "no_equilibrium",  "newton_diverged", "invalid_state",
+                                        "contact_budget", "contact_stalled", "check_failed",    "missed_contact",
+                                        "job_limit",      "dismissed",       "invalid_scene",   "exception",
+                                        "stopped"};
   // check_failed and missed_contact: tests/robustness/checks_scenes_test.cpp.
   EXPECT_EQ(tested, listed);
 }

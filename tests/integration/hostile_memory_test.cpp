@@ -63,7 +63,8 @@ TEST(HostileMemory, EightLargeAdversarialScenesAtOnceStayUnder500MbAndMemoryCome
   const Api api(server.port());
   // Warm up on small copies of the attacks (64 KB): the schema's validator is built, the
   // code that answers them is paged in; the server's idle size is measured after.
-  for (const std::string& small : {repeated_support(64 << 10), unknown_key_loads(64 << 10), same_name_obstacles(64 << 10)}) {
+  for (const std::string& small :
+       {repeated_support(64 << 10), unknown_key_loads(64 << 10), same_name_obstacles(64 << 10)}) {
     auto warm = api.post_json("/v1/jobs", small);
     ASSERT_TRUE(warm);
     ASSERT_EQ(warm->status, 422) << warm->body;
@@ -110,10 +111,10 @@ TEST(HostileMemory, EightLargeAdversarialScenesAtOnceStayUnder500MbAndMemoryCome
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
     after = status_mb(server.pid(), "VmRSS");
   }
-  std::printf("hostile scenes: %zu, %zu, %zu bytes; 8 clients answered in %.1f s; RSS idle %.1f MB, "
-              "peak (VmHWM) %.1f MB, after %.1f MB\n",
-              attacks[0].second.size(), attacks[1].second.size(), attacks[2].second.size(), seconds, idle, peak,
-              after);
+  std::printf(
+      "hostile scenes: %zu, %zu, %zu bytes; 8 clients answered in %.1f s; RSS idle %.1f MB, "
+      "peak (VmHWM) %.1f MB, after %.1f MB\n",
+      attacks[0].second.size(), attacks[1].second.size(), attacks[2].second.size(), seconds, idle, peak, after);
   EXPECT_LT(peak, 500.0);
   // Issue 34 asks for 20 % of the idle size; what stays is some 6 MB in glibc's second malloc
   // arena that malloc_trim cannot return (pages shared with live allocations): 26 MB against

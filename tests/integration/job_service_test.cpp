@@ -125,8 +125,7 @@ TEST(JobService, AShearLoadAboveWhatFrictionHoldsFailsTheJobWithItsReason) {
 // says why, with the two steps solved before it in its result, and no fields for the failed step.
 TEST(JobService, ACoupleAboveWhatFrictionHoldsFailsTheJobWithItsReason) {
   const nlohmann::json r = failed_job_result(
-      turned_beyond_the_limit(),
-      "step 3 failed: the couple exceeds what friction can hold: M / (mu sum N r) = 1.06");
+      turned_beyond_the_limit(), "step 3 failed: the couple exceeds what friction can hold: M / (mu sum N r) = 1.06");
   ASSERT_EQ(r["steps"].size(), 3u);
   for (int k = 0; k < 2; ++k) EXPECT_TRUE(r["steps"][k]["converged"].get<bool>());
   EXPECT_FALSE(r["steps"][2]["converged"].get<bool>());

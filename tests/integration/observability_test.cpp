@@ -80,7 +80,9 @@ TEST(Observability, TheRequestIdIsEchoedAttachedToTheJobAndLoggedWithTheClientIn
   const std::string log = server.log();
   // 2026-11-28T06:01:02.345Z info POST /v1/jobs 201 12.3 ms request client-chosen-42 client 127.0.0.1
   EXPECT_TRUE(std::regex_search(
-      log, std::regex(R"(\n\d{4}-\d\d-\d\dT\d\d:\d\d:\d\d\.\d{3}Z info POST /v1/jobs 201 [0-9.]+ ms request client-chosen-42 client 127\.0\.0\.1\n)")))
+      log,
+      std::regex(
+          R"(\n\d{4}-\d\d-\d\dT\d\d:\d\d:\d\d\.\d{3}Z info POST /v1/jobs 201 [0-9.]+ ms request client-chosen-42 client 127\.0\.0\.1\n)")))
       << log;
   EXPECT_NE(log.find("accepted: "), std::string::npos);
   EXPECT_TRUE(std::regex_search(log, std::regex("job " + id + " accepted: .*\\(request client-chosen-42\\)"))) << log;
@@ -102,7 +104,8 @@ TEST(Observability, JsonLogsAreOneObjectALine) {
     const json j = json::parse(line, nullptr, false);
     ASSERT_FALSE(j.is_discarded()) << "not JSON: " << line;
     ASSERT_TRUE(j.contains("time") && j.contains("level") && j.contains("message")) << line;
-    EXPECT_TRUE(std::regex_match(j["time"].get<std::string>(), std::regex(R"(\d{4}-\d\d-\d\dT\d\d:\d\d:\d\d\.\d{3}Z)")));
+    EXPECT_TRUE(
+        std::regex_match(j["time"].get<std::string>(), std::regex(R"(\d{4}-\d\d-\d\dT\d\d:\d\d:\d\d\.\d{3}Z)")));
     ++objects;
     request_line |= j["message"].get<std::string>().find("GET /v1/jobs/\"quoted\" 404") == 0 &&
                     j["message"].get<std::string>().find("request r-1 client 127.0.0.1") != std::string::npos;

@@ -25,7 +25,8 @@ struct Server {
 
 void expect_valid(const std::string& schema, const json& doc) {
   if (auto errors = schema_errors(schema, doc)) {
-    EXPECT_TRUE(errors->empty()) << schema << ": " << (errors->empty() ? "" : errors->front()) << "\n" << doc.dump().substr(0, 2000);
+    EXPECT_TRUE(errors->empty()) << schema << ": " << (errors->empty() ? "" : errors->front()) << "\n"
+                                 << doc.dump().substr(0, 2000);
   }
 }
 
@@ -92,7 +93,8 @@ void expect_one_story(const Story& s, const std::string& what) {
   EXPECT_EQ(s.convergence_trials, iterations);
   EXPECT_EQ(s.metrics_iterations, iterations);
   ASSERT_FALSE(s.log_line.empty()) << "no outcome line in the log";
-  EXPECT_NE(s.log_line.find(": " + std::to_string(iterations) + " contact iterations; "), std::string::npos) << s.log_line;
+  EXPECT_NE(s.log_line.find(": " + std::to_string(iterations) + " contact iterations; "), std::string::npos)
+      << s.log_line;
   if (s.result) {
     expect_valid("result", *s.result);
     const json& summary = (*s.result)["summary"];

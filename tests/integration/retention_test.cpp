@@ -131,8 +131,8 @@ TEST(Retention, AThousandSmallJobsWithARetentionOf100LeaveAtMost100AndASmallFile
   const double wal = std::filesystem::exists(db.string() + "-wal")
                          ? static_cast<double>(std::filesystem::file_size(db.string() + "-wal")) / (1 << 20)
                          : 0.0;
-  std::printf("1000 small jobs, retention 100: %d kept, database %.2f MB (+ WAL %.2f MB), disk_bytes %.2f MB\n",
-              listed, file, wal, metric(api, "grip_store_disk_bytes") / (1 << 20));
+  std::printf("1000 small jobs, retention 100: %d kept, database %.2f MB (+ WAL %.2f MB), disk_bytes %.2f MB\n", listed,
+              file, wal, metric(api, "grip_store_disk_bytes") / (1 << 20));
   EXPECT_LT(file, 20.0);
 }
 

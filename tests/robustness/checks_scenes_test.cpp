@@ -116,7 +116,8 @@ TEST(RobustnessCandidates, HertzAtTenTimesTheIndentationFindsTheNodesOutsideTheS
   }
   nlohmann::json strict = j;
   strict["solver"]["contact"]["outside_candidates"] = "fail";
-  expect_failure_naming(solve_scene(strict), FailureKind::missed_contact, "entered an obstacle outside the contact candidates");
+  expect_failure_naming(solve_scene(strict), FailureKind::missed_contact,
+                        "entered an obstacle outside the contact candidates");
 }
 
 // A floor 1.5 below the strip, beyond the default reach (the body's length, 1): the tip once

@@ -179,7 +179,7 @@ TEST_P(StoreContract, AnExpiredLeaseIsTakenOverAndTheOldRunIsFencedOut) {
   EXPECT_EQ(store->requeue_expired("2025-01-01T00:00:02.000Z"), 1);
   auto j = store->job("job-a", false);
   EXPECT_EQ(j->status, JobStatus::accepted);
-  EXPECT_EQ(j->last_seq, 3);  // ids given out stay given out
+  EXPECT_EQ(j->last_seq, 3);                                  // ids given out stay given out
   EXPECT_TRUE(store->events_after("job-a", 0, 100).empty());  // the interrupted run's events
 
   const auto run2 = store->claim_job("alive", "2025-01-01T00:00:03.000Z", 30);
@@ -379,9 +379,9 @@ TEST_P(StoreContract, ResultsAreStoredAsBytesAndEachFinishedJobCountsItsStoredBy
   const auto j = store->job("job-a", true);
   ASSERT_TRUE(j);
   // Its scene, its 2 events and terminal event, its result.
-  const std::int64_t expected = static_cast<std::int64_t>(
-      j->scene.size() + event(*j, 1).event.data.size() + event(*j, 2).event.data.size() +
-      success(3).terminal.data.size() + bytes.size());
+  const std::int64_t expected =
+      static_cast<std::int64_t>(j->scene.size() + event(*j, 1).event.data.size() + event(*j, 2).event.data.size() +
+                                success(3).terminal.data.size() + bytes.size());
   EXPECT_EQ(j->stored_bytes, expected);
   EXPECT_GT(store->disk_bytes(), 0);
 }

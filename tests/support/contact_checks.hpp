@@ -27,10 +27,12 @@ inline ::testing::AssertionResult step_checks_within_limits(const Problem& probl
   if (!(k.balance <= 0.1)) why << " balance " << k.balance << " > 0.1;";
   if (!(k.tension <= 1e-6)) why << " tension " << k.tension << " > 1e-6;";
   if (!(k.cone <= std::max(1e-6, 10 * tau_relative))) why << " cone " << k.cone << ";";
-  if (!(k.penetration <= 10 * tolerance_length)) why << " penetration " << k.penetration << " > " << 10 * tolerance_length << ";";
+  if (!(k.penetration <= 10 * tolerance_length))
+    why << " penetration " << k.penetration << " > " << 10 * tolerance_length << ";";
   if (!(k.normal_turn <= 90)) why << " normal turn " << k.normal_turn << " degrees;";
   if (!(k.obstacle_motion <= 1 + 1e-9)) why << " obstacle motion " << k.obstacle_motion << " of its bound;";
-  if (!problem.obstacles.empty() && !problem.candidates.empty() && k.boundary_points < static_cast<int>(problem.candidates.size()))
+  if (!problem.obstacles.empty() && !problem.candidates.empty() &&
+      k.boundary_points < static_cast<int>(problem.candidates.size()))
     why << " only " << k.boundary_points << " boundary points checked;";
   const std::string s = why.str();
   if (s.empty()) return ::testing::AssertionSuccess();
@@ -94,11 +96,13 @@ inline ::testing::AssertionResult step_invariants(const Problem& problem, const 
     const Vec2 d = axis == 0 ? Vec2::UnitX() : Vec2::UnitY();
     const Vector mode = problem.body->rigid_translation(d);
     const double sum = mode.dot(applied) + mode.dot(rec.reactions) + total.dot(d);
-    if (std::abs(sum) > 1e-7 * ref) why << " force balance along axis " << axis << " is off by " << sum << " of " << ref << ";";
+    if (std::abs(sum) > 1e-7 * ref)
+      why << " force balance along axis " << axis << " is off by " << sum << " of " << ref << ";";
     if (const double pins = pin_force_share(problem, rec, axis, ref); pins > 0.1)
       why << " the pins of the held body carry " << pins << " of the forces along axis " << axis << ";";
   }
-  if (::testing::AssertionResult checks = step_checks_within_limits(problem, rec, tol.length, tol.tau_relative); !checks)
+  if (::testing::AssertionResult checks = step_checks_within_limits(problem, rec, tol.length, tol.tau_relative);
+      !checks)
     why << " " << checks.message();
   const std::string s = why.str();
   if (s.empty()) return ::testing::AssertionSuccess();

@@ -85,10 +85,8 @@ json hertz_by_force(double P, std::optional<double> prescribed = std::nullopt) {
   j["steps"] = 1;
   const int centre = node_at(j, Vec2::Zero());
   j["body"]["supports"] = json::array({{{"set", "diameter"}, {"fix", {"x"}}}});
-  if (prescribed)
-    j["body"]["supports"].push_back({{"node", centre}, {"fix", {"y"}}, {"values", {{"y", *prescribed}}}});
-  else
-    j["body"]["loads"] = json::array({{{"node", centre}, {"force", {0.0, -P}}}});
+  if (prescribed) j["body"]["supports"].push_back({{"node", centre}, {"fix", {"y"}}, {"values", {{"y", *prescribed}}}});
+  else j["body"]["loads"] = json::array({{{"node", centre}, {"force", {0.0, -P}}}});
   return j;
 }
 
@@ -116,9 +114,10 @@ TEST_P(HeldByContactStrategy, HertzUnderAForceMatchesTheClosedFormAndDisplacemen
   EXPECT_NEAR(contact, P, balance(f.scene) * P);  // the flat carries the whole load: no support helps
   const HertzContact closed = hertz_contact(f.scene.effective["body"], P);
   const EllipseFit fit = fit_semi_ellipse(nodes);
-  std::printf("%s: force P = %.0f N/mm: a = %.4f mm (fit %+.3f %%), p0 = %.1f MPa (fit %+.3f %%); %d real solves, %d Newton\n",
-              name(), P, closed.a, 100 * (fit.a / closed.a - 1), closed.p0, 100 * (fit.p0 / closed.p0 - 1), rec.solves,
-              rec.newton_iterations);
+  std::printf(
+      "%s: force P = %.0f N/mm: a = %.4f mm (fit %+.3f %%), p0 = %.1f MPa (fit %+.3f %%); %d real solves, %d Newton\n",
+      name(), P, closed.a, 100 * (fit.a / closed.a - 1), closed.p0, 100 * (fit.p0 / closed.p0 - 1), rec.solves,
+      rec.newton_iterations);
   EXPECT_LT(std::abs(fit.a / closed.a - 1), 0.01);
   EXPECT_LT(std::abs(fit.p0 / closed.p0 - 1), 0.01);
   // The closed-form edge within half an edge element of the nodes where contact ends (a nodal
@@ -184,8 +183,8 @@ TEST_P(HeldByContactStrategy, BlockUnderShearHoldsBelowMuNAndFailsAbove) {
       zones += n.state == ContactState::stick ? 'T' : n.state == ContactState::slip ? 'L' : '.';
       slip += n.state == ContactState::slip;
     }
-    std::printf("%s: Q/(mu N) = %.2f: reaction %.9g (Q = %.4g), %d real solves, zones %s\n", name(), ratios[k], -R.x(), Q,
-                rec.solves, zones.c_str());
+    std::printf("%s: Q/(mu N) = %.2f: reaction %.9g (Q = %.4g), %d real solves, zones %s\n", name(), ratios[k], -R.x(),
+                Q, rec.solves, zones.c_str());
     if (k > 1) EXPECT_GE(slip, slip_before);  // the slip zones grow with the load
     slip_before = slip;
   }
@@ -220,10 +219,11 @@ TEST_P(HeldByContactStrategy, DiscBetweenTwoFlatsCarriesEqualForcesWithHertzWidt
     const Zone zone = contact_zone(nodes);
     ASSERT_TRUE(zone.found);
     const EllipseFit fit = fit_semi_ellipse(nodes);
-    std::printf("%s flat: P = %.0f N/mm, Hertz a = %.4f mm, fitted %+.2f %%, p0 fitted %+.2f %%; contact ends "
-                "between %.3f and %.3f\n",
-                o ? "upper" : "lower", P, closed.a, 100 * (fit.a / closed.a - 1), 100 * (fit.p0 / closed.p0 - 1),
-                zone.right.inner, zone.right.outer);
+    std::printf(
+        "%s flat: P = %.0f N/mm, Hertz a = %.4f mm, fitted %+.2f %%, p0 fitted %+.2f %%; contact ends "
+        "between %.3f and %.3f\n",
+        o ? "upper" : "lower", P, closed.a, 100 * (fit.a / closed.a - 1), 100 * (fit.p0 / closed.p0 - 1),
+        zone.right.inner, zone.right.outer);
     EXPECT_LT(std::abs(fit.a / closed.a - 1), 0.02);
     // The closed-form edge lies between the last node that touches and the first that does not.
     EXPECT_TRUE(zone.brackets(closed.a, 0.02 * closed.a)) << "a = " << closed.a;
@@ -292,9 +292,10 @@ TEST_P(HeldByContactStrategy, BeamOnAFlatPushedAlongIt) {
       const double bound = agreement_bound(s, k, cev);
       if (s.scene.params.contact.method != ContactMethod::penalty)
         EXPECT_LE(diff, bound) << kinematics << " step " << rec.index;
-      std::printf("%s: %s beam, Q/(mu N) = %.3f: %d real solves, %d Newton; forces differ from cev's by %.2e "
-                  "(bound %.2e)\n",
-                  name(), kinematics, 20.0 * rec.factors[2] / 60.0, rec.solves, rec.newton_iterations, diff, bound);
+      std::printf(
+          "%s: %s beam, Q/(mu N) = %.3f: %d real solves, %d Newton; forces differ from cev's by %.2e "
+          "(bound %.2e)\n",
+          name(), kinematics, 20.0 * rec.factors[2] / 60.0, rec.solves, rec.newton_iterations, diff, bound);
     }
     EXPECT_NE(s.run.steps.back().reason.find("the shear load exceeds what friction can hold: Q / (mu N) = 1.16667"),
               std::string::npos)
@@ -357,10 +358,11 @@ TEST(HeldByContact, VonKarmanBeamFreeToTurnIsHeldByContact) {
       for (int n = 0; n <= 20; ++n) theta = std::max(theta, std::abs(rec.state.q[3 * n + 2]));
       const double precision = force_precision(s.scene, rec) + force_precision(lin.scene, ref);
       const json step = step_json(s.scene.problem, rec, s.scene.output);
-      std::printf("von Karman beam x %g, step %d: rigid rotation %.3e, largest theta %.3e; forces differ from the "
-                  "linear beam's by %.3e of the largest (precision %.2e); %d real solves (linear %d)\n",
-                  scale, rec.index, step["rigid_motion"]["rotation"].get<double>(), theta, p_diff / p_max,
-                  precision / p_max, rec.solves, ref.solves);
+      std::printf(
+          "von Karman beam x %g, step %d: rigid rotation %.3e, largest theta %.3e; forces differ from the "
+          "linear beam's by %.3e of the largest (precision %.2e); %d real solves (linear %d)\n",
+          scale, rec.index, step["rigid_motion"]["rotation"].get<double>(), theta, p_diff / p_max, precision / p_max,
+          rec.solves, ref.solves);
       // The linear beam drops N b.w at each end of an element (N w' beside Q): at most 2 N theta a
       // node, N at most the friction forces' sum mu P. A later step adds the difference of the
       // state it starts from (its slips are measured from there).

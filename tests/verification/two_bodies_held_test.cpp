@@ -69,7 +69,8 @@ json cylinders_held_on_their_axis(double P, std::optional<double> prescribed = s
   upper["supports"].push_back({{"node", node_on_axis(j, 0, 5.0)}, {"fix", {"x"}}});
   if (prescribed) {
     upper.erase("loads");
-    upper["supports"].push_back({{"node", node_at(j, 0, Vec2(0, 10))}, {"fix", {"y"}}, {"values", {{"y", *prescribed}}}});
+    upper["supports"].push_back(
+        {{"node", node_at(j, 0, Vec2(0, 10))}, {"fix", {"y"}}, {"values", {{"y", *prescribed}}}});
   }
   return j;
 }
@@ -116,10 +117,11 @@ TEST_P(TwoBodiesHeld, CylindersUnderAForceMatchHertz) {
   const Vec2 on_lower = body_resultant(f.scene.problem, 1, contact_forces(f.scene.problem, rec));
   const HertzContact closed = combined_hertz(f.scene.effective, P);
   const EllipseFit fit = fit_semi_ellipse(contact_profile(f.scene.problem, rec));
-  std::printf("%s: force P = %.0f N/mm: a = %.4f mm (fit %+.3f %%), p0 = %.1f MPa (fit %+.3f %%), lower body carries "
-              "%.12g; %d real solves, %d Newton\n",
-              name(), P, closed.a, 100 * (fit.a / closed.a - 1), closed.p0, 100 * (fit.p0 / closed.p0 - 1), -on_lower.y(),
-              rec.solves, rec.newton_iterations);
+  std::printf(
+      "%s: force P = %.0f N/mm: a = %.4f mm (fit %+.3f %%), p0 = %.1f MPa (fit %+.3f %%), lower body carries "
+      "%.12g; %d real solves, %d Newton\n",
+      name(), P, closed.a, 100 * (fit.a / closed.a - 1), closed.p0, 100 * (fit.p0 / closed.p0 - 1), -on_lower.y(),
+      rec.solves, rec.newton_iterations);
   EXPECT_LT(std::abs(fit.a / closed.a - 1), 0.01);
   EXPECT_LT(std::abs(fit.p0 / closed.p0 - 1), 0.01);
 
@@ -132,7 +134,6 @@ TEST_P(TwoBodiesHeld, CylindersUnderAForceMatchHertz) {
   // No rotation by symmetry, to what the stopping test pins a soft mode to: measured 3e-8 to
   // 3.4e-7 rad, at the 10 mm lever 4e-5 of the descent at most.
   EXPECT_LT(std::abs(step["rigid_motions"][0]["rotation"].get<double>()) * 10.0, 1e-4 * std::abs(down));
-
 }
 
 // The state of a force P, held by contact, and the state of the displacement that P gave its
@@ -172,10 +173,11 @@ TEST_P(TwoBodiesHeld, CylindersUnderAForceOrItsDisplacementGiveTheSameFields) {
   const double q_diff = (rec.state.q - drec.state.q).lpNorm<Eigen::Infinity>();
   const double q_max = rec.state.q.lpNorm<Eigen::Infinity>();
   const double carried = -body_resultant(d.scene.problem, 0, drec.reactions).y();
-  std::printf("%s: force %d real solves, %d Newton; displacement control (delta = %.6g mm) %d real solves, %d Newton, "
-              "support carries %.12g; forces differ by %.2e, displacements by %.2e (relative)\n",
-              name(), rec.solves, rec.newton_iterations, delta, drec.solves, drec.newton_iterations, carried,
-              p_diff / p_max, q_diff / q_max);
+  std::printf(
+      "%s: force %d real solves, %d Newton; displacement control (delta = %.6g mm) %d real solves, %d Newton, "
+      "support carries %.12g; forces differ by %.2e, displacements by %.2e (relative)\n",
+      name(), rec.solves, rec.newton_iterations, delta, drec.solves, drec.newton_iterations, carried, p_diff / p_max,
+      q_diff / q_max);
   // Penalty has no contact loop: both halves are one law solved by Newton to its residual test,
   // so they agree as closely as the exact linear models do (measured 3.8e-14).
   const bool penalty = GetParam().contact.value("method", "") == "penalty";
@@ -207,10 +209,11 @@ TEST_P(TwoBodiesHeld, FreeBlockOnAFoundationUnderPressure) {
       if (n.p_n < 0) pressing.push_back(-n.sigma_n);
     for (double v : pressing) mean += v / pressing.size();
     for (double v : pressing) spread = std::max(spread, std::abs(v / (sigma * rec.load_factor) - 1));
-    std::printf("%s, step %d: %zu nodes press, mean %.4f MPa (exact %.1f), largest departure %.2f %%, contact "
-                "resultant %.12g (load %.12g); %d real solves\n",
-                name(), rec.index, pressing.size(), mean, sigma * rec.load_factor, 100 * spread, on_block.y(), load,
-                rec.solves);
+    std::printf(
+        "%s, step %d: %zu nodes press, mean %.4f MPa (exact %.1f), largest departure %.2f %%, contact "
+        "resultant %.12g (load %.12g); %d real solves\n",
+        name(), rec.index, pressing.size(), mean, sigma * rec.load_factor, 100 * spread, on_block.y(), load,
+        rec.solves);
     EXPECT_GT(pressing.size(), 15u);
     EXPECT_LT(spread, 0.02);
   }
