@@ -18,6 +18,7 @@ extras=(
   curl
   chromium  # headless, for the browser test (tests/browser)
   clang libclang-rt-14-dev  # libFuzzer build of scripts/check-extended.sh
+  clang-format              # the layout check (ctest format_clean, scripts/check-format.sh)
   postgresql                # store contract and scale-out tests start a throwaway cluster
   haproxy                   # the load balancer of deploy/ and of the scale-out test
 )
