@@ -10,16 +10,16 @@
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
+#include <chrono>
 #include <climits>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <chrono>
 #include <ctime>
-#include <fstream>
-#include <memory>
-#include <iostream>
 #include <exception>
+#include <fstream>
+#include <iostream>
+#include <memory>
 #include <optional>
 #include <string>
 #include <thread>
@@ -55,14 +55,10 @@ int solve(int argc, char** argv) {
   int threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   for (int i = 2; i < argc; ++i) {
     const std::string a = argv[i];
-    if (a == "--threads" && i + 1 < argc && std::atoi(argv[i + 1]) >= 1)
-      threads = std::atoi(argv[++i]);
-    else if ((a == "--out" || a == "--events") && i + 1 < argc)
-      (a == "--out" ? out_path : events_path) = argv[++i];
-    else if (!a.empty() && a[0] != '-' && scene_path.empty())
-      scene_path = a;
-    else
-      return usage();
+    if (a == "--threads" && i + 1 < argc && std::atoi(argv[i + 1]) >= 1) threads = std::atoi(argv[++i]);
+    else if ((a == "--out" || a == "--events") && i + 1 < argc) (a == "--out" ? out_path : events_path) = argv[++i];
+    else if (!a.empty() && a[0] != '-' && scene_path.empty()) scene_path = a;
+    else return usage();
   }
   if (scene_path.empty()) return usage();
 
@@ -97,11 +93,12 @@ int solve(int argc, char** argv) {
     }
   }
   auto emit = [&](const nlohmann::json& ev) {
-    // Flushed per event: a reader (tail -f) sees a long step as it runs.
+    // Flushed per event: a reader (tail -f) sees a long step as it runs (two cylinders with
+    // uzawa wrote nothing for over 2 minutes).
     if (events.is_open()) events << ev.dump() << '\n' << std::flush;
   };
-  std::printf("%5s %12s %6s %6s %6s %12s %7s %6s %6s %9s  %s\n", "step", "load_factor", "iters",
-              "passes", "newton", "||v||_2", "contact", "stick", "slip", "ms", "status");
+  std::printf("%5s %12s %6s %6s %6s %12s %7s %6s %6s %9s  %s\n", "step", "load_factor", "iters", "passes", "newton",
+              "||v||_2", "contact", "stick", "slip", "ms", "status");
   // With --out, the result is written on a thread of its own while the solve runs: the members
   // known before it, then each finished step while the next one solves.
   std::optional<grip::ResultWriter> writer;
@@ -113,23 +110,21 @@ int solve(int argc, char** argv) {
     emit(grip::step_finished_event(rec));
     if (writer) writer->add_step(rec);
     const auto& last = rec.history.empty() ? grip::IterationEvent{} : rec.history.back();
-    std::printf("%5d %12.6g %6d %6d %6d %12.3e %7d %6d %6d %9.2f  %s\n", rec.index,
-                rec.load_factor, rec.solves, rec.passes, rec.newton_iterations, last.v2,
-                last.stick + last.slip, last.stick, last.slip, rec.seconds * 1e3,
+    std::printf("%5d %12.6g %6d %6d %6d %12.3e %7d %6d %6d %9.2f  %s\n", rec.index, rec.load_factor, rec.solves,
+                rec.passes, rec.newton_iterations, last.v2, last.stick + last.slip, last.stick, last.slip,
+                rec.seconds * 1e3,
                 rec.converged ? (rec.warning.empty() ? "converged" : ("converged; warning: " + rec.warning).c_str())
                               : rec.reason.c_str());
     std::fflush(stdout);
   };
   scene.params.newton.parallel = on_threads(threads);
   const auto read = now();
-  const grip::RunResult run =
-      grip::run_load_steps(scene.problem, scene.steps, scene.params, observer);
+  const grip::RunResult run = grip::run_load_steps(scene.problem, scene.steps, scene.params, observer);
   const auto solved = now();
   emit(run.completed ? nlohmann::json{{"type", "job_finished"}}
-                     : nlohmann::json{{"type", "job_failed"}, {"reason", run.reason}});
-  std::printf("total: %ld contact iterations, %ld Newton iterations, %ld factorizations, %.3f s\n",
-              run.counters.solves, run.counters.newton_iterations, run.counters.factorizations,
-              run.seconds);
+                     : grip::job_failed_event(run.failure, run.reason, run.failure_step));
+  std::printf("total: %ld contact iterations, %ld Newton iterations, %ld factorizations, %.3f s\n", run.counters.solves,
+              run.counters.newton_iterations, run.counters.factorizations, run.seconds);
   if (writer) {  // the last step's text and the members the run decides
     if (!writer->finish(run)) {
       std::fprintf(stderr, "cannot write %s\n", out_path.c_str());

@@ -38,7 +38,8 @@ int main(int argc, char** argv) {
   const std::vector<std::string> args(argv + std::min(argc, 2), argv + argc);
   if (command == "serve") return serve(args);
   if (command == "healthcheck") return grip::server::healthcheck(args);
-  std::fprintf(stderr, "usage: grip serve [options]   (grip serve --help)\n"
-                       "       grip healthcheck [--host H] [--port P]\n");
+  std::fprintf(stderr,
+               "usage: grip serve [options]   (grip serve --help)\n"
+               "       grip healthcheck [--host H] [--port P]\n");
   return 2;
 }

@@ -50,7 +50,7 @@ inline void heap_on_huge_pages() {
   mallopt(M_TOP_PAD, kHeapReserve);
   const auto from = (reinterpret_cast<uintptr_t>(sbrk(0)) + 4095) & ~uintptr_t{4095};
   void* volatile grow = malloc(mallinfo2().fordblks + 1);  // more than the heap has free: it grows now
-  free(grow);  // (volatile: the compiler would drop a malloc that is freed unused)
+  free(grow);                     // (volatile: the compiler would drop a malloc that is freed unused)
   mallopt(M_TOP_PAD, 128 << 10);  // glibc's default again: later growth asks for what it needs
   const auto to = reinterpret_cast<uintptr_t>(sbrk(0));
   if (grow && to > from) madvise(reinterpret_cast<void*>(from), to - from, MADV_HUGEPAGE);

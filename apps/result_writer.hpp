@@ -93,7 +93,8 @@ class ResultWriter {
   // The result of `scene` into the file at `path`, its head first. The thread first opens the
   // file: truncating an old result (ext4 frees its blocks: 5-25 ms for 28 MB here) happens
   // while the solve runs.
-  ResultWriter(std::string path, const Scene& scene) : path_(std::move(path)), scene_(scene), thread_([this] { run(); }) {
+  ResultWriter(std::string path, const Scene& scene)
+      : path_(std::move(path)), scene_(scene), thread_([this] { run(); }) {
     add(result_head_parts(scene_));
   }
   // Without finish, what was not yet written is left out.
@@ -140,8 +141,8 @@ class ResultWriter {
     std::vector<ResultPart> parts;
     std::shared_ptr<const void> keep;
     size_t claimed = 0, formatted = 0;  // parts [0, claimed) taken; how many are done
-    std::vector<Piece> pieces;  // each part's text
-    MappedText texts[2];  // the thread's and the caller's
+    std::vector<Piece> pieces;          // each part's text
+    MappedText texts[2];                // the thread's and the caller's
   };
 
   // A text written after the ones handed over before; `keep` holds what its parts refer to
@@ -203,7 +204,8 @@ class ResultWriter {
 
   void run() {
     file_.open(path_);
-    nlohmann::json effects = effects_json(scene_);  // while the solve runs (the element quality: 2.9 M instructions at Hertz a/h 20)
+    nlohmann::json effects =
+        effects_json(scene_);  // while the solve runs (the element quality: 2.9 M instructions at Hertz a/h 20)
     std::unique_lock lock(mutex_);
     effects_ = std::move(effects);
     changed_.notify_all();
@@ -226,8 +228,8 @@ class ResultWriter {
   std::mutex mutex_;
   std::condition_variable changed_;  // the effects made, a text added, a part formatted, finishing, closed, stop
   std::deque<std::unique_ptr<Text>> texts_;  // not yet written, in order
-  std::vector<MappedText> spare_;  // written texts' memory
-  std::optional<nlohmann::json> effects_;  // effects_json(scene), made on the thread
+  std::vector<MappedText> spare_;            // written texts' memory
+  std::optional<nlohmann::json> effects_;    // effects_json(scene), made on the thread
   bool finishing_ = false, closed_ = false, written_ = false, stop_ = false;
   std::thread thread_;  // last: started once the members it uses exist
 };

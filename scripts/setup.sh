@@ -8,6 +8,8 @@ service=(
   libeigen3-dev nlohmann-json3-dev libspdlog-dev libgtest-dev
   libcpp-httplib-dev libvalijson-dev libsqlite3-dev
   libpq-dev  # the shared job store (grip serve --db postgresql://...)
+  zlib1g-dev  # results stored gzip-compressed by earlier versions (read still)
+  libzstd-dev  # results stored zstd-compressed
   libsuitesparse-dev  # CHOLMOD: sparse Cholesky of symmetric tangents; UMFPACK: LU of large contact zones' saddle-point systems
 )
 extras=(
@@ -16,6 +18,7 @@ extras=(
   curl
   chromium  # headless, for the browser test (tests/browser)
   clang libclang-rt-14-dev  # libFuzzer build of scripts/check-extended.sh
+  clang-format              # the layout check (ctest format_clean, scripts/check-format.sh)
   postgresql                # store contract and scale-out tests start a throwaway cluster
   haproxy                   # the load balancer of deploy/ and of the scale-out test
 )

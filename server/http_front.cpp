@@ -6,8 +6,8 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
-#include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <condition_variable>
@@ -47,8 +47,7 @@ std::string peer_address(int fd) {
   socklen_t len = sizeof a;
   char text[INET6_ADDRSTRLEN] = "?";
   if (::getpeername(fd, reinterpret_cast<sockaddr*>(&a), &len) == 0) {
-    if (a.ss_family == AF_INET)
-      ::inet_ntop(AF_INET, &reinterpret_cast<sockaddr_in*>(&a)->sin_addr, text, sizeof text);
+    if (a.ss_family == AF_INET) ::inet_ntop(AF_INET, &reinterpret_cast<sockaddr_in*>(&a)->sin_addr, text, sizeof text);
     else if (a.ss_family == AF_INET6)
       ::inet_ntop(AF_INET6, &reinterpret_cast<sockaddr_in6*>(&a)->sin6_addr, text, sizeof text);
   }
@@ -77,10 +76,12 @@ void address_and_port(int fd, bool peer, std::string& ip, int& port) {
 // A problem document written straight to the socket, for answers given outside httplib's
 // request cycle (a refused connection, a request line that never ended). Best effort: the
 // socket does not block.
-void write_problem(int fd, int status, const char* reason, const std::string& slug,
-                   const std::string& detail, int retry_after) {
-  const nlohmann::json body = {{"type", "urn:grip:problem:" + slug}, {"title", reason},
-                               {"status", status}, {"detail", detail},
+void write_problem(int fd, int status, const char* reason, const std::string& slug, const std::string& detail,
+                   int retry_after) {
+  const nlohmann::json body = {{"type", "urn:grip:problem:" + slug},
+                               {"title", reason},
+                               {"status", status},
+                               {"detail", detail},
                                {"errors", {{{"pointer", ""}, {"detail", detail}}}}};
   const std::string text = body.dump();
   std::string head = "HTTP/1.1 " + std::to_string(status) + " " + reason +
@@ -194,12 +195,8 @@ class GuardedStream final : public httplib::Stream {
     return n;
   }
 
-  void get_remote_ip_and_port(std::string& ip, int& port) const override {
-    address_and_port(fd_, true, ip, port);
-  }
-  void get_local_ip_and_port(std::string& ip, int& port) const override {
-    address_and_port(fd_, false, ip, port);
-  }
+  void get_remote_ip_and_port(std::string& ip, int& port) const override { address_and_port(fd_, true, ip, port); }
+  void get_local_ip_and_port(std::string& ip, int& port) const override { address_and_port(fd_, false, ip, port); }
   socket_t socket() const override { return fd_; }
   bool has_buffered() const { return pos_ < len_; }
 
@@ -337,8 +334,8 @@ bool HttpFront::process_and_close_socket(socket_t sock) {
   note.client = peer_address(sock);
   note.overflow = t_reserved;
   if (!admit(note.client)) {
-    refused_log.warn("{}: connection refused: over {} open connections from this address",
-                     note.client, limits_.per_client);
+    refused_log.warn("{}: connection refused: over {} open connections from this address", note.client,
+                     limits_.per_client);
     write_problem(sock, 503, "Service Unavailable", "too-many-connections",
                   "this address has " + std::to_string(limits_.per_client) +
                       " connections open, this server's limit per client; retry later",
@@ -366,7 +363,8 @@ void HttpFront::serve(socket_t sock, ConnectionNote& note) {
   while (svr_sock_ != INVALID_SOCKET && left > 0) {
     // Wait for the next request: the head's time on a new connection, the keep-alive time
     // (in slices, to notice stop()) on an idle one.
-    const auto until = Clock::now() + (first ? head_time : std::chrono::milliseconds(1000 * limits_.keep_alive_seconds));
+    const auto until =
+        Clock::now() + (first ? head_time : std::chrono::milliseconds(1000 * limits_.keep_alive_seconds));
     if (!first) ++idle_;
     bool ready = stream.has_buffered();
     while (!ready && svr_sock_ != INVALID_SOCKET && Clock::now() < until)
@@ -386,39 +384,33 @@ void HttpFront::serve(socket_t sock, ConnectionNote& note) {
     stream.start_head();
     stream.set_deadline(first ? until : Clock::now() + head_time);
     first = false;
-    const bool close = left == 1 || note.overflow || idle_.load() >= limits_.max_idle ||
-                       svr_sock_ == INVALID_SOCKET;
+    const bool close = left == 1 || note.overflow || idle_.load() >= limits_.max_idle || svr_sock_ == INVALID_SOCKET;
     bool closed = false;
-    const bool served = process_request(
-        stream, close, closed, [&](httplib::Request& req) {
-          // The head is in: the body has its own deadline.
-          note.in_body = true;
-          stream.set_deadline(Clock::now() + limits_.body);
-          // A DELETE (or OPTIONS) with neither length nor chunks has no body: httplib would
-          // otherwise read one until the client closes.
-          if (!req.has_header("Content-Length") && !req.has_header("Transfer-Encoding") &&
-              req.method != "POST" && req.method != "PUT" && req.method != "PATCH")
-            req.set_header("Content-Length", "0");
-        });
+    const bool served = process_request(stream, close, closed, [&](httplib::Request& req) {
+      // The head is in: the body has its own deadline.
+      note.in_body = true;
+      stream.set_deadline(Clock::now() + limits_.body);
+      note.restart_body_deadline = [&stream, this] { stream.set_deadline(Clock::now() + limits_.body); };
+      // A DELETE (or OPTIONS) with neither length nor chunks has no body: httplib would
+      // otherwise read one until the client closes.
+      if (!req.has_header("Content-Length") && !req.has_header("Transfer-Encoding") && req.method != "POST" &&
+          req.method != "PUT" && req.method != "PATCH")
+        req.set_header("Content-Length", "0");
+    });
     if (!served) {
       // Ended before httplib could answer: the request line never ended, or was too long.
       if (note.head_too_large)
         write_problem(sock, 414, "URI Too Long", "uri-too-long",
-                      "the request line is over this server's limit of " + std::to_string(kMaxLine) +
-                          " bytes",
-                      0);
+                      "the request line is over this server's limit of " + std::to_string(kMaxLine) + " bytes", 0);
       else if (note.deadline_missed && !note.in_body)
         write_problem(sock, 408, "Request Timeout", "request-timeout",
-                      "the request head did not arrive within " + std::to_string(head_time.count()) +
-                          " ms",
-                      0);
+                      "the request head did not arrive within " + std::to_string(head_time.count()) + " ms", 0);
       if (note.deadline_missed || note.head_too_large)
         slow_log.warn("{}: request line {}; closed", note.client,
                       note.head_too_large ? "over the limit" : "not complete in time");
       return;
     }
-    if (close || closed || note.close || note.deadline_missed || note.head_too_large || note.line_too_long)
-      return;
+    if (close || closed || note.close || note.deadline_missed || note.head_too_large || note.line_too_long) return;
     --left;
   }
 }

@@ -21,6 +21,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstddef>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -32,13 +33,16 @@ namespace grip::server {
 
 // What the request on this thread's connection ran into; read by the error handler.
 struct ConnectionNote {
-  std::string client;  // the peer's address
+  std::string client;            // the peer's address
   bool in_body = false;          // the head has been read
   bool deadline_missed = false;  // in the head or, with in_body, the body
   bool line_too_long = false;    // a line of the head over kMaxLine
   bool head_too_large = false;   // the head over kMaxHead
   bool overflow = false;         // served by a reserved thread: health and readiness only
   bool close = false;            // close the connection after this response
+  // Starts the body's deadline again: a handler that waited before reading the body (the
+  // memory budget of server/body_budget.hpp) gives the client its whole deadline.
+  std::function<void()> restart_body_deadline;
 };
 
 class HttpFront : public httplib::Server {

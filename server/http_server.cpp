@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -14,6 +15,9 @@
 #include <regex>
 #include <sstream>
 
+#include "server/body_budget.hpp"
+#include "server/compression.hpp"
+#include "server/observability.hpp"
 #include "server/tar.hpp"
 #include "server/ui.hpp"
 #include "server/util.hpp"
@@ -49,11 +53,15 @@ json error_list(std::string detail, std::string pointer = "") {
 }
 
 // RFC 9457 problem details with grip's `errors[]` of {pointer, detail}.
-void problem(Response& res, const Request& req, int status, const std::string& slug,
-             const std::string& title, const std::string& detail, json errors = nullptr) {
+void problem(Response& res, const Request& req, int status, const std::string& slug, const std::string& title,
+             const std::string& detail, json errors = nullptr) {
   if (errors.is_null() || errors.empty()) errors = error_list(detail);
-  const json body = {{"type", "urn:grip:problem:" + slug}, {"title", title},   {"status", status},
-                     {"detail", detail},                   {"instance", req.path}, {"errors", errors}};
+  const json body = {{"type", "urn:grip:problem:" + slug},
+                     {"title", title},
+                     {"status", status},
+                     {"detail", detail},
+                     {"instance", req.path},
+                     {"errors", errors}};
   res.status = status;
   // A parse error's message quotes the bytes it stopped at, which may not be UTF-8.
   res.set_content(body.dump(-1, ' ', false, json::error_handler_t::replace), kProblemJson);
@@ -76,8 +84,9 @@ std::optional<std::int64_t> parse_count(const std::string& s) {
 }
 
 bool safe_name(const std::string& s) {
-  return !s.empty() && s.size() < 100 && s[0] != '.' &&
-         std::all_of(s.begin(), s.end(), [](unsigned char c) { return std::isalnum(c) || c == '-' || c == '_' || c == '.'; });
+  return !s.empty() && s.size() < 100 && s[0] != '.' && std::all_of(s.begin(), s.end(), [](unsigned char c) {
+    return std::isalnum(c) || c == '-' || c == '_' || c == '.';
+  });
 }
 
 std::optional<std::string> read_file(const fs::path& p) {
@@ -105,6 +114,21 @@ std::optional<std::int64_t> decode_cursor(const std::string& c) {
 
 std::string job_path(const std::string& id) { return "/v1/jobs/" + id; }
 
+// Accept-Encoding names `coding` (or *) without q=0.
+bool accepts(const Request& req, std::string_view coding) {
+  std::stringstream list(lower(req.get_header_value("Accept-Encoding")));
+  std::string item;
+  while (std::getline(list, item, ',')) {
+    const size_t semi = item.find(';');
+    std::string c = item.substr(0, semi), params = semi == std::string::npos ? "" : item.substr(semi + 1);
+    c.erase(std::remove_if(c.begin(), c.end(), ::isspace), c.end());
+    params.erase(std::remove_if(params.begin(), params.end(), ::isspace), params.end());
+    const bool refused = params.rfind("q=0", 0) == 0 && params.find_first_of("123456789", 2) == std::string::npos;
+    if ((c == coding || c == "*") && !refused) return true;
+  }
+  return false;
+}
+
 // The methods a known route takes (empty: no such route), for 405 + Allow.
 std::string allowed_methods(const std::string& path) {
   static const std::vector<std::pair<std::regex, std::string>> routes = {
@@ -123,17 +147,23 @@ std::string allowed_methods(const std::string& path) {
 
 json job_document(const JobView& v) {
   const JobRecord& r = v.record;
-  json doc = {{"jobID", r.id},          {"processID", kProcessId}, {"type", "process"},
-              {"status", to_string(r.status)}, {"message", r.message}, {"created", r.created},
-              {"updated", r.updated},   {"nodes", r.nodes},        {"steps", r.steps},
-              {"attempts", r.attempts}};
+  json doc = {
+      {"jobID", r.id},        {"processID", kProcessId}, {"type", "process"},    {"status", to_string(r.status)},
+      {"message", r.message}, {"created", r.created},    {"updated", r.updated}, {"nodes", r.nodes},
+      {"steps", r.steps},     {"attempts", r.attempts}};
   if (!r.owner.empty()) doc["replica"] = r.owner;  // the process that runs (or last ran) it
   if (!r.started.empty()) doc["started"] = r.started;
   if (!r.finished.empty()) doc["finished"] = r.finished;
-  int percent = r.status == JobStatus::successful ? 100 : 0;
+  // Converged steps: while running from the run's progress, once finished as stored.
+  int completed = r.status == JobStatus::successful ? r.steps : r.steps_completed;
+  if (v.progress) completed = v.progress->steps_done;
+  doc["steps_completed"] = completed;
+  const int percent = r.steps > 0 ? 100 * completed / r.steps : (r.status == JobStatus::successful ? 100 : 0);
+  if (r.status == JobStatus::dismissed) doc["failure"] = {{"kind", "dismissed"}, {"message", r.message}, {"step", 0}};
+  else if (r.status == JobStatus::failed && !r.failure_kind.empty())  // empty: failed before kinds were kept
+    doc["failure"] = {{"kind", r.failure_kind}, {"message", r.message}, {"step", r.failure_step}};
   if (v.progress) {
     const Progress& p = *v.progress;
-    if (r.steps > 0) percent = 100 * p.steps_done / r.steps;
     doc["step"] = p.step;
     doc["contact_error"] = p.contact_error;
     doc["iterations"] = p.iterations;
@@ -144,18 +174,20 @@ json job_document(const JobView& v) {
     doc["iterations"] = r.iterations;
     doc["solve_seconds"] = r.solve_seconds;
   }
+  if (is_finished(r.status) && r.stored_bytes > 0) doc["stored_bytes"] = r.stored_bytes;
+  if (!r.request_id.empty()) doc["request_id"] = r.request_id;
   doc["progress"] = percent;
   const std::string self = job_path(r.id);
   json links = json::array({
       {{"href", self}, {"rel", "self"}, {"type", kJson}, {"title", "this job"}},
-      {{"href", self + "/events"}, {"rel", "monitor"}, {"type", "text/event-stream"},
+      {{"href", self + "/events"},
+       {"rel", "monitor"},
+       {"type", "text/event-stream"},
        {"title", "events: replayed, then live"}},
-      {{"href", self + "/convergence"}, {"rel", "related"}, {"type", kJson},
-       {"title", "contact error history"}},
+      {{"href", self + "/convergence"}, {"rel", "related"}, {"type", kJson}, {"title", "contact error history"}},
   });
   if (r.status == JobStatus::successful || r.status == JobStatus::failed)
-    links.push_back({{"href", self + "/result"}, {"rel", kResultsRel}, {"type", kJson},
-                     {"title", "result"}});
+    links.push_back({{"href", self + "/result"}, {"rel", kResultsRel}, {"type", kJson}, {"title", "result"}});
   doc["links"] = links;
   return doc;
 }
@@ -164,15 +196,17 @@ json job_document(const JobView& v) {
 
 struct HttpServer::Impl {
   Impl(JobService& s, HttpOptions o, std::atomic<int>& streams)
-      : service(s), options(std::move(o)), open_streams(streams), svr(options.front) {}
+      : service(s), options(std::move(o)), open_streams(streams), svr(options.front),
+        budget(options.parse_budget_bytes ? options.parse_budget_bytes : options.max_body_bytes) {}
 
   JobService& service;
   HttpOptions options;
   std::atomic<int>& open_streams;
   HttpFront svr;
   std::atomic<bool> stopping{false};
-  std::atomic<std::int64_t> requests{0};
+  RequestMetrics request_metrics;
   int listen_fd = -1;  // the listening socket, seen by the socket-options hook
+  BodyBudget budget;   // submissions' bodies being read and checked
 
   // Registers a handler for every path pattern given.
   template <class F>
@@ -218,20 +252,20 @@ void HttpServer::Impl::hooks() {
 
   svr.set_pre_routing_handler([this](const Request& req, Response& res) {
     request_start = std::chrono::steady_clock::now();
-    ++requests;
+    // Echoed in the answer, logged, and attached to a job it creates.
+    res.set_header("X-Request-Id", request_id_for(req.get_header_value("X-Request-Id")));
     ConnectionNote* note = HttpFront::note();
     if (note && note->overflow && req.path != "/v1/health" && req.path != "/v1/ready") {
       res.set_header("Retry-After", "1");
       problem(res, req, 503, "server-busy", "Server busy",
-              "every connection this server serves at once (" +
-                  std::to_string(options.front.max_connections) +
+              "every connection this server serves at once (" + std::to_string(options.front.max_connections) +
                   ") is taken; only /v1/health and /v1/ready are answered; retry later");
       return httplib::Server::HandlerResponse::Handled;
     }
     // A body of unknown length would be read until the client closes (curl -X POST without
     // data held a thread for 10 s).
-    if ((req.method == "POST" || req.method == "PUT" || req.method == "PATCH") &&
-        !req.has_header("Content-Length") && !req.has_header("Transfer-Encoding")) {
+    if ((req.method == "POST" || req.method == "PUT" || req.method == "PATCH") && !req.has_header("Content-Length") &&
+        !req.has_header("Transfer-Encoding")) {
       if (note) note->close = true;
       res.set_header("Connection", "close");
       problem(res, req, 411, "length-required", "Length required",
@@ -269,10 +303,11 @@ void HttpServer::Impl::hooks() {
       }
       if (res.status == 400 && (note->head_too_large || note->line_too_long)) {
         res.set_header("Connection", "close");
-        problem(res, req, 431, "header-too-large", "Request header fields too large",
-                note->head_too_large
-                    ? "the request head is over this server's limit of " + std::to_string(HttpFront::kMaxHead) + " bytes"
-                    : "a header line is over this server's limit of " + std::to_string(HttpFront::kMaxLine) + " bytes");
+        problem(
+            res, req, 431, "header-too-large", "Request header fields too large",
+            note->head_too_large
+                ? "the request head is over this server's limit of " + std::to_string(HttpFront::kMaxHead) + " bytes"
+                : "a header line is over this server's limit of " + std::to_string(HttpFront::kMaxLine) + " bytes");
         spdlog::warn("{}: 431: request head over its limit", note->client);
         return httplib::Server::HandlerResponse::Handled;
       }
@@ -309,6 +344,13 @@ void HttpServer::Impl::hooks() {
 
   svr.set_exception_handler([](const Request& req, Response& res, std::exception_ptr ep) {
     std::string what = "unknown exception";
+    struct KeepId {  // the headers are cleared below; the request id stays
+      Response& res;
+      const std::string id = res.get_header_value("X-Request-Id");
+      ~KeepId() {
+        if (!id.empty() && !res.has_header("X-Request-Id")) res.set_header("X-Request-Id", id);
+      }
+    } keep{res};
     try {
       std::rethrow_exception(ep);
     } catch (const StoreUnavailable& e) {
@@ -327,12 +369,13 @@ void HttpServer::Impl::hooks() {
             "the server failed to answer this request; it has been logged");
   });
 
-  svr.set_logger([](const Request& req, const Response& res) {
-    const double ms =
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - request_start).count();
+  svr.set_logger([this](const Request& req, const Response& res) {
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - request_start).count();
+    request_metrics.record(req.method, route_template(req.path), res.status, seconds);
     const bool quiet = req.path == "/v1/health" || req.path == "/v1/ready" || req.path == "/v1/metrics";
-    spdlog::log(quiet ? spdlog::level::debug : spdlog::level::info, "{} {} {} {:.1f} ms",
-                req.method, req.path, res.status, ms);
+    const std::string id = res.get_header_value("X-Request-Id");
+    spdlog::log(quiet ? spdlog::level::debug : spdlog::level::info, "{} {} {} {:.1f} ms request {} client {}",
+                req.method, req.path, res.status, 1000 * seconds, id.empty() ? "-" : id, req.remote_addr);
   });
 }
 
@@ -362,10 +405,11 @@ void HttpServer::Impl::routes() {
     send_json(res, 200,
               {{"title", "grip"},
                {"description", "2D frictional contact solver service (contact error vector scheme)"},
-               {"links", json::array({{{"href", "/"}, {"rel", "self"}, {"type", kJson}},
-                                      {{"href", "/conformance"}, {"rel", "http://www.opengis.net/def/rel/ogc/1.0/conformance"}},
-                                      {{"href", "/processes"}, {"rel", "http://www.opengis.net/def/rel/ogc/1.0/processes"}},
-                                      {{"href", "/jobs"}, {"rel", "http://www.opengis.net/def/rel/ogc/1.0/job-list"}}})}});
+               {"links",
+                json::array({{{"href", "/"}, {"rel", "self"}, {"type", kJson}},
+                             {{"href", "/conformance"}, {"rel", "http://www.opengis.net/def/rel/ogc/1.0/conformance"}},
+                             {{"href", "/processes"}, {"rel", "http://www.opengis.net/def/rel/ogc/1.0/processes"}},
+                             {{"href", "/jobs"}, {"rel", "http://www.opengis.net/def/rel/ogc/1.0/job-list"}}})}});
   });
   // ---- the browser page (server/ui.hpp)
   svr.Get("/ui", [](const Request& req, Response& res) { serve_page_file(req, res, "index.html"); });
@@ -375,10 +419,11 @@ void HttpServer::Impl::routes() {
   });
   svr.Get("/conformance", [](const Request&, Response& res) {
     send_json(res, 200,
-              {{"conformsTo", {"http://www.opengis.net/spec/ogcapi-processes-1/1.0/conf/core",
-                               "http://www.opengis.net/spec/ogcapi-processes-1/1.0/conf/json",
-                               "http://www.opengis.net/spec/ogcapi-processes-1/1.0/conf/job-list",
-                               "http://www.opengis.net/spec/ogcapi-processes-1/1.0/conf/dismiss"}}});
+              {{"conformsTo",
+                {"http://www.opengis.net/spec/ogcapi-processes-1/1.0/conf/core",
+                 "http://www.opengis.net/spec/ogcapi-processes-1/1.0/conf/json",
+                 "http://www.opengis.net/spec/ogcapi-processes-1/1.0/conf/job-list",
+                 "http://www.opengis.net/spec/ogcapi-processes-1/1.0/conf/dismiss"}}});
   });
   get({"/processes", "/v1/processes"}, [](const Request&, Response& res) {
     send_json(res, 200,
@@ -403,8 +448,7 @@ void HttpServer::Impl::routes() {
     submit(req, res, reader, false);
   });
   get({"/v1/jobs", "/jobs"}, [this](const Request& req, Response& res) { list_jobs(req, res); });
-  get({R"(/v1/jobs/([^/]+))", R"(/jobs/([^/]+))"},
-      [this](const Request& req, Response& res) { get_job(req, res); });
+  get({R"(/v1/jobs/([^/]+))", R"(/jobs/([^/]+))"}, [this](const Request& req, Response& res) { get_job(req, res); });
   svr.Delete(R"(/v1/jobs/([^/]+))", [this](const Request& req, Response& res) { dismiss(req, res); });
   svr.Delete(R"(/jobs/([^/]+))", [this](const Request& req, Response& res) { dismiss(req, res); });
   get({R"(/v1/jobs/([^/]+)/events)", R"(/jobs/([^/]+)/events)"},
@@ -419,19 +463,28 @@ void HttpServer::Impl::routes() {
   svr.Get("/v1/schemas", [this, schemas](const Request& req, Response& res) {
     file_list(req, res, schemas, ".schema.json", "/v1/schemas/");
   });
-  svr.Get(R"(/v1/schemas/([^/]+))", [this, schemas](const Request& req, Response& res) {
-    file(req, res, schemas, ".schema.json");
-  });
+  svr.Get(R"(/v1/schemas/([^/]+))",
+          [this, schemas](const Request& req, Response& res) { file(req, res, schemas, ".schema.json"); });
   svr.Get("/v1/examples", [this, schemas](const Request& req, Response& res) {
     file_list(req, res, schemas / "examples", ".json", "/v1/examples/");
   });
-  svr.Get(R"(/v1/examples/([^/]+))", [this, schemas](const Request& req, Response& res) {
-    file(req, res, schemas / "examples", ".json");
-  });
+  svr.Get(R"(/v1/examples/([^/]+))",
+          [this, schemas](const Request& req, Response& res) { file(req, res, schemas / "examples", ".json"); });
 }
 
-void HttpServer::Impl::submit(const Request& req, Response& res, const httplib::ContentReader& reader,
-                              bool ogc) {
+void HttpServer::Impl::submit(const Request& req, Response& res, const httplib::ContentReader& reader, bool ogc) {
+  // The body's length of the memory budget (server/body_budget.hpp), held until the answer is
+  // built (destroyed last).
+  const auto declared = parse_count(req.get_header_value("Content-Length"));
+  auto hold = budget.take(std::min<std::size_t>(declared.value_or(options.max_body_bytes), options.max_body_bytes),
+                          std::chrono::seconds(120));
+  if (!hold) {
+    res.set_header("Retry-After", "5");
+    return problem(res, req, 503, "busy", "Busy",
+                   "this server is reading as many scenes as its memory budget allows; nothing was accepted; "
+                   "retry after 5 s");  // after 2 minutes of waiting
+  }
+  if (ConnectionNote* note = HttpFront::note(); note && note->restart_body_deadline) note->restart_body_deadline();
   // The body is read here: httplib 0.11.4 holds a body to the payload limit only when it has
   // a Content-Length (a chunked one of 100 MB was buffered whole). Past the limit the rest is
   // read and dropped, as httplib does with a long Content-Length, so the client gets its 413.
@@ -446,9 +499,9 @@ void HttpServer::Impl::submit(const Request& req, Response& res, const httplib::
     return true;
   });
   if (too_large || res.status == 413)
-    return problem(res, req, 413, "payload-too-large", "Payload too large",
-                   "the request body is over this server's limit of " +
-                       std::to_string(options.max_body_bytes) + " bytes");
+    return problem(
+        res, req, 413, "payload-too-large", "Payload too large",
+        "the request body is over this server's limit of " + std::to_string(options.max_body_bytes) + " bytes");
   if (!complete) {
     if (const ConnectionNote* note = HttpFront::note(); note && note->deadline_missed) {
       res.set_header("Connection", "close");
@@ -461,23 +514,20 @@ void HttpServer::Impl::submit(const Request& req, Response& res, const httplib::
   const std::string media = type.substr(0, type.find(';'));
   auto trimmed = media;
   trimmed.erase(std::remove_if(trimmed.begin(), trimmed.end(), ::isspace), trimmed.end());
-  if (trimmed != "application/json" &&
-      !(trimmed.size() > 5 && trimmed.compare(trimmed.size() - 5, 5, "+json") == 0)) {
+  if (trimmed != "application/json" && !(trimmed.size() > 5 && trimmed.compare(trimmed.size() - 5, 5, "+json") == 0)) {
     res.set_header("Accept-Post", "application/json");
-    return problem(res, req, 415, "unsupported-media-type", "Unsupported media type",
-                   "a scene is submitted as application/json, not '" +
-                       (media.empty() ? std::string("(none)") : media) + "'");
+    return problem(
+        res, req, 415, "unsupported-media-type", "Unsupported media type",
+        "a scene is submitted as application/json, not '" + (media.empty() ? std::string("(none)") : media) + "'");
   }
   if (nested_deeper_than(text, kMaxJsonDepth))
     return problem(res, req, 400, "malformed-json", "Malformed JSON",
-                   "arrays and objects are nested deeper than " + std::to_string(kMaxJsonDepth) +
-                       " levels");
+                   "arrays and objects are nested deeper than " + std::to_string(kMaxJsonDepth) + " levels");
   json body;
   try {
     body = json::parse(text);
   } catch (const json::parse_error& e) {
-    return problem(res, req, 400, "malformed-json", "Malformed JSON",
-                   "the body is not JSON: " + std::string(e.what()),
+    return problem(res, req, 400, "malformed-json", "Malformed JSON", "the body is not JSON: " + std::string(e.what()),
                    error_list("parse error at byte " + std::to_string(e.byte) + ": " + e.what()));
   } catch (const json::exception& e) {  // a number out of range (1e400): out_of_range.406
     return problem(res, req, 400, "malformed-json", "Malformed JSON",
@@ -504,32 +554,35 @@ void HttpServer::Impl::submit(const Request& req, Response& res, const httplib::
                      "Idempotency-Key must have 1 to 255 characters");
   }
   try {
-    const SubmitResult r = service.submit(scene, key);
+    const SubmitResult r = service.submit(scene, key, res.get_header_value("X-Request-Id"));
     res.set_header("Location", job_path(r.job.record.id));
     if (r.replayed) res.set_header("Idempotent-Replayed", "true");
     send_json(res, 201, job_document(r.job));
   } catch (const SceneErrors& e) {
     // Listed up to a bound: 8 MB of equal nodes made a million errors, a 99 MB answer and a
     // peak of 1.9 GB.
-    constexpr size_t kMaxListed = 100;
+    // The reader and the validator stop at kMaxSceneIssues (more() then).
+    constexpr size_t kMaxListed = kMaxSceneIssues;
     const auto& issues = e.issues();
     json errors = json::array();
     for (size_t i = 0; i < std::min(issues.size(), kMaxListed); ++i)
-      errors.push_back({{"pointer", prefix + (issues[i].pointer == "/" ? "" : issues[i].pointer)},
-                        {"detail", issues[i].detail}});
+      errors.push_back(
+          {{"pointer", prefix + (issues[i].pointer == "/" ? "" : issues[i].pointer)}, {"detail", issues[i].detail}});
+    const size_t listed = std::min(issues.size(), kMaxListed);
     problem(res, req, 422, "invalid-scene", "Invalid scene",
-            std::to_string(issues.size()) + " problem(s) in the scene" +
-                (issues.size() > kMaxListed ? "; the first " + std::to_string(kMaxListed) + " are listed" : ""),
+            e.more()
+                ? "more than " + std::to_string(listed) + " problems in the scene; the first " +
+                      std::to_string(listed) + " found are listed"
+                : std::to_string(issues.size()) + " problem(s) in the scene" +
+                      (issues.size() > kMaxListed ? "; the first " + std::to_string(kMaxListed) + " are listed" : ""),
             std::move(errors));
   } catch (const QueueFull& e) {
     res.set_header("Retry-After", std::to_string(e.retry_after_seconds));
     problem(res, req, 503, "queue-full", "Queue full",
-            "the job queue is full; nothing was accepted; retry after " +
-                std::to_string(e.retry_after_seconds) + " s");
+            "the job queue is full; nothing was accepted; retry after " + std::to_string(e.retry_after_seconds) + " s");
   } catch (const ShuttingDown&) {
     res.set_header("Retry-After", "10");
-    problem(res, req, 503, "shutting-down", "Shutting down",
-            "the server is shutting down; nothing was accepted");
+    problem(res, req, 503, "shutting-down", "Shutting down", "the server is shutting down; nothing was accepted");
   } catch (const IdempotencyConflict& e) {
     problem(res, req, 422, "idempotency-key-reused", "Idempotency-Key reused", e.what());
   }
@@ -548,15 +601,13 @@ void HttpServer::Impl::list_jobs(const Request& req, Response& res) {
   if (req.has_param("limit")) {
     const auto n = parse_count(req.get_param_value("limit"));
     if (!n || *n < 1 || *n > 1000)
-      return problem(res, req, 400, "bad-parameter", "Bad query parameter",
-                     "limit must be an integer from 1 to 1000");
+      return problem(res, req, 400, "bad-parameter", "Bad query parameter", "limit must be an integer from 1 to 1000");
     limit = static_cast<int>(*n);
   }
   if (req.has_param("cursor")) {
     before = decode_cursor(req.get_param_value("cursor"));
     if (!before)
-      return problem(res, req, 400, "bad-parameter", "Bad query parameter",
-                     "cursor is not one this server gave out");
+      return problem(res, req, 400, "bad-parameter", "Bad query parameter", "cursor is not one this server gave out");
   }
   JobPage page = service.list(status, limit, before);
   json jobs = json::array();
@@ -566,9 +617,8 @@ void HttpServer::Impl::list_jobs(const Request& req, Response& res) {
   if (status) query += "&status=" + std::string(to_string(*status));
   json links = json::array({{{"href", base + query}, {"rel", "self"}, {"type", kJson}}});
   if (page.next_before)
-    links.push_back({{"href", base + query + "&cursor=" + encode_cursor(*page.next_before)},
-                     {"rel", "next"},
-                     {"type", kJson}});
+    links.push_back(
+        {{"href", base + query + "&cursor=" + encode_cursor(*page.next_before)}, {"rel", "next"}, {"type", kJson}});
   send_json(res, 200, {{"jobs", jobs}, {"links", links}});
 }
 
@@ -600,14 +650,16 @@ void HttpServer::Impl::events(const Request& req, Response& res) {
   for (const char* name : {"after", "last_event_id"})
     if (req.has_param(name)) {
       const auto n = parse_count(req.get_param_value(name));
-      if (!n) return problem(res, req, 400, "bad-parameter", "Bad query parameter",
-                             std::string(name) + " must be an event id (an integer >= 0)");
+      if (!n)
+        return problem(res, req, 400, "bad-parameter", "Bad query parameter",
+                       std::string(name) + " must be an event id (an integer >= 0)");
       after = *n;
     }
   if (req.has_header("Last-Event-ID")) {
     const auto n = parse_count(req.get_header_value("Last-Event-ID"));
-    if (!n) return problem(res, req, 400, "bad-last-event-id", "Bad Last-Event-ID",
-                           "Last-Event-ID must be an event id this server gave out");
+    if (!n)
+      return problem(res, req, 400, "bad-last-event-id", "Bad Last-Event-ID",
+                     "Last-Event-ID must be an event id this server gave out");
     after = *n;
   }
   if (!service.job(id)) return not_found_job(req, res, id);
@@ -618,9 +670,9 @@ void HttpServer::Impl::events(const Request& req, Response& res) {
   if (open_streams.fetch_add(1) >= options.max_streams) {
     --open_streams;
     res.set_header("Retry-After", "5");
-    return problem(res, req, 503, "too-many-streams", "Too many event streams",
-                   "this server has " + std::to_string(options.max_streams) +
-                       " event streams open; retry later or poll the job");
+    return problem(
+        res, req, 503, "too-many-streams", "Too many event streams",
+        "this server has " + std::to_string(options.max_streams) + " event streams open; retry later or poll the job");
   }
   struct State {
     std::int64_t last = 0;
@@ -647,8 +699,8 @@ void HttpServer::Impl::events(const Request& req, Response& res) {
         // 15 s on): each wait (at most 500 ms) is preceded by a look at the socket.
         if (!sink.is_writable()) return false;
         const auto now = std::chrono::steady_clock::now();
-        const auto until_ping = std::chrono::duration_cast<std::chrono::milliseconds>(
-            state->last_write + heartbeat - now);
+        const auto until_ping =
+            std::chrono::duration_cast<std::chrono::milliseconds>(state->last_write + heartbeat - now);
         const auto wait = std::clamp(until_ping, std::chrono::milliseconds(0), std::chrono::milliseconds(500));
         const EventBatch batch = service.wait_events(id, state->last, wait);
         if (!batch.found) {
@@ -693,7 +745,8 @@ void HttpServer::Impl::convergence(const Request& req, Response& res) {
     if (batch.size() < 5000) break;
   }
   const std::string format = req.has_param("format") ? req.get_param_value("format") : "";
-  const bool csv = format == "csv" || (format.empty() && req.get_header_value("Accept").find("text/csv") != std::string::npos);
+  const bool csv =
+      format == "csv" || (format.empty() && req.get_header_value("Accept").find("text/csv") != std::string::npos);
   if (!format.empty() && format != "csv" && format != "json")
     return problem(res, req, 400, "bad-parameter", "Bad query parameter", "format must be json or csv");
   if (csv) {
@@ -720,11 +773,25 @@ void HttpServer::Impl::result(const Request& req, Response& res) {
     return problem(res, req, 404, "no-result", "No result",
                    "job " + id + " is " + std::string(to_string(view->record.status)) + " and has no result");
   }
+  // Stored zstd-compressed: as stored to a client that accepts zstd, gzip-compressed (fast) to
+  // one that accepts gzip, as JSON text otherwise. The charset parameter keeps httplib from
+  // compressing a compressed body again (it compresses exactly "application/json", with
+  // brotli at its slowest quality where the client accepts br).
   if (format == "json") {
-    res.set_content(*data, kJson);
+    res.set_header("Vary", "Accept-Encoding");
+    const char* type = "application/json; charset=utf-8";
+    if (is_zstd(*data) && accepts(req, "zstd")) {
+      res.set_header("Content-Encoding", "zstd");
+      res.set_content(*data, type);
+    } else if (accepts(req, "gzip")) {
+      res.set_header("Content-Encoding", "gzip");
+      res.set_content(gzip_fast(stored_text(*data)), type);
+    } else {
+      res.set_content(stored_text(*data), kJson);
+    }
     return;
   }
-  const json doc = json::parse(*data);
+  const json doc = json::parse(stored_text(*data));
   if (format == "csv") {
     const std::string table = req.has_param("table") ? req.get_param_value("table") : "nodes";
     const auto& tables = result_csv_tables();
@@ -763,8 +830,8 @@ void HttpServer::Impl::metrics(const Request&, Response& res) {
   const ServiceStats s = service.stats();
   std::ostringstream os;
   os << "# HELP grip_jobs Jobs in the store by status.\n# TYPE grip_jobs gauge\n";
-  for (JobStatus st : {JobStatus::accepted, JobStatus::running, JobStatus::successful,
-                       JobStatus::failed, JobStatus::dismissed}) {
+  for (JobStatus st :
+       {JobStatus::accepted, JobStatus::running, JobStatus::successful, JobStatus::failed, JobStatus::dismissed}) {
     const auto it = s.jobs.find(st);
     os << "grip_jobs{status=\"" << to_string(st) << "\"} " << (it == s.jobs.end() ? 0 : it->second) << "\n";
   }
@@ -788,23 +855,45 @@ void HttpServer::Impl::metrics(const Request&, Response& res) {
      << "# HELP grip_events_waiting Events not yet stored (the database unreachable or slow).\n"
      << "# TYPE grip_events_waiting gauge\n"
      << "grip_events_waiting " << s.events_waiting << "\n"
-     << "# HELP grip_db_round_trips_total Queries sent to the database by this process.\n"
-     << "# TYPE grip_db_round_trips_total counter\n"
-     << "grip_db_round_trips_total " << s.db_round_trips << "\n"
-     << "# HELP grip_db_bytes_total Bytes sent to and received from the database by this process.\n"
-     << "# TYPE grip_db_bytes_total counter\n"
-     << "grip_db_bytes_total " << s.db_bytes << "\n"
-     << "# HELP grip_http_requests_total HTTP requests received by this process.\n"
-     << "# TYPE grip_http_requests_total counter\n"
-     << "grip_http_requests_total " << requests.load() << "\n";
+     << "# HELP grip_store_disk_bytes The job database on disk (SQLite: the file; PostgreSQL: grip's tables).\n"
+     << "# TYPE grip_store_disk_bytes gauge\n"
+     << "grip_store_disk_bytes " << s.disk_bytes << "\n"
+     << "# HELP grip_retention_max_jobs Finished jobs kept (0: no bound).\n# TYPE grip_retention_max_jobs gauge\n"
+     << "grip_retention_max_jobs " << s.retention.max_jobs << "\n"
+     << "# HELP grip_retention_max_age_seconds Age of finished jobs kept (0: no bound).\n"
+     << "# TYPE grip_retention_max_age_seconds gauge\n"
+     << "grip_retention_max_age_seconds " << s.retention.max_age_seconds << "\n"
+     << "# HELP grip_retention_max_bytes Stored bytes of finished jobs kept (0: no bound).\n"
+     << "# TYPE grip_retention_max_bytes gauge\n"
+     << "grip_retention_max_bytes " << s.retention.max_bytes << "\n"
+     << "# HELP grip_jobs_pruned_total Finished jobs removed by retention in this process.\n"
+     << "# TYPE grip_jobs_pruned_total counter\n"
+     << "grip_jobs_pruned_total " << s.pruned << "\n"
+     << "# HELP grip_job_stored_bytes Bytes stored per job (scene, events, compressed result) finished by this "
+        "process.\n"
+     << "# TYPE grip_job_stored_bytes histogram\n";
+  for (const auto& [le, count] : s.stored_bytes_buckets)
+    os << "grip_job_stored_bytes_bucket{le=\""
+       << (std::isinf(le) ? std::string("+Inf") : std::to_string(static_cast<std::int64_t>(le))) << "\"} " << count
+       << "\n";
+  os << "grip_job_stored_bytes_sum " << s.stored_bytes_sum << "\n"
+     << "grip_job_stored_bytes_count " << s.stored_bytes_count << "\n";
+  if (s.db_traffic)  // only where the store measures them (PostgreSQL)
+    os << "# HELP grip_db_round_trips_total Queries sent to the database by this process.\n"
+       << "# TYPE grip_db_round_trips_total counter\n"
+       << "grip_db_round_trips_total " << s.db_traffic->first << "\n"
+       << "# HELP grip_db_bytes_total Bytes sent to and received from the database by this process.\n"
+       << "# TYPE grip_db_bytes_total counter\n"
+       << "grip_db_bytes_total " << s.db_traffic->second << "\n";
+  request_metrics.write(os);
+  service.write_job_metrics(os);
   res.set_content(os.str(), "text/plain; version=0.0.4; charset=utf-8");
 }
 
 void HttpServer::Impl::process_description(const Request&, Response& res) {
   const fs::path dir = options.schemas_dir;
   auto schema_of = [&](const char* name) -> json {
-    if (fs::exists(dir / (std::string(name) + ".schema.json")))
-      return {{"$ref", std::string("/v1/schemas/") + name}};
+    if (fs::exists(dir / (std::string(name) + ".schema.json"))) return {{"$ref", std::string("/v1/schemas/") + name}};
     return {{"type", "object"}};
   };
   send_json(res, 200,
@@ -816,16 +905,22 @@ void HttpServer::Impl::process_description(const Request&, Response& res) {
              {"version", "0.1.0"},
              {"jobControlOptions", {"async-execute"}},
              {"outputTransmission", {"value"}},
-             {"inputs", {{"scene", {{"title", "Scene"}, {"description", "the scene (see /v1/examples)"},
-                                    {"minOccurs", 1}, {"maxOccurs", 1}, {"schema", schema_of("scene")}}}}},
+             {"inputs",
+              {{"scene",
+                {{"title", "Scene"},
+                 {"description", "the scene (see /v1/examples)"},
+                 {"minOccurs", 1},
+                 {"maxOccurs", 1},
+                 {"schema", schema_of("scene")}}}}},
              {"outputs", {{"result", {{"title", "Result"}, {"schema", schema_of("result")}}}}},
-             {"links", {{{"href", "/processes/contact2d/execution"},
-                         {"rel", "http://www.opengis.net/def/rel/ogc/1.0/execute"},
-                         {"title", "execute (asynchronous)"}}}}});
+             {"links",
+              {{{"href", "/processes/contact2d/execution"},
+                {"rel", "http://www.opengis.net/def/rel/ogc/1.0/execute"},
+                {"title", "execute (asynchronous)"}}}}});
 }
 
-void HttpServer::Impl::file_list(const Request&, Response& res, const fs::path& dir,
-                                 const std::string& suffix, const std::string& route) {
+void HttpServer::Impl::file_list(const Request&, Response& res, const fs::path& dir, const std::string& suffix,
+                                 const std::string& route) {
   std::vector<std::string> names;
   std::error_code ec;
   for (const auto& entry : fs::directory_iterator(dir, ec)) {
@@ -837,9 +932,8 @@ void HttpServer::Impl::file_list(const Request&, Response& res, const fs::path& 
   }
   // The paper's two examples first, then the others by name.
   auto rank = [](const std::string& n) { return n == "beam-on-cylinder" ? 0 : n == "sheet-stretching" ? 1 : 2; };
-  std::sort(names.begin(), names.end(), [&](const auto& a, const auto& b) {
-    return rank(a) != rank(b) ? rank(a) < rank(b) : a < b;
-  });
+  std::sort(names.begin(), names.end(),
+            [&](const auto& a, const auto& b) { return rank(a) != rank(b) ? rank(a) < rank(b) : a < b; });
   json items = json::array();
   for (const auto& n : names) items.push_back({{"name", n}, {"href", route + n}});
   send_json(res, 200, {{"items", items}});

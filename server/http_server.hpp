@@ -22,22 +22,23 @@ namespace grip::server {
 struct FrontLimits {
   std::chrono::milliseconds head{5000};   // a whole request head, from its first byte
   std::chrono::milliseconds body{10000};  // a whole request body, from the end of the head
-  int max_connections = 1024;  // connections served at once (a thread each)
-  int per_client = 64;         // open connections from one client address
-  int max_idle = 64;           // keep-alive connections waiting for their next request
-  int keep_alive_seconds = 2;  // how long an idle keep-alive connection is kept
-  int io_seconds = 10;         // one read or write that makes no progress
+  int max_connections = 1024;             // connections served at once (a thread each)
+  int per_client = 64;                    // open connections from one client address
+  int max_idle = 64;                      // keep-alive connections waiting for their next request
+  int keep_alive_seconds = 2;             // how long an idle keep-alive connection is kept
+  int io_seconds = 10;                    // one read or write that makes no progress
 };
 
 struct HttpOptions {
   std::string host = "127.0.0.1";
-  int port = 8080;                  // 0: any free port (see bound_port())
+  int port = 8080;  // 0: any free port (see bound_port())
   FrontLimits front;
-  int max_streams = 32;             // open event streams
+  int max_streams = 32;  // open event streams
   std::size_t max_body_bytes = 8u << 20;
-  std::optional<std::string> token;  // bearer token required on every route but health
+  std::size_t parse_budget_bytes = 0;  // bodies read and checked at once; 0: max_body_bytes
+  std::optional<std::string> token;    // bearer token required on every route but health
   std::chrono::milliseconds heartbeat{15000};
-  std::string schemas_dir;          // schemas/*.schema.json and schemas/examples/*.json
+  std::string schemas_dir;  // schemas/*.schema.json and schemas/examples/*.json
 };
 
 class HttpServer {

@@ -4,19 +4,20 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
+#include "server/compression.hpp"
 #include "server/util.hpp"
 #include "solver/io/result.hpp"
+#include "solver/model/number_text.hpp"
 
 namespace grip::server {
 
 using nlohmann::json;
 using Clock = std::chrono::steady_clock;
 
-bool is_terminal_event(const std::string& type) {
-  return type == "job_finished" || type == "job_failed";
-}
+bool is_terminal_event(const std::string& type) { return type == "job_finished" || type == "job_failed"; }
 
 struct JobService::ActiveJob {
   explicit ActiveJob(Lease l) : lease(std::move(l)), id(lease.job_id) {}
@@ -34,8 +35,24 @@ struct JobService::ActiveJob {
 
 namespace {
 
-json failed_event(const std::string& reason) {
-  return {{"type", "job_failed"}, {"reason", reason}};
+// Upper bounds of grip_job_stored_bytes' buckets (+Inf last).
+const std::vector<double> kStoredBytesBuckets = {4096,    16384,   65536,    262144,
+                                                 1048576, 4194304, 16777216, std::numeric_limits<double>::infinity()};
+
+// A run that did not succeed: its status, message (the result's reason where there is one)
+// and failure kind.
+void failed(JobOutcome& o, FailureKind kind, std::string message, int step = 0) {
+  o.status = kind == FailureKind::dismissed ? JobStatus::dismissed : JobStatus::failed;
+  o.message = std::move(message);
+  o.failure_kind = std::string(to_string(kind));
+  o.failure_step = step;
+}
+
+// The outcome's log line (one format for every end of a run; a failure at warning).
+void log_outcome(const std::string& id, JobStatus status, std::int64_t iterations, const std::string& message,
+                 double seconds) {
+  spdlog::log(status == JobStatus::successful ? spdlog::level::info : spdlog::level::warn,
+              "job {} {} in {:.3f} s: {} contact iterations; {}", id, to_string(status), seconds, iterations, message);
 }
 
 StoredEvent stored(std::int64_t seq, const json& event) {
@@ -67,10 +84,8 @@ std::optional<std::int64_t> least_generated_nodes(const json& scene) {
 
 }  // namespace
 
-JobService::JobService(Store& store, ServiceOptions options)
-    : store_(store), options_(std::move(options)) {
-  if (options_.workers <= 0)
-    options_.workers = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+JobService::JobService(Store& store, ServiceOptions options) : store_(store), options_(std::move(options)) {
+  if (options_.workers <= 0) options_.workers = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
   options_.queue_capacity = std::max(1, options_.queue_capacity);
   options_.event_buffer = std::max<std::size_t>(16, options_.event_buffer);
   if (!(options_.lease_seconds > 0)) options_.lease_seconds = 10;
@@ -94,6 +109,7 @@ void JobService::start() {
   writer_ = std::thread([this] { writer_loop(); });
   lease_thread_ = std::thread([this] { lease_loop(); });
   for (int i = 0; i < options_.workers; ++i) workers_.emplace_back([this] { worker_loop(); });
+  if (options_.retention.any()) pruner_ = std::make_unique<Pruner>(store_, options_.retention, options_.prune_interval);
   started_ = true;
   spdlog::info("replica {}: lease {} s", options_.replica, options_.lease_seconds);
 }
@@ -115,14 +131,16 @@ void JobService::on_change(const StoreChange& change) {
     }
     if (job) hear_dismissal(*job, "notification");
   }
-  {
-    std::lock_guard lock(events_mutex_);
-    if (changes_.size() > 100000) changes_.clear();  // waiters then wake once, harmlessly
-    ++changes_[change.job_id];
-    if (change.job_id.empty())
-      for (auto& [id, n] : changes_) ++n;
+  std::lock_guard lock(events_mutex_);
+  auto wake = [](Watch& w) {
+    ++w.changes;
+    w.cv.notify_all();
+  };
+  if (change.job_id.empty()) {
+    for (auto& [id, w] : watches_) wake(*w);
+  } else if (const auto it = watches_.find(change.job_id); it != watches_.end()) {
+    wake(*it->second);
   }
-  stored_cv_.notify_all();
 }
 
 void JobService::hear_dismissal(ActiveJob& job, const char* how) {
@@ -141,8 +159,7 @@ bool JobService::ready() {
   return store_.ping();
 }
 
-std::optional<SubmitResult> JobService::replay(const std::optional<std::string>& key,
-                                              const std::string& scene) {
+std::optional<SubmitResult> JobService::replay(const std::optional<std::string>& key, const std::string& scene) {
   if (!key) return std::nullopt;
   auto existing = store_.job_by_idempotency_key(*key);
   if (!existing) return std::nullopt;
@@ -152,16 +169,16 @@ std::optional<SubmitResult> JobService::replay(const std::optional<std::string>&
   return SubmitResult{JobView{*existing, std::nullopt}, true};
 }
 
-SubmitResult JobService::submit(const json& scene_json,
-                                const std::optional<std::string>& idempotency_key) {
+SubmitResult JobService::submit(const json& scene_json, const std::optional<std::string>& idempotency_key,
+                                const std::string& request_id) {
   if (draining_) throw ShuttingDown();
   const std::string canonical = scene_json.dump();
   if (auto earlier = replay(idempotency_key, canonical)) return *earlier;
   const JobLimits& lim = options_.limits;
   if (const auto least = least_generated_nodes(scene_json); least && *least > lim.max_nodes)
-    throw SceneErrors(std::vector<SceneIssue>{
-        {"/body/mesh", "the body has at least " + std::to_string(*least) +
-                           " nodes; this service takes at most " + std::to_string(lim.max_nodes)}});
+    throw SceneErrors(std::vector<SceneIssue>{{"/body/mesh", "the body has at least " + std::to_string(*least) +
+                                                                 " nodes; this service takes at most " +
+                                                                 std::to_string(lim.max_nodes)}});
   struct {
     int nodes, steps;
   } size;
@@ -172,12 +189,10 @@ SubmitResult JobService::submit(const json& scene_json,
   std::vector<SceneIssue> issues;
   if (size.nodes > lim.max_nodes)
     issues.push_back({"/body/mesh", "the body has " + std::to_string(size.nodes) +
-                                        " nodes; this service takes at most " +
-                                        std::to_string(lim.max_nodes)});
+                                        " nodes; this service takes at most " + std::to_string(lim.max_nodes)});
   if (size.steps > lim.max_steps)
     issues.push_back({scene_json.contains("stages") ? "/stages" : "/steps",
-                      "the scene has " + std::to_string(size.steps) +
-                          " load steps; this service takes at most " +
+                      "the scene has " + std::to_string(size.steps) + " load steps; this service takes at most " +
                           std::to_string(lim.max_steps)});
   if (!issues.empty()) throw SceneErrors(std::move(issues));
 
@@ -203,6 +218,7 @@ SubmitResult JobService::submit(const json& scene_json,
   rec.steps = size.steps;
   rec.nodes = size.nodes;
   rec.idempotency_key = idempotency_key;
+  rec.request_id = request_id;
   try {
     store_.insert_job(rec);
   } catch (const StoreUnavailable&) {
@@ -212,7 +228,8 @@ SubmitResult JobService::submit(const json& scene_json,
     if (auto earlier = replay(idempotency_key, canonical)) return *earlier;
     throw;
   }
-  spdlog::info("job {} accepted: {} nodes, {} steps", rec.id, size.nodes, size.steps);
+  spdlog::info("job {} accepted: {} nodes, {} steps (request {})", rec.id, size.nodes, size.steps,
+               request_id.empty() ? "-" : request_id);
   rec.scene.clear();
   return {JobView{rec, std::nullopt}, false};
 }
@@ -245,8 +262,7 @@ std::optional<JobView> JobService::job(const std::string& id) {
   return with_progress({std::move(*rec)}).front();
 }
 
-JobPage JobService::list(std::optional<JobStatus> status, int limit,
-                         std::optional<std::int64_t> before) {
+JobPage JobService::list(std::optional<JobStatus> status, int limit, std::optional<std::int64_t> before) {
   return store_.list_jobs(status, limit, before);
 }
 
@@ -259,14 +275,28 @@ std::pair<DismissOutcome, std::optional<JobView>> JobService::dismiss(const std:
   return {outcome, JobView{std::move(*rec), std::nullopt}};
 }
 
-EventBatch JobService::wait_events(const std::string& id, std::int64_t after,
-                                   std::chrono::milliseconds wait, int limit) {
+EventBatch JobService::wait_events(const std::string& id, std::int64_t after, std::chrono::milliseconds wait,
+                                   int limit) {
   const auto deadline = Clock::now() + wait;
+  std::shared_ptr<Watch> watch;
+  {
+    std::lock_guard lock(events_mutex_);
+    auto& w = watches_[id];
+    if (!w) w = std::make_shared<Watch>();
+    watch = w;
+    ++watch->waiters;
+  }
+  const auto unwatch = [&](void*) {
+    std::lock_guard lock(events_mutex_);
+    const auto it = watches_.find(id);
+    if (--watch->waiters == 0 && it != watches_.end() && it->second == watch) watches_.erase(it);
+  };
+  const std::unique_ptr<void, decltype(unwatch)> watching(watch.get(), unwatch);
   while (true) {
     std::uint64_t seen = 0;
     {
       std::lock_guard lock(events_mutex_);
-      seen = changes_[id];
+      seen = watch->changes;
     }
     try {
       EventBatch batch;
@@ -291,8 +321,7 @@ EventBatch JobService::wait_events(const std::string& id, std::int64_t after,
       return {};
     }
     std::unique_lock lock(events_mutex_);
-    const bool woke = stored_cv_.wait_until(
-        lock, deadline, [&] { return changes_[id] != seen || draining_.load(); });
+    const bool woke = watch->cv.wait_until(lock, deadline, [&] { return watch->changes != seen || draining_.load(); });
     if (!woke || draining_) return {};
   }
 }
@@ -318,11 +347,35 @@ ServiceStats JobService::stats() {
     s.events = events_stored_;
     s.events_waiting = pending_.size();
   }
-  std::tie(s.db_round_trips, s.db_bytes) = store_.traffic();
+  s.db_traffic = store_.traffic();
   s.jobs = store_.count_by_status();
+  s.retention = options_.retention;
+  s.pruned = pruner_ ? pruner_->pruned() : 0;
+  s.disk_bytes = store_.disk_bytes();
+  {
+    std::lock_guard lock(mutex_);
+    std::int64_t below = 0;
+    for (size_t b = 0; b < kStoredBytesBuckets.size(); ++b) {
+      below += b < stored_bytes_counts_.size() ? stored_bytes_counts_[b] : 0;
+      s.stored_bytes_buckets.emplace_back(kStoredBytesBuckets[b], below);
+    }
+    s.stored_bytes_sum = stored_bytes_sum_;
+    s.stored_bytes_count = stored_bytes_count_;
+  }
   const auto it = s.jobs.find(JobStatus::accepted);
   s.queue_depth = it == s.jobs.end() ? 0 : static_cast<std::size_t>(it->second);
   return s;
+}
+
+void JobService::write_job_metrics(std::ostream& os) const {
+  os << "# HELP grip_job_queue_wait_seconds From a job's acceptance to its first claim, for jobs claimed here.\n"
+     << "# TYPE grip_job_queue_wait_seconds histogram\n";
+  queue_wait_.write(os, "grip_job_queue_wait_seconds", "");
+  os << "# HELP grip_job_run_seconds From a job's claim to its stored outcome, by outcome, for runs here.\n"
+     << "# TYPE grip_job_run_seconds histogram\n";
+  std::lock_guard lock(mutex_);
+  for (const auto& [outcome, h] : run_seconds_by_outcome_)
+    h.write(os, "grip_job_run_seconds", "outcome=\"" + outcome + "\"");
 }
 
 int JobService::retry_after_seconds() const {
@@ -341,6 +394,7 @@ void JobService::begin_drain() {
   draining_ = true;
   std::lock_guard lock(events_mutex_);
   stored_cv_.notify_all();
+  for (auto& [id, w] : watches_) w->cv.notify_all();
 }
 
 void JobService::shutdown(std::chrono::milliseconds grace) {
@@ -350,8 +404,7 @@ void JobService::shutdown(std::chrono::milliseconds grace) {
     std::unique_lock lock(mutex_);
     stop_workers_ = true;
     work_cv_.notify_all();
-    if (running_ > 0)
-      spdlog::info("waiting up to {:.1f} s for {} running job(s)", grace.count() / 1000.0, running_);
+    if (running_ > 0) spdlog::info("waiting up to {:.1f} s for {} running job(s)", grace.count() / 1000.0, running_);
     if (!idle_cv_.wait_for(lock, grace, [&] { return running_ == 0; })) {
       spdlog::warn("grace period over: stopping {} running job(s); they run again later", running_);
       abort_runs_ = true;
@@ -372,6 +425,7 @@ void JobService::shutdown(std::chrono::milliseconds grace) {
   if (writer_.joinable()) writer_.join();
   lease_cv_.notify_all();
   if (lease_thread_.joinable()) lease_thread_.join();
+  pruner_.reset();
 }
 
 void JobService::worker_loop() {
@@ -392,6 +446,9 @@ void JobService::worker_loop() {
       continue;
     }
     if (!claimed) continue;
+    if (const auto created = parse_iso8601(claimed->created); created && claimed->attempts == 1)
+      queue_wait_.observe(
+          std::max(0.0, std::chrono::duration<double>(std::chrono::system_clock::now() - *created).count()));
     auto job = std::make_shared<ActiveJob>(Lease{claimed->id, claimed->generation});
     {
       std::lock_guard lock(mutex_);
@@ -406,8 +463,7 @@ void JobService::worker_loop() {
       spdlog::error("job {}: {}", job->id, e.what());
       try {
         JobOutcome o;
-        o.status = JobStatus::failed;
-        o.message = std::string("internal error: ") + e.what();
+        failed(o, FailureKind::exception, std::string("internal error: ") + e.what());
         o.finished = now_iso8601();
         finish(job, std::move(o), job->last_seq);
       } catch (const std::exception& again) {
@@ -449,8 +505,7 @@ void JobService::writer_loop() {
       std::unique_lock lock(events_mutex_);
       writer_cv_.wait(lock, [&] { return stop_writer_ || !pending_.empty() || !batch.empty(); });
       if (stop_writer_ && pending_.empty() && batch.empty()) return;
-      batch.insert(batch.end(), std::make_move_iterator(pending_.begin()),
-                   std::make_move_iterator(pending_.end()));
+      batch.insert(batch.end(), std::make_move_iterator(pending_.begin()), std::make_move_iterator(pending_.end()));
       pending_.clear();
     }
     room_cv_.notify_all();
@@ -461,15 +516,13 @@ void JobService::writer_loop() {
       failures = 0;
     } catch (const std::exception& e) {
       // Kept and retried: an acknowledged job's events are not dropped while this process runs.
-      if (failures++ % 20 == 0)
-        spdlog::error("storing {} event(s) failed, retrying: {}", batch.size(), e.what());
+      if (failures++ % 20 == 0) spdlog::error("storing {} event(s) failed, retrying: {}", batch.size(), e.what());
       std::unique_lock lock(events_mutex_);
       if (stop_writer_) {
         spdlog::warn("stopping with {} event(s) unstored; their runs are taken over", batch.size());
         return;
       }
-      writer_cv_.wait_for(lock, std::chrono::milliseconds(std::min(2000, 50 * failures)),
-                          [&] { return stop_writer_; });
+      writer_cv_.wait_for(lock, std::chrono::milliseconds(std::min(2000, 50 * failures)), [&] { return stop_writer_; });
       continue;
     }
     std::vector<std::shared_ptr<ActiveJob>> jobs;
@@ -477,8 +530,7 @@ void JobService::writer_loop() {
       std::lock_guard lock(mutex_);
       for (const NewEvent& e : batch) {
         const auto it = active_.find(e.lease.job_id);
-        if (it != active_.end() && it->second->lease.generation == e.lease.generation)
-          jobs.push_back(it->second);
+        if (it != active_.end() && it->second->lease.generation == e.lease.generation) jobs.push_back(it->second);
       }
     }
     {
@@ -553,18 +605,21 @@ bool JobService::retry_store(const std::shared_ptr<ActiveJob>& job, const std::f
   }
 }
 
-void JobService::finish(const std::shared_ptr<ActiveJob>& job, JobOutcome outcome,
-                        std::int64_t last) {
+void JobService::finish(const std::shared_ptr<ActiveJob>& job, JobOutcome outcome, std::int64_t last) {
   flush(job, last);  // the job's events come first
   if (job->lost) {
     spdlog::warn("job {}: run not recorded (its lease went to another run)", job->id);
     return;
   }
   if (outcome.terminal.type.empty()) {
-    const json ev = outcome.status == JobStatus::successful
-                        ? json{{"type", "job_finished"}}
-                        : failed_event(outcome.status == JobStatus::dismissed ? "dismissed"
-                                                                              : outcome.message);
+    const json ev =
+        outcome.status == JobStatus::successful ? json{{"type", "job_finished"}}
+        : outcome.status == JobStatus::dismissed
+            ? json::parse(kDismissedEvent)
+            : json{{"type", "job_failed"},
+                   {"reason", outcome.message},
+                   {"failure",
+                    {{"kind", outcome.failure_kind}, {"message", outcome.message}, {"step", outcome.failure_step}}}};
     outcome.terminal = stored(last + 1, ev);
   }
   std::optional<JobStatus> stored_status;
@@ -574,7 +629,25 @@ void JobService::finish(const std::shared_ptr<ActiveJob>& job, JobOutcome outcom
     spdlog::warn("job {}: run not recorded (fenced: another run holds it)", job->id);
     return;
   }
+  // What the job stores (scene, events, result), as the store counted it.
+  std::optional<JobRecord> stored_job;
+  try {
+    stored_job = store_.job(job->id);
+  } catch (const std::exception&) {
+  }
   std::lock_guard lock(mutex_);
+  run_seconds_by_outcome_.try_emplace(std::string(to_string(*stored_status)), seconds_buckets())
+      .first->second.observe(std::chrono::duration<double>(Clock::now() - job->started).count());
+  if (stored_job && stored_job->stored_bytes > 0) {
+    stored_bytes_counts_.resize(kStoredBytesBuckets.size());
+    for (size_t b = 0; b < kStoredBytesBuckets.size(); ++b)
+      if (stored_job->stored_bytes <= kStoredBytesBuckets[b]) {
+        ++stored_bytes_counts_[b];
+        break;
+      }
+    stored_bytes_sum_ += stored_job->stored_bytes;
+    ++stored_bytes_count_;
+  }
   if (*stored_status != JobStatus::dismissed || outcome.solve_seconds > 0) {
     solve_seconds_ += outcome.solve_seconds;
     iterations_ += outcome.iterations;
@@ -597,14 +670,13 @@ void JobService::run_job(const std::shared_ptr<ActiveJob>& job, const JobRecord&
   try {
     scene.emplace(read_scene(json::parse(rec.scene)));
   } catch (const SceneErrors& e) {
-    outcome.status = JobStatus::failed;
-    outcome.message = std::string("invalid scene: ") + e.what();
+    failed(outcome, FailureKind::invalid_scene, std::string("invalid scene: ") + e.what());
   } catch (const std::exception& e) {
-    outcome.status = JobStatus::failed;
-    outcome.message = std::string("cannot read the stored scene: ") + e.what();
+    failed(outcome, FailureKind::invalid_scene, std::string("cannot read the stored scene: ") + e.what());
   }
   if (!scene) {
     outcome.finished = now_iso8601();
+    log_outcome(id, outcome.status, 0, outcome.message, 0.0);
     finish(job, std::move(outcome), seq);
     return;
   }
@@ -612,9 +684,12 @@ void JobService::run_job(const std::shared_ptr<ActiveJob>& job, const JobRecord&
   const int steps = static_cast<int>(scene->steps.size());
   const int nodes = scene->problem.body->node_count();
   if (nodes > lim.max_nodes || steps > lim.max_steps) {
-    outcome.status = JobStatus::failed;
-    outcome.message = "limit: the scene is over this service's node or step limit";
+    failed(outcome, FailureKind::job_limit,
+           "limit: the scene has " + std::to_string(nodes) + " nodes and " + std::to_string(steps) +
+               " steps; this service takes at most " + std::to_string(lim.max_nodes) + " nodes and " +
+               std::to_string(lim.max_steps) + " steps");
     outcome.finished = now_iso8601();
+    log_outcome(id, outcome.status, 0, outcome.message, 0.0);
     finish(job, std::move(outcome), seq);
     return;
   }
@@ -632,8 +707,10 @@ void JobService::run_job(const std::shared_ptr<ActiveJob>& job, const JobRecord&
     std::lock_guard lock(job->progress_mutex);
     job->progress->step = step;
   };
+  // Contact iterations: real solves, the events' trials (the one count: the job document, the
+  // log, /metrics, the limit and the result's summary all read it).
   observer.iteration = [&](const IterationEvent& ev) {
-    ++iterations;
+    iterations += ev.trials;
     emit(job, ++seq, iteration_event(ev));
     std::lock_guard lock(job->progress_mutex);
     job->progress->contact_error = ev.v2;
@@ -649,9 +726,23 @@ void JobService::run_job(const std::shared_ptr<ActiveJob>& job, const JobRecord&
     else if (job->lost) stop = Stop::lost;
     else if (abort_runs_) stop = Stop::shutdown;
     else if (iterations >= lim.max_iterations) stop = Stop::iterations;
-    else if (std::chrono::duration<double>(Clock::now() - t0).count() > lim.max_seconds)
-      stop = Stop::seconds;
+    else if (std::chrono::duration<double>(Clock::now() - t0).count() > lim.max_seconds) stop = Stop::seconds;
     return stop != Stop::none;
+  };
+  observer.stop_reason = [&]() -> std::pair<FailureKind, std::string> {
+    switch (stop) {
+      case Stop::iterations:
+        return {FailureKind::job_limit, "limit: " + std::to_string(iterations) +
+                                            " contact iterations, this service's limit (--max-iterations " +
+                                            std::to_string(lim.max_iterations) + ")"};
+      case Stop::seconds:
+        return {FailureKind::job_limit, "limit: the run reached this service's wall-time limit (--max-seconds " +
+                                            number_text(lim.max_seconds) + ")"};
+      case Stop::dismissed:
+        return {FailureKind::dismissed, "dismissed"};
+      default:
+        return {FailureKind::stopped, "stopped on request"};  // shutdown or lost: not stored
+    }
   };
 
   RunResult run;
@@ -660,6 +751,7 @@ void JobService::run_job(const std::shared_ptr<ActiveJob>& job, const JobRecord&
   } catch (const std::exception& e) {
     run.completed = false;
     run.reason = std::string("solver error: ") + e.what();
+    run.failure = FailureKind::exception;
   }
   const double seconds = std::chrono::duration<double>(Clock::now() - t0).count();
 
@@ -680,21 +772,16 @@ void JobService::run_job(const std::shared_ptr<ActiveJob>& job, const JobRecord&
   outcome.finished = now_iso8601();
   outcome.solve_seconds = run.seconds > 0 ? run.seconds : seconds;
   outcome.iterations = iterations;
+  for (const StepRecord& s : run.steps) outcome.steps_completed += s.converged ? 1 : 0;
   if (job->dismissed) {
-    outcome.status = JobStatus::dismissed;
-    outcome.message = "dismissed";
+    failed(outcome, FailureKind::dismissed, "dismissed");
   } else if (run.completed) {
     outcome.status = JobStatus::successful;
     outcome.message = "solved " + std::to_string(steps) + " steps";
   } else {
-    outcome.status = JobStatus::failed;
-    if (stop == Stop::iterations)
-      outcome.message = "limit: more than " + std::to_string(lim.max_iterations) +
-                        " contact iterations";
-    else if (stop == Stop::seconds)
-      outcome.message = "limit: more than " + std::to_string(lim.max_seconds) + " s of wall time";
-    else
-      outcome.message = run.reason.empty() ? "the run failed" : run.reason;
+    // The result's reason (summary.reason), a job limit's included: the run's stop request
+    // named it (observer.stop_reason).
+    failed(outcome, run.failure, run.reason.empty() ? "the run failed" : run.reason, run.failure_step);
   }
   if (outcome.status != JobStatus::dismissed && !run.steps.empty()) {
     try {
@@ -702,16 +789,15 @@ void JobService::run_job(const std::shared_ptr<ActiveJob>& job, const JobRecord&
       // took several times the text's memory and more time than writing it.
       std::ostringstream text;
       write_result(text, *scene, run);
-      outcome.result = std::move(text).str();
+      outcome.result = zstd(std::move(text).str());  // stored and served compressed
     } catch (const std::exception& e) {
       spdlog::error("job {}: cannot build its result: {}", id, e.what());
     }
   }
-  const std::string status(to_string(outcome.status));
+  const JobStatus status = outcome.status;
   const std::string message = outcome.message;
   finish(job, std::move(outcome), seq);
-  spdlog::info("job {} {} in {:.3f} s: {} contact iterations; {}", id, status, seconds, iterations,
-               message);
+  log_outcome(id, status, iterations, message, seconds);
 }
 
 }  // namespace grip::server

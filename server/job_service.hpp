@@ -28,15 +28,19 @@
 #include <cstdint>
 #include <deque>
 #include <functional>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <ostream>
 #include <stdexcept>
 #include <string>
 #include <thread>
 #include <unordered_map>
 #include <vector>
 
+#include "server/observability.hpp"
+#include "server/pruner.hpp"
 #include "server/store.hpp"
 
 namespace grip::server {
@@ -51,23 +55,23 @@ struct JobLimits {
 };
 
 struct ServiceOptions {
-  int workers = 0;           // 0: one per core
-  int queue_capacity = 256;  // accepted jobs waiting for a worker (all processes together)
-  std::string replica;       // this process's name in leases; empty: host-pid-random
-  double lease_seconds = 10;  // a run unrenewed this long is taken over by another process
+  int workers = 0;                    // 0: one per core
+  int queue_capacity = 256;           // accepted jobs waiting for a worker (all processes together)
+  std::string replica;                // this process's name in leases; empty: host-pid-random
+  double lease_seconds = 10;          // a run unrenewed this long is taken over by another process
   std::size_t event_buffer = 100000;  // events waiting for the store before runs pause
   JobLimits limits;
+  Retention retention;  // finished jobs kept (server/pruner.hpp)
+  std::chrono::milliseconds prune_interval{60000};
   // Test and benchmark hook, called on the worker thread as each event is produced (before
   // it is stored).
-  std::function<void(const std::string& job_id, std::int64_t seq, const nlohmann::json& event)>
-      event_tap;
+  std::function<void(const std::string& job_id, std::int64_t seq, const nlohmann::json& event)> event_tap;
 };
 
 // Submission refused because the queue is full; retry after `retry_after_seconds`.
 class QueueFull : public std::runtime_error {
  public:
-  explicit QueueFull(int retry_after)
-      : std::runtime_error("the job queue is full"), retry_after_seconds(retry_after) {}
+  explicit QueueFull(int retry_after) : std::runtime_error("the job queue is full"), retry_after_seconds(retry_after) {}
   int retry_after_seconds;
 };
 
@@ -85,9 +89,9 @@ class IdempotencyConflict : public std::runtime_error {
 
 // Progress of a running job (not stored: a restarted run starts from zero).
 struct Progress {
-  int step = 0;             // step being solved, 1-based
-  int steps_done = 0;       // converged steps
-  double contact_error = 0.0;  // ||v||_2 of the last contact iteration
+  int step = 0;                 // step being solved, 1-based
+  int steps_done = 0;           // converged steps
+  double contact_error = 0.0;   // ||v||_2 of the last contact iteration
   std::int64_t iterations = 0;  // contact iterations so far
 };
 
@@ -111,13 +115,20 @@ struct ServiceStats {
   std::size_t queue_depth = 0;
   int running = 0;
   int workers = 0;
-  double solve_seconds = 0.0;     // finished runs, this process
-  std::int64_t iterations = 0;    // contact iterations of finished runs, this process
-  std::int64_t events = 0;        // events stored, this process
+  double solve_seconds = 0.0;      // finished runs, this process
+  std::int64_t iterations = 0;     // contact iterations of finished runs, this process
+  std::int64_t events = 0;         // events stored, this process
   std::size_t events_waiting = 0;  // events not yet stored
-  std::int64_t db_round_trips = 0;  // with the database, this process
-  std::int64_t db_bytes = 0;
+  // Round trips and bytes with the database, this process; none where the store does not
+  // measure them.
+  std::optional<std::pair<std::int64_t, std::int64_t>> db_traffic;
   std::map<JobStatus, std::int64_t> jobs;  // by status, from the store
+  Retention retention;
+  std::int64_t pruned = 0;      // finished jobs removed by retention, this process
+  std::int64_t disk_bytes = 0;  // the database on disk
+  // Stored bytes of the jobs this process finished: {upper bound, count} and their sum.
+  std::vector<std::pair<double, std::int64_t>> stored_bytes_buckets;
+  std::int64_t stored_bytes_sum = 0, stored_bytes_count = 0;
 };
 
 bool is_terminal_event(const std::string& type);
@@ -134,8 +145,9 @@ class JobService {
 
   // Validates and stores the scene, then queues it. Throws grip::SceneErrors (invalid scene
   // or over a limit), QueueFull, ShuttingDown, IdempotencyConflict.
-  SubmitResult submit(const nlohmann::json& scene,
-                      const std::optional<std::string>& idempotency_key = std::nullopt);
+  // `request_id`: the submitting request's, kept with the job.
+  SubmitResult submit(const nlohmann::json& scene, const std::optional<std::string>& idempotency_key = std::nullopt,
+                      const std::string& request_id = "");
   std::optional<JobView> job(const std::string& id);
   std::vector<JobView> with_progress(std::vector<JobRecord> records);
   JobPage list(std::optional<JobStatus> status, int limit, std::optional<std::int64_t> before);
@@ -145,13 +157,13 @@ class JobService {
   std::pair<DismissOutcome, std::optional<JobView>> dismiss(const std::string& id);
 
   // Stored events with seq > after, waiting up to `wait` for some to arrive.
-  EventBatch wait_events(const std::string& id, std::int64_t after,
-                         std::chrono::milliseconds wait, int limit = 256);
-  std::vector<StoredEvent> events(const std::string& id, std::int64_t after, int limit,
-                                  std::string_view type = {});
+  EventBatch wait_events(const std::string& id, std::int64_t after, std::chrono::milliseconds wait, int limit = 256);
+  std::vector<StoredEvent> events(const std::string& id, std::int64_t after, int limit, std::string_view type = {});
   std::optional<std::string> result(const std::string& id);
 
   ServiceStats stats();
+  // Queue wait and run duration histograms (Prometheus text).
+  void write_job_metrics(std::ostream& os) const;
   // Started, not draining, and the store answers.
   bool ready();
   const std::string& replica() const { return options_.replica; }
@@ -185,6 +197,11 @@ class JobService {
 
   Store& store_;
   ServiceOptions options_;
+  std::unique_ptr<Pruner> pruner_;                 // with a retention, while started
+  std::vector<std::int64_t> stored_bytes_counts_;  // per kStoredBytesBuckets (mutex_)
+  std::int64_t stored_bytes_sum_ = 0, stored_bytes_count_ = 0;
+  Histogram queue_wait_{seconds_buckets()};                  // accepted -> claimed here
+  std::map<std::string, Histogram> run_seconds_by_outcome_;  // claimed -> stored outcome (mutex_)
   std::atomic<bool> started_{false};
   std::atomic<bool> draining_{false};
 
@@ -208,10 +225,19 @@ class JobService {
   // Events: pending batch, stored sequence per active run, readers' wake-up.
   std::mutex events_mutex_;
   std::condition_variable writer_cv_;
-  std::condition_variable stored_cv_;   // events stored (this writer) or announced (any)
-  std::condition_variable room_cv_;     // the pending buffer has room again
+  std::condition_variable stored_cv_;  // events stored by this writer; draining
+  std::condition_variable room_cv_;    // the pending buffer has room again
   std::vector<NewEvent> pending_;
-  std::unordered_map<std::string, std::uint64_t> changes_;  // per job: announcements seen
+  // The jobs that event streams wait on, each with its count of announcements and a condition
+  // of its own: an event wakes its own job's streams only (one condition for all woke the 100
+  // streams of a load run at each of some 4,000 events a second; half the server's time went
+  // to waking threads). Kept while a stream waits.
+  struct Watch {
+    std::uint64_t changes = 0;
+    int waiters = 0;
+    std::condition_variable cv;
+  };
+  std::unordered_map<std::string, std::shared_ptr<Watch>> watches_;
   std::int64_t events_stored_ = 0;
   bool stop_writer_ = false;
   std::thread writer_;

@@ -1,9 +1,9 @@
 #include "server/postgres_store.hpp"
 
 #include <libpq-fe.h>
-#include <nlohmann/json.hpp>
 #include <poll.h>
 #include <spdlog/spdlog.h>
+#include <nlohmann/json.hpp>
 
 #include <chrono>
 #include <condition_variable>
@@ -39,6 +39,9 @@ CREATE TABLE IF NOT EXISTS grip_jobs (
   generation BIGINT NOT NULL DEFAULT 0,
   lease_expires TIMESTAMPTZ
 );
+ALTER TABLE grip_jobs ADD COLUMN IF NOT EXISTS failure_kind TEXT NOT NULL DEFAULT '';
+ALTER TABLE grip_jobs ADD COLUMN IF NOT EXISTS failure_step INTEGER NOT NULL DEFAULT 0;
+ALTER TABLE grip_jobs ADD COLUMN IF NOT EXISTS steps_completed INTEGER NOT NULL DEFAULT 0;
 CREATE INDEX IF NOT EXISTS grip_jobs_by_status ON grip_jobs (status, ord);
 CREATE TABLE IF NOT EXISTS grip_events (
   job_id TEXT NOT NULL,
@@ -51,12 +54,18 @@ CREATE TABLE IF NOT EXISTS grip_results (
   job_id TEXT PRIMARY KEY,
   data TEXT NOT NULL
 );
+-- Results as stored bytes (zstd; gzip from earlier versions) in `bytes`; `data` holds those stored before as JSON text.
+ALTER TABLE grip_results ADD COLUMN IF NOT EXISTS bytes BYTEA;
+ALTER TABLE grip_results ALTER COLUMN data DROP NOT NULL;
+ALTER TABLE grip_jobs ADD COLUMN IF NOT EXISTS stored_bytes BIGINT NOT NULL DEFAULT 0;
+ALTER TABLE grip_jobs ADD COLUMN IF NOT EXISTS request_id TEXT NOT NULL DEFAULT '';
 )sql";
 
 // Columns read by read_job, in this order.
 constexpr const char* kJobColumns =
     "id, ord, status, created, started, finished, updated, message, steps, nodes, "
-    "idempotency_key, last_seq, attempts, solve_seconds, iterations, owner, generation";
+    "idempotency_key, last_seq, attempts, solve_seconds, iterations, owner, generation, failure_kind, "
+    "failure_step, steps_completed, stored_bytes, request_id";
 
 using Param = std::optional<std::string>;
 
@@ -202,8 +211,8 @@ class Session {
       values.push_back(p ? p->c_str() : nullptr);
       if (p) sent += static_cast<std::int64_t>(p->size());
     }
-    PGresult* raw = PQexecParams(c_->conn, sql, static_cast<int>(values.size()), nullptr,
-                                 values.data(), nullptr, nullptr, 0);
+    PGresult* raw =
+        PQexecParams(c_->conn, sql, static_cast<int>(values.size()), nullptr, values.data(), nullptr, nullptr, 0);
     // A pooled connection that the database dropped while idle (it restarted) fails its first
     // statement: connect again and send that statement once more. Statements whose reply
     // could have been lost with a commit are safe to repeat (events: ON CONFLICT DO NOTHING;
@@ -213,8 +222,7 @@ class Session {
       PQfinish(c_->conn);
       c_->conn = nullptr;
       c_->conn = pool_.reconnect();
-      raw = PQexecParams(c_->conn, sql, static_cast<int>(values.size()), nullptr, values.data(),
-                         nullptr, nullptr, 0);
+      raw = PQexecParams(c_->conn, sql, static_cast<int>(values.size()), nullptr, values.data(), nullptr, nullptr, 0);
     }
     first_ = false;
     Result r(raw);
@@ -280,13 +288,39 @@ JobRecord read_job(const Result& r, int row, bool with_scene) {
   j.iterations = r.int64(row, 14);
   j.owner = r.text(row, 15);
   j.generation = r.int64(row, 16);
-  if (with_scene) j.scene = r.text(row, 17);
+  j.failure_kind = r.text(row, 17);
+  j.failure_step = static_cast<int>(r.int64(row, 18));
+  j.steps_completed = static_cast<int>(r.int64(row, 19));
+  j.stored_bytes = r.int64(row, 20);
+  j.request_id = r.text(row, 21);
+  if (with_scene) j.scene = r.text(row, 22);
   return j;
 }
 
 std::string select_job(bool with_scene, const std::string& where) {
-  return std::string("SELECT ") + kJobColumns + (with_scene ? ", scene" : "") +
-         " FROM grip_jobs WHERE " + where;
+  return std::string("SELECT ") + kJobColumns + (with_scene ? ", scene" : "") + " FROM grip_jobs WHERE " + where;
+}
+
+// Bytes as a bytea literal in text form (\x and hex digits): parameters are sent as text.
+std::string bytea(const std::string& bytes) {
+  static const char* digits = "0123456789abcdef";
+  std::string out = "\\x";
+  out.reserve(2 + 2 * bytes.size());
+  for (unsigned char c : bytes) {
+    out += digits[c >> 4];
+    out += digits[c & 15];
+  }
+  return out;
+}
+
+// The bytes of a bytea value in text form (hex: \x...).
+std::string from_bytea(const std::string& text) {
+  auto value = [](char c) { return c <= '9' ? c - '0' : (c | 0x20) - 'a' + 10; };
+  std::string out;
+  if (text.size() < 2 || text[0] != '\\' || text[1] != 'x') throw std::runtime_error("database: bytea not in hex form");
+  out.reserve((text.size() - 2) / 2);
+  for (size_t i = 2; i + 1 < text.size(); i += 2) out += static_cast<char>(value(text[i]) << 4 | value(text[i + 1]));
+  return out;
 }
 
 std::string num(std::int64_t v) { return std::to_string(v); }
@@ -334,8 +368,8 @@ void PostgresStore::set_listener(std::function<void(const StoreChange&)> listene
   listener_ = std::move(listener);
 }
 
-std::pair<std::int64_t, std::int64_t> PostgresStore::traffic() const {
-  return {pool_->round_trips.load(), pool_->bytes.load()};
+std::optional<std::pair<std::int64_t, std::int64_t>> PostgresStore::traffic() const {
+  return std::make_pair(pool_->round_trips.load(), pool_->bytes.load());
 }
 
 void PostgresStore::listen_loop() {
@@ -404,10 +438,10 @@ void PostgresStore::insert_job(JobRecord& job) {
   Session s(*pool_);
   const Result r = s.query(
       "WITH ins AS (INSERT INTO grip_jobs (id, status, scene, created, updated, message, steps, "
-      "nodes, idempotency_key) VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9) RETURNING ord, id) "
+      "nodes, idempotency_key, request_id) VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10) RETURNING ord, id) "
       "SELECT ord, pg_notify('grip', 'j' || id) FROM ins",
       {job.id, std::string(to_string(job.status)), job.scene, job.created, job.updated, job.message,
-       num(std::int64_t{job.steps}), num(std::int64_t{job.nodes}), job.idempotency_key});
+       num(std::int64_t{job.steps}), num(std::int64_t{job.nodes}), job.idempotency_key, job.request_id});
   job.ord = r.int64(0, 0);
 }
 
@@ -425,8 +459,7 @@ std::optional<JobRecord> PostgresStore::job_by_idempotency_key(const std::string
   return read_job(r, 0, true);
 }
 
-JobPage PostgresStore::list_jobs(std::optional<JobStatus> status, int limit,
-                                 std::optional<std::int64_t> before) {
+JobPage PostgresStore::list_jobs(std::optional<JobStatus> status, int limit, std::optional<std::int64_t> before) {
   Session s(*pool_);
   const std::string sql = select_job(false, status ? "ord < $1 AND status = $3" : "ord < $1 AND $3::text IS NULL") +
                           " ORDER BY ord DESC LIMIT $2";
@@ -552,16 +585,27 @@ std::optional<JobStatus> PostgresStore::finish_job(const Lease& lease, const Job
       "status = CASE WHEN cur.status = 'dismissed' OR $3::text = 'dismissed' THEN 'dismissed' ELSE $3::text END, "
       "message = CASE WHEN cur.status = 'dismissed' OR $3::text = 'dismissed' THEN 'dismissed' ELSE $4::text END, "
       "finished = $5::text, updated = $5::text, solve_seconds = $6::float8, iterations = $7::bigint, "
-      "last_seq = greatest(j.last_seq, $8::bigint) FROM cur WHERE j.id = cur.id RETURNING j.id, j.status), "
-      "res AS (INSERT INTO grip_results (job_id, data) SELECT id, $9::text FROM upd WHERE "
-      "upd.status <> 'dismissed' AND $9::text IS NOT NULL ON CONFLICT (job_id) DO UPDATE SET data = EXCLUDED.data), "
+      "last_seq = greatest(j.last_seq, $8::bigint), "
+      "failure_kind = CASE WHEN cur.status = 'dismissed' OR $3::text = 'dismissed' THEN 'dismissed' ELSE $13::text "
+      "END, "
+      "failure_step = CASE WHEN cur.status = 'dismissed' OR $3::text = 'dismissed' THEN 0 ELSE $14::integer END, "
+      "steps_completed = $15::integer, stored_bytes = octet_length(j.scene) + "
+      "CASE WHEN cur.status = 'dismissed' OR $3::text = 'dismissed' THEN 0 ELSE coalesce(octet_length($9::bytea), 0) "
+      "END + "
+      "octet_length($11::text) + (SELECT coalesce(sum(octet_length(e.data)), 0) FROM grip_events e WHERE e.job_id = "
+      "j.id) "
+      "FROM cur WHERE j.id = cur.id RETURNING j.id, j.status), "
+      "res AS (INSERT INTO grip_results (job_id, bytes) SELECT id, $9::bytea FROM upd WHERE "
+      "upd.status <> 'dismissed' AND $9::bytea IS NOT NULL ON CONFLICT (job_id) DO UPDATE SET bytes = EXCLUDED.bytes, "
+      "data = NULL), "
       "ev AS (INSERT INTO grip_events (job_id, seq, type, data) SELECT id, $8::bigint, "
       "CASE WHEN upd.status = 'dismissed' THEN 'job_failed' ELSE $10::text END, "
       "CASE WHEN upd.status = 'dismissed' THEN $12::text ELSE $11::text END FROM upd) "
       "SELECT status, pg_notify('grip', 'e' || id) FROM upd",
       {lease.job_id, num(lease.generation), std::string(to_string(o.status)), o.message, o.finished,
-       num(o.solve_seconds), num(o.iterations), num(o.terminal.seq), o.result, o.terminal.type,
-       o.terminal.data, std::string(kDismissedEvent)});
+       num(o.solve_seconds), num(o.iterations), num(o.terminal.seq), o.result ? Param(bytea(*o.result)) : Param(),
+       o.terminal.type, o.terminal.data, std::string(kDismissedEvent), o.failure_kind,
+       num(std::int64_t{o.failure_step}), num(std::int64_t{o.steps_completed})});
   if (r.rows() == 0) return std::nullopt;
   return parse_job_status(r.text(0, 0));
 }
@@ -589,15 +633,15 @@ std::pair<DismissOutcome, std::optional<JobRecord>> PostgresStore::dismiss_job(c
   DismissOutcome outcome = DismissOutcome::dismissed;
   if (rec.status == JobStatus::accepted) {
     const std::string seq = num(rec.last_seq + 1);
-    s.query("UPDATE grip_jobs SET status = 'dismissed', message = 'dismissed before it started', "
-            "finished = $2, updated = $2, last_seq = $3 WHERE id = $1",
-            {id, now, seq});
+    s.query(
+        "UPDATE grip_jobs SET status = 'dismissed', message = 'dismissed before it started', "
+        "finished = $2, updated = $2, last_seq = $3 WHERE id = $1",
+        {id, now, seq});
     s.query("INSERT INTO grip_events (job_id, seq, type, data) VALUES ($1, $2, 'job_failed', $3)",
             {id, seq, std::string(kDismissedEvent)});
     s.query("SELECT pg_notify('grip', 'e' || $1::text)", {id});
   } else if (!is_finished(rec.status) || rec.finished.empty()) {
-    s.query("UPDATE grip_jobs SET status = 'dismissed', message = 'dismissed', updated = $2 WHERE id = $1",
-            {id, now});
+    s.query("UPDATE grip_jobs SET status = 'dismissed', message = 'dismissed', updated = $2 WHERE id = $1", {id, now});
     s.query("SELECT pg_notify('grip', 'd' || $1::text)", {id});
   } else {
     s.query("DELETE FROM grip_events WHERE job_id = $1", {id});
@@ -615,8 +659,8 @@ std::pair<DismissOutcome, std::optional<JobRecord>> PostgresStore::dismiss_job(c
   return {outcome, after};
 }
 
-std::vector<StoredEvent> PostgresStore::events_after(const std::string& id, std::int64_t after,
-                                                     int limit, std::string_view type) {
+std::vector<StoredEvent> PostgresStore::events_after(const std::string& id, std::int64_t after, int limit,
+                                                     std::string_view type) {
   Session s(*pool_);
   const Result r = s.query(
       "SELECT seq, type, data FROM grip_events WHERE job_id = $1 AND seq > $2 AND "
@@ -629,9 +673,42 @@ std::vector<StoredEvent> PostgresStore::events_after(const std::string& id, std:
 
 std::optional<std::string> PostgresStore::result(const std::string& id) {
   Session s(*pool_);
-  const Result r = s.query("SELECT data FROM grip_results WHERE job_id = $1", {id});
+  const Result r = s.query("SELECT data, bytes FROM grip_results WHERE job_id = $1", {id});
   if (r.rows() == 0) return std::nullopt;
-  return r.text(0, 0);
+  return r.null(0, 1) ? r.text(0, 0) : from_bytea(r.text(0, 1));
+}
+
+std::int64_t PostgresStore::prune(const Retention& retention, const std::string& now) {
+  if (!retention.any()) return 0;
+  Session s(*pool_);
+  const Result r = s.query(
+      "SELECT id, status, finished, stored_bytes FROM grip_jobs WHERE finished IS NOT NULL AND "
+      "status IN ('successful', 'failed', 'dismissed') ORDER BY status = 'dismissed', ord DESC");
+  std::vector<FinishedJob> finished;
+  for (int i = 0; i < r.rows(); ++i)
+    finished.push_back({r.text(i, 0), r.text(i, 1) == "dismissed", r.text(i, 2), r.int64(i, 3)});
+  const std::vector<std::string> gone = beyond_retention(finished, retention, retention_cutoff(retention, now));
+  // In batches, each one transaction; ids are UUIDs (no quoting needed in the array literal).
+  for (size_t from = 0; from < gone.size(); from += 500) {
+    std::string ids = "{";
+    for (size_t i = from; i < std::min(gone.size(), from + 500); ++i) ids += (i > from ? "," : "") + gone[i];
+    ids += "}";
+    s.begin();
+    s.query("DELETE FROM grip_events WHERE job_id = ANY($1::text[])", {ids});
+    s.query("DELETE FROM grip_results WHERE job_id = ANY($1::text[])", {ids});
+    s.query("DELETE FROM grip_jobs WHERE id = ANY($1::text[]) AND finished IS NOT NULL", {ids});
+    s.query("SELECT pg_notify('grip', 'j')");
+    s.commit();
+  }
+  return static_cast<std::int64_t>(gone.size());
+}
+
+std::int64_t PostgresStore::disk_bytes() {
+  Session s(*pool_);
+  const Result r = s.query(
+      "SELECT coalesce(pg_total_relation_size('grip_jobs'), 0) + coalesce(pg_total_relation_size('grip_events'), 0) + "
+      "coalesce(pg_total_relation_size('grip_results'), 0)");
+  return r.int64(0, 0);
 }
 
 }  // namespace grip::server

@@ -32,14 +32,11 @@ class PostgresStore final : public Store {
   void insert_job(JobRecord& job) override;
   std::optional<JobRecord> job(const std::string& id, bool with_scene) override;
   std::optional<JobRecord> job_by_idempotency_key(const std::string& key) override;
-  JobPage list_jobs(std::optional<JobStatus> status, int limit,
-                    std::optional<std::int64_t> before) override;
+  JobPage list_jobs(std::optional<JobStatus> status, int limit, std::optional<std::int64_t> before) override;
   std::map<JobStatus, std::int64_t> count_by_status() override;
   std::int64_t count_accepted() override;
-  std::optional<JobRecord> claim_job(const std::string& owner, const std::string& now,
-                                     double lease_seconds) override;
-  LeaseRenewal renew_leases(const std::string& owner, const std::vector<Lease>& leases,
-                            double lease_seconds) override;
+  std::optional<JobRecord> claim_job(const std::string& owner, const std::string& now, double lease_seconds) override;
+  LeaseRenewal renew_leases(const std::string& owner, const std::vector<Lease>& leases, double lease_seconds) override;
   void release_leases(const std::string& owner) override;
   int requeue_expired(const std::string& now) override;
   std::vector<Lease> append_events(const std::vector<NewEvent>& events) override;
@@ -50,9 +47,11 @@ class PostgresStore final : public Store {
   std::vector<StoredEvent> events_after(const std::string& id, std::int64_t after, int limit,
                                         std::string_view type) override;
   std::optional<std::string> result(const std::string& id) override;
+  std::int64_t prune(const Retention& retention, const std::string& now) override;
+  std::int64_t disk_bytes() override;
   bool ping() override;
   void set_listener(std::function<void(const StoreChange&)> listener) override;
-  std::pair<std::int64_t, std::int64_t> traffic() const override;
+  std::optional<std::pair<std::int64_t, std::int64_t>> traffic() const override;
 
   struct Connection;
   struct Pool;

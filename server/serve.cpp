@@ -1,6 +1,7 @@
 #include "server/serve.hpp"
 
 #include <httplib.h>
+#include <malloc.h>
 #include <pthread.h>
 #include <spdlog/spdlog.h>
 #include <unistd.h>
@@ -12,6 +13,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "server/observability.hpp"
 #include "server/postgres_store.hpp"
 #include "server/sqlite_store.hpp"
 
@@ -37,8 +39,8 @@ long long integer(const std::string& v, const std::string& what, long long lo, l
     used = 0;
   }
   if (used != v.size() || v.empty() || n < lo || n > hi)
-    throw std::invalid_argument(what + ": '" + v + "' is not an integer from " + std::to_string(lo) +
-                                " to " + std::to_string(hi));
+    throw std::invalid_argument(what + ": '" + v + "' is not an integer from " + std::to_string(lo) + " to " +
+                                std::to_string(hi));
   return n;
 }
 
@@ -64,17 +66,29 @@ const std::vector<Flag>& flags() {
       {"db", "GRIP_DB", "PATH|URL", "SQLite file (default data/grip.sqlite) or postgresql:// URL",
        [](ServeConfig& c, const std::string& v) { c.db = v; }},
       {"workers", "GRIP_WORKERS", "N", "solver threads (default: one per core)",
-       [](ServeConfig& c, const std::string& v) { c.service.workers = static_cast<int>(integer(v, "--workers", 1, 1024)); }},
+       [](ServeConfig& c, const std::string& v) {
+         c.service.workers = static_cast<int>(integer(v, "--workers", 1, 1024));
+       }},
       {"queue", "GRIP_QUEUE", "N", "accepted jobs that may wait for a worker (default 256)",
-       [](ServeConfig& c, const std::string& v) { c.service.queue_capacity = static_cast<int>(integer(v, "--queue", 1, 1000000)); }},
+       [](ServeConfig& c, const std::string& v) {
+         c.service.queue_capacity = static_cast<int>(integer(v, "--queue", 1, 1000000));
+       }},
       {"streams", "GRIP_STREAMS", "N", "open event streams (default 32)",
-       [](ServeConfig& c, const std::string& v) { c.http.max_streams = static_cast<int>(integer(v, "--streams", 1, 10000)); }},
+       [](ServeConfig& c, const std::string& v) {
+         c.http.max_streams = static_cast<int>(integer(v, "--streams", 1, 10000));
+       }},
       {"http-threads", "GRIP_HTTP_THREADS", "N", "connections served at once, a thread each (default 1024)",
-       [](ServeConfig& c, const std::string& v) { c.http.front.max_connections = static_cast<int>(integer(v, "--http-threads", 2, 20000)); }},
+       [](ServeConfig& c, const std::string& v) {
+         c.http.front.max_connections = static_cast<int>(integer(v, "--http-threads", 2, 20000));
+       }},
       {"per-client", "GRIP_PER_CLIENT", "N", "open connections from one client address (default 64)",
-       [](ServeConfig& c, const std::string& v) { c.http.front.per_client = static_cast<int>(integer(v, "--per-client", 1, 100000)); }},
+       [](ServeConfig& c, const std::string& v) {
+         c.http.front.per_client = static_cast<int>(integer(v, "--per-client", 1, 100000));
+       }},
       {"idle-connections", "GRIP_IDLE_CONNECTIONS", "N", "keep-alive connections kept waiting (default 64)",
-       [](ServeConfig& c, const std::string& v) { c.http.front.max_idle = static_cast<int>(integer(v, "--idle-connections", 0, 100000)); }},
+       [](ServeConfig& c, const std::string& v) {
+         c.http.front.max_idle = static_cast<int>(integer(v, "--idle-connections", 0, 100000));
+       }},
       {"head-timeout", "GRIP_HEAD_TIMEOUT", "S", "seconds for a whole request head (default 5)",
        [](ServeConfig& c, const std::string& v) {
          c.http.front.head = std::chrono::milliseconds(static_cast<long long>(1000 * real(v, "--head-timeout", 0.1)));
@@ -84,21 +98,52 @@ const std::vector<Flag>& flags() {
          c.http.front.body = std::chrono::milliseconds(static_cast<long long>(1000 * real(v, "--body-timeout", 0.1)));
        }},
       {"max-body", "GRIP_MAX_BODY", "BYTES", "largest request body (default 8388608)",
-       [](ServeConfig& c, const std::string& v) { c.http.max_body_bytes = static_cast<size_t>(integer(v, "--max-body", 1024, 1LL << 34)); }},
+       [](ServeConfig& c, const std::string& v) {
+         c.http.max_body_bytes = static_cast<size_t>(integer(v, "--max-body", 1024, 1LL << 34));
+       }},
+      {"parse-budget", "GRIP_PARSE_BUDGET", "BYTES",
+       "submitted bodies read and checked at once; more wait (default: max-body)",
+       [](ServeConfig& c, const std::string& v) {
+         c.http.parse_budget_bytes = static_cast<size_t>(integer(v, "--parse-budget", 1024, 1LL << 36));
+       }},
       {"max-nodes", "GRIP_MAX_NODES", "N", "nodes per job (default 100000)",
-       [](ServeConfig& c, const std::string& v) { c.service.limits.max_nodes = static_cast<int>(integer(v, "--max-nodes", 1, 1LL << 30)); }},
+       [](ServeConfig& c, const std::string& v) {
+         c.service.limits.max_nodes = static_cast<int>(integer(v, "--max-nodes", 1, 1LL << 30));
+       }},
       {"max-steps", "GRIP_MAX_STEPS", "N", "load steps per job (default 10000)",
-       [](ServeConfig& c, const std::string& v) { c.service.limits.max_steps = static_cast<int>(integer(v, "--max-steps", 1, 1LL << 30)); }},
+       [](ServeConfig& c, const std::string& v) {
+         c.service.limits.max_steps = static_cast<int>(integer(v, "--max-steps", 1, 1LL << 30));
+       }},
       {"max-iterations", "GRIP_MAX_ITERATIONS", "N", "contact iterations per job (default 1000000)",
-       [](ServeConfig& c, const std::string& v) { c.service.limits.max_iterations = integer(v, "--max-iterations", 1, 1LL << 50); }},
+       [](ServeConfig& c, const std::string& v) {
+         c.service.limits.max_iterations = integer(v, "--max-iterations", 1, 1LL << 50);
+       }},
       {"max-seconds", "GRIP_MAX_SECONDS", "S", "wall seconds per job run (default 3600)",
        [](ServeConfig& c, const std::string& v) { c.service.limits.max_seconds = real(v, "--max-seconds", 0.001); }},
+      {"retain-jobs", "GRIP_RETAIN_JOBS", "N",
+       "finished jobs kept; older ones are removed, dismissed first (default 10000; 0: all)",
+       [](ServeConfig& c, const std::string& v) {
+         c.service.retention.max_jobs = integer(v, "--retain-jobs", 0, 1LL << 40);
+       }},
+      {"retain-age", "GRIP_RETAIN_AGE", "S", "seconds a finished job is kept (default 0: no age bound)",
+       [](ServeConfig& c, const std::string& v) { c.service.retention.max_age_seconds = real(v, "--retain-age", 0); }},
+      {"retain-bytes", "GRIP_RETAIN_BYTES", "BYTES", "stored bytes of finished jobs kept (default 0: no size bound)",
+       [](ServeConfig& c, const std::string& v) {
+         c.service.retention.max_bytes = integer(v, "--retain-bytes", 0, 1LL << 50);
+       }},
+      {"prune-interval", "GRIP_PRUNE_INTERVAL", "S", "seconds between retention passes (default 60)",
+       [](ServeConfig& c, const std::string& v) {
+         c.service.prune_interval =
+             std::chrono::milliseconds(static_cast<long long>(1000 * real(v, "--prune-interval", 0.05)));
+       }},
       {"replica", "GRIP_REPLICA", "NAME", "this process's name in job leases (default host-pid-random)",
        [](ServeConfig& c, const std::string& v) { c.service.replica = v; }},
       {"lease", "GRIP_LEASE", "S", "a run unrenewed this long is taken over by another replica (default 10)",
        [](ServeConfig& c, const std::string& v) { c.service.lease_seconds = real(v, "--lease", 0.3); }},
       {"token", "GRIP_TOKEN", "TOKEN", "bearer token required on every route but /v1/health",
-       [](ServeConfig& c, const std::string& v) { if (!v.empty()) c.http.token = v; }},
+       [](ServeConfig& c, const std::string& v) {
+         if (!v.empty()) c.http.token = v;
+       }},
       {"grace", "GRIP_GRACE", "S", "SIGTERM: seconds running jobs may still finish (default 8)",
        [](ServeConfig& c, const std::string& v) { c.grace_seconds = real(v, "--grace", 0); }},
       {"heartbeat", "GRIP_HEARTBEAT", "S", "seconds between event-stream pings (default 15)",
@@ -107,6 +152,11 @@ const std::vector<Flag>& flags() {
        }},
       {"schemas", "GRIP_SCHEMAS", "DIR", "schemas and examples folder (default: found beside the binary)",
        [](ServeConfig& c, const std::string& v) { c.http.schemas_dir = v; }},
+      {"log-format", "GRIP_LOG_FORMAT", "FORMAT", "text or json (one object a line, for log shippers; default text)",
+       [](ServeConfig& c, const std::string& v) {
+         if (v != "text" && v != "json") throw std::invalid_argument("--log-format: '" + v + "' is not text or json");
+         c.log_format = v;
+       }},
       {"log-level", "GRIP_LOG_LEVEL", "LEVEL", "trace, debug, info, warn, error (default info)",
        [](ServeConfig& c, const std::string& v) {
          if (spdlog::level::from_str(v) == spdlog::level::off && v != "off")
@@ -122,7 +172,7 @@ std::string find_schemas_dir() {
   const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
   std::vector<fs::path> candidates;
   if (!ec) {
-    candidates.push_back(exe.parent_path() / "../../schemas");      // build/apps/grip
+    candidates.push_back(exe.parent_path() / "../../schemas");          // build/apps/grip
     candidates.push_back(exe.parent_path() / "../share/grip/schemas");  // installed
   }
   candidates.push_back("schemas");
@@ -145,6 +195,7 @@ std::string serve_usage() {
 
 ServeConfig read_serve_config(const std::vector<std::string>& args) {
   ServeConfig c;
+  c.service.retention.max_jobs = 10000;  // the disk stays bounded unless asked otherwise
   for (const Flag& f : flags())
     if (const char* v = std::getenv(f.env)) f.set(c, v);
   for (size_t i = 0; i < args.size(); ++i) {
@@ -173,9 +224,11 @@ ServeConfig read_serve_config(const std::vector<std::string>& args) {
 }
 
 int serve(const ServeConfig& config) {
-  spdlog::set_pattern("%Y-%m-%dT%H:%M:%S.%e %^%l%$ %v");
-  spdlog::set_level(spdlog::level::from_str(config.log_level));
-  spdlog::flush_on(spdlog::level::info);
+  setup_logging(config.log_format, config.log_level);
+  // Two malloc arenas, not glibc's 8 per core: a thread per connection otherwise spreads what
+  // large requests freed over arenas that keep it (8 hostile 6 MB scenes left 44 MB resident
+  // against 25 MB with two; docs/limits.md#memory).
+  mallopt(M_ARENA_MAX, 2);
 
   // Signals go to one thread only: block them before any thread starts.
   sigset_t signals;
@@ -187,18 +240,22 @@ int serve(const ServeConfig& config) {
 
   const ServeConfig& c = config;
   const FrontLimits& f = c.http.front;
-  spdlog::info("grip serve: host {} port {} db {} workers {} queue {} streams {} http-threads {}",
-               c.http.host, c.http.port, is_postgresql_url(c.db) ? redacted_url(c.db) : c.db,
+  spdlog::info("grip serve: host {} port {} db {} workers {} queue {} streams {} http-threads {}", c.http.host,
+               c.http.port, is_postgresql_url(c.db) ? redacted_url(c.db) : c.db,
                c.service.workers > 0 ? c.service.workers : static_cast<int>(std::thread::hardware_concurrency()),
                c.service.queue_capacity, c.http.max_streams, f.max_connections);
-  spdlog::info("connections: {} per client, {} kept idle, head within {} s, body within {} s",
-               f.per_client, f.max_idle, f.head.count() / 1000.0, f.body.count() / 1000.0);
-  spdlog::info("limits: body {} bytes, {} nodes, {} steps, {} contact iterations, {} s per job",
-               c.http.max_body_bytes, c.service.limits.max_nodes, c.service.limits.max_steps,
-               c.service.limits.max_iterations, c.service.limits.max_seconds);
+  spdlog::info("connections: {} per client, {} kept idle, head within {} s, body within {} s", f.per_client, f.max_idle,
+               f.head.count() / 1000.0, f.body.count() / 1000.0);
+  spdlog::info("limits: body {} bytes, {} nodes, {} steps, {} contact iterations, {} s per job", c.http.max_body_bytes,
+               c.service.limits.max_nodes, c.service.limits.max_steps, c.service.limits.max_iterations,
+               c.service.limits.max_seconds);
+  const Retention& keep = c.service.retention;
+  spdlog::info("retention: {} finished jobs, {} s, {} bytes (0: no bound), every {} s; parse budget {} bytes",
+               keep.max_jobs, keep.max_age_seconds, keep.max_bytes, c.service.prune_interval.count() / 1000.0,
+               c.http.parse_budget_bytes ? c.http.parse_budget_bytes : c.http.max_body_bytes);
   spdlog::info("token {}, grace {} s, heartbeat {} s, schemas {}, log level {}",
-               c.http.token ? "required" : "not required", c.grace_seconds,
-               c.http.heartbeat.count() / 1000.0, c.http.schemas_dir, c.log_level);
+               c.http.token ? "required" : "not required", c.grace_seconds, c.http.heartbeat.count() / 1000.0,
+               c.http.schemas_dir, c.log_level);
 
   std::unique_ptr<Store> store;
   try {

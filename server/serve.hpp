@@ -16,6 +16,7 @@ struct ServeConfig {
   std::string db = "data/grip.sqlite";
   double grace_seconds = 8.0;  // SIGTERM: running jobs may finish this long (docker stop: 10 s)
   std::string log_level = "info";
+  std::string log_format = "text";  // or "json"
 };
 
 // Reads GRIP_* variables from `environ`, then the flags. Throws std::invalid_argument naming

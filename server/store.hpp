@@ -41,20 +41,21 @@ class StoreUnavailable : public std::runtime_error {
 };
 
 // The terminal event of a dismissed job, as the store writes it.
-inline constexpr std::string_view kDismissedEvent = R"({"reason":"dismissed","type":"job_failed"})";
+inline constexpr std::string_view kDismissedEvent =
+    R"({"failure":{"kind":"dismissed","message":"dismissed","step":0},"reason":"dismissed","type":"job_failed"})";
 
 struct JobRecord {
   std::string id;
   std::int64_t ord = 0;  // creation order, assigned by the store
   JobStatus status = JobStatus::accepted;
-  std::string scene;     // compact JSON as accepted (only filled when asked for)
-  std::string created;   // ISO 8601 UTC timestamps; empty: not yet
+  std::string scene;    // compact JSON as accepted (only filled when asked for)
+  std::string created;  // ISO 8601 UTC timestamps; empty: not yet
   std::string started;
   std::string finished;
   std::string updated;
   std::string message;
-  int steps = 0;         // load steps of the scene
-  int nodes = 0;         // nodes of the body's mesh
+  int steps = 0;  // load steps of the scene
+  int nodes = 0;  // nodes of the body's mesh
   std::optional<std::string> idempotency_key;
   std::int64_t last_seq = 0;  // highest event sequence number ever given out
   int attempts = 0;           // runs started; above 1 after an interrupted run
@@ -62,7 +63,39 @@ struct JobRecord {
   std::int64_t iterations = 0;  // contact iterations of the final run
   std::string owner;            // replica holding (or that last held) the lease
   std::int64_t generation = 0;  // lease generation: grows with every claim
+  // A finished job: why it did not succeed (a FailureKind's name, empty when it did), the step
+  // that failed (0: none), and the steps that converged.
+  std::string failure_kind;
+  int failure_step = 0;
+  int steps_completed = 0;
+  std::int64_t stored_bytes = 0;  // of its scene, events and result, once finished
+  std::string request_id;         // of the request that submitted it (X-Request-Id)
 };
+
+// Which finished jobs the store keeps; 0: no bound of that kind. Beyond a bound the
+// dismissed jobs go first, then the oldest.
+struct Retention {
+  double max_age_seconds = 0;  // finished longer ago than this
+  std::int64_t max_jobs = 0;   // finished jobs
+  std::int64_t max_bytes = 0;  // stored bytes of finished jobs
+  bool any() const { return max_age_seconds > 0 || max_jobs > 0 || max_bytes > 0; }
+};
+
+// A finished job as retention sees it, in the order it keeps them: the ones it keeps first.
+struct FinishedJob {
+  std::string id;
+  bool dismissed = false;
+  std::string finished;
+  std::int64_t stored_bytes = 0;
+};
+
+// The time (ISO 8601) before which a job finished is too old at `now`; empty: no age bound.
+std::string retention_cutoff(const Retention& r, const std::string& now);
+
+// The ids of `jobs` (ordered as FinishedJob says) that `r` removes at `cutoff` (the ISO 8601
+// time before which finished jobs are too old; empty: no age bound).
+std::vector<std::string> beyond_retention(const std::vector<FinishedJob>& jobs, const Retention& r,
+                                          const std::string& cutoff);
 
 // A run's hold on a job (fencing token).
 struct Lease {
@@ -87,8 +120,11 @@ struct JobOutcome {
   std::string finished;  // timestamp
   double solve_seconds = 0.0;
   std::int64_t iterations = 0;
-  std::optional<std::string> result;  // result JSON, when the run produced one
-  StoredEvent terminal;                // job_finished | job_failed
+  std::string failure_kind;  // as JobRecord's
+  int failure_step = 0;
+  int steps_completed = 0;
+  std::optional<std::string> result;  // the result as stored (zstd of its JSON), when the run produced one
+  StoredEvent terminal;               // job_finished | job_failed
 };
 
 struct JobPage {
@@ -100,8 +136,8 @@ enum class DismissOutcome { not_found, dismissed, removed };
 
 // What renew_leases found about the owner's jobs.
 struct LeaseRenewal {
-  std::vector<Lease> held;                // leases still this owner's (renewed)
-  std::vector<std::string> dismissed;     // among them: jobs dismissed meanwhile
+  std::vector<Lease> held;             // leases still this owner's (renewed)
+  std::vector<std::string> dismissed;  // among them: jobs dismissed meanwhile
 };
 
 // A change announced to listeners.
@@ -120,8 +156,7 @@ class Store {
   virtual std::optional<JobRecord> job(const std::string& id, bool with_scene = false) = 0;
   virtual std::optional<JobRecord> job_by_idempotency_key(const std::string& key) = 0;
   // Newest first; `before`: only jobs with a smaller ord.
-  virtual JobPage list_jobs(std::optional<JobStatus> status, int limit,
-                            std::optional<std::int64_t> before) = 0;
+  virtual JobPage list_jobs(std::optional<JobStatus> status, int limit, std::optional<std::int64_t> before) = 0;
   virtual std::map<JobStatus, std::int64_t> count_by_status() = 0;
   virtual std::int64_t count_accepted() = 0;
 
@@ -152,20 +187,28 @@ class Store {
   // Atomically: an accepted job is finished as dismissed (with the dismissed event), a running
   // one marked dismissed (its runner finishes it), a finished one removed with its events and
   // result. Returns the job as it is afterwards (removed: as it was).
-  virtual std::pair<DismissOutcome, std::optional<JobRecord>> dismiss_job(
-      const std::string& id, const std::string& now) = 0;
+  virtual std::pair<DismissOutcome, std::optional<JobRecord>> dismiss_job(const std::string& id,
+                                                                          const std::string& now) = 0;
 
   // Events with seq > after, in order, at most `limit`; only of `type` when given.
-  virtual std::vector<StoredEvent> events_after(const std::string& id, std::int64_t after,
-                                                int limit, std::string_view type = {}) = 0;
+  virtual std::vector<StoredEvent> events_after(const std::string& id, std::int64_t after, int limit,
+                                                std::string_view type = {}) = 0;
+  // The result as stored: bytes (zstd; gzip or JSON text if stored by an earlier version).
   virtual std::optional<std::string> result(const std::string& id) = 0;
+
+  // Removes the finished jobs beyond `retention` at `now` (ISO 8601), with their events and
+  // results, and hands their space back (SQLite: incremental vacuum). Returns how many.
+  virtual std::int64_t prune(const Retention& retention, const std::string& now) = 0;
+  // Bytes the database takes on disk (SQLite: the file; PostgreSQL: grip's tables).
+  virtual std::int64_t disk_bytes() = 0;
 
   // True when the database answers now.
   virtual bool ping() = 0;
   // Called (on a store thread) for every change on the database, from any store instance.
   virtual void set_listener(std::function<void(const StoreChange&)> listener) = 0;
-  // Round trips and bytes exchanged with the database so far (benchmarks; 0 when embedded).
-  virtual std::pair<std::int64_t, std::int64_t> traffic() const { return {0, 0}; }
+  // Round trips and bytes exchanged with the database so far (benchmarks); none when the
+  // store does not measure them (embedded).
+  virtual std::optional<std::pair<std::int64_t, std::int64_t>> traffic() const { return std::nullopt; }
 };
 
 }  // namespace grip::server

@@ -29,10 +29,21 @@ function elapsed(job) {
   const s = seconds(job.started, job.finished || new Date().toISOString());
   return s < 60 ? `${s.toFixed(1)} s` : `${Math.floor(s / 60)} min ${Math.round(s % 60)} s`;
 }
+// Converged steps (a failed job's too); while running, the step being solved.
 function stepsText(job) {
-  if (job.status === "successful") return `${job.steps} of ${job.steps}`;
-  if (job.step) return `${job.step} of ${job.steps}`;
-  return `- of ${job.steps}`;
+  if (job.status === "running" && job.step) return `${job.step} of ${job.steps}`;
+  return `${job.steps_completed ?? 0} of ${job.steps}`;
+}
+
+// A failure in a sentence, by its kind (schemas/result.schema.json#/definitions/failure).
+function failureText(failure, reason) {
+  switch (failure?.kind) {
+    case "dismissed": return "dismissed";
+    case "job_limit": return "stopped by this service's limit: " + failure.message;
+    case "friction_limit": return "failed: the load exceeds what friction can hold: " + failure.message;
+    case undefined: return "failed: " + reason;
+    default: return `failed (${failure.kind}): ${failure.message}`;
+  }
 }
 
 function showConnection(error) {
@@ -66,7 +77,7 @@ async function refreshJobs() {
     const open = button(job.jobID.slice(0, 8), `open job ${job.jobID}`, () => { location.hash = "job=" + job.jobID; });
     open.className = "link";
     cell(row, "").append(open);
-    cell(row, job.status, { class: "status " + job.status });
+    cell(row, job.status, { class: "status " + job.status, title: job.failure ? job.failure.kind : "" });
     cell(row, stepsText(job));
     cell(row, elapsed(job));
     cell(row, "").append(button("Dismiss", `dismiss job ${job.jobID}`, async () => {
@@ -170,7 +181,9 @@ function resetWatch() {
   watched.result = null;
   $("step-table").tBodies[0].replaceChildren();
   $("result-view").hidden = true;
+  watched.trials = 0;
   $("count-iterations").textContent = "0";
+  $("count-iterations").dataset.events = "0";
   for (const k of ["open", "stick", "slip", "v2"]) $("count-" + k).textContent = "-";
   drawConvergence($("conv-plot"), [], watched.tolerance);  // at once: no stale points
 }
@@ -187,7 +200,10 @@ function onEvent(seq, type, data) {
     $("job-status").textContent = `running: step ${data.step}, load factor ${data.load_factor}`;
   } else if (type === "iteration") {
     watched.points.push({ seq, step: data.step, v2: data.v2 });
-    $("count-iterations").textContent = String(watched.points.length);
+    // Contact iterations are real solves: the events' trials (the job's and the result's count).
+    watched.trials += data.trials;
+    $("count-iterations").textContent = String(watched.trials);
+    $("count-iterations").dataset.events = String(watched.points.length);
     for (const k of ["open", "stick", "slip"]) $("count-" + k).textContent = String(data[k]);
     $("count-v2").textContent = data.v2 === null ? "-" : data.v2.toExponential(3);
     queueConvergenceDraw();
@@ -196,7 +212,8 @@ function onEvent(seq, type, data) {
     row.dataset.step = data.step;
     cell(row, String(data.step));
     cell(row, String(data.load_factor));
-    cell(row, data.converged ? "yes" : "no: " + (data.reason || ""), { class: data.converged ? "" : "bad" });
+    cell(row, data.converged ? "yes" : "no: " + (data.reason || ""),
+      { class: data.converged ? "" : "bad", title: data.failure ? data.failure.kind : "" });
     cell(row, String(data.contact_iterations));
     cell(row, String(data.newton_iterations));
     cell(row, data.seconds.toFixed(3));
@@ -206,10 +223,11 @@ function onEvent(seq, type, data) {
     $("step-table").tBodies[0].append(row);
     if (atEnd) box.scrollTop = box.scrollHeight;
   } else if (type === "job_finished" || type === "job_failed") {
-    $("job-status").textContent = type === "job_finished" ? "finished: every step solved" : "failed: " + data.reason;
+    $("job-status").textContent = type === "job_finished" ? "finished: every step solved" : failureText(data.failure, data.reason);
     $("job-panel").dataset.state = type;
+    $("job-panel").dataset.failure = data.failure ? data.failure.kind : "";
     refreshJobs();
-    showResult(watched.id);
+    if (data.failure?.kind !== "dismissed") showResult(watched.id);  // a dismissed job keeps no result
   }
 }
 

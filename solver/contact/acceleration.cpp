@@ -29,8 +29,8 @@ double next_eps(double e) {
 AcceleratedStep accelerate(const Matrix& C1, double eps1, int n) {
   check_level_args(eps1, n);
   if (C1.rows() != C1.cols())
-    throw std::invalid_argument("acceleration: C1 must be square, got " + std::to_string(C1.rows()) +
-                                " x " + std::to_string(C1.cols()));
+    throw std::invalid_argument("acceleration: C1 must be square, got " + std::to_string(C1.rows()) + " x " +
+                                std::to_string(C1.cols()));
   const Eigen::Index size = C1.rows();
   Matrix C = C1;
   Matrix M = Matrix::Identity(size, size);

@@ -11,9 +11,9 @@
 //
 // Each level maps the eigenvalue interval [eps, omega] of C_(n-1) to [eps*omega, b^2/4]
 // (b = eps + omega), so the condition number kappa becomes (1 + kappa)^2 / (4 kappa).
-// The recursion is normalized so that every level's upper bound is 1 (ALGORITHM.md
-// section 8): the paper's omega_n underflows past n ~ 9, the normalized form is the same
-// alpha * M_n without that.
+// The recursion is normalized so that every level's upper bound is 1
+// (docs/algorithm.md#the-accelerated-multiplier-update): the paper's omega_n underflows past n ~ 9,
+// the normalized form is the same alpha * M_n without that.
 #include <vector>
 
 #include "solver/model/types.hpp"
@@ -27,7 +27,7 @@ inline constexpr double kMinEpsilon = 1e-15;
 
 // The accelerated step of eq. 13 on the active block: step = alpha * M_n * v / ||C'||_inf.
 struct AcceleratedStep {
-  Matrix step_matrix;  // alpha * M_n, normalized (ALGORITHM.md section 8), on the active block
+  Matrix step_matrix;  // alpha * M_n, normalized as above, on the active block
   double alpha = 1.0;  // 2 / (1 + e_n) in the normalized form (eq. 29)
   double eps_n = 1.0;  // normalized lower eigenvalue bound of C1 * M_n after n levels (upper bound 1)
   int n = 1;           // acceleration level used
@@ -59,7 +59,6 @@ double smallest_eigenvalue(const Matrix& C1);
 // >= 1 (no contraction seen) makes the min non-positive and so gives the floor, the
 // conservative bound. Throws std::invalid_argument unless alpha > 0,
 // 1 <= first <= last and v_norms reaches index first.
-double warmup_epsilon(const std::vector<double>& v_norms, double alpha, int first = 3,
-                      int last = 10);
+double warmup_epsilon(const std::vector<double>& v_norms, double alpha, int first = 3, int last = 10);
 
 }  // namespace grip

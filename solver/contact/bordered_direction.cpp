@@ -1,9 +1,9 @@
-// eq. 13 on the bordered active block [C G; G^T 0] of a body held by contact (ALGORITHM.md 7).
-// The amplitudes' rows are equalities (always active, no sign condition, no cone) and the block
-// is indefinite, so neither a Cholesky solve nor the polynomial accelerator applies to it. The
-// amplitudes are eliminated instead: force changes split into a part dp0 that restores the
-// whole body's equilibrium and a part Z y in the null space of G^T that keeps it, on which C is
-// positive definite (it is the compliance of the pinned body):
+// eq. 13 on the bordered active block [C G; G^T 0] of a body held by contact
+// (docs/algorithm.md#bodies-held-only-by-contact). The amplitudes' rows are equalities (always
+// active, no sign condition, no cone) and the block is indefinite, so neither a Cholesky solve nor
+// the polynomial accelerator applies to it. The amplitudes are eliminated instead: force changes
+// split into a part dp0 that restores the whole body's equilibrium and a part Z y in the null space
+// of G^T that keeps it, on which C is positive definite (it is the compliance of the pinned body):
 //     dp  = dp0 + Z y,   dp0 = -(G^T)^+ v_a,   y = -step(C_r) Z^T w,   w = v_c + C dp0
 //     da  = -G^+ (w + C Z y)       (what of the new contact error lies in range G)
 // with C_r = Z^T C Z, Z an orthonormal basis of null(G^T), and step() the ordinary eq. 13 on
@@ -19,8 +19,7 @@
 
 namespace grip {
 
-Direction StepSolver::bordered_direction(const Compliance& C, const ContactError& err, int level,
-                                         double alpha_fixed) {
+Direction StepSolver::bordered_direction(const Compliance& C, const ContactError& err, int level, double alpha_fixed) {
   Direction dir;
   dir.d = Vector::Zero(err.v.size());
   std::vector<int> contact, amplitude;

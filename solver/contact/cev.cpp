@@ -3,7 +3,8 @@
 // (coulomb_model.hpp), then makes one real solve at the prediction with its line search; the
 // friction bound moves with p_eta, so there are no tau passes. Options: the tau passes of
 // eq. 14 around the same inner loop with eq. 13 on the model (`friction_loop: passes`,
-// ALGORITHM.md section 5), or around the paper's literal loop (`loop: paper`).
+// docs/algorithm.md#friction_loop-passes-the-tau-passes), or around the paper's literal loop
+// (`loop: paper`).
 #include "solver/contact/acceleration.hpp"
 #include "solver/contact/coulomb_model.hpp"
 #include "solver/contact/step.hpp"
@@ -18,8 +19,8 @@ constexpr double kStaleContraction = 0.03;
 
 class CevStep : public StepSolver {
  public:
-  CevStep(Equilibrium& eq, const ContactParams& params, int step, const IterationObserver& obs,
-          const StopRequest& stop, double v_previous)
+  CevStep(Equilibrium& eq, const ContactParams& params, int step, const IterationObserver& obs, const StopRequest& stop,
+          double v_previous)
       : StepSolver(eq, params, step, obs, stop), v_previous_(v_previous) {}
 
  private:
@@ -28,8 +29,7 @@ class CevStep : public StepSolver {
       return coulomb_loop(q_guess, p_start);
     tau_passes(q_guess, p_start, p_star, [this] {
       if (needs_warmup() && !warmup()) return false;
-      return params_.loop == ContactLoop::paper ? literal_pass(params_.acceleration, 0.0)
-                                                : inner_pass();
+      return params_.loop == ContactLoop::paper ? literal_pass(params_.acceleration, 0.0) : inner_pass();
     });
   }
 
@@ -99,6 +99,7 @@ class CevStep : public StepSolver {
     if (!line_search(pl, du, trials)) {
       if (!stale || !budget_left()) return Update::failed;
       out_.reason.clear();
+      out_.failure = FailureKind::none;
       eq_.refresh_compliance();
       return Update::retry;
     }
@@ -156,15 +157,15 @@ class CevStep : public StepSolver {
 
   // The bordered model (a body held by contact) is a saddle point, not a minimum of q: there a
   // step must lower ||v|| on the model instead.
-  bool lowers_model_error(const Compliance& C, const Vector& p, const Vector& s, const Vector& dp,
-                          const Vector& tau, const ContactError& e) const {
+  bool lowers_model_error(const Compliance& C, const Vector& p, const Vector& s, const Vector& dp, const Vector& tau,
+                          const ContactError& e) const {
     return contact_error(problem_, p + dp, s + model_change(C, dp), tau, out_.state.enabled).norm2 < e.norm2;
   }
 
   // eq. 13 with the bounds tau iterated on s(p) = s0 + C (p - p0), accepted by the decrease
   // of q(p) = p.C.p/2 + (s0 - C p0).p; returns the predicted force.
-  Vector predict(const Compliance& C, const Vector& p0, const Vector& s0, const Vector& tau, int& inner,
-                 int& halvings, int& n_used, double& alpha_used) {
+  Vector predict(const Compliance& C, const Vector& p0, const Vector& s0, const Vector& tau, int& inner, int& halvings,
+                 int& n_used, double& alpha_used) {
     Vector pl = p0, sl = s0;
     const double target = model_target();
     for (inner = 0; inner < params_.max_inner_iterations; ++inner) {
@@ -175,8 +176,7 @@ class CevStep : public StepSolver {
       // The accelerated direction first; the plain gradient (n = 1, always a descent
       // direction for a small enough step) if the projection spoiled it.
       for (int attempt = 0; attempt < 2 && !descended; ++attempt) {
-        const Direction dir = attempt == 0 ? direction(C, e, params_.acceleration, 0.0)
-                                           : direction(C, e, 1, 1.0);
+        const Direction dir = attempt == 0 ? direction(C, e, params_.acceleration, 0.0) : direction(C, e, 1, 1.0);
         if (!dir.ok) continue;
         double a = 1.0;
         for (int k = 0; k <= params_.max_halvings; ++k, a *= 0.5) {
@@ -233,9 +233,9 @@ class CevStep : public StepSolver {
 
 }  // namespace
 
-StepOutcome solve_cev_step(Equilibrium& eq, const Vector& q_guess, const Vector& p_start,
-                           const Vector& p_star, const ContactParams& params, int step,
-                           const IterationObserver& observer, const StopRequest& stop, double v_previous) {
+StepOutcome solve_cev_step(Equilibrium& eq, const Vector& q_guess, const Vector& p_start, const Vector& p_star,
+                           const ContactParams& params, int step, const IterationObserver& observer,
+                           const StopRequest& stop, double v_previous) {
   return CevStep(eq, params, step, observer, stop, v_previous).run(q_guess, p_start, p_star);
 }
 

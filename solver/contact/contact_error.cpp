@@ -11,8 +11,8 @@ bool at_bound(double p_xi, double tau) { return std::abs(p_xi) >= tau * (1 - kBo
 
 }  // namespace
 
-ContactError contact_error(const Problem& problem, const Vector& p, const Vector& s,
-                           const Vector& tau, const std::vector<char>& enabled) {
+ContactError contact_error(const Problem& problem, const Vector& p, const Vector& s, const Vector& tau,
+                           const std::vector<char>& enabled) {
   ContactError e;
   e.v = Vector::Zero(problem.component_count);
   e.active.assign(problem.component_count, 0);
@@ -40,21 +40,19 @@ ContactError contact_error(const Problem& problem, const Vector& p, const Vector
   return e;
 }
 
-Vector project_forces(const Problem& problem, const Vector& p, const Vector& pbar,
-                      const ContactError& error, const Vector& tau) {
+Vector project_forces(const Problem& problem, const Vector& p, const Vector& pbar, const ContactError& error,
+                      const Vector& tau) {
   Vector out = p;
   for (size_t i = 0; i < problem.candidates.size(); ++i) {
     const Candidate& c = problem.candidates[i];
     out[c.eta] = std::min(0.0, pbar[c.eta]);
     if (c.xi < 0) continue;
-    if (tau[i] <= 0)
-      out[c.xi] = 0.0;
-    else if (error.active[c.xi])
-      out[c.xi] = std::clamp(pbar[c.xi], -tau[i], tau[i]);
+    if (tau[i] <= 0) out[c.xi] = 0.0;
+    else if (error.active[c.xi]) out[c.xi] = std::clamp(pbar[c.xi], -tau[i], tau[i]);
     else  // slipping: stays on the bound, on its side
       out[c.xi] = sign(p[c.xi]) * tau[i];
   }
-  // The rigid amplitudes have no bound (ALGORITHM.md 7).
+  // The rigid amplitudes have no bound (docs/algorithm.md#bodies-held-only-by-contact).
   for (int k = 0; k < problem.rigid.count(); ++k) out[problem.rigid.first + k] = pbar[problem.rigid.first + k];
   return out;
 }
@@ -75,8 +73,7 @@ void clip_to_bounds(const Problem& problem, const Vector& tau, Vector& p) {
   }
 }
 
-ContactState contact_state(const Problem& problem, size_t candidate, const Vector& p,
-                           const Vector& tau) {
+ContactState contact_state(const Problem& problem, size_t candidate, const Vector& p, const Vector& tau) {
   const Candidate& c = problem.candidates[candidate];
   if (p[c.eta] >= 0) return ContactState::open;
   if (c.xi < 0) return ContactState::slip;  // frictionless contact slides freely
@@ -85,9 +82,12 @@ ContactState contact_state(const Problem& problem, size_t candidate, const Vecto
 
 const char* to_string(ContactState state) {
   switch (state) {
-    case ContactState::open: return "open";
-    case ContactState::stick: return "stick";
-    case ContactState::slip: return "slip";
+    case ContactState::open:
+      return "open";
+    case ContactState::stick:
+      return "stick";
+    case ContactState::slip:
+      return "slip";
   }
   return "open";
 }

@@ -32,8 +32,8 @@ class Model {
       if (r.xi >= 0 && C.diagonal(r.xi) > 0) r.r_xi = augmentation / C.diagonal(r.xi);
       rows_.push_back(r);
     }
-    // The rigid amplitudes' rows (ALGORITHM.md 7): the body's equilibrium s = 0, an equality,
-    // scaled like a contact row by the largest contact compliance.
+    // The rigid amplitudes' rows (docs/algorithm.md#bodies-held-only-by-contact): the body's
+    // equilibrium s = 0, an equality, scaled like a contact row by the largest contact compliance.
     double c_max = 0.0;
     for (const Rows& r : rows_)
       c_max = std::max({c_max, r.eta >= 0 ? C.diagonal(r.eta) : 0.0, r.xi >= 0 ? C.diagonal(r.xi) : 0.0});
@@ -115,8 +115,7 @@ class Model {
   Vector x0_, s0_;
 };
 
-ContactError coulomb_error(const Problem& problem, const Vector& p, const Vector& s,
-                           const std::vector<char>& enabled) {
+ContactError coulomb_error(const Problem& problem, const Vector& p, const Vector& s, const std::vector<char>& enabled) {
   return contact_error(problem, p, s, friction_bounds(problem, p), enabled);
 }
 

@@ -1,7 +1,7 @@
 #pragma once
 // Coulomb's law on the linear model s(p) = s0 + C (p - p0) of one contact iteration, with the
 // friction bound mu |p_eta| moving with p_eta (no tau passes): a semismooth Newton method on
-// the Alart-Curnier function (Alart & Curnier 1991; signs of ALGORITHM.md section 1)
+// the Alart-Curnier function (Alart & Curnier 1991; signs of docs/algorithm.md#notation)
 //     F_eta = p_eta - min(0, p_eta - r s_eta)
 //     F_xi  = p_xi - clamp(p_xi - r s_xi, -tau, tau),   tau = mu max(0, -(p_eta - r s_eta))
 // whose zeros are the contact conditions with the Coulomb cone. Globalized by backtracking on
@@ -23,12 +23,12 @@ struct CoulombModelParams {
 };
 
 struct CoulombModelSolution {
-  Vector p, s;             // full component vectors; p in the cone exactly
-  ContactError error;      // on the model, with tau = mu |p_eta|
-  int iterations = 0;      // Newton iterations on the model
+  Vector p, s;         // full component vectors; p in the cone exactly
+  ContactError error;  // on the model, with tau = mu |p_eta|
+  int iterations = 0;  // Newton iterations on the model
   int halvings = 0;
-  int factorizations = 0;   // of reduced Newton systems or of C's active block (newton_rows.hpp)
-  int capacitances = 0;     // low-rank corrections of a kept factorization
+  int factorizations = 0;  // of reduced Newton systems or of C's active block (newton_rows.hpp)
+  int capacitances = 0;    // low-rank corrections of a kept factorization
   bool converged = false;  // error.norm2 <= target
 };
 

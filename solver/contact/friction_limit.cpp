@@ -6,7 +6,8 @@
 #include <vector>
 
 #include "solver/contact/contact_error.hpp"
-#include "solver/equilibrium/rigid_equilibrium.hpp"
+#include "solver/contact/held_by_contact.hpp"
+#include "solver/problem/rigid_modes.hpp"
 
 namespace grip {
 namespace {
@@ -33,9 +34,8 @@ std::string friction_limit_exceeded(const Problem& problem, const EquilibriumSta
                                     const Vector& tau, const LoadFactors& factors) {
   const RigidModes& rigid = problem.rigid;
   const int n = static_cast<int>(problem.candidates.size());
-  if (rigid.count() == 0 || static_cast<int>(state.points.size()) != n ||
-      state.q.size() != problem.body->dof_count() || p.size() != problem.component_count ||
-      state.s.size() != problem.component_count)
+  if (rigid.count() == 0 || static_cast<int>(state.points.size()) != n || state.q.size() != problem.body->dof_count() ||
+      p.size() != problem.component_count || state.s.size() != problem.component_count)
     return "";
   const Matrix R = rigid_modes_at(problem, state.q);
   // The generalized force of the load and of the normal forces on the free motions.
@@ -99,8 +99,8 @@ std::string friction_limit_exceeded(const Problem& problem, const EquilibriumSta
   const std::string ratio = number(work / capacity), at = load_factors_text(problem, factors);
   const Vec2 centre = omega != 0 ? Vec2(mean.x() - t.y() / omega, mean.y() + t.x() / omega) : mean;
   if (m > 1 && omega != 0 && (centre - mean).norm() <= 10 * problem.body->characteristic_length())
-    return "the couple exceeds what friction can hold: M / (mu sum N r) = " + ratio + " " + at + " (the body turns about " +
-           point_text(centre) + "; M = " + number(work / std::abs(omega)) +
+    return "the couple exceeds what friction can hold: M / (mu sum N r) = " + ratio + " " + at +
+           " (the body turns about " + point_text(centre) + "; M = " + number(work / std::abs(omega)) +
            ", the moment of the load and the normal contact forces N about it; mu sum N r = " +
            number(capacity / std::abs(omega)) +
            ", the largest moment friction opposes at those normal forces, r the levers of the slips); no static "

@@ -1,9 +1,9 @@
 #pragma once
 // Whether friction can hold a body held by contact at the normal forces its deformation gives
-// (ALGORITHM.md 7): decided after a failed attempt of a step, from a state on Coulomb's law that
-// cev's default loop reached at its target (load_stepping.cpp), where the rigid check before
-// solving (unreachable_equilibrium) cannot decide (the normal forces come from the deformation:
-// a disc squeezed between two flats and turned by a couple).
+// (docs/algorithm.md#the-friction-limit-decision): decided after a failed attempt of a step, from a
+// state on Coulomb's law that cev's default loop reached at its target (load_stepping.cpp), where
+// the rigid check before solving (unreachable_equilibrium) cannot decide (the normal forces come
+// from the deformation: a disc squeezed between two flats and turned by a couple).
 #include <string>
 
 #include "solver/equilibrium/equilibrium.hpp"

@@ -6,13 +6,12 @@
 #include <map>
 
 #include "solver/contact/contact_error.hpp"
-#include "solver/model/body_set.hpp"
 
 namespace grip {
 
-std::vector<MasterReading> master_readings(const Problem& problem, const Vector& q, const Vector& p,
-                                           const Vector& tau, int obstacle) {
-  const auto& all = dynamic_cast<const BodySet&>(*problem.body);
+std::vector<MasterReading> master_readings(const Problem& problem, const Vector& q, const Vector& p, const Vector& tau,
+                                           int obstacle) {
+  const Body& all = *problem.body;
   const ObstacleInstance& pair = problem.obstacles.at(obstacle);
   std::map<int, std::array<double, 3>> slave;  // site -> sigma_n, sigma_t, pressing
   for (size_t i = 0; i < problem.candidates.size(); ++i) {

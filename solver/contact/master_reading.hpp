@@ -22,7 +22,7 @@ struct MasterReading {
 
 // One reading per site of the master body of the pair on `obstacle`, in site order, at the
 // displacements q, contact forces p and friction bounds tau of a step.
-std::vector<MasterReading> master_readings(const Problem& problem, const Vector& q, const Vector& p,
-                                           const Vector& tau, int obstacle);
+std::vector<MasterReading> master_readings(const Problem& problem, const Vector& q, const Vector& p, const Vector& tau,
+                                           int obstacle);
 
 }  // namespace grip

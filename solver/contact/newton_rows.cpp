@@ -18,7 +18,7 @@ namespace grip {
 // Z = Q^-1 A_E (Woodbury).
 struct ComplianceFactor {
   std::vector<int> base;
-  Matrix l;                                       // C_BB, then its factor in place
+  Matrix l;  // C_BB, then its factor in place
   std::optional<Eigen::LLT<Eigen::Ref<Matrix>>> llt;
   bool ok = false;
   // The last system's capacitance.
@@ -144,8 +144,9 @@ Vector solve_newton_rows(const Compliance& C, const Vector& F, const Vector& s, 
     for (const SlipRow& r : rows.slip)
       for (int a = 0; a < n; ++a) M(a, pos[r.eta]) += r.c * Cb(rows.active[a], r.xi);
     Vector y = Eigen::PartialPivLU<Matrix>(M).solve(b);
-    // Singular where every point slips along a free rigid motion held by contact (ALGORITHM.md
-    // 7: its amplitude's column vanishes): the least-squares step, still a descent direction.
+    // Singular where every point slips along a free rigid motion held by contact
+    // (docs/algorithm.md#bodies-held-only-by-contact: its amplitude's column vanishes): the
+    // least-squares step, still a descent direction.
     if (!y.allFinite()) y = M.completeOrthogonalDecomposition().solve(b);
     return spread(y);
   };

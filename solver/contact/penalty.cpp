@@ -13,6 +13,7 @@
 #include <string>
 
 #include "solver/contact/step.hpp"
+#include "solver/model/number_text.hpp"
 
 namespace grip {
 namespace {
@@ -24,8 +25,8 @@ class PenaltyStep : public StepSolver {
  private:
   void solve(const Vector& q_guess, const Vector& p_start, const Vector& p_previous) override {
     PenaltyLaw law;
-    law.normal = params_.penalty_normal > 0 ? params_.penalty_normal
-                                            : params_.penalty_factor * eq_.stiffness_scale(q_guess);
+    law.normal =
+        params_.penalty_normal > 0 ? params_.penalty_normal : params_.penalty_factor * eq_.stiffness_scale(q_guess);
     law.tangential = params_.penalty_tangential > 0 ? params_.penalty_tangential : law.normal;
     law.previous = p_previous;  // the springs start from the last step's force
     Vector q0 = q_guess;
@@ -33,11 +34,11 @@ class PenaltyStep : public StepSolver {
     const double pin_scale = problem_.rigid.count() ? eq_.stiffness_scale(q_guess) : 0.0;
     int solves = 0;
     EquilibriumState s = levels(law, pin_scale, q0, p_start, 1.0, solves);
-    if (!s.converged) s = levels(law, pin_scale, q0, p_start, kRamp, solves);
+    if (!s.converged && !out_.stopped) s = levels(law, pin_scale, q0, p_start, kRamp, solves);
     eq_.set_penalty(std::nullopt);
     pass_ = out_.passes = 1;
     if (!s.converged) {
-      fail("equilibrium solve failed: " + s.reason);
+      if (!out_.stopped) fail(s.failure, "equilibrium solve failed: " + s.reason);
       return;
     }
     Vector p_star = Vector::Zero(problem_.component_count);
@@ -54,9 +55,10 @@ class PenaltyStep : public StepSolver {
       double penetration = 0.0;
       for (const Candidate& c : problem_.candidates) penetration = std::max(penetration, out_.state.s[c.eta]);
       const double raise = error_.norm2 > tol_ ? error_.norm2 / tol_ : 1.0;
-      fail("penalty: contact error " + to_text(error_.norm2) + " above the bound " + to_text(tol_) +
-           " (penetration " + to_text(penetration) + ", k_n = " + to_text(law.normal) +
-           "): a penalty stiffness (or a tolerance) about " + to_text(raise) + " x larger would meet it");
+      fail(FailureKind::penalty_inexact,
+           "penalty: contact error " + number_text(error_.norm2) + " above the bound " + number_text(tol_) +
+               " (penetration " + number_text(penetration) + ", k_n = " + number_text(law.normal) +
+               "): a penalty stiffness (or a tolerance) about " + number_text(raise) + " x larger would meet it");
       return;
     }
     out_.converged = true;
@@ -77,22 +79,18 @@ class PenaltyStep : public StepSolver {
       const double pn = out_.p[c.eta], pt = c.xi >= 0 ? out_.p[c.xi] : 0.0;
       const double mu = problem_.obstacles[c.obstacle].friction;
       if (pn > slack)
-        return fail("penalty: its normal force pulls at contact point " + std::to_string(i) + " (p_n = " + to_text(pn) +
-                    "): its law gives no tension");
+        return fail(FailureKind::penalty_inexact, "penalty: its normal force pulls at contact point " +
+                                                      std::to_string(i) + " (p_n = " + number_text(pn) +
+                                                      "): its law gives no tension");
       if (std::abs(pt) > mu * std::abs(pn) * (1 + 1e-9) + slack)
-        return fail("penalty: its friction force at contact point " + std::to_string(i) + " (|p_t| = " +
-                    to_text(std::abs(pt)) + ") exceeds mu |p_n| = " + to_text(mu * std::abs(pn)));
+        return fail(FailureKind::penalty_inexact, "penalty: its friction force at contact point " + std::to_string(i) +
+                                                      " (|p_t| = " + number_text(std::abs(pt)) +
+                                                      ") exceeds mu |p_n| = " + number_text(mu * std::abs(pn)));
     }
     for (const Candidate& c : problem_.candidates) out_.p[c.eta] = std::min(0.0, out_.p[c.eta]);
     out_.tau = friction_bounds(problem_, out_.p);
     clip_to_bounds(problem_, out_.tau, out_.p);
     return true;
-  }
-
-  static std::string to_text(double x) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.3g", x);
-    return buf;
   }
 
   // One solve per level, each from the last. A body held by contact has springs on its pins,
@@ -108,12 +106,20 @@ class PenaltyStep : public StepSolver {
     const int count = held || ramp < 1.0 ? kLevels : 1;
     EquilibriumState s;
     s.reason = "no level solved";
+    s.failure = FailureKind::newton_diverged;
     for (int level = 0; level < count; ++level) {
       PenaltyLaw at = law;
       const double stiffer = std::pow(ramp, static_cast<double>(count - 1 - level) / std::max(1, count - 1));
       at.normal *= stiffer;
       at.tangential *= stiffer;
       at.pin_spring = held && level + 1 < count ? kPinSpring * std::pow(1e-2, level) * pin_scale : 0.0;
+      // A stop (a dismissal, a job limit) is heard before every real solve, as by the others.
+      if (stop_ && stop_()) {
+        out_.stopped = true;
+        fail(FailureKind::stopped, "stopped on request");
+        s.converged = false;
+        return s;
+      }
       eq_.set_penalty(at);
       s = eq_.solve(q, p_start);
       ++solves;
@@ -134,7 +140,8 @@ class PenaltyStep : public StepSolver {
     out_.p = p_start;
     out_.state = eq_.evaluate(q);
     const Vector applied = eq_.applied_forces(out_.state, p_start);
-    for (int k = 0; k < rigid.count(); ++k) out_.state.s[rigid.first + k] = rigid.scale * rigid.modes.col(k).dot(applied);
+    for (int k = 0; k < rigid.count(); ++k)
+      out_.state.s[rigid.first + k] = rigid.scale * rigid.modes.col(k).dot(applied);
     Vector dq;
     if (approach_motion(dq)) q += dq;
   }
@@ -150,9 +157,9 @@ class PenaltyStep : public StepSolver {
 
 }  // namespace
 
-StepOutcome solve_penalty_step(Equilibrium& eq, const Vector& q_guess, const Vector& p_start,
-                               const Vector& p_star, const ContactParams& params, int step,
-                               const IterationObserver& observer, const StopRequest& stop) {
+StepOutcome solve_penalty_step(Equilibrium& eq, const Vector& q_guess, const Vector& p_start, const Vector& p_star,
+                               const ContactParams& params, int step, const IterationObserver& observer,
+                               const StopRequest& stop) {
   return PenaltyStep(eq, params, step, observer, stop).run(q_guess, p_start, p_star);
 }
 

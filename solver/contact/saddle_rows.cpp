@@ -147,8 +147,7 @@ Vector solve_saddle_rows(const Compliance& C, const Vector& F, const Vector& s, 
       f.current = kinds;
     else if (f.units.cols() + static_cast<Eigen::Index>(f.changed.size()) > kSaddleCorrectionRows || !f.ok)
       factorize(C, f, kinds, stats);
-    else
-      correct(C, f, kinds, stats);
+    else correct(C, f, kinds, stats);
   }
   if (!f.ok) return Vector::Constant(m, std::numeric_limits<double>::quiet_NaN());
   Vector rhs = Vector::Zero(f.nf + m);

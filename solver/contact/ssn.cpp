@@ -20,14 +20,14 @@
 
 #include "solver/contact/coulomb_model.hpp"
 #include "solver/contact/step.hpp"
+#include "solver/model/number_text.hpp"
 
 namespace grip {
 namespace {
 
 class SsnStep : public StepSolver {
  public:
-  SsnStep(Equilibrium& eq, const ContactParams& params, int step, const IterationObserver& obs,
-          const StopRequest& stop)
+  SsnStep(Equilibrium& eq, const ContactParams& params, int step, const IterationObserver& obs, const StopRequest& stop)
       : StepSolver(eq, params, step, obs, stop) {
     const int n = problem_.body->dof_count();
     // A body held by contact: its pins join the unknowns, the rigid amplitudes with them.
@@ -61,9 +61,9 @@ class SsnStep : public StepSolver {
     for (int it = 1; !error_met(error_); ++it) {
       if (!budget_left()) return;
       if (it > params_.max_iterations) {
-        out_.budget_spent = true;  // ends the step: no cut (load_stepping.cpp)
-        return void(fail("semismooth Newton did not converge in " + std::to_string(params_.max_iterations) +
-                         " iterations (contact error " + std::to_string(error_.norm2) + ")"));
+        return void(fail(FailureKind::contact_budget,
+                         "semismooth Newton did not converge in " + std::to_string(params_.max_iterations) +
+                             " iterations (contact error " + number_text(error_.norm2) + ")"));
       }
       Triplets tangent;
       const EquilibriumState paired = eq_.evaluate(q);
@@ -81,13 +81,15 @@ class SsnStep : public StepSolver {
       Eigen::SparseLU<Eigen::SparseMatrix<double>> lu;
       lu.compute(J);
       if (lu.info() != Eigen::Success)
-        return void(fail("semismooth Newton: singular system in iteration " + std::to_string(it)));
+        return void(fail(FailureKind::contact_stalled,
+                         "semismooth Newton: singular system in iteration " + std::to_string(it)));
       Vector rhs(free_count_ + components);
       for (int i = 0; i < R.size(); ++i)
         if (free_index_[i] >= 0) rhs[free_index_[i]] = -R[i];
       rhs.tail(components) = -F;
       const Vector x = lu.solve(rhs);
-      if (!x.allFinite()) return void(fail("semismooth Newton produced a non-finite correction"));
+      if (!x.allFinite())
+        return void(fail(FailureKind::contact_stalled, "semismooth Newton produced a non-finite correction"));
       Vector dq = Vector::Zero(q.size());
       for (int i = 0; i < q.size(); ++i)
         if (free_index_[i] >= 0) dq[i] = x[free_index_[i]];
@@ -109,12 +111,13 @@ class SsnStep : public StepSolver {
         // Back onto equilibrium: the oracle at the current forces (projected onto the cone),
         // then Newton again from there.
         if (++restarts > kMaxRestarts)
-          return void(fail("semismooth Newton: no decrease of the residual along the Newton direction"));
+          return void(fail(FailureKind::contact_stalled,
+                           "semismooth Newton: no decrease of the residual along the Newton direction"));
         Vector p_cone = p;
         project_to_cone(problem_, p_cone);
         if (!budget_left()) return;
         EquilibriumState solved = eq_.solve(q, p_cone);
-        if (!solved.converged) return void(fail("equilibrium solve failed: " + solved.reason));
+        if (!solved.converged) return void(fail(solved.failure, "equilibrium solve failed: " + solved.reason));
         q = solved.q;
         p = p_cone;
         accept(std::move(solved), p_cone);
@@ -137,7 +140,7 @@ class SsnStep : public StepSolver {
       if (scaled_length(F_now) <= 0.1 * tol_) {
         if (!budget_left()) return;
         EquilibriumState solved = eq_.solve(q, p_cone);
-        if (!solved.converged) return void(fail("equilibrium solve failed: " + solved.reason));
+        if (!solved.converged) return void(fail(solved.failure, "equilibrium solve failed: " + solved.reason));
         q = solved.q;
         accept(std::move(solved), p_cone);
         ++m_;
@@ -172,8 +175,9 @@ class SsnStep : public StepSolver {
     rises_ = error_.norm2 > previous_error_ ? rises_ + 1 : 0;
     previous_error_ = error_.norm2;
     if (rises_ < kMaxRises) return false;
-    return !fail("semismooth Newton: the contact error grew at " + std::to_string(kMaxRises) +
-                 " real solves in a row (to " + std::to_string(error_.norm2) + "): its iterates drift");
+    return !fail(FailureKind::contact_stalled, "semismooth Newton: the contact error grew at " +
+                                                   std::to_string(kMaxRises) + " real solves in a row (to " +
+                                                   number_text(error_.norm2) + "): its iterates drift");
   }
 
   // A body held by contact starts a step unbalanced: the load grew, the forces are the last
@@ -340,9 +344,9 @@ class SsnStep : public StepSolver {
 
 }  // namespace
 
-StepOutcome solve_ssn_step(Equilibrium& eq, const Vector& q_guess, const Vector& p_start,
-                           const Vector& p_star, const ContactParams& params, int step,
-                           const IterationObserver& observer, const StopRequest& stop) {
+StepOutcome solve_ssn_step(Equilibrium& eq, const Vector& q_guess, const Vector& p_start, const Vector& p_star,
+                           const ContactParams& params, int step, const IterationObserver& observer,
+                           const StopRequest& stop) {
   return SsnStep(eq, params, step, observer, stop).run(q_guess, p_start, p_star);
 }
 

@@ -8,7 +8,8 @@
 #include "solver/contact/acceleration.hpp"
 #include "solver/contact/coulomb_model.hpp"
 #include "solver/contact/friction_limit.hpp"
-#include "solver/equilibrium/rigid_equilibrium.hpp"
+#include "solver/model/number_text.hpp"
+#include "solver/problem/rigid_modes.hpp"
 
 namespace grip {
 namespace {
@@ -35,17 +36,7 @@ constexpr long kProgressNewton = 200;
 // difference of, per contact component (bound_at).
 constexpr double kRoundOffGaps = 4.0;
 
-// A length in a message: small errors and bounds in three significant digits (to_string's six
-// decimals printed the bound 2e-15 as 0.000000).
-std::string length_text(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g", x);
-  return buf;
-}
-
-double inf_norm(const Matrix& A) {
-  return A.size() ? A.cwiseAbs().rowwise().sum().maxCoeff() : 0.0;
-}
+double inf_norm(const Matrix& A) { return A.size() ? A.cwiseAbs().rowwise().sum().maxCoeff() : 0.0; }
 
 }  // namespace
 
@@ -56,10 +47,10 @@ std::vector<int> active_indices(const ContactError& e) {
   return idx;
 }
 
-StepSolver::StepSolver(Equilibrium& eq, const ContactParams& params, int step,
-                       const IterationObserver& obs, const StopRequest& stop)
-    : eq_(eq), problem_(eq.problem()), params_(params), step_(step), observer_(obs), stop_(stop),
-      start_(Clock::now()), newton_emitted_(eq.counters().newton_iterations) {
+StepSolver::StepSolver(Equilibrium& eq, const ContactParams& params, int step, const IterationObserver& obs,
+                       const StopRequest& stop)
+    : eq_(eq), problem_(eq.problem()), params_(params), step_(step), observer_(obs), stop_(stop), start_(Clock::now()),
+      newton_emitted_(eq.counters().newton_iterations) {
   tol_ = params.tolerance * problem_.body->characteristic_length();
   length_scales_ = problem_.body->dof_length_scales();
   strict_balance_ = rigid_modes_follow_state(problem_);
@@ -74,9 +65,9 @@ StepOutcome StepSolver::run(const Vector& q_guess, const Vector& p_start, const 
   // displacement (the last state's, extrapolated) until a state is accepted (accept).
   const double guess_scale = displacement_size(q_guess);
   if (guess_scale > 0)
-    eq_.params().displacement_tolerance =
-        std::max(params_.newton_fraction * newton_tolerance * std::min(guess_scale, problem_.body->characteristic_length()),
-                 10 * std::numeric_limits<double>::epsilon() * problem_.body->characteristic_length());
+    eq_.params().displacement_tolerance = std::max(
+        params_.newton_fraction * newton_tolerance * std::min(guess_scale, problem_.body->characteristic_length()),
+        10 * std::numeric_limits<double>::epsilon() * problem_.body->characteristic_length());
   newton_base_ = eq_.params();
   eq_.set_compliance_reuse(params_.reuse_compliance && params_.method == ContactMethod::cev &&
                            params_.loop == ContactLoop::inner);
@@ -84,8 +75,17 @@ StepOutcome StepSolver::run(const Vector& q_guess, const Vector& p_start, const 
   solves_at_start_ = solves0;
   solve(q_guess, p_start, p_star);
   out_.solves = static_cast<int>(eq_.counters().solves - solves0);
-  out_.newton_iterations =
-      static_cast<int>(eq_.counters().newton_iterations - newton0 + own_newton_iterations_);
+  // One count of contact iterations: the real solves, each reported in an event's trials. The
+  // trials that a failure cut short before their update was accepted (a line search or an
+  // alpha halving without a decrease, a stop) go in one closing event, at the state the
+  // attempt ended on: a cut step's attempts and the job's limit count them as well.
+  int reported = 0;
+  for (const IterationEvent& ev : out_.history) reported += ev.trials;
+  if (out_.solves > reported) {
+    m_ = 0;  // no update: like a pass's starting solve, it is no step of the pass's descent
+    emit(out_.solves - reported, 0, 0, 0, 0.0);
+  }
+  out_.newton_iterations = static_cast<int>(eq_.counters().newton_iterations - newton0 + own_newton_iterations_);
   out_.v2 = error_.norm2;
   out_.bound = tol_;
   out_.scale = scale_;
@@ -185,7 +185,8 @@ void StepSolver::tau_passes(const Vector& q_guess, const Vector& p_start, const 
     if (literal_ && change <= force_precision()) pin_forces_ = 0.1 * settled;
     for (const Candidate& c : problem_.candidates) p_star[c.eta] = out_.p[c.eta];
     if (!passes_to_budget_ && pass_index == params_.max_tau_passes)
-      fail("the friction bound did not settle in " + std::to_string(pass_index) + " tau passes");
+      fail(FailureKind::contact_budget,
+           "the friction bound did not settle in " + std::to_string(pass_index) + " tau passes");
   }
   if (no_friction && out_.reason.empty()) out_.converged = true;
   if (out_.converged) final_check();
@@ -210,7 +211,8 @@ bool StepSolver::bound_from_model(Vector& p_star) {
   const Compliance& C = eq_.compliance(out_.state, relevant_components());
   const CoulombModelSolution model = solve_model(C, 0.1 * tol_);
   out_.inner_iterations += model.iterations;
-  if (!presses(model.p)) return fail("the linear model at the step's first state presses no point");
+  if (!presses(model.p))
+    return fail(FailureKind::no_equilibrium, "the linear model at the step's first state presses no point");
   for (const Candidate& c : problem_.candidates) p_star[c.eta] = model.p[c.eta];
   out_.tau = friction_bounds(problem_, p_star);
   return true;
@@ -221,7 +223,7 @@ bool StepSolver::fresh_solve(const Vector& q, double v_scale) {
   const bool loose = loosen_newton(v_scale);
   EquilibriumState s = eq_.solve(q, out_.p);
   tighten_newton();
-  if (!s.converged) return fail("equilibrium solve failed: " + s.reason);
+  if (!s.converged) return fail(s.failure, "equilibrium solve failed: " + s.reason);
   if (loose) {
     // v_scale was another state's error. Newton is finished to the precision this state's
     // error asks for where that one is within the tolerance (the full precision), or far below
@@ -232,7 +234,7 @@ bool StepSolver::fresh_solve(const Vector& q, double v_scale) {
       if (v > bound) loosen_newton(v);
       eq_.continue_solve(s, out_.p);
       tighten_newton();
-      if (!s.converged) return fail("equilibrium solve failed: " + s.reason);
+      if (!s.converged) return fail(s.failure, "equilibrium solve failed: " + s.reason);
     }
   }
   accept(std::move(s), out_.p);
@@ -301,8 +303,8 @@ void StepSolver::accept(EquilibriumState s, const Vector& p) {
   // A correction below the rounding of the positions (10 eps x their size) is noise: Newton's
   // correction test no tighter (a strip with finite kinematics under loads x 1e-6 otherwise
   // ran its 40 iterations at that floor, which its residual test does not see).
-  newton_base_.displacement_tolerance =
-      std::max(params_.newton_fraction * tol_, 10 * std::numeric_limits<double>::epsilon() * coordinate_size(out_.state));
+  newton_base_.displacement_tolerance = std::max(
+      params_.newton_fraction * tol_, 10 * std::numeric_limits<double>::epsilon() * coordinate_size(out_.state));
   eq_.params().displacement_tolerance = newton_base_.displacement_tolerance;
   if (coulomb_) out_.tau = friction_bounds(problem_, p);
   error_ = error_at(out_.p, out_.state.s, out_.state.enabled);
@@ -314,8 +316,7 @@ void StepSolver::accept(EquilibriumState s, const Vector& p) {
     // tolerance x length while 28 % out of balance. Where its free motions follow its state
     // (finite kinematics) the linear model's rows are not exact: Newton's share of it there.
     double size = problem_.load(eq_.factors()).cwiseAbs().sum();
-    for (const Candidate& c : problem_.candidates)
-      size += std::hypot(p[c.eta], c.xi >= 0 ? p[c.xi] : 0.0);
+    for (const Candidate& c : problem_.candidates) size += std::hypot(p[c.eta], c.xi >= 0 ? p[c.xi] : 0.0);
     balance_tol_ = problem_.rigid.scale * (strict_balance_ ? params_.newton_fraction : 1.0) * params_.tolerance * size;
   }
   // A load beyond what friction holds (friction_limit.hpp), shown at two accepted states in a
@@ -328,18 +329,21 @@ void StepSolver::accept(EquilibriumState s, const Vector& p) {
   }
 }
 
-bool StepSolver::fail(std::string reason) {
+bool StepSolver::fail(FailureKind kind, std::string reason) {
   out_.converged = false;
-  if (out_.reason.empty()) out_.reason = std::move(reason);
+  if (out_.reason.empty()) {
+    out_.reason = std::move(reason);
+    out_.failure = kind;
+  }
   return false;
 }
 
 bool StepSolver::budget_left() {
   if (stop_ && stop_()) {
     out_.stopped = true;
-    return fail("stopped on request");
+    return fail(FailureKind::stopped, "stopped on request");
   }
-  if (!friction_limit_.empty()) return fail(friction_limit_);
+  if (!friction_limit_.empty()) return fail(FailureKind::friction_limit, friction_limit_);
   // A long stretch of rejected trials (halvings of alpha, a line search) still reports: an
   // event with no new update (trials 0, the accepted state's error), so that no step runs
   // thousands of Newton iterations in silence (two cylinders with uzawa: 7,000 in 118 s).
@@ -347,10 +351,12 @@ bool StepSolver::budget_left() {
   if (eq_.counters().solves < solves_at_start_ + params_.max_iterations) return true;
   out_.budget_spent = true;
   if (error_met(error_))  // what is left is the tau passes' p*
-    return fail("the friction bound did not settle in " + std::to_string(params_.max_iterations) +
-                " contact iterations (" + std::to_string(pass_) + " tau passes; ||v|| within the tolerance)");
-  return fail("contact error " + length_text(error_.norm2) + " above tolerance " + length_text(tol_) + " after " +
-              std::to_string(params_.max_iterations) + " contact iterations");
+    return fail(FailureKind::contact_budget, "the friction bound did not settle in " +
+                                                 std::to_string(params_.max_iterations) + " contact iterations (" +
+                                                 std::to_string(pass_) + " tau passes; ||v|| within the tolerance)");
+  return fail(FailureKind::contact_budget, "contact error " + number_text(error_.norm2) + " above tolerance " +
+                                               number_text(tol_) + " after " + std::to_string(params_.max_iterations) +
+                                               " contact iterations");
 }
 
 bool StepSolver::line_search(const Vector& pl, const Vector& du, int& trials) {
@@ -379,8 +385,8 @@ bool StepSolver::line_search(const Vector& pl, const Vector& du, int& trials) {
     }
   }
   if (reached_precision()) return true;
-  return fail("no decrease of the contact error along the predicted force change (||v|| = " +
-              length_text(v0) + ")");
+  return fail(FailureKind::contact_stalled,
+              "no decrease of the contact error along the predicted force change (||v|| = " + number_text(v0) + ")");
 }
 
 bool StepSolver::reached_precision() {
@@ -398,12 +404,9 @@ bool StepSolver::loosen_newton(double v_ref) {
   return true;
 }
 
-void StepSolver::tighten_newton() {
-  eq_.params().displacement_tolerance = newton_base_.displacement_tolerance;
-}
+void StepSolver::tighten_newton() { eq_.params().displacement_tolerance = newton_base_.displacement_tolerance; }
 
-Direction StepSolver::direction(const Compliance& C, const ContactError& err, int level,
-                                double alpha_fixed) {
+Direction StepSolver::direction(const Compliance& C, const ContactError& err, int level, double alpha_fixed) {
   if (C.bordered) return bordered_direction(C, err, level, alpha_fixed);
   Direction dir;
   const std::vector<int> idx = active_indices(err);
@@ -467,7 +470,8 @@ bool StepSolver::literal_pass(int first_level, double alpha_fixed) {
     while (true) {
       Vector pbar, asked;
       const Direction dir = held_direction(C, e, level, alpha_fixed, a, pbar, asked);
-      if (!dir.ok) return fail("the active block of the compliance is not positive definite");
+      if (!dir.ok)
+        return fail(FailureKind::contact_stalled, "the active block of the compliance is not positive definite");
       if (!budget_left()) return false;
       const Vector pt = project(C, out_.p, pbar, e, out_.tau, &asked);
       ++trials;
@@ -489,8 +493,8 @@ bool StepSolver::literal_pass(int first_level, double alpha_fixed) {
       }
       if (halvings > params_.max_halvings && reached_precision()) return true;
       if (halvings > params_.max_halvings)
-        return fail("alpha halved " + std::to_string(params_.max_halvings) +
-                    " times without a decrease of the contact error");
+        return fail(FailureKind::contact_stalled, "alpha halved " + std::to_string(params_.max_halvings) +
+                                                      " times without a decrease of the contact error");
     }
   }
   return true;
@@ -578,32 +582,35 @@ double StepSolver::force_precision() {
 
 void StepSolver::final_check() {
   if (error_.norm2 > tol_) {
-    fail("contact error above tolerance at the end of the step");
+    fail(FailureKind::contact_stalled, "contact error above tolerance at the end of the step");
     return;
   }
   if (!error_met(error_)) {
-    fail("the load and the contact forces do not balance on the body's free motions to the tolerance at the end of "
+    fail(FailureKind::contact_stalled,
+         "the load and the contact forces do not balance on the body's free motions to the tolerance at the end of "
          "the step");
     return;
   }
-  // A free motion that no pressing point resists has no determined amplitude (ALGORITHM.md 7).
+  // A free motion that no pressing point resists has no determined amplitude
+  // (docs/algorithm.md#bodies-held-only-by-contact).
   for (int k = 0; k < problem_.rigid.count(); ++k)
     if (!mode_held(k))
-      fail("no contact holds the body's free motion (" + problem_.rigid.names[k] +
-           "): no point presses against an obstacle in that direction, so its position is not determined; "
-           "no static equilibrium fixes it");
+      fail(FailureKind::no_equilibrium,
+           "no contact holds the body's free motion (" + problem_.rigid.names[k] +
+               "): no point presses against an obstacle in that direction, so its position is not determined; "
+               "no static equilibrium fixes it");
   for (size_t i = 0; i < problem_.candidates.size(); ++i) {
     const Candidate& c = problem_.candidates[i];
-    if (out_.p[c.eta] > 0) fail("a normal contact force pulls");
+    if (out_.p[c.eta] > 0) fail(FailureKind::contact_stalled, "a normal contact force pulls");
     if (c.xi >= 0 && std::abs(out_.p[c.xi]) > out_.tau[i] * (1 + 1e-9) + 1e-300)
-      fail("a friction force exceeds its Coulomb bound");
+      fail(FailureKind::contact_stalled, "a friction force exceeds its Coulomb bound");
   }
 }
 
 void StepSolver::emit(int trials, int inner, int halvings, int n, double alpha, int own_newton) {
   IterationEvent ev;
   ev.step = step_;
-  ev.pass = pass_;
+  ev.pass = std::max(pass_, 1);  // 1 also for a closing event before the first pass began
   ev.m = m_;
   ev.trials = trials;
   ev.inner_iterations = inner;
@@ -612,17 +619,24 @@ void StepSolver::emit(int trials, int inner, int halvings, int n, double alpha, 
   ev.alpha = alpha;
   ev.v2 = error_.norm2;
   ev.v_inf = error_.norm_inf;
-  for (size_t i = 0; i < problem_.candidates.size(); ++i) {
+  const bool forces =
+      out_.p.size() == problem_.component_count && static_cast<size_t>(out_.tau.size()) == problem_.candidates.size();
+  for (size_t i = 0; forces && i < problem_.candidates.size(); ++i) {
     switch (contact_state(problem_, i, out_.p, out_.tau)) {
-      case ContactState::open: ++ev.open; break;
-      case ContactState::stick: ++ev.stick; break;
-      case ContactState::slip: ++ev.slip; break;
+      case ContactState::open:
+        ++ev.open;
+        break;
+      case ContactState::stick:
+        ++ev.stick;
+        break;
+      case ContactState::slip:
+        ++ev.slip;
+        break;
     }
   }
   // Every Newton iteration since the last event, rejected line-search trials' included, so
   // that the events of a step add up to its count (plus those made outside the oracle: ssn).
-  ev.newton_iterations = static_cast<int>(eq_.counters().newton_iterations - newton_emitted_) +
-                         own_newton;
+  ev.newton_iterations = static_cast<int>(eq_.counters().newton_iterations - newton_emitted_) + own_newton;
   newton_emitted_ = eq_.counters().newton_iterations;
   ev.elapsed_ms = std::chrono::duration<double, std::milli>(Clock::now() - start_).count();
   out_.history.push_back(ev);

@@ -40,9 +40,9 @@ class StepSolver {
   // The strategy itself: fills out_ (converged, reason, p, tau, state).
   virtual void solve(const Vector& q_guess, const Vector& p_start, const Vector& p_star) = 0;
 
-  // The tau passes of eq. 14 (ALGORITHM.md sections 4, 5): each pass holds tau = mu |p*| and
-  // runs `pass` (a Tresca problem); passes end when p* settles. They start from p_star_in, or
-  // from p_start where the free motions follow the state (step.cpp).
+  // The tau passes of eq. 14 (docs/algorithm.md#friction_loop-passes-the-tau-passes): each pass
+  // holds tau = mu |p*| and runs `pass` (a Tresca problem); passes end when p* settles. They start
+  // from p_star_in, or from p_start where the free motions follow the state (step.cpp).
   void tau_passes(const Vector& q_guess, const Vector& p_start, const Vector& p_star_in,
                   const std::function<bool()>& pass);
 
@@ -70,7 +70,8 @@ class StepSolver {
   Vec2 mode_rates(size_t candidate, int mode) const;
   bool mode_held(int mode) const;
   void accept(EquilibriumState s, const Vector& p);
-  bool fail(std::string reason);
+  // Records the first failure of the step (its kind and reason); false.
+  bool fail(FailureKind kind, std::string reason);
   // False (with the reason) once the step's real-solve budget is spent or a stop is asked.
   bool budget_left();
 
@@ -99,8 +100,8 @@ class StepSolver {
   // eq. 13's projection of pbar (project_forces), keeping a held body's equilibrium rows met.
   // `asked` (if given): the forces the direction's step assumed, where they differ from pbar
   // (held_direction's forces put on their bound): the rows are kept against those.
-  Vector project(const Compliance& C, const Vector& p, const Vector& pbar, const ContactError& e,
-                 const Vector& tau, const Vector* asked = nullptr) const;
+  Vector project(const Compliance& C, const Vector& p, const Vector& pbar, const ContactError& e, const Vector& tau,
+                 const Vector* asked = nullptr) const;
 
   // eq. 13's direction for the literal loop, on the components that eq. 13's projection lets
   // move: a force on its bound (|p_xi| = tau, or p_eta = 0) that the direction pushes beyond it
@@ -162,41 +163,41 @@ class StepSolver {
   const IterationObserver& observer_;
   const StopRequest& stop_;
   std::chrono::steady_clock::time_point start_;
-  double tol_ = 0.0;            // the bound on ||v|| at the accepted state (bound_at)
-  double scale_ = 0.0;          // the displacement it is relative to
-  bool at_round_off_ = false;   // the round-off of the gaps set it, not tolerance x scale_
-  Vector length_scales_;        // of the body's dofs (a rotation's: a length)
+  double tol_ = 0.0;             // the bound on ||v|| at the accepted state (bound_at)
+  double scale_ = 0.0;           // the displacement it is relative to
+  bool at_round_off_ = false;    // the round-off of the gaps set it, not tolerance x scale_
+  Vector length_scales_;         // of the body's dofs (a rotation's: a length)
   bool strict_balance_ = false;  // error_met tests the amplitudes' rows
   double balance_tol_ = 0.0;     // their bound, at the accepted state (accept)
-  NewtonParams newton_base_;  // Newton's tests at the contact tolerance (couple_newton)
+  NewtonParams newton_base_;     // Newton's tests at the contact tolerance (couple_newton)
   int pass_ = 0, m_ = 0;
   long solves_at_start_ = 0;
   long newton_emitted_ = 0;  // the Newton counter at the last event
   double warmup_eps_ = 0.0;
-  bool coulomb_ = false;  // the friction bound moves with p (no tau passes)
-  bool literal_ = false;  // the passes run the literal loop (literal_pass)
-  double pin_forces_ = 0.0;  // > 0: the literal loop's passes pin p_eta to this (tau_passes)
-  bool passes_to_budget_ = false;  // the tau passes end at the budget, not max_tau_passes (uzawa)
+  bool coulomb_ = false;            // the friction bound moves with p (no tau passes)
+  bool literal_ = false;            // the passes run the literal loop (literal_pass)
+  double pin_forces_ = 0.0;         // > 0: the literal loop's passes pin p_eta to this (tau_passes)
+  bool passes_to_budget_ = false;   // the tau passes end at the budget, not max_tau_passes (uzawa)
   long own_newton_iterations_ = 0;  // Newton iterations made outside the oracle (ssn)
   std::vector<char> is_normal_;
-  int beyond_friction_ = 0;    // accepted states in a row beyond what friction holds (accept)
+  int beyond_friction_ = 0;     // accepted states in a row beyond what friction holds (accept)
   std::string friction_limit_;  // why, once shown: budget_left ends the step with it
   ContactError error_;
   StepOutcome out_;
 };
 
 // One entry per strategy file.
-StepOutcome solve_cev_step(Equilibrium& eq, const Vector& q_guess, const Vector& p_start,
-                           const Vector& p_star, const ContactParams& params, int step,
-                           const IterationObserver& observer, const StopRequest& stop, double v_previous);
-StepOutcome solve_uzawa_step(Equilibrium& eq, const Vector& q_guess, const Vector& p_start,
-                             const Vector& p_star, const ContactParams& params, int step,
-                             const IterationObserver& observer, const StopRequest& stop);
-StepOutcome solve_ssn_step(Equilibrium& eq, const Vector& q_guess, const Vector& p_start,
-                           const Vector& p_star, const ContactParams& params, int step,
-                           const IterationObserver& observer, const StopRequest& stop);
-StepOutcome solve_penalty_step(Equilibrium& eq, const Vector& q_guess, const Vector& p_start,
-                               const Vector& p_star, const ContactParams& params, int step,
-                               const IterationObserver& observer, const StopRequest& stop);
+StepOutcome solve_cev_step(Equilibrium& eq, const Vector& q_guess, const Vector& p_start, const Vector& p_star,
+                           const ContactParams& params, int step, const IterationObserver& observer,
+                           const StopRequest& stop, double v_previous);
+StepOutcome solve_uzawa_step(Equilibrium& eq, const Vector& q_guess, const Vector& p_start, const Vector& p_star,
+                             const ContactParams& params, int step, const IterationObserver& observer,
+                             const StopRequest& stop);
+StepOutcome solve_ssn_step(Equilibrium& eq, const Vector& q_guess, const Vector& p_start, const Vector& p_star,
+                           const ContactParams& params, int step, const IterationObserver& observer,
+                           const StopRequest& stop);
+StepOutcome solve_penalty_step(Equilibrium& eq, const Vector& q_guess, const Vector& p_start, const Vector& p_star,
+                               const ContactParams& params, int step, const IterationObserver& observer,
+                               const StopRequest& stop);
 
 }  // namespace grip

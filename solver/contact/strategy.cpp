@@ -4,11 +4,9 @@
 
 namespace grip {
 
-StepOutcome solve_contact_step(Equilibrium& equilibrium, const Vector& q_guess,
-                               const Vector& p_start, const Vector& p_star,
-                               const ContactParams& params, int step,
-                               const IterationObserver& observer, const StopRequest& stop,
-                               double v_previous) {
+StepOutcome solve_contact_step(Equilibrium& equilibrium, const Vector& q_guess, const Vector& p_start,
+                               const Vector& p_star, const ContactParams& params, int step,
+                               const IterationObserver& observer, const StopRequest& stop, double v_previous) {
   switch (params.method) {
     case ContactMethod::uzawa:
       return solve_uzawa_step(equilibrium, q_guess, p_start, p_star, params, step, observer, stop);

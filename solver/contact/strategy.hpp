@@ -1,6 +1,6 @@
 #pragma once
 // Contact strategies behind one step contract (solve_contact_step): the paper's accelerated
-// contact error vector scheme `cev` (ALGORITHM.md sections 2-5, 8, 9), `uzawa` (the same
+// contact error vector scheme `cev` (docs/algorithm.md), `uzawa` (the same
 // literal loop with n = 1 and a fixed alpha), and the `penalty` baseline (one Newton solve
 // with a penalty law; its error falls as k grows). Each solves one load step given an
 // equilibrium oracle, and reports every real solve to an observer. One file per strategy
@@ -45,9 +45,9 @@ struct ContactParams {
   // r_i = augmentation / C_ii (each component's own contact stiffness), ssn r = augmentation x
   // the largest diagonal entry of the body's stiffness. It changes the path, not the answer.
   double augmentation = 1.0;
-  int max_halvings = 40;  // halvings of the step inside the inner loop, or of alpha (paper)
+  int max_halvings = 40;             // halvings of the step inside the inner loop, or of alpha (paper)
   int halvings_before_fallback = 4;  // paper loop: then n -> n - 1
-  int line_search_steps = 10;  // H of the line search along p -> prediction
+  int line_search_steps = 10;        // H of the line search along p -> prediction
   int max_tau_passes = 30;
   // Passes end when max |p_eta - p*| <= tau_tolerance * max |p_eta| (section 9: 1e-5 settles
   // in a few passes; much tighter makes p* cycle at the precision ||v|| pins p to).
@@ -89,13 +89,13 @@ inline double newton_coupling_tolerance(const ContactParams& c) {
 }
 
 struct IterationEvent {
-  int step = 0;           // load step, 1-based
-  int pass = 0;           // tau pass, 1-based
-  int m = 0;              // accepted update in this pass (0: the pass's starting solve)
-  int trials = 1;         // real solves this update took (rejected line-search trials too)
+  int step = 0;    // load step, 1-based
+  int pass = 0;    // tau pass, 1-based
+  int m = 0;       // accepted update in this pass (0: the pass's starting solve)
+  int trials = 1;  // real solves this update took (rejected line-search trials too)
   int inner_iterations = 0;
   int halvings = 0;
-  int n = 0;              // acceleration level (0 = infinity)
+  int n = 0;  // acceleration level (0 = infinity)
   double alpha = 0.0;
   double v2 = 0.0, v_inf = 0.0;
   int open = 0, stick = 0, slip = 0;
@@ -110,6 +110,7 @@ struct StepOutcome {
   bool converged = false;
   bool stopped = false;  // by the StopRequest, not by the numerics
   std::string reason;
+  FailureKind failure = FailureKind::none;  // the kind of the reason
   Vector p;
   Vector tau;
   EquilibriumState state;
@@ -118,12 +119,12 @@ struct StepOutcome {
   int newton_iterations = 0;
   int inner_iterations = 0;
   double v2 = 0.0;
-  double bound = 0.0;          // the bound ||v|| was held to at the last accepted state
-  double scale = 0.0;          // the displacement that bound is relative to
-  bool at_round_off = false;   // the round-off of the gaps set the bound
-  bool definitive = false;     // no retry or cut of the increment can help (penalty's error)
-  bool budget_spent = false;   // ended by max_iterations real solves
-  std::string epsilon_used;  // "exact" or "warmup", where a finite n needed it
+  double bound = 0.0;         // the bound ||v|| was held to at the last accepted state
+  double scale = 0.0;         // the displacement that bound is relative to
+  bool at_round_off = false;  // the round-off of the gaps set the bound
+  bool definitive = false;    // no retry or cut of the increment can help (penalty's error)
+  bool budget_spent = false;  // ended by max_iterations real solves
+  std::string epsilon_used;   // "exact" or "warmup", where a finite n needed it
   std::vector<IterationEvent> history;
 };
 
@@ -132,9 +133,8 @@ struct StepOutcome {
 // step's force (the first pass's friction bound, penalty's springs). v_previous: the contact
 // error of the previous step's first solve (0: none), which cev's first solve of this step
 // takes as the scale of its own (its Newton tolerance, StepSolver::fresh_solve).
-StepOutcome solve_contact_step(Equilibrium& equilibrium, const Vector& q_guess,
-                               const Vector& p_start, const Vector& p_star,
-                               const ContactParams& params, int step,
+StepOutcome solve_contact_step(Equilibrium& equilibrium, const Vector& q_guess, const Vector& p_start,
+                               const Vector& p_star, const ContactParams& params, int step,
                                const IterationObserver& observer, const StopRequest& stop = {},
                                double v_previous = 0.0);
 

@@ -27,9 +27,9 @@ class UzawaStep : public StepSolver {
 
 }  // namespace
 
-StepOutcome solve_uzawa_step(Equilibrium& eq, const Vector& q_guess, const Vector& p_start,
-                             const Vector& p_star, const ContactParams& params, int step,
-                             const IterationObserver& observer, const StopRequest& stop) {
+StepOutcome solve_uzawa_step(Equilibrium& eq, const Vector& q_guess, const Vector& p_start, const Vector& p_star,
+                             const ContactParams& params, int step, const IterationObserver& observer,
+                             const StopRequest& stop) {
   return UzawaStep(eq, params, step, observer, stop).run(q_guess, p_start, p_star);
 }
 

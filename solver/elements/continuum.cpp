@@ -1,6 +1,7 @@
 #include "solver/elements/continuum.hpp"
 
 #include <Eigen/Dense>
+#include <algorithm>
 #include <stdexcept>
 
 namespace grip {
@@ -11,8 +12,7 @@ QuadShape quad_shape(ContinuumElement element) {
 
 ContinuumBody::ContinuumBody(PlaneMesh mesh, const std::vector<int>& contact_set,
                              std::shared_ptr<const PlaneMaterial> material, ContinuumOptions options)
-    : mesh_(std::move(mesh)), options_(options), shape_(quad_shape(options.element)),
-      material_(std::move(material)) {
+    : mesh_(std::move(mesh)), options_(options), shape_(quad_shape(options.element)), material_(std::move(material)) {
   if (options_.element == ContinuumElement::q4_bbar && options_.kinematics == ContinuumKinematics::finite)
     throw std::invalid_argument("q4_bbar is implemented for linear kinematics (use q9 for finite strain)");
   if (!(options_.thickness > 0)) throw std::invalid_argument("thickness must be positive");
@@ -123,6 +123,48 @@ std::vector<std::array<int, 2>> ContinuumBody::surface_segments() const {
   for (const auto& side : contact_.sides)
     for (size_t k = 0; k + 1 < side.size(); ++k) segments.push_back({site_of[side[k]], site_of[side[k + 1]]});
   return segments;
+}
+
+std::vector<int> ContinuumBody::nodes_without_site() const {
+  std::vector<char> seen(node_count(), 0);
+  for (int node : contact_.nodes) seen[node] = 1;
+  std::vector<int> out;
+  for (const auto& side : boundary_sides(mesh_, shape_))
+    for (int node : side)
+      if (!seen[node]) {
+        seen[node] = 1;
+        out.push_back(node);
+      }
+  return out;
+}
+
+std::vector<int> ContinuumBody::add_sites(const std::vector<int>& nodes) {
+  // Each node with every boundary side through it: boundary_part needs whole sides.
+  std::vector<char> in(node_count(), 0), wanted(node_count(), 0);
+  for (int node : contact_.nodes) in[node] = 1;
+  for (int node : nodes) wanted[node] = 1;
+  std::vector<int> set = contact_.nodes;
+  for (const auto& side : boundary_sides(mesh_, shape_)) {
+    if (std::none_of(side.begin(), side.end(), [&](int n) { return wanted[n]; })) continue;
+    for (int node : side)
+      if (!in[node]) {
+        in[node] = 1;
+        set.push_back(node);
+      }
+  }
+  const int before = site_count();
+  if (static_cast<int>(set.size()) == before) return {};
+  BoundaryPart grown = boundary_part(mesh_, shape_, set);
+  // The existing sites keep their indices; the new ones follow. Tributary lengths from the grown part.
+  std::vector<double> length_of(node_count(), 0.0);
+  for (size_t k = 0; k < grown.nodes.size(); ++k) length_of[grown.nodes[k]] = grown.lengths[k];
+  grown.nodes = set;
+  grown.lengths.clear();
+  for (int node : set) grown.lengths.push_back(length_of[node]);
+  contact_ = std::move(grown);
+  std::vector<int> added;
+  for (int s = before; s < site_count(); ++s) added.push_back(s);
+  return added;
 }
 
 std::vector<std::vector<int>> ContinuumBody::cells() const {

@@ -18,8 +18,8 @@
 #include <mutex>
 #include <vector>
 
-#include "solver/model/body.hpp"
 #include "solver/elements/plane_mesh.hpp"
+#include "solver/model/body.hpp"
 
 namespace grip {
 
@@ -40,8 +40,8 @@ class ContinuumBody final : public Body {
   // The mesh must pass check_mesh (InvalidMesh otherwise); contact_set is a node set on the
   // boundary (boundary_part). Throws std::invalid_argument otherwise, or for q4_bbar with
   // finite kinematics.
-  ContinuumBody(PlaneMesh mesh, const std::vector<int>& contact_set,
-                std::shared_ptr<const PlaneMaterial> material, ContinuumOptions options);
+  ContinuumBody(PlaneMesh mesh, const std::vector<int>& contact_set, std::shared_ptr<const PlaneMaterial> material,
+                ContinuumOptions options);
 
   int dof_count() const override { return 2 * node_count(); }
   Vector dof_length_scales() const override { return Vector::Ones(dof_count()); }
@@ -53,6 +53,11 @@ class ContinuumBody final : public Body {
   SurfacePoint surface_point(const VectorRef& q, int site, int side) const override;
   // The contact sides, a q9 side as its two halves.
   std::vector<std::array<int, 2>> surface_segments() const override;
+  std::vector<int> nodes_without_site() const override;
+  Vec2 node_position(const VectorRef& q, int node) const override {
+    return mesh_.nodes[node] + Vec2(q[node_dof(node, 0)], q[node_dof(node, 1)]);
+  }
+  std::vector<int> add_sites(const std::vector<int>& nodes) override;
   double tributary_area(int site) const override { return contact_.lengths[site] * options_.thickness; }
   double characteristic_length() const override { return length_; }
 
@@ -86,8 +91,8 @@ class ContinuumBody final : public Body {
   struct Integration {
     std::vector<std::vector<QuadPoint>> points;  // per element, reference configuration
     std::vector<QuadPoint> centroids;
-    std::vector<ShapeGradients> mean_dN;         // per element (q4_bbar)
-    Triplets linear_tangent;                     // linear kinematics: the constant K
+    std::vector<ShapeGradients> mean_dN;  // per element (q4_bbar)
+    Triplets linear_tangent;              // linear kinematics: the constant K
     Eigen::SparseMatrix<double> linear_K;
   };
   const Integration& integration() const;

@@ -101,8 +101,7 @@ void add_block_elements(PlaneMesh& mesh, QuadShape shape, const std::vector<std:
   for (int i = 0; i < ni; i += step)
     for (int j = 0; j < nj; j += step) {
       const int I = i + step, J = j + step;
-      if (shape == QuadShape::q4)
-        mesh.elements.push_back({ids[i][j], ids[I][j], ids[I][J], ids[i][J]});
+      if (shape == QuadShape::q4) mesh.elements.push_back({ids[i][j], ids[I][j], ids[I][J], ids[i][J]});
       else
         mesh.elements.push_back({ids[i][j], ids[I][j], ids[I][J], ids[i][J], ids[i + 1][j], ids[I][j + 1],
                                  ids[i + 1][J], ids[i][j + 1], ids[i + 1][j + 1]});
@@ -168,7 +167,8 @@ PlaneMesh build_half_disc(const HalfDiscSpec& spec, QuadShape shape) {
     const Vec2 radial(std::cos(at), std::sin(at)), toward_other = -sign * Vec2(-std::sin(at), std::cos(at));
     const Vec2 bisector = -(radial + toward_other).normalized();
     const Vec2 control = V + 0.5 * (W - V).norm() * bisector;
-    interface[k] = by_length([=](double u) { return Vec2((1 - u) * (1 - u) * V + 2 * u * (1 - u) * control + u * u * W); });
+    interface[k] =
+        by_length([=](double u) { return Vec2((1 - u) * (1 - u) * V + 2 * u * (1 - u) * control + u * u * W); });
     std::vector<double> along;  // the side's arc divisions, from S to the end of the arc
     for (int q = 0; q <= m; ++q) along.push_back(std::abs(s[k == 0 ? m - q : spec.ns - m + q]));
     const auto nodes = patch_nodes(circle_arc(c, R, at, 1.5 * pi + sign * pi / 2), interface[k], segment(S, V),
@@ -182,9 +182,9 @@ PlaneMesh build_half_disc(const HalfDiscSpec& spec, QuadShape shape) {
   }
 
   // The core: i across, j from the pole block up to the diameter.
-  const auto nodes = patch_nodes(circle_arc(c, R - depth, a0, a1), segment(c - Vec2(w, 0), c + Vec2(w, 0)),
-                                 interface[0], interface[1], fractions(angles),
-                                 refine_for(shape, even(nf)), ring_f, ring_f);
+  const auto nodes =
+      patch_nodes(circle_arc(c, R - depth, a0, a1), segment(c - Vec2(w, 0), c + Vec2(w, 0)), interface[0], interface[1],
+                  fractions(angles), refine_for(shape, even(nf)), ring_f, ring_f);
   std::vector<std::vector<int>> core(NF + 1, std::vector<int>(M + 1));
   for (int i = 0; i <= NF; ++i)
     for (int j = 0; j <= M; ++j)
@@ -226,9 +226,7 @@ PlaneMesh build_half_disc(const HalfDiscSpec& spec, QuadShape shape) {
 // 23-162 degrees).
 constexpr double kAngleSlack = 60.0;
 
-bool well_shaped(const PlaneMesh& mesh) {
-  return corner_angles_within(mesh, 90 - kAngleSlack, 90 + kAngleSlack);
-}
+bool well_shaped(const PlaneMesh& mesh) { return corner_angles_within(mesh, 90 - kAngleSlack, 90 + kAngleSlack); }
 
 }  // namespace
 

@@ -3,11 +3,11 @@
 #include "solver/elements/corner_angles.hpp"
 
 #include <Eigen/Dense>
-#include <array>
 #include <algorithm>
+#include <array>
 #include <cmath>
-#include <limits>
 #include <functional>
+#include <limits>
 #include <numbers>
 #include <numeric>
 #include <sstream>
@@ -104,8 +104,6 @@ std::vector<double> one_sided(double length, double fine_length, int n_fine, int
   return x;
 }
 
-
-
 // A structured mesh of ni x nj elements on a grid of (m ni + 1) x (m nj + 1) nodes (m = 1 for
 // q4, 2 for q9), node (I, J) at `at(I, J)`, I along the first and J along the second
 // direction (a right-handed pair gives counter-clockwise elements).
@@ -118,11 +116,10 @@ PlaneMesh grid_mesh(int ni, int nj, QuadShape shape, const std::function<Vec2(in
   for (int j = 0; j < nj; ++j)
     for (int i = 0; i < ni; ++i) {
       const int I = m * i, J = m * j;
-      if (shape == QuadShape::q4)
-        mesh.elements.push_back({id(I, J), id(I + 1, J), id(I + 1, J + 1), id(I, J + 1)});
+      if (shape == QuadShape::q4) mesh.elements.push_back({id(I, J), id(I + 1, J), id(I + 1, J + 1), id(I, J + 1)});
       else
-        mesh.elements.push_back({id(I, J), id(I + 2, J), id(I + 2, J + 2), id(I, J + 2), id(I + 1, J),
-                                 id(I + 2, J + 1), id(I + 1, J + 2), id(I, J + 1), id(I + 1, J + 1)});
+        mesh.elements.push_back({id(I, J), id(I + 2, J), id(I + 2, J + 2), id(I, J + 2), id(I + 1, J), id(I + 2, J + 1),
+                                 id(I + 1, J + 2), id(I, J + 1), id(I + 1, J + 1)});
     }
   return mesh;
 }
@@ -209,8 +206,9 @@ std::vector<MeshIssue> check_mesh(const PlaneMesh& mesh, QuadShape shape) {
   for (int e = 0; e < static_cast<int>(mesh.elements.size()); ++e) {
     const auto& el = mesh.elements[e];
     if (static_cast<int>(el.size()) != n) {
-      issues.push_back({e, -1, "has " + std::to_string(el.size()) + " nodes; a " +
-                                   (shape == QuadShape::q4 ? "q4" : "q9") + " element has " + std::to_string(n)});
+      issues.push_back({e, -1,
+                        "has " + std::to_string(el.size()) + " nodes; a " + (shape == QuadShape::q4 ? "q4" : "q9") +
+                            " element has " + std::to_string(n)});
       continue;
     }
     bool ids_ok = true;
@@ -239,9 +237,10 @@ std::vector<MeshIssue> check_mesh(const PlaneMesh& mesh, QuadShape shape) {
     for (size_t c = 0; c < checks.size(); ++c) {
       const double det = n == 4 ? det_j<4>(x, &dN[c * n]) : det_j<9>(x, &dN[c * n]);
       if (!(det > 1e-12 * size2)) {
-        issues.push_back({e, -1, std::string(det < 0 ? "is inverted or its nodes are not counter-clockwise"
-                                                     : "has zero area") +
-                                     " (det J = " + std::to_string(det) + " at xi, eta = " + point_text(checks[c]) + ")"});
+        issues.push_back(
+            {e, -1,
+             std::string(det < 0 ? "is inverted or its nodes are not counter-clockwise" : "has zero area") +
+                 " (det J = " + std::to_string(det) + " at xi, eta = " + point_text(checks[c]) + ")"});
         break;
       }
     }
@@ -253,7 +252,7 @@ std::vector<MeshIssue> check_mesh(const PlaneMesh& mesh, QuadShape shape) {
 
 InvalidMesh::InvalidMesh(std::vector<MeshIssue> all)
     : std::invalid_argument((all.at(0).element >= 0 ? "element " + std::to_string(all[0].element)
-                                                     : "node " + std::to_string(all[0].node)) +
+                                                    : "node " + std::to_string(all[0].node)) +
                             " " + all[0].detail),
       issues(std::move(all)) {}
 
@@ -375,7 +374,8 @@ bool corner_angles_within(const PlaneMesh& mesh, double lo, double hi) {
   // decides where the corner is more than 1e-12 radians from the limit, far beyond the
   // rounding of either, and atan2 in degrees, element_quality's value, decides the rest.
   const double degrees = 180.0 / std::acos(-1.0);
-  const Vec2 lo_dir(std::cos(lo / degrees), std::sin(lo / degrees)), hi_dir(std::cos(hi / degrees), std::sin(hi / degrees));
+  const Vec2 lo_dir(std::cos(lo / degrees), std::sin(lo / degrees)),
+      hi_dir(std::cos(hi / degrees), std::sin(hi / degrees));
   for (const auto& el : mesh.elements)
     for (int a = 0; a < 4; ++a) {
       const Vec2& here = mesh.nodes[el[a]];
@@ -454,9 +454,11 @@ std::string free_rigid_motion(const PlaneMesh& mesh, const std::vector<char>& fi
       }
     }
     std::string text;
-    for (size_t m = 0; m < motions.size(); ++m) text += (m ? m + 1 == motions.size() ? " and " : ", " : "") + motions[m];
-    if (parts > 1) text = "the part containing node " +
-                          std::to_string(std::find(part.begin(), part.end(), k) - part.begin()) + " can " + text;
+    for (size_t m = 0; m < motions.size(); ++m)
+      text += (m ? m + 1 == motions.size() ? " and " : ", " : "") + motions[m];
+    if (parts > 1)
+      text = "the part containing node " + std::to_string(std::find(part.begin(), part.end(), k) - part.begin()) +
+             " can " + text;
     found.push_back(text);
   }
   std::string all;
@@ -489,13 +491,13 @@ std::vector<double> graded_divisions(double lo, double hi, int n, std::optional<
   if (coarse_total < needed[0] + needed[1])
     throw std::invalid_argument(std::to_string(n) + " divisions cannot hold the refinement: it takes " +
                                 std::to_string(n - coarse_total) + " within the extent and " +
-                                std::to_string(needed[0] + needed[1]) +
-                                " more outside it (elements growing at most " + growth_text(max_growth) + "-fold): give at least " +
+                                std::to_string(needed[0] + needed[1]) + " more outside it (elements growing at most " +
+                                growth_text(max_growth) + "-fold): give at least " +
                                 std::to_string(n - coarse_total + needed[0] + needed[1]));
   const double total_coarse_len = coarse_len[0] + coarse_len[1];
   if (sides_needing == 2) {
-    coarse[0] = std::clamp(static_cast<int>(std::lround(coarse_total * coarse_len[0] / total_coarse_len)),
-                           needed[0], coarse_total - needed[1]);
+    coarse[0] = std::clamp(static_cast<int>(std::lround(coarse_total * coarse_len[0] / total_coarse_len)), needed[0],
+                           coarse_total - needed[1]);
     coarse[1] = coarse_total - coarse[0];
   } else if (sides_needing == 1) {
     coarse[coarse_len[0] > coarse_len[1] ? 0 : 1] = coarse_total;
@@ -514,10 +516,10 @@ std::vector<double> graded_divisions(double lo, double hi, int n, std::optional<
 
 PlaneMesh rectangle_mesh(const RectangleSpec& spec, QuadShape shape) {
   const Vec2 o = spec.origin, s = spec.size;
-  const std::vector<double> x = refine_for(
-      shape, graded_divisions(o.x(), o.x() + s.x(), spec.nx, spec.towards.x(), spec.refine));
-  const std::vector<double> y = refine_for(
-      shape, graded_divisions(o.y(), o.y() + s.y(), spec.ny, spec.towards.y(), spec.refine));
+  const std::vector<double> x =
+      refine_for(shape, graded_divisions(o.x(), o.x() + s.x(), spec.nx, spec.towards.x(), spec.refine));
+  const std::vector<double> y =
+      refine_for(shape, graded_divisions(o.y(), o.y() + s.y(), spec.ny, spec.towards.y(), spec.refine));
   PlaneMesh mesh = grid_mesh(spec.nx, spec.ny, shape, [&](int I, int J) { return Vec2(x[I], y[J]); });
   const int NI = static_cast<int>(x.size()), NJ = static_cast<int>(y.size());
   mesh.sets["bottom"] = grid_line(NI, 0, 0, 1, 0, NI);

@@ -59,15 +59,13 @@ void quad_shape_functions(QuadShape shape, double xi, double eta, Vector& N, Sha
 }
 
 const std::vector<GaussPoint>& quad_gauss_rule(QuadShape shape) {
-  static const std::vector<GaussPoint> two =
-      tensor_rule({-1 / std::sqrt(3.0), 1 / std::sqrt(3.0)}, {1, 1});
+  static const std::vector<GaussPoint> two = tensor_rule({-1 / std::sqrt(3.0), 1 / std::sqrt(3.0)}, {1, 1});
   static const std::vector<GaussPoint> three =
       tensor_rule({-std::sqrt(0.6), 0, std::sqrt(0.6)}, {5.0 / 9, 8.0 / 9, 5.0 / 9});
   return shape == QuadShape::q4 ? two : three;
 }
 
-QuadPoint quad_point(QuadShape shape, const ShapeGradients& X, double xi, double eta,
-                     double weight_thickness) {
+QuadPoint quad_point(QuadShape shape, const ShapeGradients& X, double xi, double eta, double weight_thickness) {
   QuadPoint p;
   ShapeGradients dN_nat;
   quad_shape_functions(shape, xi, eta, p.N, dN_nat);
@@ -132,8 +130,8 @@ Mat2 deformation_gradient(const QuadPoint& point, const ShapeGradients& u) {
   return Mat2::Identity() + u.transpose() * point.dN;  // F_ij = delta_ij + sum_a u_ai dN_a/dX_j
 }
 
-void total_lagrangian(const std::vector<QuadPoint>& points, const ShapeGradients& u,
-                      const PlaneMaterial& material, Vector& fe, Matrix* Ke) {
+void total_lagrangian(const std::vector<QuadPoint>& points, const ShapeGradients& u, const PlaneMaterial& material,
+                      Vector& fe, Matrix* Ke) {
   const int n = static_cast<int>(u.rows());
   fe = Vector::Zero(2 * n);
   if (Ke) *Ke = Matrix::Zero(2 * n, 2 * n);

@@ -29,15 +29,14 @@ const std::vector<GaussPoint>& quad_gauss_rule(QuadShape shape);
 
 // The reference-configuration data of one integration point.
 struct QuadPoint {
-  Vector N;            // shape functions
-  ShapeGradients dN;   // dN/dX in the reference configuration
-  double detJ = 0.0;   // det dX/d(xi, eta); <= 0 means an inverted or degenerate element
-  double dV = 0.0;     // weight * detJ * thickness
+  Vector N;           // shape functions
+  ShapeGradients dN;  // dN/dX in the reference configuration
+  double detJ = 0.0;  // det dX/d(xi, eta); <= 0 means an inverted or degenerate element
+  double dV = 0.0;    // weight * detJ * thickness
 };
 
 // X holds the element's node coordinates, one row per node.
-QuadPoint quad_point(QuadShape shape, const ShapeGradients& X, double xi, double eta,
-                     double weight_thickness);
+QuadPoint quad_point(QuadShape shape, const ShapeGradients& X, double xi, double eta, double weight_thickness);
 std::vector<QuadPoint> quad_points(QuadShape shape, const ShapeGradients& X, double thickness);
 
 // The volume average of dN/dX over the element: the gradient of the mean dilatation.
@@ -55,8 +54,8 @@ Matrix small_strain_stiffness(const std::vector<QuadPoint>& points, const Eigen:
 // Ke is given, its exact derivative B^T D B + (dN_a . S dN_b) I. u holds the nodal
 // displacements, one row per node.
 Mat2 deformation_gradient(const QuadPoint& point, const ShapeGradients& u);
-void total_lagrangian(const std::vector<QuadPoint>& points, const ShapeGradients& u,
-                      const PlaneMaterial& material, Vector& fe, Matrix* Ke);
+void total_lagrangian(const std::vector<QuadPoint>& points, const ShapeGradients& u, const PlaneMaterial& material,
+                      Vector& fe, Matrix* Ke);
 
 // The Cauchy stress (sxx, syy, sxy, szz) for a deformation gradient F (in-plane) and the
 // material response at E = (F^T F - I) / 2.

@@ -4,20 +4,20 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "solver/model/number_text.hpp"
+
 namespace grip {
 
 double HillMaterial::plane_strain_factor() const {
   return 0.5 * std::pow(2 * (1 + r), 1 / M) * std::pow(1 + std::pow(1 + 2 * r, -1 / (M - 1)), (M - 1) / M);
 }
 double HillMaterial::flow_stress(double eps_bar) const { return H * std::pow(eps_bar + a0, n); }
-double HillMaterial::hardening_slope(double eps_bar) const {
-  return n * H * std::pow(eps_bar + a0, n - 1);
-}
+double HillMaterial::hardening_slope(double eps_bar) const { return n * H * std::pow(eps_bar + a0, n - 1); }
 
-RigidPlasticMembrane::RigidPlasticMembrane(std::vector<Vec2> nodes, double thickness,
-                                           HillMaterial material, double width)
-    : nodes_(std::move(nodes)), width_(width), material_(material),
-      c_(material.plane_strain_factor()), initial_thickness_(thickness) {
+RigidPlasticMembrane::RigidPlasticMembrane(std::vector<Vec2> nodes, double thickness, HillMaterial material,
+                                           double width)
+    : nodes_(std::move(nodes)), width_(width), material_(material), c_(material.plane_strain_factor()),
+      initial_thickness_(thickness) {
   if (nodes_.size() < 2) throw std::invalid_argument("a membrane needs at least two nodes");
   for (int e = 0; e < element_count(); ++e) {
     const double L = (nodes_[e + 1] - nodes_[e]).norm();
@@ -40,7 +40,7 @@ RigidPlasticMembrane::ElementState RigidPlasticMembrane::element_state(const Vec
   s.d1 = std::log(std::max(s.l, 1e-300) / L0);
   const double root = std::sqrt(c_ * c_ * s.d1 * s.d1 + e0 * e0);
   s.deps = root - e0;
-  const double g = c_ * c_ * s.d1 / root;                 // d(deps)/d(d1)
+  const double g = c_ * c_ * s.d1 / root;                      // d(deps)/d(d1)
   const double g1 = c_ * c_ * e0 * e0 / (root * root * root);  // d2(deps)/d(d1)^2
   const double eps = eps_bar_[e] + s.deps;
   s.sigma = material_.flow_stress(eps);
@@ -122,24 +122,21 @@ FieldTable RigidPlasticMembrane::site_fields(const Vector& q) const {
 }
 
 FieldTable RigidPlasticMembrane::element_fields(const Vector& q) const {
-  FieldTable t{{"s0", "x", "y", "major_strain", "thickness_strain", "thickness", "eps_bar",
-                "tension", "strain_increment"},
-               {}};
+  FieldTable t{
+      {"s0", "x", "y", "major_strain", "thickness_strain", "thickness", "eps_bar", "tension", "strain_increment"}, {}};
   double s0 = 0.0;
   for (int e = 0; e < element_count(); ++e) {
     const ElementState s = element_state(q, e);
-    const Vec2 mid = 0.5 * (nodes_[e] + q.segment<2>(node_dof(e, 0)) + nodes_[e + 1] +
-                            q.segment<2>(node_dof(e + 1, 0)));
-    t.rows.push_back({s0 + 0.5 * initial_length_[e], mid.x(), mid.y(),
-                      std::log(s.l / initial_length_[e]), std::log(s.thickness / initial_thickness_),
-                      s.thickness, eps_bar_[e] + s.deps, s.tension, s.d1});
+    const Vec2 mid =
+        0.5 * (nodes_[e] + q.segment<2>(node_dof(e, 0)) + nodes_[e + 1] + q.segment<2>(node_dof(e + 1, 0)));
+    t.rows.push_back({s0 + 0.5 * initial_length_[e], mid.x(), mid.y(), std::log(s.l / initial_length_[e]),
+                      std::log(s.thickness / initial_thickness_), s.thickness, eps_bar_[e] + s.deps, s.tension, s.d1});
     s0 += initial_length_[e];
   }
   return t;
 }
 
-Vector RigidPlasticMembrane::start_guess(const Vector& prescribed,
-                                         const std::vector<char>& is_prescribed) const {
+Vector RigidPlasticMembrane::start_guess(const Vector& prescribed, const std::vector<char>& is_prescribed) const {
   // Each component interpolated linearly (in initial arc length) between the nodes where it
   // is prescribed: a stretched, tensioned start instead of a slack flat sheet.
   Vector q = prescribed;
@@ -185,8 +182,8 @@ std::string RigidPlasticMembrane::inadmissible(const Vector& q) const {
   for (int e = 0; e < element_count(); ++e) {
     const ElementState s = element_state(q, e);
     if (s.d1 < -10 * material_.regularization)
-      return "membrane element " + std::to_string(e) + " is compressed (stretch increment " +
-             std::to_string(s.d1) + "): the sheet would wrinkle";
+      return "membrane element " + std::to_string(e) + " is compressed (stretch increment " + number_text(s.d1) +
+             "): the sheet would wrinkle";
   }
   return {};
 }

@@ -5,7 +5,7 @@
 // committed at the end of the previous step.
 //
 // Hill's 1979 yield with r and M; hardening sigma_bar = H (eps_bar + a0)^n. In plane strain
-// (d2 = 0) the effective strain increment of ALGORITHM.md section 6 is c |d1| with
+// (d2 = 0) the effective strain increment (docs/algorithm.md#reading-the-paper) is c |d1| with
 //   c = 0.5 [2(1+r)]^(1/M) [1 + (1+2r)^(-1/(M-1))]^((M-1)/M)   (2/sqrt(3) for r = 1, M = 2),
 // d1 = ln(l / L0) the logarithmic stretch increment of the element. An element with d1 = 0 has
 // an indeterminate stress, so d1 enters through the smooth regularization of section 9,
@@ -24,11 +24,11 @@
 namespace grip {
 
 struct HillMaterial {
-  double r = 1.0;        // normal anisotropy
-  double M = 2.0;        // yield-surface exponent, > 1
-  double H = 0.0;        // hardening coefficient (stress)
-  double a0 = 1e-4;      // pre-strain
-  double n = 0.2;        // hardening exponent
+  double r = 1.0;                // normal anisotropy
+  double M = 2.0;                // yield-surface exponent, > 1
+  double H = 0.0;                // hardening coefficient (stress)
+  double a0 = 1e-4;              // pre-strain
+  double n = 0.2;                // hardening exponent
   double regularization = 1e-5;  // e0: strain-increment scale of the smooth cut-off
   // The plane-strain factor c of d_eps_bar = c |d1|.
   double plane_strain_factor() const;
@@ -39,8 +39,7 @@ struct HillMaterial {
 class RigidPlasticMembrane final : public Body {
  public:
   // Nodes in order along the sheet; `thickness` initial; `width` out of plane.
-  RigidPlasticMembrane(std::vector<Vec2> nodes, double thickness, HillMaterial material,
-                       double width = 1.0);
+  RigidPlasticMembrane(std::vector<Vec2> nodes, double thickness, HillMaterial material, double width = 1.0);
 
   int dof_count() const override { return 2 * node_count(); }
   Vector dof_length_scales() const override { return Vector::Ones(dof_count()); }
@@ -68,12 +67,12 @@ class RigidPlasticMembrane final : public Body {
 
   // The element's kinematics and stress at state q, from the committed state.
   struct ElementState {
-    Vec2 e;             // unit vector node a -> node b
-    double l = 0.0;     // current length
-    double d1 = 0.0;    // logarithmic stretch increment of the step
-    double deps = 0.0;  // regularized effective strain increment
-    double sigma = 0.0; // flow stress at eps_bar + deps
-    double tension = 0.0;    // per unit width
+    Vec2 e;                // unit vector node a -> node b
+    double l = 0.0;        // current length
+    double d1 = 0.0;       // logarithmic stretch increment of the step
+    double deps = 0.0;     // regularized effective strain increment
+    double sigma = 0.0;    // flow stress at eps_bar + deps
+    double tension = 0.0;  // per unit width
     double dtension_dl = 0.0;
     double thickness = 0.0;  // current
   };
@@ -83,7 +82,7 @@ class RigidPlasticMembrane final : public Body {
   std::vector<Vec2> nodes_;
   double width_;
   HillMaterial material_;
-  double c_;                        // plane-strain factor
+  double c_;  // plane-strain factor
   double initial_thickness_;
   std::vector<double> initial_length_;
   // Committed state (end of the last converged step).

@@ -26,8 +26,7 @@ const Gauss kGauss3{{-std::sqrt(0.6), 0, std::sqrt(0.6)}, {5.0 / 9, 8.0 / 9, 5.0
 
 }  // namespace
 
-TimoshenkoBeam::TimoshenkoBeam(std::vector<double> node_x, double y0, BeamSection section,
-                               Kinematics kinematics)
+TimoshenkoBeam::TimoshenkoBeam(std::vector<double> node_x, double y0, BeamSection section, Kinematics kinematics)
     : x_(std::move(node_x)), y0_(y0), section_(section), kinematics_(kinematics) {
   if (x_.size() < 2) throw std::invalid_argument("a beam needs at least two nodes");
   for (size_t i = 1; i < x_.size(); ++i)
@@ -124,8 +123,7 @@ SectionForces TimoshenkoBeam::section_forces(const Vector& q, int e) const {
   }
   const Vec3 b = shape_dx(0.0, L), h = shape(0.0);
   const double bw = kinematics_ == Kinematics::von_karman ? b.dot(w) : 0.0;
-  return {section_.EA * (b.dot(u) + 0.5 * bw * bw), section_.kGA * (b.dot(w) + h.dot(t)),
-          section_.EI * b.dot(t)};
+  return {section_.EA * (b.dot(u) + 0.5 * bw * bw), section_.kGA * (b.dot(w) + h.dot(t)), section_.EI * b.dot(t)};
 }
 
 Vector TimoshenkoBeam::rigid_translation(const Vec2& d) const {
@@ -146,6 +144,13 @@ Vector TimoshenkoBeam::rigid_rotation() const {
     q[node_dof(k, 2)] = -1.0;
   }
   return q;
+}
+
+Vector TimoshenkoBeam::own_rotation_at(const Vector& q) const {
+  Vector rot = rigid_rotation();
+  for (int k = 0; k < node_count(); ++k) rot[node_dof(k, 0)] -= q[node_dof(k, 1)];
+  for (int e = 0; e < element_count(); ++e) rot[mid_dof(e, 0)] -= q[mid_dof(e, 1)];
+  return rot;
 }
 
 Body::Traits TimoshenkoBeam::traits() const {

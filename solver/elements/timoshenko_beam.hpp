@@ -44,6 +44,11 @@ class TimoshenkoBeam final : public Body {
 
   Vector rigid_translation(const Vec2& d) const override;
   Vector rigid_rotation() const override;
+  // Its own finite rotation (the von Karman beam's exact null motion): the rigid rotation with -w
+  // added to u, nodal and mid values (solver/problem/rigid_modes.cpp, rotation_at).
+  Vector own_rotation_at(const Vector& q) const override;
+  // Three dofs a node (u, w, theta); each element's mid values three more after the nodes'.
+  int dof_node(int dof) const override { return dof / 3; }
   Traits traits() const override;
   // Rotations beyond kModerateRotation: the moment arm of eq. 2 stays at its reference
   // length, so the answer drifts from an exact-rotation model like 0.45 theta^2 (a

@@ -1,5 +1,5 @@
 #pragma once
-// SOLVE(U, p) of ALGORITHM.md section 5: equilibrium of eq. 1-2 for given contact forces p,
+// SOLVE(U, p) (docs/algorithm.md#equilibrium-for-given-contact-forces): equilibrium of eq. 1-2 for given contact forces p,
 // by Newton's method with the pairing, T(u) and the stiffness of the follower contact load
 // d(T(u) p)/du re-evaluated at every iterate. Also the contact compliance C = T^T K^-1 T.
 #include <Eigen/SparseCore>
@@ -10,133 +10,18 @@
 #include <string>
 #include <vector>
 
+#include "solver/equilibrium/compliance.hpp"
+#include "solver/equilibrium/equilibrium_state.hpp"
+#include "solver/equilibrium/free_block_solver.hpp"
+#include "solver/equilibrium/newton_params.hpp"
+#include "solver/equilibrium/penalty_law.hpp"
 #include "solver/model/parallel.hpp"
 #include "solver/problem/problem.hpp"
-#include "solver/equilibrium/free_block_solver.hpp"
 
 namespace grip {
 
-// Newton's stopping tests, each always reachable in floating point (ALGORITHM.md 9). An
-// iterate is converged when one of them holds:
-// - correction: the largest correction, in length units (rotations times their dof's length
-//   scale), is below `displacement_tolerance` (the contact loop's precision);
-// - residual: the largest free residual, in force units (moments over the length scale), is
-//   below `residual_tolerance` times the force scale (the largest of the applied loads, the
-//   internal forces, which hold the reactions, and the contact forces);
-// - round-off floor: after a first correction, the residual is within `floor_factor` x
-//   machine precision of the scale of the sums that form it (|K| |q| + force scale), where
-//   a further correction is noise. Recorded in the state.
-// couple_newton() sets the first two from the contact tolerance.
-struct NewtonParams {
-  int max_iterations = 40;
-  double displacement_tolerance = 1e-10;  // length
-  double residual_tolerance = 1e-11;      // relative to the force scale
-  double floor_factor = 1e2;
-  // Diverged when a correction exceeds this many body lengths.
-  double divergence_lengths = 10.0;
-  // Steps of the line search along a Newton correction.
-  int max_backtracks = 8;
-  // Runs the bodies' own factorizations and solves of a scene of several bodies (the solver
-  // starts no threads of its own); empty: one after another.
-  ParallelFor parallel;
-};
-
-// Newton's tests as a fraction of the contact tolerance (relative to `length`, the body's
-// characteristic length): the contact error has a floor of about ||K^-1|| x the Newton
-// residual, so Newton must be that much tighter (ALGORITHM.md 9).
-inline void couple_newton(NewtonParams& newton, double contact_tolerance, double fraction, double length) {
-  newton.displacement_tolerance = fraction * contact_tolerance * length;
-  newton.residual_tolerance = fraction * contact_tolerance;
-}
-
-// The kinematics of one candidate at a state.
-struct PairedPoint {
-  SurfacePoint point;
-  Projection projection;  // in the obstacle's moved frame: point already translated
-  Vec2 eta, xi;           // eta = -normal (into the obstacle), xi = tangent
-};
-
-struct EquilibriumState {
-  Vector q;
-  Vector p;                   // the contact forces in equilibrium (given, or from the penalty law)
-  Vector s;                   // (s_eta, s_xi) per component
-  std::vector<PairedPoint> points;
-  // Per obstacle: the master surface of a pair of bodies in this state's configuration (null
-  // for a rigid obstacle); its force_derivative() is the pair's stiffness.
-  std::vector<std::shared_ptr<const DeformedMaster>> masters;
-  std::vector<char> enabled;  // component has a non-zero column of T on the free dofs
-  int newton_iterations = 0;
-  bool converged = false;
-  // Converged at the round-off floor (not by the correction or residual test); then the
-  // last correction (length units) is the noise of the displacements.
-  bool at_floor = false;
-  double noise = 0.0;
-  double relative_residual = 0.0;  // final free residual over the force scale
-  std::string reason;              // why Newton failed
-};
-
-struct EquilibriumCounters {
-  long solves = 0;            // calls of solve(): real equilibrium solves
-  long newton_iterations = 0;
-  long factorizations = 0;
-  long compliance_forms = 0;    // G formed afresh (each on a factorization of its own)
-  long compliance_columns = 0;  // columns of G solved for, all forms together
-};
-
-// The penalty baseline (strategy `penalty`): p_eta = -k_n <s_eta>, and a tangential spring
-// k_t on the incremental slip from the previous step's force, returned to the Coulomb cone.
-struct PenaltyLaw {
-  double normal = 0.0;      // k_n, force / length
-  double tangential = 0.0;  // k_t, force / length
-  Vector previous;          // the previous step's forces (the tangential springs start there)
-  // A body held by contact (problem.rigid): its amplitudes are solved with the deformation (the
-  // pins are free dofs), held by the springs; `pin_spring` (force / length) on each pin keeps
-  // Newton non-singular while fewer points press or stick than hold every motion.
-  double pin_spring = 0.0;
-};
-
-// Factorizations of blocks of a compliance, kept by the inner contact solver (coulomb_model.cpp)
-// for as long as the compliance stays the same: dense (C's active block) or sparse (the
-// saddle-point systems of the sparse form).
-struct ComplianceFactor;
-struct SaddleFactor;
-
-// The contact compliance C = T^T K^-1 T on a subset of the components (the ones that can
-// take part in this iteration); zero elsewhere. Dense (`block`) or, for large contact zones,
-// sparse: T on the free dofs and the body's factorization, C z = T^T K^-1 T z by one sparse
-// solve, nothing of size components^2 (Equilibrium::compliance).
-struct Compliance {
-  std::vector<int> position;  // component -> row of `block` (or column of `t`), -1 where not computed
-  Matrix block;               // the dense form; empty in the sparse form
-  mutable std::shared_ptr<ComplianceFactor> factor;  // reset whenever `block` changes
-  // With the rigid amplitudes' border [C G; G^T 0] (ALGORITHM.md 7): indefinite, no Cholesky.
-  // Dense form only.
-  bool bordered = false;
-  // The sparse form: `body` is the body's factorization of K (free dofs), `t` is T on the free
-  // dofs (free dofs x rows), `diagonal` is C's diagonal.
-  const FreeBlockSolver* body = nullptr;
-  Eigen::SparseMatrix<double> t;
-  Vector diagonal_entries;
-  std::vector<int> normal_of;  // row -> the row of its candidate's normal (tangent rows), else -1
-  mutable std::shared_ptr<SaddleFactor> saddle;  // reset whenever `t` or `body` changes
-
-  bool sparse() const { return body != nullptr; }
-  int size() const { return sparse() ? static_cast<int>(t.cols()) : static_cast<int>(block.rows()); }
-  double diagonal(int i) const { return sparse() ? diagonal_entries[i] : block(i, i); }
-  // C z over the rows (one sparse solve in the sparse form).
-  Vector apply(const Vector& z) const;
-  // Dense form only:
-  double operator()(int a, int b) const {
-    const int i = position[a], j = position[b];
-    return i < 0 || j < 0 ? 0.0 : block(i, j);
-  }
-  // C restricted to the given components, in their order.
-  Matrix sub(const std::vector<int>& components) const;
-};
-
-// Never the sparse form (Equilibrium::compliance's `sparse_from`).
-inline constexpr int kDenseCompliance = std::numeric_limits<int>::max();
-
+// Implemented in equilibrium.cpp (set-up, residual, reactions), pairing.cpp, newton.cpp,
+// compliance.cpp and penalty_law.cpp.
 class Equilibrium {
  public:
   // `extra` prescribes further dofs at absolute values (the start-up solve).
@@ -207,8 +92,8 @@ class Equilibrium {
   // force_scale (if asked): the largest of |A(q)|, |lambda F| and |T p| over all dofs, in
   // force units (the scale Newton's residual test is relative to). Without body_tangent, the
   // tangent's contact terms only.
-  Vector residual(const Vector& q, const EquilibriumState& paired, const Vector& p,
-                  Triplets* tangent, double* force_scale = nullptr, bool body_tangent = true) const;
+  Vector residual(const Vector& q, const EquilibriumState& paired, const Vector& p, Triplets* tangent,
+                  double* force_scale = nullptr, bool body_tangent = true) const;
   // Newton's step K_t^-1 rhs for the constant body tangent plus the pair's stiffness (the
   // `contact` triplets): the body's factorization and a Krylov solve on the pair's dofs.
   Vector low_rank_step(const Triplets& contact, const Vector& rhs) const;
@@ -269,15 +154,15 @@ class Equilibrium {
   // dofs afresh at every iterate (13 such G's cost 6x one factorization, two cylinders).
   FreeBlockSolver lu_;
   double body_tangent_norm_ = 0.0;  // |K|_inf of the constant body tangent (round-off scale)
-  std::vector<int> surface_free_;  // surface row of G -> free index
-  std::vector<int> surface_row_;   // free index -> surface row of G, -1 off the surface
-  Matrix g_;                       // G = K^-1 on the surface dofs
+  std::vector<int> surface_free_;   // surface row of G -> free index
+  std::vector<int> surface_row_;    // free index -> surface row of G, -1 off the surface
+  Matrix g_;                        // G = K^-1 on the surface dofs
   bool g_valid_ = false;
   bool compliance_reuse_ = false, compliance_reused_ = false;
   Eigen::SparseMatrix<double> t_surface_;  // the last compliance's T_s (surface rows x block)
   Compliance c_;
-  long g_version_ = 0, c_version_ = -1;  // G's content; the G that c_ was formed from
-  Compliance sparse_;                     // the sparse form
+  long g_version_ = 0, c_version_ = -1;             // G's content; the G that c_ was formed from
+  Compliance sparse_;                               // the sparse form
   long tangent_version_ = 0, sparse_version_ = -1;  // body_lu_'s content; the one sparse_ uses
 };
 

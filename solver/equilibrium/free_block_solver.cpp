@@ -5,8 +5,8 @@
 
 namespace grip {
 
-bool FreeBlockSolver::factorize(const Triplets& triplets, const std::vector<int>& free_index,
-                                int free_count, double near_symmetric_tolerance) {
+bool FreeBlockSolver::factorize(const Triplets& triplets, const std::vector<int>& free_index, int free_count,
+                                double near_symmetric_tolerance) {
   bool same = triplets.size() == rows_.size();
   for (size_t k = 0; same && k < triplets.size(); ++k)
     same = triplets[k].row() == rows_[k] && triplets[k].col() == cols_[k];
@@ -226,8 +226,7 @@ bool CholmodFactor::inverse_block(const std::vector<int>& rows, Matrix& G) {
   // cost 4 nnz(L) per row. Where W is not sparse enough (thin strips: long elimination-tree
   // paths), give up after a few columns.
   double nnz_l = 0.0;  // the entries a solve goes through (supernodal: its dense blocks)
-  if (L->is_super)
-    nnz_l = static_cast<double>(L->xsize);
+  if (L->is_super) nnz_l = static_cast<double>(L->xsize);
   else
     for (int j = 0; j < n; ++j) nnz_l += static_cast<const int*>(L->nz)[j];
   const double budget = 2.0 * nnz_l * s;  // half the dense solves' flops
@@ -260,7 +259,8 @@ bool CholmodFactor::quadratic_forms(const Eigen::SparseMatrix<double>& t, Vector
   constexpr int kSample = 8;
   return forward_solves(t, [&](int a, const int* xi, const double* xv, int count) {
     reach += count;
-    if (max_mean_reach > 0 && a + 1 == std::min(static_cast<int>(t.cols()), kSample) && reach / (a + 1) > max_mean_reach)
+    if (max_mean_reach > 0 && a + 1 == std::min(static_cast<int>(t.cols()), kSample) &&
+        reach / (a + 1) > max_mean_reach)
       return false;
     double sum = 0.0;
     for (int k = 0; k < count; ++k) sum += xv[xi[k]] * xv[xi[k]];

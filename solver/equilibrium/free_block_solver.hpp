@@ -102,7 +102,7 @@ class FreeBlockSolver {
   Eigen::SparseMatrix<double> matrix_;
   std::vector<int> rows_, cols_;  // the triplet sequence the pattern was built from
   std::vector<int> slot_;         // triplet k -> index in matrix_.valuePtr(), -1 if dropped
-  std::vector<int> mirror_;        // value index -> index of its transpose entry
+  std::vector<int> mirror_;       // value index -> index of its transpose entry
   Eigen::SparseLU<Eigen::SparseMatrix<double>> lu_;
   CholmodFactor llt_;
   CholmodFactor dissected_;  // nested-dissection order, for inverse_block only

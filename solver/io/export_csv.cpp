@@ -80,8 +80,7 @@ std::vector<json> step_rows(const json& result) {
     json row = json::object();
     row["step"] = step.value("step", 0);
     for (auto it = step.begin(); it != step.end(); ++it)
-      if (!it.value().is_array() && !it.value().is_object() && it.key() != "step")
-        row[it.key()] = it.value();
+      if (!it.value().is_array() && !it.value().is_object() && it.key() != "step") row[it.key()] = it.value();
     if (step.contains("obstacles"))
       for (const json& o : step["obstacles"])
         row["offset." + o.value("name", std::string("obstacle"))] = o.value("offset", json::array());
@@ -96,8 +95,8 @@ std::vector<json> step_rows(const json& result) {
 }  // namespace
 
 const std::vector<std::string>& result_csv_tables() {
-  static const std::vector<std::string> names = {"steps", "nodes", "elements", "contact_points",
-                                                 "master_points", "history"};
+  static const std::vector<std::string> names = {"steps",          "nodes",         "elements",
+                                                 "contact_points", "master_points", "history"};
   return names;
 }
 
@@ -113,8 +112,8 @@ std::string result_csv(const json& result, std::string_view table) {
 
 std::string objects_csv(const std::vector<json>& rows) {
   // JSON objects keep their keys sorted: the identifying columns go first.
-  static const std::vector<std::string> leading = {"step", "load_factor", "pass", "m", "body",
-                                                   "node", "element", "obstacle"};
+  static const std::vector<std::string> leading = {"step", "load_factor", "pass",    "m",
+                                                   "body", "node",        "element", "obstacle"};
   std::vector<std::string> columns;
   std::map<std::string, size_t> index;
   std::vector<std::vector<std::pair<std::string, json>>> flat(rows.size());

@@ -33,11 +33,16 @@ struct Grid {
 
 int cell_type(size_t sites) {
   switch (sites) {
-    case 1: return 1;  // VTK_VERTEX
-    case 2: return 3;  // VTK_LINE
-    case 3: return 5;  // VTK_TRIANGLE
-    case 4: return 9;  // VTK_QUAD
-    default: return 7;  // VTK_POLYGON
+    case 1:
+      return 1;  // VTK_VERTEX
+    case 2:
+      return 3;  // VTK_LINE
+    case 3:
+      return 5;  // VTK_TRIANGLE
+    case 4:
+      return 9;  // VTK_QUAD
+    default:
+      return 7;  // VTK_POLYGON
   }
 }
 
@@ -68,8 +73,7 @@ Grid grid_of(const json& result, size_t k) {
   if (k >= steps.size()) throw std::invalid_argument("no step " + std::to_string(k + 1));
   const json& step = steps[k];
   if (!step.contains("nodes") || step["nodes"].empty())
-    throw std::invalid_argument("step " + std::to_string(step.value("step", 0)) +
-                                " has no node fields");
+    throw std::invalid_argument("step " + std::to_string(step.value("step", 0)) + " has no node fields");
   Grid g;
   g.step = step.value("step", static_cast<int>(k) + 1);
   g.load_factor = step.value("load_factor", 0.0);
@@ -101,8 +105,7 @@ Grid grid_of(const json& result, size_t k) {
       const std::string pre = prefix ? p.value("obstacle", std::string()) + "." : "";
       for (const char* f : fields)
         if (p.contains(f) && p[f].is_number()) array(pre + f, 0.0).values[node] = p[f].get<double>();
-      if (p.contains("state"))
-        array(pre + "state", -1.0).values[node] = state_code(p.value("state", std::string()));
+      if (p.contains("state")) array(pre + "state", -1.0).values[node] = state_code(p.value("state", std::string()));
     }
   }
   if (step.contains("elements") && step["elements"].size() == g.cells.size())
@@ -125,7 +128,8 @@ Grid grid_of(const json& result, size_t k) {
   for (const auto& [first_point, points, first_cell, cells] : g.pieces) {
     whole = whole && first_point + points <= g.points.size() && first_cell + cells <= g.cells.size();
     for (size_t c = first_cell; whole && c < first_cell + cells; ++c)
-      for (int s : g.cells[c]) whole = whole && s >= static_cast<int>(first_point) && s < static_cast<int>(first_point + points);
+      for (int s : g.cells[c])
+        whole = whole && s >= static_cast<int>(first_point) && s < static_cast<int>(first_point + points);
   }
   if (g.pieces.empty() || !whole) g.pieces = {{0, g.points.size(), 0, g.cells.size()}};
   return g;
@@ -149,11 +153,20 @@ std::string xml_escape(const std::string& s) {
   std::string out;
   for (char c : s) {
     switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out += c;
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += c;
     }
   }
   return out;
@@ -245,8 +258,7 @@ std::string pvd_collection(const std::vector<std::pair<double, std::string>>& da
      << "<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
      << "<Collection>\n";
   for (const auto& [time, file] : datasets)
-    os << "<DataSet timestep=\"" << number(time) << "\" group=\"\" part=\"0\" file=\""
-       << xml_escape(file) << "\"/>\n";
+    os << "<DataSet timestep=\"" << number(time) << "\" group=\"\" part=\"0\" file=\"" << xml_escape(file) << "\"/>\n";
   os << "</Collection>\n</VTKFile>\n";
   return os.str();
 }

@@ -83,8 +83,12 @@ void JsonWriter::value(const nlohmann::json& j) {
       put(']');
       return;
     }
-    case T::number_float: number(j.get<double>()); return;
-    case T::number_integer: integer(j.get<long long>()); return;
+    case T::number_float:
+      number(j.get<double>());
+      return;
+    case T::number_integer:
+      integer(j.get<long long>());
+      return;
     case T::number_unsigned: {
       room(24);
       size_ = static_cast<size_t>(
@@ -92,8 +96,12 @@ void JsonWriter::value(const nlohmann::json& j) {
           buffer_.data());
       return;
     }
-    case T::string: string(j.get_ref<const std::string&>()); return;
-    default: raw(j.dump()); return;  // true, false, null; binary (never in a result)
+    case T::string:
+      string(j.get_ref<const std::string&>());
+      return;
+    default:
+      raw(j.dump());
+      return;  // true, false, null; binary (never in a result)
   }
 }
 

@@ -3,6 +3,8 @@
 #include "solver/io/json_writer.hpp"
 
 #include <algorithm>
+#include <charconv>
+#include <cmath>
 #include <functional>
 #include <limits>
 #include <memory>
@@ -11,18 +13,28 @@
 #include "solver/contact/contact_error.hpp"
 #include "solver/contact/master_reading.hpp"
 #include "solver/model/body_set.hpp"
-#include "solver/equilibrium/rigid_equilibrium.hpp"
+#include "solver/problem/rigid_modes.hpp"
 
 namespace grip {
 
 using nlohmann::json;
 
 json iteration_event(const IterationEvent& ev) {
-  return {{"type", "iteration"}, {"step", ev.step}, {"pass", ev.pass}, {"m", ev.m},
-          {"trials", ev.trials}, {"inner_iterations", ev.inner_iterations},
-          {"halvings", ev.halvings}, {"n", ev.n == 0 ? json("inf") : json(ev.n)},
-          {"alpha", ev.alpha}, {"v2", ev.v2}, {"v_inf", ev.v_inf}, {"open", ev.open},
-          {"stick", ev.stick}, {"slip", ev.slip}, {"newton_iterations", ev.newton_iterations},
+  return {{"type", "iteration"},
+          {"step", ev.step},
+          {"pass", ev.pass},
+          {"m", ev.m},
+          {"trials", ev.trials},
+          {"inner_iterations", ev.inner_iterations},
+          {"halvings", ev.halvings},
+          {"n", ev.n == 0 ? json("inf") : json(ev.n)},
+          {"alpha", ev.alpha},
+          {"v2", ev.v2},
+          {"v_inf", ev.v_inf},
+          {"open", ev.open},
+          {"stick", ev.stick},
+          {"slip", ev.slip},
+          {"newton_iterations", ev.newton_iterations},
           {"elapsed_ms", ev.elapsed_ms}};
 }
 
@@ -31,23 +43,54 @@ json step_started_event(int step, double load_factor) {
 }
 
 json step_finished_event(const StepRecord& rec) {
-  json j = {{"type", "step_finished"}, {"step", rec.index}, {"load_factor", rec.load_factor},
-            {"converged", rec.converged}, {"tau_passes", rec.passes},
-            {"contact_iterations", rec.solves}, {"newton_iterations", rec.newton_iterations},
-            {"seconds", rec.seconds}, {"stage", rec.stage}, {"factors", rec.factors}};
-  if (!rec.converged) j["reason"] = rec.reason;
+  json j = {{"type", "step_finished"},
+            {"step", rec.index},
+            {"load_factor", rec.load_factor},
+            {"converged", rec.converged},
+            {"tau_passes", rec.passes},
+            {"contact_iterations", rec.solves},
+            {"newton_iterations", rec.newton_iterations},
+            {"seconds", rec.seconds},
+            {"stage", rec.stage},
+            {"factors", rec.factors}};
+  if (!rec.converged) {
+    j["reason"] = rec.reason;
+    j["failure"] = failure_json(rec.failure, rec.reason, rec.index);
+  }
   if (!rec.warning.empty()) j["warning"] = rec.warning;
   return j;
 }
 
+json failure_json(FailureKind kind, const std::string& message, int step) {
+  return {{"kind", to_string(kind)}, {"message", message}, {"step", step}};
+}
+
+json job_failed_event(FailureKind kind, const std::string& reason, int step) {
+  return {{"type", "job_failed"}, {"reason", reason}, {"failure", failure_json(kind, reason, step)}};
+}
+
+double field_value(double v) {
+  if (!std::isfinite(v) || v == 0) return v;
+  char text[32];
+  const char* end = std::to_chars(text, text + sizeof text, v, std::chars_format::scientific, kFieldDigits - 1).ptr;
+  double rounded = v;
+  std::from_chars(text, end, rounded);
+  return rounded;
+}
+
 namespace {
+
+// The scene's bodies where it has several (the BodySet that the scene reader built for
+// "bodies"), null for a scene of one body: the result takes the scene's form ("bodies",
+// "rigid_motions", "master_points"), so io asks for the type it built (docs/design.md).
+const BodySet* body_set_of(const Body& body) { return dynamic_cast<const BodySet*>(&body); }
 
 json table_json(const FieldTable& t, const char* index_name) {
   json rows = json::array();
   for (size_t i = 0; i < t.rows.size(); ++i) {
     json row = {{index_name, i}};
-    for (size_t c = 0; c < t.names.size(); ++c)
-      if (!std::isnan(t.rows[i][c])) row[t.names[c]] = t.rows[i][c];  // NaN: a column the row's body lacks
+    for (size_t c = 0; c < t.names.size(); ++c)  // NaN: a column the row's body lacks
+      if (!std::isnan(t.rows[i][c])) row[t.names[c]] = field_value(t.rows[i][c]);
     rows.push_back(row);
   }
   return rows;
@@ -58,7 +101,7 @@ json table_json(const FieldTable& t, const char* index_name) {
 // The contact points' numbers, read from the problem and the record.
 std::vector<ContactPointRow> contact_point_rows(const Problem& problem, const StepRecord& rec) {
   const Body& body = *problem.body;
-  const auto* all = dynamic_cast<const BodySet*>(&body);
+  const auto* all = body_set_of(body);
   std::vector<ContactPointRow> rows;
   rows.reserve(problem.candidates.size());
   for (size_t i = 0; i < problem.candidates.size(); ++i) {
@@ -66,10 +109,19 @@ std::vector<ContactPointRow> contact_point_rows(const Problem& problem, const St
     const PairedPoint& pp = rec.state.points[i];
     const double area = body.tributary_area(c.site);
     const double p_n = rec.p[c.eta], p_t = c.xi >= 0 ? rec.p[c.xi] : 0.0;
-    ContactPointRow r{body.site_node(c.site), problem.obstacles[c.obstacle].name,
-                      to_string(contact_state(problem, i, rec.p, rec.tau)), {}, {},
-                      pp.point.x, pp.projection.point, pp.projection.normal,
-                      p_n, p_t, p_n / area, p_t / area, pp.projection.gap,
+    ContactPointRow r{body.site_node(c.site),
+                      problem.obstacles[c.obstacle].name,
+                      to_string(contact_state(problem, i, rec.p, rec.tau)),
+                      {},
+                      {},
+                      pp.point.x,
+                      pp.projection.point,
+                      pp.projection.normal,
+                      p_n,
+                      p_t,
+                      p_n / area,
+                      p_t / area,
+                      pp.projection.gap,
                       c.xi >= 0 ? rec.state.s[c.xi] : 0.0};
     if (all) {  // several bodies: who touches whom
       const ObstacleInstance& o = problem.obstacles[c.obstacle];
@@ -85,12 +137,20 @@ std::vector<ContactPointRow> contact_point_rows(const Problem& problem, const St
 json contact_points_json(const std::vector<ContactPointRow>& rows) {
   json points = json::array();
   for (const ContactPointRow& r : rows) {
-    json point = {{"node", r.node}, {"obstacle", r.obstacle},
-                  {"x", r.x.x()}, {"y", r.x.y()},
-                  {"pair", {r.pair.x(), r.pair.y()}},
-                  {"normal", {r.normal.x(), r.normal.y()}},
-                  {"p_n", r.p_n}, {"p_t", r.p_t}, {"sigma_n", r.sigma_n}, {"sigma_t", r.sigma_t},
-                  {"gap", r.gap}, {"slip", r.slip}, {"state", r.state}};
+    const auto f = field_value;
+    json point = {{"node", r.node},
+                  {"obstacle", r.obstacle},
+                  {"x", f(r.x.x())},
+                  {"y", f(r.x.y())},
+                  {"pair", {f(r.pair.x()), f(r.pair.y())}},
+                  {"normal", {f(r.normal.x()), f(r.normal.y())}},
+                  {"p_n", f(r.p_n)},
+                  {"p_t", f(r.p_t)},
+                  {"sigma_n", f(r.sigma_n)},
+                  {"sigma_t", f(r.sigma_t)},
+                  {"gap", f(r.gap)},
+                  {"slip", f(r.slip)},
+                  {"state", r.state}};
     if (r.several_bodies) {
       point["body"] = r.body;
       point["master"] = r.master;
@@ -110,14 +170,25 @@ json step_json(const Problem& problem, const StepRecord& rec, const OutputOption
   j.erase("type");
   j["inner_iterations"] = rec.inner_iterations;
   j["cuts"] = rec.cuts;
+  // The step checks (solver/stepping/step_checks.hpp): the worst value of each over the step.
+  const StepChecks& c = rec.checks;
+  j["checks"] = {{"balance", c.balance},
+                 {"tension", c.tension},
+                 {"cone", c.cone},
+                 {"penetration", c.penetration},
+                 {"normal_turn", c.normal_turn},
+                 {"obstacle_motion", c.obstacle_motion},
+                 {"boundary_points", c.boundary_points}};
+  if (!rec.notes.empty()) j["notes"] = rec.notes;
   if (rec.converged)
-    j["equilibrium"] = {{"relative_residual", rec.state.relative_residual},
-                        {"at_round_off_floor", rec.state.at_floor}};
+    j["equilibrium"] = {{"relative_residual", rec.state.relative_residual}, {"at_round_off_floor", rec.state.at_floor}};
   if (!rec.epsilon_used.empty()) j["epsilon"] = rec.epsilon_used;
   if (rec.state.q.size() && rec.bound > 0) {
     double penetration = -std::numeric_limits<double>::infinity();
     for (const PairedPoint& pp : rec.state.points) penetration = std::max(penetration, -pp.projection.gap);
-    j["contact_error"] = {{"v2", rec.contact_error}, {"bound", rec.bound}, {"displacement_scale", rec.scale},
+    j["contact_error"] = {{"v2", rec.contact_error},
+                          {"bound", rec.bound},
+                          {"displacement_scale", rec.scale},
                           {"at_round_off", rec.at_round_off},
                           {"penetration", rec.state.points.empty() ? 0.0 : penetration}};
   }
@@ -130,9 +201,9 @@ json step_json(const Problem& problem, const StepRecord& rec, const OutputOption
       if (a.size() > 2) m["rotation"] = a[2];
       return m;
     };
-    if (const auto* all = dynamic_cast<const BodySet*>(&body)) {
+    if (const auto* all = body_set_of(body)) {
       json motions = json::array();
-      for (int b = 0; b < all->count(); ++b) {
+      for (int b = 0; b < all->part_count(); ++b) {
         if (std::find(problem.rigid.body.begin(), problem.rigid.body.end(), b) == problem.rigid.body.end()) continue;
         json m = motion(all->part(b), all->part_q(rec.state.q, b));
         m["body"] = all->name(b);
@@ -166,14 +237,14 @@ json step_json(const Problem& problem, const StepRecord& rec, const OutputOption
   if (rec.reactions.size() && output.wants("reactions")) {
     json reactions = json::array();
     for (const Constraint& c : problem.constraints)
-      reactions.push_back({{"dof", c.dof}, {"force", rec.reactions[c.dof]}});
+      reactions.push_back({{"dof", c.dof}, {"force", field_value(rec.reactions[c.dof])}});
     j["reactions"] = reactions;
   }
   if (!output.wants("contact_points")) return j;
   std::vector<ContactPointRow> points = contact_point_rows(problem, rec);
   if (rows) *rows = std::move(points);
   else j["contact_points"] = contact_points_json(points);
-  if (const auto* all = dynamic_cast<const BodySet*>(&body)) {  // each pair's field read on its master
+  if (const auto* all = body_set_of(body)) {  // each pair's field read on its master
     json readings = json::array();
     for (size_t o = 0; o < problem.obstacles.size(); ++o) {
       const ObstacleInstance& pair = problem.obstacles[o];
@@ -181,10 +252,15 @@ json step_json(const Problem& problem, const StepRecord& rec, const OutputOption
       for (const MasterReading& r : master_readings(problem, rec.state.q, rec.p, rec.tau, static_cast<int>(o))) {
         const double area = body.tributary_area(r.site);
         const Vec2 x = body.surface_point(rec.state.q, r.site, 0).x;
-        readings.push_back({{"node", body.site_node(r.site)}, {"obstacle", pair.name},
-                            {"body", all->name(pair.master->body)}, {"x", x.x()}, {"y", x.y()},
-                            {"p_n", r.sigma_n * area}, {"p_t", r.sigma_t * area},
-                            {"sigma_n", r.sigma_n}, {"sigma_t", r.sigma_t}});
+        readings.push_back({{"node", body.site_node(r.site)},
+                            {"obstacle", pair.name},
+                            {"body", all->name(pair.master->body)},
+                            {"x", field_value(x.x())},
+                            {"y", field_value(x.y())},
+                            {"p_n", field_value(r.sigma_n * area)},
+                            {"p_t", field_value(r.sigma_t * area)},
+                            {"sigma_n", field_value(r.sigma_n)},
+                            {"sigma_t", field_value(r.sigma_t)}});
       }
     }
     j["master_points"] = readings;
@@ -228,15 +304,16 @@ json effects_json(const Scene& scene) {
   }
   for (const Candidate& c : problem.candidates) tangential += c.xi >= 0;
   json effects = {{"friction", friction},
-          {"geometric_nonlinearity", traits.geometric_nonlinearity},
-          {"plasticity", traits.plasticity},
-          {"moving_obstacles", moving},
-          {"constant_tangent", traits.constant_tangent},
-          {"contact_candidates", problem.candidates.size()},
-          {"contact_unknowns", problem.component_count},
-          {"held_by_contact", problem.rigid.names},
-          {"unknowns_per_contact_point", tangential > 0 ? 2 : 1}};
-  // How the free motions were held (ALGORITHM.md 7), and that no regularization is left.
+                  {"geometric_nonlinearity", traits.geometric_nonlinearity},
+                  {"plasticity", traits.plasticity},
+                  {"moving_obstacles", moving},
+                  {"constant_tangent", traits.constant_tangent},
+                  {"contact_candidates", problem.candidates.size()},
+                  {"contact_unknowns", problem.component_count},
+                  {"held_by_contact", problem.rigid.names},
+                  {"unknowns_per_contact_point", tangential > 0 ? 2 : 1}};
+  // How the free motions were held (docs/algorithm.md#bodies-held-only-by-contact), and that no
+  // regularization is left.
   if (problem.rigid.count())
     effects["held_by_contact_by"] =
         scene.params.contact.method == ContactMethod::penalty
@@ -248,25 +325,31 @@ json effects_json(const Scene& scene) {
               "forces, the whole body's equilibrium their rows; no regularization"
             : "the contact forces: the rigid amplitudes are contact unknowns and the whole body's equilibrium "
               "their condition; no regularization";
-  if (const auto* all = dynamic_cast<const BodySet*>(problem.body.get())) {
+  if (const auto* all = body_set_of(*problem.body)) {
     // Per body what it simulates, and per contact pair its candidates.
     json bodies = json::array(), pairs = json::array();
-    for (int b = 0; b < all->count(); ++b) {
+    for (int b = 0; b < all->part_count(); ++b) {
       const Body::Traits t = all->part(b).traits();
       json held = json::array();  // its motions held by contact, without the "BODY: " of the scene's list
       for (int k = 0; k < problem.rigid.count(); ++k)
         if (problem.rigid.body[k] == b) held.push_back(problem.rigid.names[k].substr(all->name(b).size() + 2));
-      bodies.push_back({{"name", all->name(b)}, {"geometric_nonlinearity", t.geometric_nonlinearity},
-                        {"plasticity", t.plasticity}, {"constant_tangent", t.constant_tangent},
-                        {"dofs", all->part(b).dof_count()}, {"held_by_contact", held}});
+      bodies.push_back({{"name", all->name(b)},
+                        {"geometric_nonlinearity", t.geometric_nonlinearity},
+                        {"plasticity", t.plasticity},
+                        {"constant_tangent", t.constant_tangent},
+                        {"dofs", all->part(b).dof_count()},
+                        {"held_by_contact", held}});
     }
     for (size_t o = 0; o < problem.obstacles.size(); ++o) {
       const ObstacleInstance& pair = problem.obstacles[o];
       if (!pair.master) continue;
       int candidates = 0;
       for (const Candidate& c : problem.candidates) candidates += c.obstacle == static_cast<int>(o);
-      pairs.push_back({{"name", pair.name}, {"slave", all->name(pair.slave_body)}, {"master", all->name(pair.master->body)},
-                       {"friction", pair.frictional}, {"contact_candidates", candidates}});
+      pairs.push_back({{"name", pair.name},
+                       {"slave", all->name(pair.slave_body)},
+                       {"master", all->name(pair.master->body)},
+                       {"friction", pair.frictional},
+                       {"contact_candidates", candidates}});
     }
     effects["bodies"] = bodies;
     effects["contacts"] = pairs;
@@ -283,31 +366,39 @@ namespace {
 
 // Each body's rows of the nodes and elements tables and of mesh.cells (several bodies only).
 std::optional<json> bodies_json(const Body& body) {
-  const auto* all = dynamic_cast<const BodySet*>(&body);
+  const auto* all = body_set_of(body);
   if (!all) return std::nullopt;
   json bodies = json::array();
   int first_element = 0;
-  for (int b = 0; b < all->count(); ++b) {
+  for (int b = 0; b < all->part_count(); ++b) {
     const int elements = static_cast<int>(all->part(b).cells().size());
-    bodies.push_back({{"name", all->name(b)}, {"first_node", all->node_offset(b)}, {"nodes", all->part(b).node_count()},
-                      {"first_element", first_element}, {"elements", elements}});
+    bodies.push_back({{"name", all->name(b)},
+                      {"first_node", all->node_offset(b)},
+                      {"nodes", all->part(b).node_count()},
+                      {"first_element", first_element},
+                      {"elements", elements}});
     first_element += elements;
   }
   return bodies;
 }
 
 json summary_json(const RunResult& run) {
-  return {{"completed", run.completed}, {"reason", run.reason}, {"steps", run.steps.size()},
-          {"contact_iterations", run.counters.solves},
-          {"newton_iterations", run.counters.newton_iterations},
-          {"factorizations", run.counters.factorizations}, {"seconds", run.seconds}};
+  json j = {{"completed", run.completed},
+            {"reason", run.reason},
+            {"steps", run.steps.size()},
+            {"contact_iterations", run.counters.solves},
+            {"newton_iterations", run.counters.newton_iterations},
+            {"factorizations", run.counters.factorizations},
+            {"seconds", run.seconds}};
+  if (!run.completed) j["failure"] = failure_json(run.failure, run.reason, run.failure_step);
+  return j;
 }
 
 // table_json's rows, written as they are made (no document of the table's size in memory),
 // kRowsPerPart rows a part.
 std::vector<ResultPart> table_parts(const FlatTable& t, const std::string& index_name) {
   struct Columns {
-    std::vector<int> column;  // of each key in nlohmann's order (sorted); -1: the row index
+    std::vector<int> column;          // of each key in nlohmann's order (sorted); -1: the row index
     std::vector<std::string> quoted;  // "key":
   };
   std::vector<std::pair<std::string, int>> keys{{index_name, -1}};
@@ -335,10 +426,8 @@ std::vector<ResultPart> table_parts(const FlatTable& t, const std::string& index
           if (!first) w.put(',');
           first = false;
           w.raw(columns->quoted[k]);
-          if (c < 0)
-            w.integer(static_cast<long long>(i));
-          else
-            w.number(row[c]);
+          if (c < 0) w.integer(static_cast<long long>(i));
+          else w.number(row[c]);
         }
         w.put('}');
       }
@@ -353,7 +442,7 @@ FlatTable flat_table(const FieldTable& t) {
   f.values.reserve(t.rows.size() * t.names.size());
   for (const auto& row : t.rows) {
     if (row.size() != t.names.size()) throw std::logic_error("a field table's row is not as wide as its names");
-    f.values.insert(f.values.end(), row.begin(), row.end());
+    for (double v : row) f.values.push_back(field_value(v));  // NaN stays: a column the row's body lacks
   }
   return f;
 }

@@ -1,6 +1,6 @@
 #pragma once
-// Results and events as JSON (DESIGN.md vocabulary). Events are the same objects whether
-// written to an NDJSON file by `grip solve --events` or streamed by the service.
+// Results and events as JSON (docs/design.md#scenes-results-and-events). Events are the same
+// objects whether written to an NDJSON file by `grip solve --events` or streamed by the service.
 #include <functional>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -16,6 +16,21 @@ namespace grip {
 nlohmann::json iteration_event(const IterationEvent& ev);
 nlohmann::json step_started_event(int step, double load_factor);
 nlohmann::json step_finished_event(const StepRecord& rec);
+// The failure member of a failed step, run or job: {kind, message, step}; step 0 where the
+// failure is no step's (a dismissal, an invalid scene, a node or step limit).
+nlohmann::json failure_json(FailureKind kind, const std::string& message, int step);
+// The terminal event of a job that did not solve every step.
+nlohmann::json job_failed_event(FailureKind kind, const std::string& reason, int step);
+
+// The digits a step's fields (nodes, elements, reactions, contact and master points) are
+// written with: single precision's, within 5e-7 of the value, far below any mesh's discretisation
+// error; full doubles' 17 digits, which no mesh resolves, took most of a stored result's
+// bytes (docs/design.md#scenes-results-and-events). Summaries, histories, events and
+// the scene keep the shortest round-trip form of their doubles.
+constexpr int kFieldDigits = 7;
+// v rounded to kFieldDigits significant digits (written as at most that many); 0, infinities
+// and NaN as they are.
+double field_value(double v);
 
 // One step's fields: nodes, elements, reactions, contact points, obstacle positions.
 // Fields only where the step was recorded (see SteppingParams::record_fields) and wanted.
@@ -59,8 +74,8 @@ struct ContactPointRow {
 std::vector<ContactPointRow> contact_point_rows(const Problem& problem, const StepRecord& rec);
 nlohmann::json contact_points_json(const std::vector<ContactPointRow>& rows);
 struct StepOutput {
-  nlohmann::json summary;  // step_json without the tables and the contact points
-  std::optional<FlatTable> nodes, elements;  // where recorded and wanted
+  nlohmann::json summary;                                      // step_json without the tables and the contact points
+  std::optional<FlatTable> nodes, elements;                    // where recorded and wanted
   std::optional<std::vector<ContactPointRow>> contact_points;  // as JSON on the writer's thread
 };
 StepOutput step_output(const Problem& problem, const StepRecord& rec, const OutputOptions& output);

@@ -8,12 +8,15 @@
 #include <numbers>
 #include <optional>
 #include <sstream>
+#include <unordered_map>
+#include <unordered_set>
 
-#include "solver/model/body_set.hpp"
 #include "solver/io/json_depth.hpp"
 #include "solver/io/scene_reader.hpp"
 #include "solver/io/schema_validation.hpp"
-#include "solver/equilibrium/rigid_equilibrium.hpp"
+#include "solver/model/body_set.hpp"
+#include "solver/model/number_text.hpp"
+#include "solver/problem/rigid_modes.hpp"
 
 namespace grip {
 namespace {
@@ -25,8 +28,7 @@ using scene_io::token;
 
 std::string join(const std::vector<SceneIssue>& issues) {
   std::ostringstream os;
-  for (size_t i = 0; i < issues.size(); ++i)
-    os << (i ? "\n" : "") << issues[i].pointer << ": " << issues[i].detail;
+  for (size_t i = 0; i < issues.size(); ++i) os << (i ? "\n" : "") << issues[i].pointer << ": " << issues[i].detail;
   return os.str();
 }
 
@@ -36,13 +38,12 @@ ProfilePiece read_piece(Reader& r, json& j, const std::string& ptr) {
   const std::string type = r.choice(j, ptr, "type", {"segment", "arc"}, std::nullopt);
   if (type == "segment") return SegmentPiece{r.vec2(j, ptr, "from"), r.vec2(j, ptr, "to")};
   const double deg = std::numbers::pi / 180;
-  return ArcPiece{r.vec2(j, ptr, "centre"), r.positive(j, ptr, "radius"),
-                  r.number(j, ptr, "start_angle") * deg, r.number(j, ptr, "end_angle") * deg};
+  return ArcPiece{r.vec2(j, ptr, "centre"), r.positive(j, ptr, "radius"), r.number(j, ptr, "start_angle") * deg,
+                  r.number(j, ptr, "end_angle") * deg};
 }
 
 std::unique_ptr<Obstacle> read_shape(Reader& r, json& j, const std::string& ptr) {
-  const std::string type =
-      r.choice(j, ptr, "type", {"circle", "segment", "arc", "profile"}, std::nullopt);
+  const std::string type = r.choice(j, ptr, "type", {"circle", "segment", "arc", "profile"}, std::nullopt);
   const size_t before = r.issues.size();
   std::vector<ProfilePiece> pieces;
   if (type == "circle") {
@@ -77,8 +78,9 @@ std::unique_ptr<Obstacle> read_shape(Reader& r, json& j, const std::string& ptr)
 
 // ---- solver parameters
 
-// solver.start: {"node", "component": "x" | "y", "value", "obstacle"} (ALGORITHM.md section 9):
-// the first step starts from a solve with that displacement prescribed and no contact.
+// solver.start: {"node", "component": "x" | "y", "value", "obstacle"}
+// (docs/algorithm.md#load-stepping-and-cuts): the first step starts from a solve with that
+// displacement prescribed and no contact.
 void read_start(Reader& r, json& scene, Problem& problem) {
   const bool membrane = scene.contains("body") && scene["body"].is_object() &&
                         scene["body"].value("model", "") == "rigid_plastic_membrane";
@@ -86,9 +88,10 @@ void read_start(Reader& r, json& scene, Problem& problem) {
   if (!solver) return;
   if (!solver->contains("start")) {
     if (membrane)
-      r.error("/solver/start", "is required for a rigid_plastic_membrane: a flat sheet has no transverse "
-                                "stiffness, so its first step starts from a prescribed depth of one node "
-                                "(e.g. {\"node\": 0, \"component\": \"y\", \"value\": -1, \"obstacle\": \"punch\"})");
+      r.error("/solver/start",
+              "is required for a rigid_plastic_membrane: a flat sheet has no transverse "
+              "stiffness, so its first step starts from a prescribed depth of one node "
+              "(e.g. {\"node\": 0, \"component\": \"y\", \"value\": -1, \"obstacle\": \"punch\"})");
     return;
   }
   json* st = r.object(*solver, "/solver", "start", true);
@@ -140,8 +143,9 @@ std::string motion_name(const Vector& coefficients, double L) {
   const double omega = c.size() > 2 ? c[2] / L : 0.0;
   if (std::abs(omega) * L < 1e-9) {
     const Vec2 d = Vec2(c[0], c[1]).normalized();
-    return std::abs(d.y()) < 1e-9 ? "translate along x" : std::abs(d.x()) < 1e-9 ? "translate along y"
-                                                                                : "translate along " + format_point(d);
+    return std::abs(d.y()) < 1e-9   ? "translate along x"
+           : std::abs(d.x()) < 1e-9 ? "translate along y"
+                                    : "translate along " + format_point(d);
   }
   Vec2 pivot(-c[1] / omega, c[0] / omega);
   for (int d = 0; d < 2; ++d)
@@ -202,11 +206,13 @@ struct BodyPart {
 };
 
 std::vector<BodyPart> body_parts(const Problem& problem) {
+  // The BodySet that scene_bodies.cpp built for "bodies": its names and pointers are the scene's.
   const auto* all = dynamic_cast<const BodySet*>(problem.body.get());
   if (!all) return {{problem.body.get(), 0, "/body/supports", ""}};
   std::vector<BodyPart> parts;
-  for (int b = 0; b < all->count(); ++b)
-    parts.push_back({&all->part(b), all->dof_offset(b), "/bodies/" + std::to_string(b) + "/supports", all->name(b) + ": "});
+  for (int b = 0; b < all->part_count(); ++b)
+    parts.push_back(
+        {&all->part(b), all->dof_offset(b), "/bodies/" + std::to_string(b) + "/supports", all->name(b) + ": "});
   return parts;
 }
 
@@ -231,13 +237,14 @@ std::pair<std::string, int> motion_words(const std::vector<BodyPart>& parts, con
   return {moved > 1 ? "move together (" + words + ")" : words, std::max(first, 0)};
 }
 
-// Free rigid motions are held by contact (ALGORITHM.md section 7) where the model allows it:
-// translations always (internal forces are self-equilibrated at any state), rotations where
-// the tangent is constant (linear kinematics: an infinitesimal rotation is a null mode of K) or
-// where a finite rotation leaves the body's strain unchanged (the continuum with finite
-// kinematics, the von Karman beam, about at most one supported node: its motions then follow its
-// state, rigid_modes_at); a membrane (no reference stiffness) never. Records them in problem.rigid (pins come later);
-// in a scene of several bodies each body's motions on its own dofs.
+// Free rigid motions are held by contact (docs/algorithm.md#bodies-held-only-by-contact) where the
+// model allows it: translations always (internal forces are self-equilibrated at any state),
+// rotations where the tangent is constant (linear kinematics: an infinitesimal rotation is a null
+// mode of K) or where a finite rotation leaves the body's strain unchanged (the continuum with
+// finite kinematics, the von Karman beam, about at most one supported node: its motions then follow
+// its state, rigid_modes_at); a membrane (no reference stiffness) never. Records them in
+// problem.rigid (pins come later); in a scene of several bodies each body's motions on its own
+// dofs.
 void check_rigid_modes(Reader& r, Problem& problem) {
   const std::vector<BodyPart> parts = body_parts(problem);
   for (size_t b = 0; b < parts.size(); ++b) {
@@ -252,10 +259,8 @@ void check_rigid_modes(Reader& r, Problem& problem) {
     for (const Vector& c : free) {
       const bool rotates = c.size() > 2 && std::abs(c[2]) > 1e-9;
       std::string why;
-      if (problem.start)
-        why = "a membrane has no stiffness of its own to carry a load to its contacts";
-      else if (rotates && !body.traits().constant_tangent)
-        why = finite_rotation_refusal(body, fixed);
+      if (problem.start) why = "a membrane has no stiffness of its own to carry a load to its contacts";
+      else if (rotates && !body.traits().constant_tangent) why = finite_rotation_refusal(body, fixed);
       if (!why.empty()) {
         r.error(parts[b].supports, "leave the body free to " + motion_name(c, L) + ": " + why +
                                        "; fix a component that this motion moves, or drive the body by a "
@@ -316,7 +321,7 @@ void hold_rigid_modes(Reader& r, Problem& problem) {
     // The motion that no contact point resists, in words, at the first body it moves.
     const auto [words, b] = motion_words(parts, Vector(rigid.modes * svd.matrixV().col(k)));
     r.error(parts[b].supports, std::string(words.rfind("move together", 0) == 0 ? "leave the bodies free to "
-                                                                                 : "leave the body free to ") +
+                                                                                : "leave the body free to ") +
                                    words + unstoppable);
   }
   if (!r.issues.empty()) return;
@@ -383,24 +388,22 @@ void read_solver(Reader& r, json& scene, SteppingParams& params) {
     // 0: the body's characteristic length (written back as 0, meaning "automatic").
     params.contact_reach = r.number(*contact, cp, "reach", 0.0);
     if (params.contact_reach < 0) r.error(cp + "/reach", "is negative");
+    params.fail_outside_candidates = r.choice(*contact, cp, "outside_candidates", {"add", "fail"}, "add") == "fail";
     if (json* acc = r.object(*contact, cp, "acceleration", false)) {
       const std::string ap = cp + "/acceleration";
       if (!acc->contains("n")) (*acc)["n"] = "inf";
       const json& n = (*acc)["n"];
-      if (n.is_string() && n == "inf")
-        c.acceleration = kAccelerationInfinity;
-      else if (n.is_string() && n == "auto")
-        c.acceleration = kAccelerationAuto;
-      else if (n.is_number_integer())
-        c.acceleration = r.integer_value(n, ap + "/n", 1, 64);
-      else
-        r.error(ap + "/n", show(n) + " is not \"inf\", \"auto\" or an integer from 1 to 64");
+      if (n.is_string() && n == "inf") c.acceleration = kAccelerationInfinity;
+      else if (n.is_string() && n == "auto") c.acceleration = kAccelerationAuto;
+      else if (n.is_number_integer()) c.acceleration = r.integer_value(n, ap + "/n", 1, 64);
+      else r.error(ap + "/n", show(n) + " is not \"inf\", \"auto\" or an integer from 1 to 64");
       const std::string eps = r.choice(*acc, ap, "epsilon", {"exact", "warmup"}, "exact");
       c.epsilon = eps == "warmup" ? EpsilonSource::warmup : EpsilonSource::exact;
     }
   }
   if (json* newton = r.object(*solver, sp, "newton", false))
-    params.newton.max_iterations = r.integer(*newton, sp + "/newton", "max_iterations", 1, 1000, params.newton.max_iterations);
+    params.newton.max_iterations =
+        r.integer(*newton, sp + "/newton", "max_iterations", 1, 1000, params.newton.max_iterations);
   params.max_cuts = r.integer(*solver, sp, "max_cuts", 0, 30, params.max_cuts);
 }
 
@@ -419,7 +422,8 @@ void read_output(Reader& r, json& scene, Scene& out) {
   } else if (steps.is_array()) {
     out.params.record_fields.assign(n, 0);
     for (size_t i = 0; i < steps.size(); ++i) {
-      const int k = r.integer_value(steps[i], "/output/steps/" + std::to_string(i), 1, static_cast<int>(std::max<size_t>(n, 1)));
+      const int k =
+          r.integer_value(steps[i], "/output/steps/" + std::to_string(i), 1, static_cast<int>(std::max<size_t>(n, 1)));
       if (n) out.params.record_fields[k - 1] = 1;
     }
   } else {
@@ -431,10 +435,12 @@ void read_output(Reader& r, json& scene, Scene& out) {
   out.output.fields.clear();
   for (size_t i = 0; i < fields->size(); ++i) {
     const json& f = (*fields)[i];
-    if (f.is_string() && std::find(OutputOptions::kAllFields.begin(), OutputOptions::kAllFields.end(), f.get<std::string>()) != OutputOptions::kAllFields.end())
+    if (f.is_string() && std::find(OutputOptions::kAllFields.begin(), OutputOptions::kAllFields.end(),
+                                   f.get<std::string>()) != OutputOptions::kAllFields.end())
       out.output.fields.push_back(f.get<std::string>());
     else
-      r.error("/output/fields/" + std::to_string(i), show(f) + " is not one of " + Reader::list(OutputOptions::kAllFields));
+      r.error("/output/fields/" + std::to_string(i),
+              show(f) + " is not one of " + Reader::list(OutputOptions::kAllFields));
   }
 }
 
@@ -462,8 +468,7 @@ std::vector<double> read_step_factors(Reader& r, json& scene) {
     for (size_t i = 0; i < s.size(); ++i) {
       if (!s[i].is_number() || !std::isfinite(s[i].get<double>()))
         r.error("/steps/" + std::to_string(i), show(s[i]) + " is not a finite number");
-      else
-        factors.push_back(s[i].get<double>());
+      else factors.push_back(s[i].get<double>());
     }
   } else {
     r.error("/steps", show(s) + " is neither a step count nor a list of load factors");
@@ -479,7 +484,11 @@ std::vector<double> read_step_factors(Reader& r, json& scene) {
 std::vector<LoadStep> read_load_path(Reader& r, json& scene, std::vector<ObstacleInstance>& obstacles,
                                      bool cases_known) {
   std::vector<double> base_friction;
-  for (const auto& o : obstacles) base_friction.push_back(o.friction);
+  std::unordered_map<std::string, size_t> obstacle_index;
+  for (const auto& o : obstacles) {
+    obstacle_index.emplace(o.name, base_friction.size());
+    base_friction.push_back(o.friction);
+  }
   const size_t cases = r.cases.size();
   std::vector<LoadStep> path;
   if (!scene.contains("stages")) {
@@ -503,9 +512,9 @@ std::vector<LoadStep> read_load_path(Reader& r, json& scene, std::vector<Obstacl
     LoadFactors target = current;
     if (json* f = r.object(st, sp, "factors", true))
       for (auto& [name, v] : f->items()) {
-        size_t k = 0;
-        while (k < cases && r.cases[k] != name) ++k;
-        if (k == cases) {
+        const int found = r.find_case(name);
+        const size_t k = found < 0 ? cases : static_cast<size_t>(found);
+        if (k >= cases) {
           if (cases_known)
             r.error(sp + "/factors/" + token(name), "names no load case (cases: " + Reader::list(r.cases) + ")");
           continue;
@@ -515,8 +524,8 @@ std::vector<LoadStep> read_load_path(Reader& r, json& scene, std::vector<Obstacl
     std::vector<double> friction = base_friction;
     if (json* fr = r.object(st, sp, "friction", false))
       for (auto& [name, v] : fr->items()) {
-        size_t o = 0;
-        while (o < obstacles.size() && obstacles[o].name != name) ++o;
+        const auto named = obstacle_index.find(name);
+        const size_t o = named == obstacle_index.end() ? obstacles.size() : named->second;
         if (o == obstacles.size()) {
           r.error(sp + "/friction/" + token(name), "names no obstacle");
           continue;
@@ -544,34 +553,71 @@ std::vector<LoadStep> read_load_path(Reader& r, json& scene, std::vector<Obstacl
 
 Scene read_checked_scene(const nlohmann::json& input);
 
-SceneErrors::SceneErrors(std::vector<SceneIssue> issues)
-    : std::runtime_error(join(issues)), issues_(std::move(issues)) {}
+SceneErrors::SceneErrors(std::vector<SceneIssue> issues, bool more)
+    : std::runtime_error(join(issues)), issues_(std::move(issues)), more_(more) {}
 
 Scene read_scene(const nlohmann::json& input) {
   // Stage 1: the schema (types, ranges, unknown keys); stage 2: the readers' own checks
   // (references, meshes, rigid motions). Both run, so every error is reported at once; a
   // reader error under a value the schema already rejected is left out. The readers run
   // first: a caller may build the schema's validator meanwhile (prepare_schema, grip solve).
+  // Each stage lists at most kMaxSceneIssues problems, and so does the whole.
   std::optional<Scene> scene;
   std::vector<SceneIssue> reader_issues;
+  bool more = false;
   try {
     scene.emplace(read_checked_scene(input));
   } catch (const SceneErrors& e) {
     reader_issues = e.issues();
+    more = e.more();
   }
-  std::vector<SceneIssue> schema_issues = validate_against(input, SchemaName::scene);
+  bool schema_more = false;
+  std::vector<SceneIssue> schema_issues = validate_against(input, SchemaName::scene, &schema_more);
   if (schema_issues.empty()) {
     if (scene) return std::move(*scene);
-    throw SceneErrors(std::move(reader_issues));
+    throw SceneErrors(std::move(reader_issues), more);
   }
+  more |= schema_more;
   for (const SceneIssue& issue : reader_issues) {
     bool covered = false;
     for (const SceneIssue& s : schema_issues)
       covered |= issue.pointer == s.pointer || issue.pointer.rfind(s.pointer + "/", 0) == 0 || s.pointer == "/";
-    if (!covered) schema_issues.push_back(issue);
+    if (covered) continue;
+    if (schema_issues.size() >= kMaxSceneIssues) {
+      more = true;
+      break;
+    }
+    schema_issues.push_back(issue);
   }
-  throw SceneErrors(std::move(schema_issues));
+  throw SceneErrors(std::move(schema_issues), more);
 }
+
+namespace {
+
+// Magnitudes beyond what the arithmetic carries: a modulus or a load of 1e300 overflows the
+// products and squared norms of a solve (a diverging Newton then reported a 300-digit
+// correction). No quantity of a scene comes near 1e30 in any consistent units.
+constexpr double kLargestMagnitude = 1e30;
+
+void refuse_huge_numbers(Reader& r, const json& v, const std::string& pointer) {
+  if (v.is_number_float() || v.is_number_integer()) {
+    const double x = v.get<double>();
+    if (std::abs(x) > kLargestMagnitude)
+      r.error(pointer.empty() ? "/" : pointer,
+              show(v) + " is beyond " + number_text(kLargestMagnitude) +
+                  " in magnitude: the solver's arithmetic would overflow; give the scene in other units");
+  } else if (v.is_object()) {
+    for (const auto& [key, item] : v.items()) {
+      std::string escaped;
+      for (const char c : key) escaped += c == '~' ? "~0" : c == '/' ? "~1" : std::string(1, c);
+      refuse_huge_numbers(r, item, pointer + "/" + escaped);
+    }
+  } else if (v.is_array()) {
+    for (size_t i = 0; i < v.size(); ++i) refuse_huge_numbers(r, v[i], pointer + "/" + std::to_string(i));
+  }
+}
+
+}  // namespace
 
 Scene read_checked_scene(const nlohmann::json& input) {
   Reader r;
@@ -579,8 +625,11 @@ Scene read_checked_scene(const nlohmann::json& input) {
   scene.effective = input;
   json& e = scene.effective;
   if (!e.is_object()) throw SceneErrors(std::vector<SceneIssue>{{"/", "a scene is a JSON object"}});
+  refuse_huge_numbers(r, e, "");
+  if (!r.issues.empty()) throw SceneErrors(std::move(r.issues));
   const bool several = e.contains("bodies");
-  if (several && e.contains("body")) r.error("/body", "cannot be given together with bodies (body is the one-body shorthand)");
+  if (several && e.contains("body"))
+    r.error("/body", "cannot be given together with bodies (body is the one-body shorthand)");
   if (!several && e.contains("contacts")) r.error("/contacts", "pairs the surfaces of bodies: give bodies, not body");
   if (several) {
     if (json* bodies = r.array(e, "", "bodies", true)) scene_io::read_bodies(r, *bodies, scene.problem);
@@ -590,6 +639,7 @@ Scene read_checked_scene(const nlohmann::json& input) {
   json* obs = several && !e.contains("obstacles") ? nullptr : r.array(e, "", "obstacles", !several);
   if (obs) {
     if (obs->empty() && !several) r.error("/obstacles", "needs at least one obstacle");
+    std::unordered_set<std::string> obstacle_names;
     for (size_t i = 0; i < obs->size(); ++i) {
       const std::string op = "/obstacles/" + std::to_string(i);
       json& o = (*obs)[i];
@@ -601,9 +651,8 @@ Scene read_checked_scene(const nlohmann::json& input) {
       if (!o.contains("name")) o["name"] = "obstacle" + std::to_string(i);
       if (!o["name"].is_string()) r.error(op + "/name", "is not a string");
       else inst.name = o["name"].get<std::string>();
-      for (const auto& other : scene.problem.obstacles)
-        if (!inst.name.empty() && other.name == inst.name)
-          r.error(op + "/name", "\"" + inst.name + "\" names another obstacle already");
+      if (!inst.name.empty() && !obstacle_names.insert(inst.name).second)
+        r.error(op + "/name", "\"" + inst.name + "\" names another obstacle already");
       if (json* shape = r.object(o, op, "shape", true)) inst.shape = read_shape(r, *shape, op + "/shape");
       inst.friction = r.number(o, op, "friction", 0.0);
       if (inst.friction < 0) r.error(op + "/friction", show(o["friction"]) + " is negative");
@@ -612,8 +661,7 @@ Scene read_checked_scene(const nlohmann::json& input) {
       if (o["motion"].is_array())
         for (size_t m = 0; m < o["motion"].size(); ++m)
           read_motion(r, o["motion"][m], op + "/motion/" + std::to_string(m), inst);
-      else
-        read_motion(r, o["motion"], op + "/motion", inst);
+      else read_motion(r, o["motion"], op + "/motion", inst);
       scene.problem.obstacles.push_back(std::move(inst));
     }
   }
@@ -628,8 +676,8 @@ Scene read_checked_scene(const nlohmann::json& input) {
   if (r.issues.empty() && scene.problem.body) check_rigid_modes(r, scene.problem);
   if (r.issues.empty()) read_start(r, e, scene.problem);
   if (!r.issues.empty()) throw SceneErrors(std::move(r.issues));
-  const double reach = scene.params.contact_reach > 0 ? scene.params.contact_reach
-                                                      : scene.problem.body->characteristic_length();
+  const double reach =
+      scene.params.contact_reach > 0 ? scene.params.contact_reach : scene.problem.body->characteristic_length();
   add_candidates(scene.problem, scene.steps, reach);
   hold_rigid_modes(r, scene.problem);
   if (!r.issues.empty()) throw SceneErrors(std::move(r.issues));
@@ -642,8 +690,8 @@ Scene read_scene_file(const std::string& path) {
   std::ostringstream text;
   text << in.rdbuf();
   if (nested_deeper_than(text.str(), kMaxJsonDepth))
-    throw SceneErrors(std::vector<SceneIssue>{
-        {"/", "malformed JSON: arrays and objects are nested deeper than " + std::to_string(kMaxJsonDepth) + " levels"}});
+    throw SceneErrors(std::vector<SceneIssue>{{"/", "malformed JSON: arrays and objects are nested deeper than " +
+                                                        std::to_string(kMaxJsonDepth) + " levels"}});
   json j;
   try {
     j = json::parse(text.str());

@@ -4,10 +4,7 @@
 #include "solver/io/scene_reader.hpp"
 
 namespace grip::scene_io {
-namespace {
-
-
-}  // namespace
+namespace {}  // namespace
 
 void read_timoshenko_beam(Reader& r, json& body, Problem& problem, const std::string& ptr) {
   const std::string kin = r.choice(body, ptr, "kinematics", {"von_karman", "linear"}, "von_karman");
@@ -19,16 +16,14 @@ void read_timoshenko_beam(Reader& r, json& body, Problem& problem, const std::st
   if (mat) {
     E = r.positive(*mat, ptr + "/material", "young");
     nu = r.number(*mat, ptr + "/material", "poisson", 0.3);
-    if (!(nu >= 0 && nu < 0.5))
-      r.error(ptr + "/material/poisson", show((*mat)["poisson"]) + " is not in [0, 0.5)");
+    if (!(nu >= 0 && nu < 0.5)) r.error(ptr + "/material/poisson", show((*mat)["poisson"]) + " is not in [0, 0.5)");
   }
   if (sec) {
     const double width = r.positive(*sec, ptr + "/section", "width");
     const double depth = r.positive(*sec, ptr + "/section", "depth");
     const double k = r.positive(*sec, ptr + "/section", "shear_factor", 5.0 / 6.0);
     const double G = E / (2 * (1 + nu));
-    section = {E * width * depth, E * width * depth * depth * depth / 12, k * G * width * depth,
-               depth / 2, width};
+    section = {E * width * depth, E * width * depth * depth * depth / 12, k * G * width * depth, depth / 2, width};
   }
   std::vector<double> x;
   Vec2 origin = Vec2::Zero();
@@ -39,8 +34,8 @@ void read_timoshenko_beam(Reader& r, json& body, Problem& problem, const std::st
     for (int i = 0; i <= elements; ++i) x.push_back(origin.x() + length * i / elements);
   }
   if (!r.issues.empty()) return;
-  auto beam = std::make_unique<TimoshenkoBeam>(
-      x, origin.y(), section, kin == "linear" ? Kinematics::linear : Kinematics::von_karman);
+  auto beam = std::make_unique<TimoshenkoBeam>(x, origin.y(), section,
+                                               kin == "linear" ? Kinematics::linear : Kinematics::von_karman);
   const int nodes = beam->node_count();
   problem.body = std::move(beam);
   const auto& body_model = static_cast<const TimoshenkoBeam&>(*problem.body);

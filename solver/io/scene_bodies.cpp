@@ -2,11 +2,12 @@
 // [{"slave": "BODY.SET", "master": "BODY.SET" | "OBSTACLE", "friction", "name"}].
 #include <algorithm>
 #include <set>
+#include <unordered_map>
 
-#include "solver/model/body_set.hpp"
 #include "solver/elements/continuum.hpp"
 #include "solver/elements/timoshenko_beam.hpp"
 #include "solver/io/scene_reader.hpp"
+#include "solver/model/body_set.hpp"
 
 namespace grip::scene_io {
 
@@ -29,6 +30,7 @@ void read_bodies(Reader& r, json& bodies, Problem& problem) {
   if (bodies.empty()) r.error("/bodies", "needs at least one body");
   std::vector<Problem> parts;
   std::vector<std::string> names;
+  std::set<std::string> named;  // names, for lookup
   for (size_t b = 0; b < bodies.size(); ++b) {
     const std::string bp = "/bodies/" + std::to_string(b);
     json& body = bodies[b];
@@ -41,23 +43,25 @@ void read_bodies(Reader& r, json& bodies, Problem& problem) {
       continue;
     }
     const json& name = body["name"];
-    if (!name.is_string() || name.get<std::string>().empty() || name.get<std::string>().find('.') != std::string::npos) {
+    if (!name.is_string() || name.get<std::string>().empty() ||
+        name.get<std::string>().find('.') != std::string::npos) {
       r.error(bp + "/name", show(name) + " is not a name (a non-empty string without '.')");
       continue;
     }
-    for (const std::string& other : names)
-      if (other == name) r.error(bp + "/name", show(name) + " names another body already");
+    if (named.count(name.get<std::string>())) r.error(bp + "/name", show(name) + " names another body already");
     if (body.value("model", "") == "rigid_plastic_membrane")
       r.error(bp + "/model",
               "a rigid_plastic_membrane has no stiffness in its flat reference state: its first step starts from a "
               "prescribed depth of one node pressed by a rigid obstacle (solver.start), whose reaction is the first "
-              "contact force (ALGORITHM.md 9); against a deformable body that depth would be shared with the other "
+              "contact force (docs/algorithm.md#load-stepping-and-cuts); against a deformable body that depth would be "
+              "shared with the other "
               "body's compliance, which gives no starting force, so a membrane is for one-body scenes (body)");
     if (!r.issues.empty()) continue;
     Problem part;
     read_body(r, body, part, bp);
     if (!r.issues.empty() || !part.body) continue;
     names.push_back(name.get<std::string>());
+    named.insert(names.back());
     parts.push_back(std::move(part));
   }
   if (!r.issues.empty()) return;
@@ -66,13 +70,14 @@ void read_bodies(Reader& r, json& bodies, Problem& problem) {
   auto set = std::make_unique<BodySet>(std::move(bodies_owned), names);
   problem.body = std::move(set);
   const BodySet& all = static_cast<const BodySet&>(*problem.body);
-  for (int b = 0; b < all.count(); ++b) {
+  for (int b = 0; b < all.part_count(); ++b) {
     const int offset = all.dof_offset(b), n = all.part(b).dof_count();
     for (Constraint c : parts[b].constraints) {
       c.dof += offset;
       problem.constraints.push_back(c);
     }
-    for (size_t k = 0; k < parts[b].loads.size(); ++k) case_load(problem, static_cast<int>(k)).segment(offset, n) += parts[b].loads[k];
+    for (size_t k = 0; k < parts[b].loads.size(); ++k)
+      case_load(problem, static_cast<int>(k)).segment(offset, n) += parts[b].loads[k];
   }
 }
 
@@ -84,21 +89,24 @@ namespace {
 // half the depth toward +y or -y (Body::surface_point's side), through every node.
 struct SetRef {
   int body = -1;
-  std::vector<int> sites;                      // sites of the BodySet
-  std::vector<std::array<int, 2>> segments;    // its surface pieces, body on the left of a -> b
-  int side = 0;                                // a beam's surface side; 0 for a continuum
+  std::vector<int> sites;                    // sites of the BodySet
+  std::vector<std::array<int, 2>> segments;  // its surface pieces, body on the left of a -> b
+  int side = 0;                              // a beam's surface side; 0 for a continuum
 };
 
 std::optional<SetRef> find_set(Reader& r, const BodySet& all, const std::string& text, const std::string& ptr) {
   const size_t dot = text.find('.');
   const std::string body = text.substr(0, dot), set = dot == std::string::npos ? "" : text.substr(dot + 1);
-  for (int b = 0; b < all.count(); ++b) {
+  for (int b = 0; b < all.part_count(); ++b) {
     if (all.name(b) != body) continue;
     const int first = all.site_offset(b), count = all.part(b).site_count();
+    // The body that read_body built from this scene: a set names a beam's surface or a node set
+    // of the continuum's mesh, so io asks for the type it built (docs/design.md).
     if (dynamic_cast<const TimoshenkoBeam*>(&all.part(b))) {
       if (set != "upper" && set != "lower") {
-        r.error(ptr, "\"" + set + "\" names no surface of the beam \"" + body + "\" (surfaces: upper, lower: its axis "
-                     "offset by half the depth toward +y or -y)");
+        r.error(ptr, "\"" + set + "\" names no surface of the beam \"" + body +
+                         "\" (surfaces: upper, lower: its axis "
+                         "offset by half the depth toward +y or -y)");
         return std::nullopt;
       }
       SetRef ref{b, {}, {}, set == "upper" ? +1 : -1};
@@ -109,7 +117,8 @@ std::optional<SetRef> find_set(Reader& r, const BodySet& all, const std::string&
     }
     const auto* continuum = dynamic_cast<const ContinuumBody*>(&all.part(b));
     if (!continuum) {
-      r.error(ptr, "body \"" + body + "\" has no surface that pairs with another body's (continuum and beam bodies do)");
+      r.error(ptr,
+              "body \"" + body + "\" has no surface that pairs with another body's (continuum and beam bodies do)");
       return std::nullopt;
     }
     const auto& sets = continuum->mesh().sets;
@@ -134,7 +143,7 @@ std::optional<SetRef> find_set(Reader& r, const BodySet& all, const std::string&
     return ref;
   }
   std::vector<std::string> names;
-  for (int b = 0; b < all.count(); ++b) names.push_back(all.name(b));
+  for (int b = 0; b < all.part_count(); ++b) names.push_back(all.name(b));
   r.error(ptr, show(text) + " names no body (\"BODY.SET\", bodies: " + Reader::list(names) + ")");
   return std::nullopt;
 }
@@ -147,6 +156,9 @@ void read_contacts(Reader& r, json& scene, Problem& problem) {
   const auto& all = static_cast<const BodySet&>(*problem.body);
   const size_t rigid = problem.obstacles.size();
   std::vector<std::vector<int>> obstacle_slaves(rigid);
+  // The obstacles' and the pairs' names (a linear search per contact made reading quadratic).
+  std::unordered_map<std::string, size_t> obstacle_index;
+  for (size_t o = 0; o < rigid; ++o) obstacle_index.emplace(problem.obstacles[o].name, o);
   for (size_t i = 0; i < contacts->size(); ++i) {
     const std::string cp = "/contacts/" + std::to_string(i);
     json& c = (*contacts)[i];
@@ -155,17 +167,20 @@ void read_contacts(Reader& r, json& scene, Problem& problem) {
       continue;
     }
     if (!c.contains("slave") || !c["slave"].is_string()) r.error(cp + "/slave", "is required: \"BODY.SET\"");
-    if (!c.contains("master") || !c["master"].is_string()) r.error(cp + "/master", "is required: \"BODY.SET\" or an obstacle's name");
+    if (!c.contains("master") || !c["master"].is_string())
+      r.error(cp + "/master", "is required: \"BODY.SET\" or an obstacle's name");
     if (!r.issues.empty()) continue;
     const auto slave = find_set(r, all, c["slave"].get<std::string>(), cp + "/slave");
     const std::string master = c["master"].get<std::string>();
-    int obstacle = -1;
-    for (size_t o = 0; o < rigid; ++o)
-      if (problem.obstacles[o].name == master) obstacle = static_cast<int>(o);
+    const auto named_master = obstacle_index.find(master);
+    const int obstacle = named_master != obstacle_index.end() && named_master->second < rigid
+                             ? static_cast<int>(named_master->second)
+                             : -1;
     if (obstacle >= 0) {
       if (c.contains("friction"))
         r.error(cp + "/friction", "is the obstacle's: give it in /obstacles/" + std::to_string(obstacle) + "/friction");
-      if (slave) obstacle_slaves[obstacle].insert(obstacle_slaves[obstacle].end(), slave->sites.begin(), slave->sites.end());
+      if (slave)
+        obstacle_slaves[obstacle].insert(obstacle_slaves[obstacle].end(), slave->sites.begin(), slave->sites.end());
       continue;
     }
     const auto master_set = find_set(r, all, master, cp + "/master");
@@ -182,8 +197,8 @@ void read_contacts(Reader& r, json& scene, Problem& problem) {
     if (!c.contains("name")) c["name"] = c["slave"].get<std::string>() + " on " + master;
     if (!c["name"].is_string()) r.error(cp + "/name", "is not a string");
     else pair.name = c["name"].get<std::string>();
-    for (const auto& other : problem.obstacles)
-      if (other.name == pair.name) r.error(cp + "/name", show(c["name"]) + " names an obstacle or another contact already");
+    if (!pair.name.empty() && !obstacle_index.emplace(pair.name, problem.obstacles.size()).second)
+      r.error(cp + "/name", show(c["name"]) + " names an obstacle or another contact already");
     pair.friction = r.number(c, cp, "friction", 0.0);
     if (pair.friction < 0) r.error(cp + "/friction", show(c["friction"]) + " is negative");
     pair.frictional = pair.friction > 0;

@@ -21,8 +21,8 @@ namespace grip::scene_io {
 namespace {
 
 // [a, b] of integers in [lo, hi].
-std::optional<std::pair<int, int>> integer_pair(Reader& r, json& obj, const std::string& ptr, const char* key,
-                                                int lo, int hi) {
+std::optional<std::pair<int, int>> integer_pair(Reader& r, json& obj, const std::string& ptr, const char* key, int lo,
+                                                int hi) {
   const std::string p = ptr + "/" + token(key);
   if (!obj.contains(key)) {
     r.error(p, "is required ([n1, n2])");
@@ -61,8 +61,7 @@ std::optional<PlaneMesh> read_explicit_mesh(Reader& r, json& mesh, const std::st
       const json& v = (*nodes)[i];
       if (!v.is_array() || v.size() != 2 || !v[0].is_number() || !v[1].is_number())
         r.error(ptr + "/nodes/" + std::to_string(i), show(v) + " is not a pair of numbers [x, y]");
-      else
-        m.nodes.emplace_back(v[0].get<double>(), v[1].get<double>());
+      else m.nodes.emplace_back(v[0].get<double>(), v[1].get<double>());
     }
   if (elements)
     for (size_t e = 0; e < elements->size(); ++e) {
@@ -119,7 +118,8 @@ std::optional<PlaneMesh> read_generated_mesh(Reader& r, json& mesh, const std::s
       spec.radius = r.positive(*gen, gp, "radius");
       const auto div = integer_pair(r, *gen, gp, "divisions", 1, 2000);
       if (div && (div->first % 2 || div->first < 4))
-        r.error(gp + "/divisions/0", "must be an even integer from 4: a node sits at the pole, and the arc has a block at each end");
+        r.error(gp + "/divisions/0",
+                "must be an even integer from 4: a node sits at the pole, and the arc has a block at each end");
       if (div && div->second < 2) r.error(gp + "/divisions/1", "must be at least 2: a pole block and a ring round it");
       spec.facing_up = r.choice(*gen, gp, "facing", {"down", "up"}, "down") == "up";
       spec.refine = read_refinement(r, *gen, gp, nullptr);
@@ -187,8 +187,7 @@ void for_each_object(Reader& r, json& body, const std::string& ptr, const char* 
   }
 }
 
-void read_continuum_supports(Reader& r, json& body, const std::string& ptr, const PlaneMesh& mesh,
-                             Problem& problem) {
+void read_continuum_supports(Reader& r, json& body, const std::string& ptr, const PlaneMesh& mesh, Problem& problem) {
   // Per dof: the support that fixes it (an index of `pointers`, -1 for none) and its value.
   std::vector<int> fixed_by(2 * mesh.nodes.size(), -1);
   std::vector<double> fixed_value(fixed_by.size(), 0.0);
@@ -274,13 +273,15 @@ void read_continuum(Reader& r, json& body, Problem& problem, const std::string& 
   ContinuumOptions options;
   options.kinematics = kin == "linear" ? ContinuumKinematics::linear : ContinuumKinematics::finite;
   options.analysis = analysis == "plane_stress" ? PlaneAnalysis::plane_stress : PlaneAnalysis::plane_strain;
-  options.element = element == "q9" ? ContinuumElement::q9
-                    : element == "q4_bbar" ? ContinuumElement::q4_bbar : ContinuumElement::q4;
+  options.element = element == "q9"        ? ContinuumElement::q9
+                    : element == "q4_bbar" ? ContinuumElement::q4_bbar
+                                           : ContinuumElement::q4;
   options.thickness = r.positive(body, ptr, "thickness", 1.0);
   if (options.element == ContinuumElement::q4_bbar) {
     if (options.kinematics == ContinuumKinematics::finite)
-      r.error(ptr + "/element", "\"q4_bbar\" (mean dilatation) is implemented for linear kinematics; "
-                                "for finite strain near incompressibility use \"q9\"");
+      r.error(ptr + "/element",
+              "\"q4_bbar\" (mean dilatation) is implemented for linear kinematics; "
+              "for finite strain near incompressibility use \"q9\"");
     if (options.analysis == PlaneAnalysis::plane_stress)
       r.error(ptr + "/element", "\"q4_bbar\" is for plane strain: plane stress does not lock, use \"q4\"");
   }
@@ -348,8 +349,8 @@ void read_continuum(Reader& r, json& body, Problem& problem, const std::string& 
   read_continuum_supports(r, body, ptr, checked, problem);
   read_continuum_loads(r, body, ptr, checked, shape, problem, options.thickness);
   if (!r.issues.empty()) return;
-  // ALGORITHM.md section 7: contact holds the free rigid motions of one connected body
-  // (scene.cpp); a mesh of several parts must have each part held by its supports.
+  // docs/algorithm.md#bodies-held-only-by-contact: contact holds the free rigid motions of one
+  // connected body (scene.cpp); a mesh of several parts must have each part held by its supports.
   std::vector<char> fixed(problem.body->dof_count(), 0);
   for (const Constraint& c : problem.constraints) fixed[c.dof] = 1;
   const std::string free = free_rigid_motion(checked, fixed);

@@ -2,9 +2,8 @@
 
 namespace grip::scene_io {
 
-void read_supports(Reader& r, json& body, const std::string& ptr, int nodes,
-                   const std::vector<std::string>& components, int (*dof)(int, int),
-                   Problem& problem) {
+void read_supports(Reader& r, json& body, const std::string& ptr, int nodes, const std::vector<std::string>& components,
+                   int (*dof)(int, int), Problem& problem) {
   if (json* sup = r.array(body, ptr, "supports", false))
     for (size_t i = 0; i < sup->size(); ++i) {
       const std::string sp = ptr + "/supports/" + std::to_string(i);
@@ -31,7 +30,8 @@ void read_supports(Reader& r, json& body, const std::string& ptr, int nodes,
         bool repeated = false;
         for (const Constraint& other : problem.constraints) repeated |= other.dof == dof(node, index);
         if (repeated) {
-          r.error(sp + "/fix/" + std::to_string(c), "\"" + name + "\" of node " + std::to_string(node) + " is fixed already");
+          r.error(sp + "/fix/" + std::to_string(c),
+                  "\"" + name + "\" of node " + std::to_string(node) + " is fixed already");
           continue;
         }
         double value = 0.0;
@@ -45,7 +45,6 @@ void read_supports(Reader& r, json& body, const std::string& ptr, int nodes,
           if (!fixed) r.error(sp + "/values/" + token(name), "is given but \"" + name + "\" is not in fix");
         }
     }
-
 }
 
 }  // namespace grip::scene_io

@@ -5,10 +5,11 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
-#include "solver/problem/problem.hpp"
 #include "solver/io/scene.hpp"
+#include "solver/problem/problem.hpp"
 
 namespace grip::scene_io {
 
@@ -28,12 +29,14 @@ inline std::string show(const json& j) {
 }
 
 // Reads values out of the (mutable) effective scene, writing defaults in and collecting
-// every problem with its JSON pointer.
+// every problem with its JSON pointer, up to kMaxSceneIssues: the next one ends the reading
+// (SceneErrors with more()), so a scene's problems cost at most that many.
 class Reader {
  public:
   std::vector<SceneIssue> issues;
 
   void error(const std::string& pointer, std::string detail) {
+    if (issues.size() >= kMaxSceneIssues) throw SceneErrors(std::move(issues), true);
     issues.push_back({pointer.empty() ? "/" : pointer, std::move(detail)});
   }
 
@@ -73,8 +76,7 @@ class Reader {
   }
 
   // A finite number; `fallback` fills it in when absent (required when no fallback).
-  double number(json& obj, const std::string& ptr, const char* key,
-                std::optional<double> fallback = std::nullopt) {
+  double number(json& obj, const std::string& ptr, const char* key, std::optional<double> fallback = std::nullopt) {
     const std::string p = ptr + "/" + token(key);
     if (!obj.is_object()) return fallback.value_or(0.0);
     if (!obj.contains(key)) {
@@ -98,8 +100,7 @@ class Reader {
     return d;
   }
 
-  double positive(json& obj, const std::string& ptr, const char* key,
-                  std::optional<double> fallback = std::nullopt) {
+  double positive(json& obj, const std::string& ptr, const char* key, std::optional<double> fallback = std::nullopt) {
     const double d = number(obj, ptr, key, fallback);
     if (obj.is_object() && obj.contains(key) && obj[key].is_number() && !(d > 0))
       error(ptr + "/" + token(key), show(obj[key]) + " is not positive");
@@ -134,8 +135,8 @@ class Reader {
     return static_cast<int>(i);
   }
 
-  std::string choice(json& obj, const std::string& ptr, const char* key,
-                     const std::vector<std::string>& options, std::optional<std::string> fallback) {
+  std::string choice(json& obj, const std::string& ptr, const char* key, const std::vector<std::string>& options,
+                     std::optional<std::string> fallback) {
     const std::string p = ptr + "/" + token(key);
     if (!obj.is_object()) return fallback.value_or(options.front());
     if (!obj.contains(key)) {
@@ -154,8 +155,7 @@ class Reader {
     return fallback.value_or(options.front());
   }
 
-  Vec2 vec2(json& obj, const std::string& ptr, const char* key,
-            std::optional<Vec2> fallback = std::nullopt) {
+  Vec2 vec2(json& obj, const std::string& ptr, const char* key, std::optional<Vec2> fallback = std::nullopt) {
     const std::string p = ptr + "/" + token(key);
     if (!obj.is_object()) return Vec2::Zero();
     if (!obj.contains(key)) {
@@ -186,20 +186,31 @@ class Reader {
       error(ptr + "/case", show(obj["case"]) + " is not a string");
       return 0;
     }
-    const std::string name = obj["case"].get<std::string>();
-    for (size_t k = 0; k < cases.size(); ++k)
-      if (cases[k] == name) return static_cast<int>(k);
-    cases.push_back(name);
-    return static_cast<int>(cases.size()) - 1;
+    const std::string& name = obj["case"].get_ref<const std::string&>();
+    const auto [it, added] = case_index_.try_emplace(name, static_cast<int>(cases.size()));
+    if (added) cases.push_back(name);
+    return it->second;
   }
 
+  // The index of a registered load case; -1 for none.
+  int find_case(const std::string& name) const {
+    const auto it = case_index_.find(name);
+    return it == case_index_.end() ? -1 : it->second;
+  }
+
+  // "\"a\", \"b\"": the first 20, then how many more (a scene may name thousands).
   static std::string list(const std::vector<std::string>& options) {
+    constexpr size_t kShown = 20;
     std::string s;
-    for (size_t i = 0; i < options.size(); ++i) s += (i ? ", " : "") + ("\"" + options[i] + "\"");
+    for (size_t i = 0; i < std::min(options.size(), kShown); ++i) s += (i ? ", " : "") + ("\"" + options[i] + "\"");
+    if (options.size() > kShown) s += " and " + std::to_string(options.size() - kShown) + " more";
     return s;
   }
-};
 
+ private:
+  // cases by name: a scene may name thousands (a linear search made reading quadratic).
+  std::unordered_map<std::string, int> case_index_{{"main", 0}};
+};
 
 // The load vector of a case, created (zero) on first use.
 inline Vector& case_load(Problem& problem, int load_case) {
@@ -210,9 +221,8 @@ inline Vector& case_load(Problem& problem, int load_case) {
 
 // body.supports: [{"node", "fix": [component names], "values": {name: value}, "case"}];
 // `dof(node, component index)` maps to the global dof.
-void read_supports(Reader& r, json& body, const std::string& ptr, int nodes,
-                   const std::vector<std::string>& components, int (*dof)(int, int),
-                   Problem& problem);
+void read_supports(Reader& r, json& body, const std::string& ptr, int nodes, const std::vector<std::string>& components,
+                   int (*dof)(int, int), Problem& problem);
 
 // Body model readers: fill problem.body, constraints and load from the body at `ptr`
 // (scene["body"], or an entry of scene["bodies"]).

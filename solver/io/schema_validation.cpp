@@ -1,6 +1,8 @@
 #include "solver/io/schema_validation.hpp"
 
 #include <valijson/adapters/nlohmann_json_adapter.hpp>
+#include <valijson/constraint_builder.hpp>
+#include <valijson/constraints/concrete_constraints.hpp>
 #include <valijson/schema.hpp>
 #include <valijson/schema_parser.hpp>
 #include <valijson/validation_results.hpp>
@@ -10,8 +12,10 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <new>
 #include <optional>
 #include <regex>
+#include <set>
 #include <stdexcept>
 #include <string>
 
@@ -26,6 +30,46 @@ using scene_io::show;
 using Tokens = std::vector<std::string>;
 
 // ---- loading
+
+// Collecting stops once this many errors are collected (wrappers and repeats included): a
+// document's errors then cost at most about that many, however large it is (80,000 invalid
+// entries made valijson collect every error of every entry before any was described).
+constexpr size_t kEnough = 10 * kMaxSceneIssues;
+constexpr const char* kEnoughKeyword = "x-grip-enough";
+
+// Thrown by the kEnoughKeyword constraint out of valijson's visitor: it ends the collection,
+// carrying the errors of the results it was collecting into (under an if/then or an anyOf
+// those are a nested visitor's, which the unwinding drops).
+struct Enough {
+  std::vector<valijson::ValidationResults::Error> errors;
+};
+
+// kEnoughKeyword: a constraint that every value passes; while errors are collected it ends
+// the collection at kEnough of them.
+class EnoughConstraint : public valijson::constraints::PolyConstraint {
+ public:
+  bool validate(const valijson::adapters::Adapter&, const std::vector<std::string>&,
+                valijson::ValidationResults* results) const override {
+    if (results && results->numErrors() >= kEnough) {
+      Enough enough;
+      valijson::ValidationResults::Error e;
+      while (results->popError(e)) enough.errors.push_back(std::move(e));
+      throw enough;
+    }
+    return true;
+  }
+
+ private:
+  Constraint* cloneInto(void* where) const override { return new (where) EnoughConstraint(*this); }
+  size_t sizeOf() const override { return sizeof(EnoughConstraint); }
+};
+
+class EnoughBuilder : public valijson::ConstraintBuilder {
+ public:
+  valijson::constraints::Constraint* make(const valijson::adapters::Adapter&) const override {
+    return new EnoughConstraint;
+  }
+};
 
 // Two rewrites that keep each schema's meaning and sharpen valijson's reports:
 // - a `false` subschema (`additionalProperties: false`) becomes {"not": {}}: valijson reports
@@ -43,8 +87,10 @@ class Rewriter {
   json schema(json s) const {
     if (s.is_boolean()) return s.get<bool>() ? json::object() : json{{"not", json::object()}};
     if (!s.is_object()) return s;
-    for (const char* key : {"additionalProperties", "additionalItems", "contains", "propertyNames", "not",
-                            "if", "then", "else"})
+    // Each subschema with keywords of its own checks the collected errors' count (kEnough).
+    if (!s.empty() && !s.contains("$ref")) s[kEnoughKeyword] = true;
+    for (const char* key :
+         {"additionalProperties", "additionalItems", "contains", "propertyNames", "not", "if", "then", "else"})
       if (s.contains(key)) s[key] = schema(std::move(s[key]));
     for (const char* key : {"properties", "patternProperties", "definitions"})
       if (s.contains(key) && s[key].is_object())
@@ -52,7 +98,8 @@ class Rewriter {
     if (s.contains("dependencies") && s["dependencies"].is_object())
       for (json& sub : s["dependencies"])
         if (!sub.is_array()) sub = schema(std::move(sub));
-    if (s.contains("items")) s["items"] = s["items"].is_array() ? list(std::move(s["items"])) : schema(std::move(s["items"]));
+    if (s.contains("items"))
+      s["items"] = s["items"].is_array() ? list(std::move(s["items"])) : schema(std::move(s["items"]));
     for (const char* key : {"allOf", "anyOf", "oneOf"})
       if (s.contains(key) && s[key].is_array()) s[key] = list(std::move(s[key]));
     if (s.contains("oneOf")) split_discriminated(s);
@@ -102,8 +149,8 @@ class Rewriter {
     json all = s.value("allOf", json::array());
     all.push_back({{"required", {*key}}, {"properties", {{*key, {{"enum", values}}}}}});
     for (size_t i = 0; i < branches.size(); ++i)
-      all.push_back({{"if", {{"required", {*key}}, {"properties", {{*key, {{"const", values[i]}}}}}}},
-                     {"then", branches[i]}});
+      all.push_back(
+          {{"if", {{"required", {*key}}, {"properties", {{*key, {{"const", values[i]}}}}}}}, {"then", branches[i]}});
     s.erase("oneOf");
     s["allOf"] = all;
   }
@@ -141,7 +188,8 @@ struct Registry {
 
   const Loaded& get(std::string_view stem) const {
     const auto it = by_stem.find(stem);
-    if (it == by_stem.end()) throw std::logic_error("no schema schemas/" + std::string(stem) + ".schema.json was embedded");
+    if (it == by_stem.end())
+      throw std::logic_error("no schema schemas/" + std::string(stem) + ".schema.json was embedded");
     return it->second;
   }
 };
@@ -166,6 +214,7 @@ const valijson::Schema& Loaded::schema(const Registry& reg, std::string_view ste
     auto release = [](const json* doc) { delete doc; };
     auto schema = std::make_unique<valijson::Schema>();
     valijson::SchemaParser parser;
+    parser.addConstraintBuilder(kEnoughKeyword, new EnoughBuilder);  // the parser deletes it
     const valijson::adapters::NlohmannJsonAdapter adapter(doc());
     try {
       parser.populateSchema(adapter, *schema, fetch, release);
@@ -308,8 +357,8 @@ class Walker {
       return r == false;
     };
     for (const auto& [key, arg] : s->items()) {
-      if (key == "description" || key == "title" || key == "$comment" || key == "errorMessage" ||
-          key == "default" || key == "examples" || key == "definitions" || key == "$schema") {
+      if (key == "description" || key == "title" || key == "$comment" || key == "errorMessage" || key == "default" ||
+          key == "examples" || key == "definitions" || key == "$schema" || key == kEnoughKeyword) {
         continue;
       } else if (key == "const") {
         if (value != arg) return false;
@@ -395,9 +444,29 @@ std::string pointer_of(const Tokens& tokens) {
 
 // What valijson's description says failed.
 enum class Failure {
-  wrapper, required, unknown_key, not_, type, enum_, const_, minimum, exclusive_minimum, maximum,
-  exclusive_maximum, min_items, max_items, min_length, max_length, min_properties, max_properties,
-  pattern, multiple_of, unique_items, one_of, format, other
+  wrapper,
+  required,
+  unknown_key,
+  not_,
+  type,
+  enum_,
+  const_,
+  minimum,
+  exclusive_minimum,
+  maximum,
+  exclusive_maximum,
+  min_items,
+  max_items,
+  min_length,
+  max_length,
+  min_properties,
+  max_properties,
+  pattern,
+  multiple_of,
+  unique_items,
+  one_of,
+  format,
+  other
 };
 
 struct Classified {
@@ -500,8 +569,7 @@ class Describer {
       for (const Located& l : here)
         if (l.schema->contains(c.keyword) && keyword_fails(c, *l.schema, subject, walker_, l.root)) {
           // Prefer the subschema that explains itself.
-          if (!chosen || (!chosen->schema->contains("errorMessage") && l.schema->contains("errorMessage")))
-            chosen = &l;
+          if (!chosen || (!chosen->schema->contains("errorMessage") && l.schema->contains("errorMessage"))) chosen = &l;
         }
     }
     if (chosen && chosen->schema->contains("errorMessage") && (*chosen->schema)["errorMessage"].is_string())
@@ -549,7 +617,8 @@ class Describer {
       case Failure::required:
         return "is required";
       case Failure::not_:
-        if (arg && arg->empty()) return tokens.empty() ? "is not allowed" : unknown_key({tokens.begin(), tokens.end() - 1}, tokens.back());
+        if (arg && arg->empty())
+          return tokens.empty() ? "is not allowed" : unknown_key({tokens.begin(), tokens.end() - 1}, tokens.back());
         if (arg && arg->contains("const")) return "must not be " + (*arg)["const"].dump();
         if (arg && arg->contains("enum")) return "must not be " + list_values((*arg)["enum"]);
         return v + " has a form that is not allowed here";
@@ -633,10 +702,14 @@ Tokens tokens_of(const std::vector<std::string>& context) {
 
 std::string_view schema_file_stem(SchemaName which) {
   switch (which) {
-    case SchemaName::scene: return "scene";
-    case SchemaName::event: return "event";
-    case SchemaName::result: return "result";
-    case SchemaName::job: return "job";
+    case SchemaName::scene:
+      return "scene";
+    case SchemaName::event:
+      return "event";
+    case SchemaName::result:
+      return "result";
+    case SchemaName::job:
+      return "job";
   }
   throw std::invalid_argument("unknown SchemaName");
 }
@@ -669,20 +742,29 @@ void prepare_schema(SchemaName which) {
   registry().get(stem).schema(registry(), stem);
 }
 
-std::vector<SceneIssue> validate_against(const nlohmann::json& document, SchemaName which) {
+std::vector<SceneIssue> validate_against(const nlohmann::json& document, SchemaName which, bool* more) {
   const std::string_view stem = schema_file_stem(which);
-  const Loaded& loaded = registry().get(stem);
+  const valijson::Schema& schema = registry().get(stem).schema(registry(), stem);
   valijson::Validator validator(valijson::Validator::kStrongTypes);
-  valijson::ValidationResults results;
   const valijson::adapters::NlohmannJsonAdapter target(document);
-  if (validator.validate(loaded.schema(registry(), stem), target, &results)) return {};
+  if (more) *more = false;
+  // First without collecting: a valid document is answered by one pass that keeps nothing.
+  if (validator.validate(schema, target, nullptr)) return {};
+  valijson::ValidationResults results;
+  bool stopped = false;
+  try {
+    validator.validate(schema, target, &results);
+  } catch (const Enough& enough) {
+    for (const auto& e : enough.errors) results.pushError(e);
+    stopped = true;
+  }
 
-  const Describer describer(document, stem);
-  struct Found {
-    Tokens tokens;  // of the issue's pointer, for sorting
-    SceneIssue issue;
+  struct Raw {
+    Tokens tokens;         // of the issue's pointer, for sorting
+    Tokens object_tokens;  // of the value the schema applies to (the object, for a key)
+    std::string description;
   };
-  std::vector<Found> found;
+  std::vector<Raw> raw;
   std::optional<Tokens> deepest_wrapper;
   valijson::ValidationResults::Error e;
   while (results.popError(e)) {
@@ -692,21 +774,26 @@ std::vector<SceneIssue> validate_against(const nlohmann::json& document, SchemaN
       if (!deepest_wrapper || tokens.size() > deepest_wrapper->size()) deepest_wrapper = tokens;
       continue;
     }
-    if (c.failure == Failure::required || c.failure == Failure::unknown_key) tokens.push_back(c.name);
     Tokens object_tokens = tokens;
-    if (c.failure == Failure::required || c.failure == Failure::unknown_key) object_tokens.pop_back();
-    found.push_back({tokens, describer.issue(object_tokens, e.description)});
+    if (c.failure == Failure::required || c.failure == Failure::unknown_key) tokens.push_back(c.name);
+    raw.push_back({std::move(tokens), std::move(object_tokens), std::move(e.description)});
   }
   // Only wrappers (a subschema that fails without saying why): name the deepest place.
-  if (found.empty() && deepest_wrapper) found.push_back({*deepest_wrapper, {pointer_of(*deepest_wrapper), "is not valid"}});
-  std::stable_sort(found.begin(), found.end(), [](const Found& a, const Found& b) { return pointer_less(a.tokens, b.tokens); });
+  if (raw.empty() && deepest_wrapper) return {{pointer_of(*deepest_wrapper), "is not valid"}};
+  std::stable_sort(raw.begin(), raw.end(), [](const Raw& a, const Raw& b) { return pointer_less(a.tokens, b.tokens); });
+  // Described in pointer order, each once, up to kMaxSceneIssues.
+  const Describer describer(document, stem);
   std::vector<SceneIssue> issues;
-  for (const Found& f : found) {
-    const bool repeated = std::any_of(issues.begin(), issues.end(), [&](const SceneIssue& i) {
-      return i.pointer == f.issue.pointer && i.detail == f.issue.detail;
-    });
-    if (!repeated) issues.push_back(f.issue);
+  std::set<std::pair<std::string, std::string>> seen;
+  for (size_t i = 0; i < raw.size(); ++i) {
+    if (issues.size() == kMaxSceneIssues) {
+      stopped = true;
+      break;
+    }
+    SceneIssue issue = describer.issue(raw[i].object_tokens, raw[i].description);
+    if (seen.emplace(issue.pointer, issue.detail).second) issues.push_back(std::move(issue));
   }
+  if (more) *more = stopped;
   return issues;
 }
 

@@ -3,7 +3,7 @@
 // which the build embeds in the library (no file is read at run time). Every error is a
 // SceneIssue: the JSON pointer of the offending value ("/body/material/poisson"; "/" for
 // the document itself) and a plain sentence ("0.62 is not below 0.5"). All errors are
-// reported, sorted by pointer (array indices numerically), each once.
+// reported, sorted by pointer (array indices numerically), each once, up to kMaxSceneIssues.
 //
 // The schemas may annotate a subschema with `errorMessage` (the ajv-errors keyword, ignored
 // by other validators): it replaces the generic sentence for that subschema's own failures.
@@ -24,9 +24,11 @@ std::string_view schema_file_stem(SchemaName which);
 // The schema as written in schemas/ (the text the build embedded).
 std::string_view schema_text(SchemaName which);
 
-// Errors of `document` against the schema; empty when it is valid. Thread-safe; the schemas
-// are parsed once, on first use (std::logic_error if one was not embedded or does not parse).
-std::vector<SceneIssue> validate_against(const nlohmann::json& document, SchemaName which);
+// Errors of `document` against the schema; empty when it is valid. At most kMaxSceneIssues:
+// collecting stops at a bound, and `more` (when given) tells whether it did. Thread-safe; the
+// schemas are parsed once, on first use (std::logic_error if one was not embedded or does not
+// parse).
+std::vector<SceneIssue> validate_against(const nlohmann::json& document, SchemaName which, bool* more = nullptr);
 
 // Builds the schema's validator now, as the first validate_against would: for a caller that
 // does it on a thread of its own while it reads the document (grip solve: 5 ms of a refined

@@ -16,11 +16,11 @@ enum class PlaneAnalysis { plane_strain, plane_stress };
 
 // Response of a law at one material point.
 struct MaterialResponse {
-  Eigen::Vector3d S = Eigen::Vector3d::Zero();   // (S11, S22, S12)
-  Eigen::Matrix3d D = Eigen::Matrix3d::Zero();   // dS/dE, with E as (E11, E22, 2 E12); symmetric
-  double S33 = 0.0;          // out-of-plane normal stress (zero in plane stress)
+  Eigen::Vector3d S = Eigen::Vector3d::Zero();           // (S11, S22, S12)
+  Eigen::Matrix3d D = Eigen::Matrix3d::Zero();           // dS/dE, with E as (E11, E22, 2 E12); symmetric
+  double S33 = 0.0;                                      // out-of-plane normal stress (zero in plane stress)
   Eigen::RowVector3d dS33 = Eigen::RowVector3d::Zero();  // dS33/dE (zero in plane stress)
-  double C33 = 1.0;          // out-of-plane stretch squared (one in plane strain)
+  double C33 = 1.0;                                      // out-of-plane stretch squared (one in plane strain)
 };
 
 class PlaneMaterial {

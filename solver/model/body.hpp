@@ -64,6 +64,16 @@ class Body {
   // the left of a -> b: what a slave surface of another body pairs with (mortar segments).
   // Empty where the model offers no master surface.
   virtual std::vector<std::array<int, 2>> surface_segments() const { return {}; }
+  // Nodes of the boundary that carry no site (the continuum's boundary outside its contact
+  // set): with the sites, every boundary point that the step checks hold against the obstacles.
+  virtual std::vector<int> nodes_without_site() const { return {}; }
+  // The current position of such a node (an index of node_count()).
+  virtual Vec2 node_position(const VectorRef& /*q*/, int /*node*/) const { return Vec2::Zero(); }
+  // Makes boundary nodes sites, with the boundary sides that join them to the boundary (their
+  // indices after the existing sites, which keep theirs): a node that entered an obstacle outside
+  // the contact set becomes a contact candidate. Returns the sites added; none where the model
+  // cannot (its every boundary node is already a site).
+  virtual std::vector<int> add_sites(const std::vector<int>& /*nodes*/) { return {}; }
   // Surface area that a site's contact force acts on (tributary length x width).
   virtual double tributary_area(int site) const = 0;
   // Characteristic length (size of the undeformed body): the scale of relative tolerances.
@@ -74,6 +84,20 @@ class Body {
   // An infinitesimal rigid rotation by one radian about the origin (empty if the model has
   // none): with the translations, the motions that supports must remove.
   virtual Vector rigid_rotation() const { return {}; }
+  // For a model with a changing tangent whose own finite rotation is not the turn of its current
+  // positions (the von Karman beam): the rate of that rotation at q, by one radian about the
+  // origin. Empty (default): the model has none of its own (solver/problem/rigid_modes.cpp).
+  virtual Vector own_rotation_at(const Vector& /*q*/) const { return {}; }
+  // The node that a dof moves (default: two dofs a node, x and y).
+  virtual int dof_node(int dof) const { return dof / 2; }
+
+  // A body made of several (BodySet: a scene of several bodies) answers for its parts: their
+  // number, each part, and the dof and the site each part starts at (b = part_count(): the
+  // totals). A single body is not made of parts (part_count() 0) and is its own part 0.
+  virtual int part_count() const { return 0; }
+  virtual const Body& part(int /*b*/) const { return *this; }
+  virtual int dof_offset(int b) const { return b == 0 ? 0 : dof_count(); }
+  virtual int site_offset(int b) const { return b == 0 ? 0 : site_count(); }
 
   // What the model simulates, for the result's effects block; a constant tangent lets one
   // factorization serve every solve.

@@ -27,12 +27,13 @@ int BodySet::body_of_node(int node) const { return find_part(node_offset_, node)
 
 Vector BodySet::dof_length_scales() const {
   Vector s(dof_count());
-  for (int b = 0; b < count(); ++b) s.segment(dof_offset_[b], parts_[b]->dof_count()) = parts_[b]->dof_length_scales();
+  for (int b = 0; b < part_count(); ++b)
+    s.segment(dof_offset_[b], parts_[b]->dof_count()) = parts_[b]->dof_length_scales();
   return s;
 }
 
 void BodySet::internal_force(const Vector& q, Vector& force, Triplets* tangent) const {
-  for (int b = 0; b < count(); ++b) {
+  for (int b = 0; b < part_count(); ++b) {
     const int n = parts_[b]->dof_count(), o = dof_offset_[b];
     Vector f = Vector::Zero(n);
     Triplets t;
@@ -53,18 +54,31 @@ int BodySet::site_node(int site) const {
   return node_offset_[b] + parts_[b]->site_node(site - site_offset_[b]);
 }
 
+std::vector<int> BodySet::nodes_without_site() const {
+  std::vector<int> out;
+  for (int b = 0; b < part_count(); ++b)
+    for (int node : parts_[b]->nodes_without_site()) out.push_back(node_offset_[b] + node);
+  return out;
+}
+
+Vec2 BodySet::node_position(const VectorRef& q, int node) const {
+  const int b = body_of_node(node);
+  return parts_[b]->node_position(q.segment(dof_offset_[b], parts_[b]->dof_count()), node - node_offset_[b]);
+}
+
 SurfacePoint BodySet::surface_point(const VectorRef& q, int site, int side) const {
   const int b = body_of_site(site);
   // A view of the body's part of q: a copy of it per point made pairing quadratic (12 % of the
   // 1501-point interface's time).
-  SurfacePoint p = parts_[b]->surface_point(q.segment(dof_offset_[b], parts_[b]->dof_count()), site - site_offset_[b], side);
+  SurfacePoint p =
+      parts_[b]->surface_point(q.segment(dof_offset_[b], parts_[b]->dof_count()), site - site_offset_[b], side);
   for (auto& j : p.jacobian) j.dof += dof_offset_[b];
   return p;
 }
 
 std::vector<std::array<int, 2>> BodySet::surface_segments() const {
   std::vector<std::array<int, 2>> all;
-  for (int b = 0; b < count(); ++b)
+  for (int b = 0; b < part_count(); ++b)
     for (const auto& s : parts_[b]->surface_segments()) all.push_back({s[0] + site_offset_[b], s[1] + site_offset_[b]});
   return all;
 }
@@ -82,13 +96,14 @@ double BodySet::characteristic_length() const {
 
 Vector BodySet::rigid_translation(const Vec2& d) const {
   Vector t(dof_count());
-  for (int b = 0; b < count(); ++b) t.segment(dof_offset_[b], parts_[b]->dof_count()) = parts_[b]->rigid_translation(d);
+  for (int b = 0; b < part_count(); ++b)
+    t.segment(dof_offset_[b], parts_[b]->dof_count()) = parts_[b]->rigid_translation(d);
   return t;
 }
 
 Vector BodySet::rigid_rotation() const {
   Vector r(dof_count());
-  for (int b = 0; b < count(); ++b) {
+  for (int b = 0; b < part_count(); ++b) {
     const Vector part = parts_[b]->rigid_rotation();
     if (part.size() == 0) return {};
     r.segment(dof_offset_[b], part.size()) = part;
@@ -126,7 +141,7 @@ std::optional<ElementQuality> BodySet::element_quality() const {
 
 std::vector<std::vector<int>> BodySet::cells() const {
   std::vector<std::vector<int>> all;
-  for (int b = 0; b < count(); ++b)
+  for (int b = 0; b < part_count(); ++b)
     for (auto cell : parts_[b]->cells()) {
       for (int& n : cell) n += node_offset_[b];
       all.push_back(std::move(cell));
@@ -137,7 +152,7 @@ std::vector<std::vector<int>> BodySet::cells() const {
 FieldTable BodySet::stacked(FieldTable (Body::*fields)(const Vector&) const, const Vector& q) const {
   FieldTable all;
   std::vector<FieldTable> tables;
-  for (int b = 0; b < count(); ++b) {
+  for (int b = 0; b < part_count(); ++b) {
     tables.push_back((parts_[b].get()->*fields)(part_q(q, b)));
     for (const std::string& name : tables.back().names)
       if (std::find(all.names.begin(), all.names.end(), name) == all.names.end()) all.names.push_back(name);
@@ -161,7 +176,7 @@ FieldTable BodySet::element_fields(const Vector& q) const { return stacked(&Body
 
 Vector BodySet::start_guess(const Vector& prescribed, const std::vector<char>& is_prescribed) const {
   Vector q(dof_count());
-  for (int b = 0; b < count(); ++b) {
+  for (int b = 0; b < part_count(); ++b) {
     const int o = dof_offset_[b], n = parts_[b]->dof_count();
     const std::vector<char> part(is_prescribed.begin() + o, is_prescribed.begin() + o + n);
     q.segment(o, n) = parts_[b]->start_guess(part_q(prescribed, b), part);
@@ -171,24 +186,24 @@ Vector BodySet::start_guess(const Vector& prescribed, const std::vector<char>& i
 
 double BodySet::newton_step_fraction(const Vector& q, const Vector& dq) const {
   double a = 1.0;
-  for (int b = 0; b < count(); ++b) a = std::min(a, parts_[b]->newton_step_fraction(part_q(q, b), part_q(dq, b)));
+  for (int b = 0; b < part_count(); ++b) a = std::min(a, parts_[b]->newton_step_fraction(part_q(q, b), part_q(dq, b)));
   return a;
 }
 
 std::string BodySet::inadmissible(const Vector& q) const {
-  for (int b = 0; b < count(); ++b)
+  for (int b = 0; b < part_count(); ++b)
     if (std::string why = parts_[b]->inadmissible(part_q(q, b)); !why.empty()) return names_[b] + ": " + why;
   return {};
 }
 
 std::string BodySet::validity_warning(const Vector& q) const {
-  for (int b = 0; b < count(); ++b)
+  for (int b = 0; b < part_count(); ++b)
     if (std::string why = parts_[b]->validity_warning(part_q(q, b)); !why.empty()) return names_[b] + ": " + why;
   return {};
 }
 
 void BodySet::commit(const Vector& q) {
-  for (int b = 0; b < count(); ++b) parts_[b]->commit(part_q(q, b));
+  for (int b = 0; b < part_count(); ++b) parts_[b]->commit(part_q(q, b));
 }
 
 }  // namespace grip

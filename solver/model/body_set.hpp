@@ -15,11 +15,11 @@ class BodySet final : public Body {
  public:
   BodySet(std::vector<std::unique_ptr<Body>> parts, std::vector<std::string> names);
 
-  int count() const { return static_cast<int>(parts_.size()); }
-  const Body& part(int b) const { return *parts_[b]; }
+  int part_count() const override { return static_cast<int>(parts_.size()); }
+  const Body& part(int b) const override { return *parts_[b]; }
   const std::string& name(int b) const { return names_[b]; }
-  int dof_offset(int b) const { return dof_offset_[b]; }
-  int site_offset(int b) const { return site_offset_[b]; }
+  int dof_offset(int b) const override { return dof_offset_[b]; }
+  int site_offset(int b) const override { return site_offset_[b]; }
   int node_offset(int b) const { return node_offset_[b]; }
   // The body a site (or a node) of the set belongs to.
   int body_of_site(int site) const;
@@ -36,6 +36,8 @@ class BodySet final : public Body {
   int site_node(int site) const override;
   SurfacePoint surface_point(const VectorRef& q, int site, int side) const override;
   std::vector<std::array<int, 2>> surface_segments() const override;
+  std::vector<int> nodes_without_site() const override;
+  Vec2 node_position(const VectorRef& q, int node) const override;
   double tributary_area(int site) const override;
   double characteristic_length() const override;
   // The whole set translated, or rotated (when every body has a rotation).

@@ -45,16 +45,35 @@ template <class S>
 struct P2 {
   S x, y;
 };
-template <class S> P2<S> operator+(const P2<S>& a, const P2<S>& b) { return {a.x + b.x, a.y + b.y}; }
-template <class S> P2<S> operator-(const P2<S>& a, const P2<S>& b) { return {a.x - b.x, a.y - b.y}; }
-template <class S> P2<S> operator*(const S& s, const P2<S>& a) { return {s * a.x, s * a.y}; }
-template <class S> S dot(const P2<S>& a, const P2<S>& b) { return a.x * b.x + a.y * b.y; }
-template <class S> P2<S> rot90(const P2<S>& a) { return {-a.y, a.x}; }
-template <class S> S length(const P2<S>& a) {
+template <class S>
+P2<S> operator+(const P2<S>& a, const P2<S>& b) {
+  return {a.x + b.x, a.y + b.y};
+}
+template <class S>
+P2<S> operator-(const P2<S>& a, const P2<S>& b) {
+  return {a.x - b.x, a.y - b.y};
+}
+template <class S>
+P2<S> operator*(const S& s, const P2<S>& a) {
+  return {s * a.x, s * a.y};
+}
+template <class S>
+S dot(const P2<S>& a, const P2<S>& b) {
+  return a.x * b.x + a.y * b.y;
+}
+template <class S>
+P2<S> rot90(const P2<S>& a) {
+  return {-a.y, a.x};
+}
+template <class S>
+S length(const P2<S>& a) {
   using std::sqrt;
   return sqrt(dot(a, a));
 }
-template <class S> P2<S> unit(const P2<S>& a) { return (S(1.0) / length(a)) * a; }
+template <class S>
+P2<S> unit(const P2<S>& a) {
+  return (S(1.0) / length(a)) * a;
+}
 inline P2<double> p2(const Vec2& a) { return {a.x(), a.y()}; }
 inline Vec2 vec2(const P2<double>& a) { return {a.x, a.y}; }
 

@@ -149,7 +149,7 @@ DeformedMaster::Closest DeformedMaster::closest(const Vec2& x) const {
 
 void DeformedMaster::integrate_mortar(const Body& body, const Vector& q, const MasterSurface& surface) {
   surface_ = &surface;
-  std::map<int, double> tributary;                          // D_j
+  std::map<int, double> tributary;                        // D_j
   std::map<int, std::map<std::array<int, 2>, double>> m;  // M_jk, k as (chain, index)
   for (const std::vector<int>& slave : surface.slave_chains)
     for (int site : slave) slave_points_[site] = body.surface_point(q, site, surface.slave_side);
@@ -165,8 +165,9 @@ void DeformedMaster::integrate_mortar(const Body& body, const Vector& q, const M
       const int chain = (*range)[0];
       const auto at = [&](int k) { return p2(chains_[chain].points[k].x); };
       const std::array<int, 2> ends{slave[e], slave[e + 1]};
-      segment_mortar(p2(a), p2(b), at, (*range)[1], (*range)[2],
-                     [&](int end, int k, double v) { m[ends[end]][{chain, k}] += v; });
+      segment_mortar(p2(a), p2(b), at, (*range)[1], (*range)[2], [&](int end, int k, double v) {
+        m[ends[end]][{chain, k}] += v;
+      });
     }
   }
   for (const auto& [site, row] : m) {
@@ -300,8 +301,8 @@ DeformedMaster::DualPairing DeformedMaster::dual_pairing(const SurfacePoint& sla
     for (const Piece& piece : pieces) {
       const int chain = piece.range[0];
       const int end = piece.a == slave_site ? 0 : 1;
-      segment_mortar(seeded(slave_slot.at(piece.a)), seeded(slave_slot.at(piece.b)), master_at(chain),
-                     piece.range[1], piece.range[2], [&](int e, int k, const Dual& v) {
+      segment_mortar(seeded(slave_slot.at(piece.a)), seeded(slave_slot.at(piece.b)), master_at(chain), piece.range[1],
+                     piece.range[2], [&](int e, int k, const Dual& v) {
                        if (e == end) m[{chain, k}] += v;
                      });
     }

@@ -41,8 +41,8 @@
 namespace grip {
 
 struct MasterSurface {
-  int body = -1;                         // the master body (index into the scene's bodies)
-  std::vector<std::vector<int>> chains;  // sites of the problem's body along each run, body on the left
+  int body = -1;                                    // the master body (index into the scene's bodies)
+  std::vector<std::vector<int>> chains;             // sites of the problem's body along each run, body on the left
   std::vector<std::vector<double>> reference_zeta;  // per chain and site: reference arc length
   std::vector<std::vector<int>> slave_chains;       // the slave surface's runs (sites, body on the left)
   // The sides (Body::surface_point) of the master's and the slave's sites: 0 for a continuum's
@@ -58,7 +58,7 @@ MasterSurface make_master_surface(const Body& body, int body_index, const std::v
                                   int slave_side = 0);
 
 struct MasterPoint {
-  Projection projection;  // zeta: the master's reference arc length (material, for slips)
+  Projection projection;                     // zeta: the master's reference arc length (material, for slips)
   std::vector<PointJacobianEntry> jacobian;  // of -x_m: -w_k dx_k over the master sites
 };
 
@@ -87,7 +87,7 @@ class DeformedMaster {
   struct Chain {
     std::unique_ptr<Obstacle> profile;
     std::vector<SurfacePoint> points;
-    std::vector<double> zeta;            // current arc length at each site
+    std::vector<double> zeta;  // current arc length at each site
     const std::vector<double>* reference;
   };
   struct Closest {

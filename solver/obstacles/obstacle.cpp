@@ -10,6 +10,8 @@
 
 namespace grip {
 
+double Obstacle::smallest_radius() const { return std::numeric_limits<double>::infinity(); }
+
 double Obstacle::zeta_difference(double zeta1, double zeta0) const {
   const double diff = zeta1 - zeta0;
   const double p = period();
@@ -79,6 +81,7 @@ class Circle final : public Obstacle {
   }
 
   double period() const override { return kTwoPi * radius_; }
+  double smallest_radius() const override { return radius_; }
 
  private:
   Vec2 centre_;
@@ -98,9 +101,7 @@ struct Piece {
   double length = 0.0;
   double zeta0 = 0.0;
 
-  Vec2 normal_at_start() const {
-    return arc ? Vec2(turn * unit_at(from_angle)) : normal_of_direction(direction);
-  }
+  Vec2 normal_at_start() const { return arc ? Vec2(turn * unit_at(from_angle)) : normal_of_direction(direction); }
   Vec2 normal_at_end() const {
     return arc ? Vec2(turn * unit_at(from_angle + turn * span)) : normal_of_direction(direction);
   }
@@ -186,8 +187,7 @@ Piece make_piece(const ProfilePiece& input, std::size_t index) {
     return p;
   }
   const auto& a = std::get<ArcPiece>(input);
-  if (!a.centre.allFinite() || !std::isfinite(a.radius) || !std::isfinite(a.from_angle) ||
-      !std::isfinite(a.to_angle))
+  if (!a.centre.allFinite() || !std::isfinite(a.radius) || !std::isfinite(a.from_angle) || !std::isfinite(a.to_angle))
     throw piece_error(index, "has a non-finite value");
   if (!(a.radius > 0.0)) throw piece_error(index, "has a non-positive radius");
   p.arc = true;
@@ -212,8 +212,7 @@ class Profile final : public Obstacle {
     // Size scale for the tolerances: coordinates, lengths and radii.
     scale_ = 0.0;
     for (const Piece& p : pieces_) {
-      scale_ =
-          std::max({scale_, p.start.cwiseAbs().maxCoeff(), p.end.cwiseAbs().maxCoeff(), p.length, p.radius});
+      scale_ = std::max({scale_, p.start.cwiseAbs().maxCoeff(), p.end.cwiseAbs().maxCoeff(), p.length, p.radius});
     }
     for (std::size_t i = 0; i < pieces_.size(); ++i) {
       if (!(pieces_[i].length > kTiny * scale_)) throw piece_error(i, "has zero length");
@@ -238,12 +237,18 @@ class Profile final : public Obstacle {
     end_ = Extension{last.end, rot90(n1), n1, zeta, 1.0};
   }
 
+  double smallest_radius() const override {
+    double r = std::numeric_limits<double>::infinity();
+    for (const Piece& p : pieces_)
+      if (p.arc) r = std::min(r, p.radius);
+    return r;
+  }
+
   Projection project(const Vec2& x) const override {
     // At a corner the nearest direction is undefined: use the bisecting normal.
     for (const Vertex& v : vertices_) {
       if (v.corner && safe_norm(x - v.position) <= kTiny * scale_) {
-        Projection p =
-            straight_projection(v.position, v.mean_normal, (x - v.position).dot(v.mean_normal), v.zeta);
+        Projection p = straight_projection(v.position, v.mean_normal, (x - v.position).dot(v.mean_normal), v.zeta);
         p.zeta_rate = 0.0;
         return p;
       }
@@ -316,13 +321,10 @@ class Profile final : public Obstacle {
 
 std::unique_ptr<Obstacle> make_circle(Vec2 centre, double radius) {
   if (!centre.allFinite()) throw std::invalid_argument("make_circle: non-finite centre");
-  if (!std::isfinite(radius) || !(radius > 0.0))
-    throw std::invalid_argument("make_circle: non-positive radius");
+  if (!std::isfinite(radius) || !(radius > 0.0)) throw std::invalid_argument("make_circle: non-positive radius");
   return std::make_unique<Circle>(centre, radius);
 }
 
-std::unique_ptr<Obstacle> make_profile(std::vector<ProfilePiece> pieces) {
-  return std::make_unique<Profile>(pieces);
-}
+std::unique_ptr<Obstacle> make_profile(std::vector<ProfilePiece> pieces) { return std::make_unique<Profile>(pieces); }
 
 }  // namespace grip

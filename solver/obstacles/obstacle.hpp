@@ -1,7 +1,7 @@
 #pragma once
 // Rigid obstacles: closest-point projection of a query point onto the obstacle surface.
 //
-// Conventions (ALGORITHM.md section 1):
+// Conventions (docs/algorithm.md#notation):
 // - `normal` is the obstacle's outward unit normal at the closest point; the paper's eta = -normal.
 // - `tangent` = rot90(normal): the boundary is traversed with the solid on the LEFT
 //   (counter-clockwise round a convex solid).
@@ -37,6 +37,10 @@ class Obstacle {
   virtual ~Obstacle() = default;
   // Projection of x, both in the obstacle's own (unmoved) frame.
   virtual Projection project(const Vec2& x) const = 0;
+  // The smallest radius of curvature of its arcs (infinity for straight pieces only; a corner
+  // between pieces does not count): an obstacle moving farther than this in one increment can
+  // pass a point of the body from one side to the other (the step checks cut such increments).
+  virtual double smallest_radius() const;
   // 0 for an open surface; the circumference for a closed circle.
   virtual double period() const { return 0.0; }
   // zeta1 - zeta0, taken modulo the period (into (-period/2, period/2]) on closed surfaces.

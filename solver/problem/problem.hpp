@@ -24,8 +24,8 @@ struct ObstacleInstance {
   // Coulomb coefficient (the paper's nu) in force at the current step: the load stepping
   // sets it from the step's stage.
   double friction = 0.0;
-  bool frictional = false;            // friction > 0 in some stage: tangential unknowns exist
-  std::vector<Vec2> translations;     // prescribed translation per load case at factor 1
+  bool frictional = false;         // friction > 0 in some stage: tangential unknowns exist
+  std::vector<Vec2> translations;  // prescribed translation per load case at factor 1
   std::optional<MasterSurface> master;
   // The sites that pair with it (a contact's slave set); empty: every site of the body.
   std::vector<int> slaves;
@@ -63,7 +63,8 @@ struct Candidate {
 
 // A body with no stiffness in its reference state (a flat membrane) starts its first step
 // from a preliminary solve with one dof prescribed and no contact; the reaction there is the
-// starting force of the candidate at `site` on `obstacle` (ALGORITHM.md section 9).
+// starting force of the candidate at `site` on `obstacle`
+// (docs/algorithm.md#load-stepping-and-cuts).
 struct StartUp {
   int dof;
   double value;
@@ -71,17 +72,18 @@ struct StartUp {
   int obstacle;
 };
 
-// Rigid motions that the supports leave free and contact holds (ALGORITHM.md section 7). Each
-// equilibrium solve prescribes one pin dof per mode at the mode's amplitude, so the body is held
-// there and q = u + modes alpha, u zero at the pins; the amplitudes alpha join the contact
-// unknowns as the components first.., and the pins' reactions -R^T (F + T p) must vanish: that
-// equilibrium of the whole body is the component's s. In p an amplitude is stored divided by
-// `scale` (length per force: 1 / the largest stiffness), and its s multiplied by it, so the
-// compliance with its border [C, G; G^T, 0] stays symmetric and the error vector in length.
-// In a scene of several bodies each mode moves one body (zero on the others' dofs): its s is that
-// body's equilibrium, with the forces of its pairs on it (the mortar Jacobian moves both sides).
+// Rigid motions that the supports leave free and contact holds
+// (docs/algorithm.md#bodies-held-only-by-contact). Each equilibrium solve prescribes one pin dof
+// per mode at the mode's amplitude, so the body is held there and q = u + modes alpha, u zero at
+// the pins; the amplitudes alpha join the contact unknowns as the components first.., and the pins'
+// reactions -R^T (F + T p) must vanish: that equilibrium of the whole body is the component's s. In
+// p an amplitude is stored divided by `scale` (length per force: 1 / the largest stiffness), and
+// its s multiplied by it, so the compliance with its border [C, G; G^T, 0] stays symmetric and the
+// error vector in length. In a scene of several bodies each mode moves one body (zero on the
+// others' dofs): its s is that body's equilibrium, with the forces of its pairs on it (the mortar
+// Jacobian moves both sides).
 struct RigidModes {
-  Matrix modes;                    // dof x count, column k is 1 at pins[k] and 0 at the other pins
+  Matrix modes;  // dof x count, column k is 1 at pins[k] and 0 at the other pins
   std::vector<int> pins;
   std::vector<std::string> names;  // "translate along x", ...; "BODY: ..." in a scene of several bodies
   std::vector<int> body;           // the body each mode moves (index into the scene's bodies; 0 for one body)
@@ -95,7 +97,7 @@ struct Problem {
   std::unique_ptr<Body> body;
   std::vector<ObstacleInstance> obstacles;
   std::vector<Constraint> constraints;
-  std::vector<Vector> loads;  // generalized external force per load case at factor 1
+  std::vector<Vector> loads;            // generalized external force per load case at factor 1
   std::vector<std::string> case_names;  // the load cases' names, in the order of the factors
   // The generalized external force at the given factors.
   Vector load(const LoadFactors& factors) const {

@@ -3,10 +3,14 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <optional>
+#include <tuple>
 
 #include "solver/contact/friction_limit.hpp"
-#include "solver/equilibrium/rigid_equilibrium.hpp"
+#include "solver/contact/held_by_contact.hpp"
+#include "solver/problem/rigid_modes.hpp"
+#include "solver/stepping/candidate_growth.hpp"
 
 namespace grip {
 namespace {
@@ -19,9 +23,8 @@ LoadFactors blend(const LoadFactors& from, const LoadFactors& to, double t) {
 
 // The start-up solve of a body without reference stiffness (Problem::start): returns the
 // displacement to start the first step's Newton from, and sets the starting contact force.
-std::optional<Vector> start_up(const Problem& problem, const SteppingParams& params,
-                               const LoadFactors& factors, const std::vector<double>& zeta,
-                               Vector& p, std::string& reason) {
+std::optional<Vector> start_up(const Problem& problem, const SteppingParams& params, const LoadFactors& factors,
+                               const std::vector<double>& zeta, Vector& p, std::string& reason, FailureKind& failure) {
   const StartUp& st = *problem.start;
   Equilibrium pre(problem, params.newton, {{st.dof, st.value, 0}});
   couple_newton(pre.params(), newton_coupling_tolerance(params.contact), params.contact.newton_fraction,
@@ -36,6 +39,7 @@ std::optional<Vector> start_up(const Problem& problem, const SteppingParams& par
   const EquilibriumState s = pre.solve(problem.body->start_guess(prescribed, mask), p);
   if (!s.converged) {
     reason = "the start-up solve failed: " + s.reason;
+    failure = s.failure;
     return std::nullopt;
   }
   const Vector reaction = pre.reactions(s, p);
@@ -100,30 +104,34 @@ StepRecord step_record(const LoadStep& step, int index) {
 // The steps in order into `result`, up to the first that fails.
 void step_through(Problem& problem, const std::vector<LoadStep>& steps, const SteppingParams& params,
                   const SteppingObserver& observer, RunResult& result) {
-  Equilibrium eq(problem, params.newton);
+  auto eq = std::make_unique<Equilibrium>(problem, params.newton);
+  EquilibriumCounters spent;  // by the oracles that candidates added since replaced
   const int ndof = problem.body->dof_count();
   // The rigid amplitudes' unit: length per force of the stiffest dof (problem.hpp).
-  if (problem.rigid.count()) problem.rigid.scale = 1.0 / eq.stiffness_scale(Vector::Zero(ndof));
+  if (problem.rigid.count()) problem.rigid.scale = 1.0 / eq->stiffness_scale(Vector::Zero(ndof));
   const size_t cases = steps.empty() ? 1 : steps.front().factors.size();
   Vector q = Vector::Zero(ndof), q_before = q;
   Vector p = Vector::Zero(problem.component_count), p_before = p;
   // Node-to-segment pairs start from the last force: from the extrapolated one, the slave
   // nodes' forces land on other master segments and the loop wanders (two cylinders of
   // unequal materials, step 2: 59 real solves and 1958 Newton iterations instead of 4 and 24).
-  const bool extrapolate_forces =
-      std::none_of(problem.obstacles.begin(), problem.obstacles.end(), [](const ObstacleInstance& o) { return o.master.has_value(); });
+  const bool extrapolate_forces = std::none_of(problem.obstacles.begin(), problem.obstacles.end(),
+                                               [](const ObstacleInstance& o) { return o.master.has_value(); });
   LoadFactors current(cases, 0.0), before = current;
-  eq.set_step(current, std::vector<double>(problem.candidates.size(), 0.0));
-  std::vector<double> zeta = eq.zetas(eq.evaluate(q));
+  eq->set_step(current, std::vector<double>(problem.candidates.size(), 0.0));
+  std::vector<double> zeta = eq->zetas(eq->evaluate(q));
   std::optional<Vector> start_q;
   double v_first = 0.0;  // the contact error of the last increment's first solve
   if (problem.start) {
-    start_q = start_up(problem, params, current, zeta, p, result.reason);
+    start_q = start_up(problem, params, current, zeta, p, result.reason, result.failure);
     if (!start_q) {
-      result.counters = eq.counters();
+      result.failure_step = 1;  // the start-up solve is the first step's
+      result.counters = eq->counters();
       return;
     }
   }
+  auto checker = std::make_unique<StepChecker>(problem, params.contact, params.contact_reach);
+  AcceptedContact accepted = accepted_contact(eq->evaluate(q), p);
 
   for (size_t k = 0; k < steps.size(); ++k) {
     const LoadStep& target_step = steps[k];
@@ -158,15 +166,90 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
       if (!extrapolated && problem.rigid.count())
         p_guess.segment(problem.rigid.first, problem.rigid.count()) +=
             amplitudes_following_supports(problem, current, target);
-      eq.set_step(target, zeta);
+      eq->set_step(target, zeta);
       // A load that no static equilibrium can carry: no cut of the increment can help.
-      if (std::string why = unreachable_equilibrium(problem, eq.evaluate(guess), target); !why.empty()) {
-        rec.reason = std::move(why);
+      if (Unreachable why = unreachable_equilibrium(problem, eq->evaluate(guess), target); !why.reason.empty()) {
+        rec.reason = std::move(why.reason);
+        rec.failure = why.kind;
         break;
       }
-      StepOutcome out = solve_contact_step(eq, guess, p_guess, p, params.contact, step,
-                                           observer.iteration, observer.stop_requested, v_first);
+      // An obstacle that moves farther than the body's element size or its own radius in one
+      // increment can pass through the body into a state that satisfies every contact condition.
+      // Such an increment is cut into as many parts as the travel asks for, up to as many as
+      // max_cuts halvings make: beyond, the step fails before any solve.
+      StepChecks attempt;
+      std::string too_far;
+      auto check_start = Clock::now();
+      const double travel = checker->increment(current, target, attempt, too_far);
+      result.check_seconds += std::chrono::duration<double>(Clock::now() - check_start).count();
+      if (const double parts = std::ceil(travel - 1e-9); !too_far.empty()) {
+        if (parts * (1.0 / increment) > std::ldexp(1.0, params.max_cuts)) {
+          rec.checks.worst_of(attempt);
+          rec.failure = FailureKind::check_failed;
+          rec.reason = "refused by the step checks: " + too_far + " (more than " +
+                       std::to_string(1 << params.max_cuts) + " parts of the step would be needed)";
+          break;
+        }
+        increment = (t - done) / parts;
+        ++rec.cuts;
+        continue;
+      }
+      StepOutcome out = solve_contact_step(*eq, guess, p_guess, p, params.contact, step, observer.iteration,
+                                           observer.stop_requested, v_first);
       count_attempt(rec, out);
+      bool refused = false;  // converged, but the step checks refused the state
+      if (out.converged) {
+        std::vector<OutsidePoint> outside;
+        check_start = Clock::now();
+        std::string why = checker->state(*eq, out.state, out.p, accepted, attempt, outside);
+        result.check_seconds += std::chrono::duration<double>(Clock::now() - check_start).count();
+        if (params.fail_outside_candidates) std::erase_if(outside, [](const OutsidePoint& o) { return !o.entered; });
+        if (!outside.empty()) {
+          const CandidateGrowth g =
+              params.fail_outside_candidates ? CandidateGrowth{} : add_candidates_for(problem, outside);
+          if (g.grew()) {
+            // The same increment again with the new candidates, from the last accepted state.
+            rec.notes.push_back(g.note);
+            spent.solves += eq->counters().solves;
+            spent.newton_iterations += eq->counters().newton_iterations;
+            spent.factorizations += eq->counters().factorizations;
+            spent.compliance_forms += eq->counters().compliance_forms;
+            spent.compliance_columns += eq->counters().compliance_columns;
+            eq = std::make_unique<Equilibrium>(problem, params.newton);
+            p = grown_components(p, g, problem);
+            p_before = grown_components(p_before, g, problem);
+            zeta.resize(problem.candidates.size(), 0.0);
+            eq->set_step(current, zeta);
+            const EquilibriumState now = eq->evaluate(q);
+            for (size_t i = g.old_candidates; i < problem.candidates.size(); ++i)
+              zeta[i] = now.points[i].projection.zeta;
+            accepted.p = grown_components(accepted.p, g, problem);
+            for (size_t i = g.old_candidates; i < problem.candidates.size(); ++i)
+              accepted.eta.push_back(now.points[i].eta);
+            for (StepRecord& done_step : result.steps) grow_record(done_step, g, problem);
+            grow_record(rec, g, problem);
+            checker = std::make_unique<StepChecker>(problem, params.contact, params.contact_reach);
+            continue;
+          }
+          std::string nodes;
+          for (const OutsidePoint& o : outside)
+            if (o.entered && nodes.size() < 200) nodes += (nodes.empty() ? "" : ", ") + std::to_string(o.node);
+          if (!nodes.empty()) {
+            rec.checks.worst_of(attempt);
+            rec.failure = FailureKind::missed_contact;
+            rec.reason = "nodes " + nodes + " entered an obstacle outside the contact candidates" +
+                         (params.fail_outside_candidates ? " (solver.contact.outside_candidates: fail)" : "");
+            break;
+          }
+        }
+        if (!why.empty()) {
+          rec.checks.worst_of(attempt);
+          out.converged = false;
+          out.reason = "refused by the step checks: " + why;
+          out.failure = FailureKind::check_failed;
+          refused = true;
+        }
+      }
       if (!out.converged) {
         if (out.stopped) result.stopped = true;
         // A load beyond what friction holds (friction_limit.hpp): no retry or cut of the
@@ -181,21 +264,23 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
         // default's own attempt, from the compliance of its previous step, stopped 1.3e-4 away
         // in the squeeze force. Run once a target (a retry from the previous force has the same
         // target); after cev default's own attempt only where that attempt shows the limit.
-        if (!out.stopped && problem.rigid.count() && target != probed &&
+        if (!refused && !out.stopped && problem.rigid.count() && target != probed &&
             (!is_coulomb_loop(params.contact) ||
              !friction_limit_exceeded(problem, out.state, out.p, out.tau, target).empty())) {
           probed = target;
-          eq.refresh_compliance();
-          StepOutcome decided = solve_contact_step(eq, guess, p_guess, p, coulomb_loop(params.contact), step,
+          eq->refresh_compliance();
+          StepOutcome decided = solve_contact_step(*eq, guess, p_guess, p, coulomb_loop(params.contact), step,
                                                    observer.iteration, observer.stop_requested, v_first);
           count_attempt(rec, decided);
           if (decided.stopped) {
             out.stopped = result.stopped = true;
             out.reason = decided.reason;
+            out.failure = decided.failure;
           } else if (!decided.converged) {
             if (std::string why = friction_limit_exceeded(problem, decided.state, decided.p, decided.tau, target);
                 !why.empty()) {
               rec.reason = std::move(why);
+              rec.failure = FailureKind::friction_limit;
               rec.p = decided.p;
               rec.tau = decided.tau;
               rec.state = std::move(decided.state);
@@ -215,7 +300,11 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
           continue;
         }
         if (depth >= params.max_cuts || out.stopped || out.definitive || spent) {
-          rec.reason = out.reason + (depth ? " (after " + std::to_string(depth) + " cuts of the increment)" : "");
+          rec.failure = out.failure;
+          rec.reason = out.reason;
+          // A stop names its cause where the caller gives one (the service: a job limit, a dismissal).
+          if (out.stopped && observer.stop_reason) std::tie(rec.failure, rec.reason) = observer.stop_reason();
+          if (depth) rec.reason += " (after " + std::to_string(depth) + " cuts of the increment)";
           rec.p = out.p;
           rec.tau = out.tau;
           rec.state = std::move(out.state);
@@ -230,7 +319,7 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
         rec.converged = true;
         rec.p = out.p;
         rec.tau = out.tau;
-        rec.reactions = eq.reactions(out.state, out.p);
+        rec.reactions = eq->reactions(out.state, out.p);
         rec.warning = problem.body->validity_warning(out.state.q);
         if (params.record_fields.empty() || params.record_fields[k]) {
           rec.site_fields = problem.body->site_fields(out.state.q);
@@ -238,6 +327,8 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
         }
       }
       // Commit.
+      rec.checks.worst_of(attempt);
+      accepted = accepted_contact(out.state, out.p);
       v_first = start_q || out.history.empty() ? 0.0 : out.history.front().v2;
       start_q.reset();
       q_before = q;
@@ -247,7 +338,7 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
       p = out.p;
       current = target;
       done = t;
-      zeta = eq.zetas(out.state);
+      zeta = eq->zetas(out.state);
       problem.body->commit(q);
       if (t == 1.0) {
         rec.state = std::move(out.state);
@@ -256,19 +347,28 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
     }
     rec.seconds = std::chrono::duration<double>(Clock::now() - step_start).count();
     const bool ok = rec.converged;
-    if (!ok) result.reason = "step " + std::to_string(step) + " failed: " + rec.reason;
+    if (!ok) {
+      result.reason = "step " + std::to_string(step) + " failed: " + rec.reason;
+      result.failure = rec.failure;
+      result.failure_step = step;
+    }
     if (observer.step_finished) observer.step_finished(rec);
     result.steps.push_back(std::move(rec));
     if (!ok) break;
   }
   result.completed = result.reason.empty();
-  result.counters = eq.counters();
+  result.counters = eq->counters();
+  result.counters.solves += spent.solves;
+  result.counters.newton_iterations += spent.newton_iterations;
+  result.counters.factorizations += spent.factorizations;
+  result.counters.compliance_forms += spent.compliance_forms;
+  result.counters.compliance_columns += spent.compliance_columns;
 }
 
 }  // namespace
 
-RunResult run_load_steps(Problem& problem, const std::vector<LoadStep>& steps,
-                         const SteppingParams& params, const SteppingObserver& observer) {
+RunResult run_load_steps(Problem& problem, const std::vector<LoadStep>& steps, const SteppingParams& params,
+                         const SteppingObserver& observer) {
   const auto run_start = Clock::now();
   RunResult result;
   try {
@@ -280,7 +380,10 @@ RunResult run_load_steps(Problem& problem, const std::vector<LoadStep>& steps,
     const size_t k = result.steps.size();
     StepRecord rec = step_record(k < steps.size() ? steps[k] : LoadStep{}, static_cast<int>(k) + 1);
     rec.reason = std::string("solver error: ") + e.what();
+    rec.failure = FailureKind::exception;
     result.reason = "step " + std::to_string(rec.index) + " failed: " + rec.reason;
+    result.failure = FailureKind::exception;
+    result.failure_step = rec.index;
     result.completed = false;
     result.steps.push_back(std::move(rec));
     if (observer.step_finished) observer.step_finished(result.steps.back());

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "solver/contact/strategy.hpp"
+#include "solver/stepping/step_checks.hpp"
 
 namespace grip {
 
@@ -17,20 +18,27 @@ struct SteppingParams {
   // An obstacle pairs with a site only if it comes this close over the load path (length;
   // 0: the body's characteristic length). Read by the scene layer when building candidates.
   double contact_reach = 0.0;
+  // A boundary point outside the contact candidates that enters an obstacle (or a site that
+  // comes within reach of one it was not paired with): false adds it to the candidates for the
+  // rest of the run (a note in the step), true fails the step naming the node.
+  bool fail_outside_candidates = false;
   // Steps whose fields (nodes, elements) are kept; empty: every step.
   std::vector<char> record_fields;
 };
 
 struct StepRecord {
-  int index = 0;               // 1-based output step
+  int index = 0;  // 1-based output step
   int stage = 0;
-  double load_factor = 0.0;    // the first load case's factor
-  LoadFactors factors;         // every load case's factor
+  double load_factor = 0.0;  // the first load case's factor
+  LoadFactors factors;       // every load case's factor
   bool converged = false;
   std::string reason;
-  std::string warning;         // the converged state lies beyond the model's accurate range
-  int cuts = 0;                // sub-increments this step needed beyond one
-  int restarts = 0;            // attempts from the extrapolated force retried from the last one
+  FailureKind failure = FailureKind::none;  // the kind of the reason
+  std::string warning;                      // the converged state lies beyond the model's accurate range
+  std::vector<std::string> notes;           // what the step changed in the problem (candidates added)
+  StepChecks checks;                        // the step checks' worst values (step_checks.hpp)
+  int cuts = 0;                             // sub-increments this step needed beyond one
+  int restarts = 0;                         // attempts from the extrapolated force retried from the last one
   int passes = 0, solves = 0, newton_iterations = 0, inner_iterations = 0;
   double seconds = 0.0;
   std::string epsilon_used;
@@ -48,6 +56,9 @@ struct SteppingObserver {
   std::function<void(int step, double load_factor)> step_started;
   IterationObserver iteration;
   StopRequest stop_requested;  // checked before every real solve
+  // After a stop: its kind and reason (a job limit, a dismissal), which the stopped step
+  // records instead of "stopped on request".
+  std::function<std::pair<FailureKind, std::string>()> stop_reason;
   std::function<void(const StepRecord&)> step_finished;
 };
 
@@ -56,11 +67,14 @@ struct RunResult {
   bool completed = false;
   bool stopped = false;  // by the observer's stop request
   std::string reason;
+  FailureKind failure = FailureKind::none;  // the kind of the reason
+  int failure_step = 0;                     // the step that failed, from 1
   EquilibriumCounters counters;
   double seconds = 0.0;
+  double check_seconds = 0.0;  // spent in the step checks (bench/results/robustness.md)
 };
 
-RunResult run_load_steps(Problem& problem, const std::vector<LoadStep>& steps,
-                         const SteppingParams& params, const SteppingObserver& observer = {});
+RunResult run_load_steps(Problem& problem, const std::vector<LoadStep>& steps, const SteppingParams& params,
+                         const SteppingObserver& observer = {});
 
 }  // namespace grip

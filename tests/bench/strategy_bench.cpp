@@ -37,11 +37,11 @@
 
 #include <nlohmann/json.hpp>
 
+#include "solver/equilibrium/equilibrium.hpp"
 #include "solver/io/scene.hpp"
+#include "solver/stepping/load_stepping.hpp"
 #include "tests/support/contact_profile.hpp"
 #include "tests/support/elastica.hpp"
-#include "solver/equilibrium/equilibrium.hpp"
-#include "solver/stepping/load_stepping.hpp"
 
 #ifndef GRIP_SOURCE_DIR
 #define GRIP_SOURCE_DIR "."
@@ -120,8 +120,8 @@ double peak_normal_stress(const Problem& problem, const StepRecord& rec) {
 // Scenes.
 
 struct SceneCase {
-  std::string name;  // short name used in the CSV and the plots
-  std::string file;  // schemas/examples/<file>.json
+  std::string name;                                // short name used in the CSV and the plots
+  std::string file;                                // schemas/examples/<file>.json
   std::function<json(json, int level)> with_mesh;  // level 0, 1, 2: coarse to fine
   std::function<std::string(const json&)> mesh_label;
   std::function<Quantities(const Scene&, const RunResult&)> measure;
@@ -214,8 +214,10 @@ SceneCase half_disc_case(bool sheared, std::array<double, 3> sizes) {
     return q;
   };
   const std::string load = sheared ? "force: tangential load Q" : "force: load P";
-  s.quantities = load + " per unit thickness from the reactions (N/mm); peak: peak nodal normal contact stress "
-                 "(MPa); point: " + (sheared ? "tangential" : "vertical") +
+  s.quantities = load +
+                 " per unit thickness from the reactions (N/mm); peak: peak nodal normal contact stress "
+                 "(MPa); point: " +
+                 (sheared ? "tangential" : "vertical") +
                  " displacement on the axis at half the radius below the centre (mm); extent: " +
                  (sheared ? "stick-zone half-width c (mm)"
                           : "contact half-width a from the semi-ellipse fitted to the nodal stresses (mm)");
@@ -292,8 +294,9 @@ std::vector<SceneCase> scene_cases() {
       q.point = -column(last.site_fields, "w").back();  // tip deflection at the end node
       return q;
     };
-    s.quantities = "force: total contact force (kgf); peak: peak normal contact stress (kgf/cm2); "
-                   "point: tip deflection at the end node (cm)";
+    s.quantities =
+        "force: total contact force (kgf); peak: peak normal contact stress (kgf/cm2); "
+        "point: tip deflection at the end node (cm)";
     out.push_back(std::move(s));
   }
   {
@@ -316,8 +319,9 @@ std::vector<SceneCase> scene_cases() {
       q.point = -column(last.site_fields, "uy").front();  // the pole's displacement
       return q;
     };
-    s.quantities = "force: punch force (N per mm width); peak: peak major strain; "
-                   "point: pole displacement (mm)";
+    s.quantities =
+        "force: punch force (N per mm width); peak: peak major strain; "
+        "point: pole displacement (mm)";
     out.push_back(std::move(s));
   }
   out.push_back(half_disc_case(false, {0.1, 0.05, 0.025}));  // 0.05 as shipped
@@ -367,9 +371,9 @@ std::vector<SceneCase> scene_cases() {
 
 struct Strategy {
   std::string name;
-  json contact;       // solver.contact of the scene
-  int max_cuts = -1;  // solver.max_cuts; -1: the scene's default
-  std::string family; // cev, ssn, cev-inner (tau passes), cev-paper, uzawa, penalty (for the plots)
+  json contact;        // solver.contact of the scene
+  int max_cuts = -1;   // solver.max_cuts; -1: the scene's default
+  std::string family;  // cev, ssn, cev-inner (tau passes), cev-paper, uzawa, penalty (for the plots)
 };
 
 // Real solves per load step for the loops that are known to stall (the paper's literal loop
@@ -455,8 +459,8 @@ struct RunStats {
   long solves = 0, newton = 0, factorizations = 0, inner = 0, passes = 0, cuts = 0;
   double max_v_rel = 0.0;  // the largest final ||v||_2 of a step, relative to the body's length
   Quantities q;
-  std::vector<int> step_solves;      // contact iterations of each step that ended
-  std::vector<StepRecord> steps;     // for the replay
+  std::vector<int> step_solves;   // contact iterations of each step that ended
+  std::vector<StepRecord> steps;  // for the replay
 };
 
 RunStats run_once(const SceneCase& sc, const json& scene_json, double wall_limit) {
@@ -615,13 +619,13 @@ void write_csv(const std::filesystem::path& path, std::vector<Row> rows) {
     const RunStats& s = r.stats;
     out << r.scene << ',' << r.mesh << ',' << r.level << ',' << r.strategy << ',' << r.family << ','
         << csv_number(r.tolerance) << ',' << r.runs << ',' << csv_number(r.median_seconds) << ','
-        << csv_number(r.min_seconds) << ',' << csv_number(r.median_cpu_seconds) << ',' << s.status << ',' << (s.status == "ok" ? 1 : 0) << ',' << s.solves << ','
-        << s.inner << ',' << s.passes << ',' << s.cuts << ',' << s.newton << ',' << s.factorizations << ','
-        << csv_number(s.max_v_rel) << ',' << csv_number(s.q.force) << ',' << csv_number(s.q.peak) << ','
-        << csv_number(s.q.point) << ',' << csv_number(s.q.extent) << ',' << csv_number(r.error.force) << ','
-        << csv_number(r.error.peak) << ',' << csv_number(r.error.point) << ',' << csv_number(r.error.extent) << ','
-        << csv_number(r.contact_seconds) << ',' << csv_number(r.floor_seconds) << ','
-        << csv_number(r.overhead_ratio) << ',' << join(s.step_solves) << ',' << csv_text(s.reason) << '\n';
+        << csv_number(r.min_seconds) << ',' << csv_number(r.median_cpu_seconds) << ',' << s.status << ','
+        << (s.status == "ok" ? 1 : 0) << ',' << s.solves << ',' << s.inner << ',' << s.passes << ',' << s.cuts << ','
+        << s.newton << ',' << s.factorizations << ',' << csv_number(s.max_v_rel) << ',' << csv_number(s.q.force) << ','
+        << csv_number(s.q.peak) << ',' << csv_number(s.q.point) << ',' << csv_number(s.q.extent) << ','
+        << csv_number(r.error.force) << ',' << csv_number(r.error.peak) << ',' << csv_number(r.error.point) << ','
+        << csv_number(r.error.extent) << ',' << csv_number(r.contact_seconds) << ',' << csv_number(r.floor_seconds)
+        << ',' << csv_number(r.overhead_ratio) << ',' << join(s.step_solves) << ',' << csv_text(s.reason) << '\n';
   }
 }
 
@@ -636,7 +640,7 @@ struct Options {
   std::string label;         // what was measured (a commit), for machine.txt
   std::vector<std::string> scenes;
   std::vector<std::string> strategies;  // names to run; empty: all
-  std::vector<int> levels;  // mesh levels to run (0 coarse .. 2 fine); empty: all
+  std::vector<int> levels;              // mesh levels to run (0 coarse .. 2 fine); empty: all
 };
 
 struct Task {
@@ -681,8 +685,8 @@ class Bench {
           if (opt_.strategies.empty() ||
               std::find(opt_.strategies.begin(), opt_.strategies.end(), st.name) != opt_.strategies.end())
             tasks.push_back({&sc, level, &st});
-    std::printf("%zu scene x mesh x strategy combinations, %zu tolerances each, %d runs, %d worker(s)\n",
-                tasks.size(), tolerances_.size(), opt_.runs, opt_.jobs);
+    std::printf("%zu scene x mesh x strategy combinations, %zu tolerances each, %d runs, %d worker(s)\n", tasks.size(),
+                tolerances_.size(), opt_.runs, opt_.jobs);
     std::atomic<size_t> next{0};
     auto worker = [&] {
       for (size_t i = next++; i < tasks.size(); i = next++) measure(tasks[i], i, tasks.size());
@@ -701,7 +705,9 @@ class Bench {
   }
 
  private:
-  std::string label(const SceneCase& sc, int level) const { return sc.mesh_label(sc.with_mesh(base_.at(sc.name), level)); }
+  std::string label(const SceneCase& sc, int level) const {
+    return sc.mesh_label(sc.with_mesh(base_.at(sc.name), level));
+  }
 
   json scene_json(const SceneCase& sc, int level, const Strategy& st, double tol) const {
     json j = sc.with_mesh(base_.at(sc.name), level);
@@ -828,8 +834,10 @@ class Bench {
         RunResult run;
         run.steps = row.stats.steps;
         const Quantities exact = sc.closed_form(scene, run);
-        for (auto [mine, theirs] : {std::pair{&ref.force, exact.force}, {&ref.peak, exact.peak},
-                                    {&ref.point, exact.point}, {&ref.extent, exact.extent}})
+        for (auto [mine, theirs] : {std::pair{&ref.force, exact.force},
+                                    {&ref.peak, exact.peak},
+                                    {&ref.point, exact.point},
+                                    {&ref.extent, exact.extent}})
           if (std::isfinite(theirs)) *mine = theirs;
       }
       row.error = errors(row.stats.q, ref);
@@ -849,8 +857,8 @@ class Bench {
       std::string meshes;
       for (int level : levels_) meshes += (meshes.empty() ? "" : " / ") + label(sc, level);
       const std::string ref = reference_note_.count(sc.name) ? reference_note_.at(sc.name)
-                              : sc.closed_form ? sc.closed_form_note + " (the finest-mesh run failed)"
-                                               : "none: the reference run failed";
+                              : sc.closed_form               ? sc.closed_form_note + " (the finest-mesh run failed)"
+                                                             : "none: the reference run failed";
       out << sc.name << ',' << sc.file << ',' << csv_text(meshes) << ',' << csv_text(sc.quantities) << ','
           << csv_text(ref) << '\n';
     }
@@ -874,9 +882,9 @@ class Bench {
         << " hardware threads)\nworkers: " << opt_.jobs << " (each run on one thread)\nruns per timing: " << opt_.runs
         << "\nwall-time limit per run: the larger of " << opt_.run_seconds << " s and " << kLimitFactor
         << " x the default strategy's time at 1e-8 on the same mesh";
-    for (const auto& [key, limit] : limits_) out << "; " << key.first << " level " << key.second << ": " << limit << " s";
-    out << "\nload average (1, 5, 15 min) at start: "
-        << load_at_start_ << "\nload average at end: " << load_average()
+    for (const auto& [key, limit] : limits_)
+      out << "; " << key.first << " level " << key.second << ": " << limit << " s";
+    out << "\nload average (1, 5, 15 min) at start: " << load_at_start_ << "\nload average at end: " << load_average()
         << "\nduration: " << static_cast<int>(seconds_since(start_)) << " s\n";
   }
 
@@ -900,8 +908,8 @@ class Bench {
                     label(sc, level).c_str(), cev->stats.solves, cev->stats.status.c_str(), uzawa->stats.solves,
                     uzawa->stats.status.c_str());
       if (const Row* def = find(sc.name, level, "cev", tol))
-        std::printf("  %s mesh %s: cev %.1f ms, overhead ratio %.2f\n", sc.name.c_str(),
-                    label(sc, level).c_str(), 1e3 * def->median_seconds, def->overhead_ratio);
+        std::printf("  %s mesh %s: cev %.1f ms, overhead ratio %.2f\n", sc.name.c_str(), label(sc, level).c_str(),
+                    1e3 * def->median_seconds, def->overhead_ratio);
     }
     // The paper's scenes as shipped: beam mesh 40 (level 1), sheet mesh 30 (level 0).
     for (const auto& [scene, level] : std::vector<std::pair<std::string, int>>{{"beam", 1}, {"sheet", 0}})
@@ -982,7 +990,9 @@ int main(int argc, char** argv) {
       } else {
         std::fprintf(stderr,
                      "usage: grip_bench [--quick] [--out DIR] [--runs N] [--jobs N] [--budget MINUTES] "
-                     "[--run-seconds S] [--scenes beam,sheet,hertz,cattaneo-mindlin,cantilever,strip-cylinder,sliding-block,beam-mu0,sheet-mu0,sliding-block-mu0] [--strategies cev,ssn,...] "
+                     "[--run-seconds S] [--scenes "
+                     "beam,sheet,hertz,cattaneo-mindlin,cantilever,strip-cylinder,sliding-block,beam-mu0,sheet-mu0,"
+                     "sliding-block-mu0] [--strategies cev,ssn,...] "
                      "[--levels 0,1,2] "
                      "[--source DIR] [--label TEXT]\n");
         return a == "--help" ? 0 : 2;

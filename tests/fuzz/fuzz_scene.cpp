@@ -32,8 +32,7 @@ void check_issues(const grip::SceneErrors& e) {
       }
     }
     if (!ok) {
-      std::cerr << "issue without a valid JSON pointer: '" << issue.pointer << "': "
-                << issue.detail << "\n";
+      std::cerr << "issue without a valid JSON pointer: '" << issue.pointer << "': " << issue.detail << "\n";
       std::abort();
     }
   }

@@ -71,9 +71,10 @@ TEST(BeamOnFoundationHard, SlenderBeamOnASoftFoundationPressesUniformly) {
     if (n.p_n < 0) ++pressing;
     if (n.x < kLength / 2 - edge_zone) spread = std::max(spread, std::abs(-n.sigma_n / kLoad - 1));
   }
-  std::printf("%d of %d slave nodes press, largest departure from %.0f MPa away from the end %.3f %%; %d real solves, "
-              "%d Newton\n",
-              pressing, nodes, kLoad, 100 * spread, rec.solves, rec.newton_iterations);
+  std::printf(
+      "%d of %d slave nodes press, largest departure from %.0f MPa away from the end %.3f %%; %d real solves, "
+      "%d Newton\n",
+      pressing, nodes, kLoad, 100 * spread, rec.solves, rec.newton_iterations);
   EXPECT_EQ(nodes, 68);
   EXPECT_EQ(pressing, nodes);
   EXPECT_LT(spread, 0.01);  // the 1 % of the foundation's patch test, as in the friendly case

@@ -73,7 +73,8 @@ TEST(FrictionExtremes, BeamOnCylinderWithMuFiveAndTauPassesFailsWithAReason) {
   const Solved s = solve_scene(j);
   print_work("beam on cylinder, mu 5, tau passes", s);
   expect_sound_or_stated_failure(s);
-  if (!s.run.completed) EXPECT_NE(s.run.reason.find("friction bound did not settle"), std::string::npos) << s.run.reason;
+  if (!s.run.completed)
+    EXPECT_NE(s.run.reason.find("friction bound did not settle"), std::string::npos) << s.run.reason;
 }
 
 // The block pressed onto the flat and sheared (schemas/examples/sliding-block.json): with

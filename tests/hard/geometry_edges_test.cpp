@@ -72,8 +72,7 @@ TEST(GeometryEdges, PointsBeyondTheEndsOfAnOpenProfile) {
   long_flat["body"]["loads"].push_back({{"node", 20}, {"force", {2000, 0}}});
   json short_profile = long_flat;
   short_profile["obstacles"][0]["shape"] = {
-      {"type", "profile"},
-      {"pieces", json::array({{{"type", "segment"}, {"from", {8, -0.25}}, {"to", {5, -0.25}}}})}};
+      {"type", "profile"}, {"pieces", json::array({{{"type", "segment"}, {"from", {8, -0.25}}, {"to", {5, -0.25}}}})}};
   const Solved a = solve_scene(long_flat), b = solve_scene(short_profile);
   print_work("beam on a long flat, pulled", a);
   print_work("beam on a short profile, pulled", b);

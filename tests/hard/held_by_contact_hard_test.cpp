@@ -171,10 +171,11 @@ void expect_turned_near_the_limit(const Strategy& strategy) {
     const Vec2 lower = flat_resultant(s.scene.problem, rec, 0), upper = flat_resultant(s.scene.problem, rec, 1);
     const json step = step_json(s.scene.problem, rec, s.scene.output);
     ratio = std::abs(lower.x()) / (0.3 * lower.y());
-    std::printf("%s, step %d: P = %.3f N/mm, Q / (mu P) lower %.4f upper %.4f, rotation %.4e rad; %d real solves, "
-                "%d Newton\n",
-                strategy.name, rec.index, lower.y(), ratio, std::abs(upper.x()) / (0.3 * -upper.y()),
-                step["rigid_motion"]["rotation"].get<double>(), rec.solves, rec.newton_iterations);
+    std::printf(
+        "%s, step %d: P = %.3f N/mm, Q / (mu P) lower %.4f upper %.4f, rotation %.4e rad; %d real solves, "
+        "%d Newton\n",
+        strategy.name, rec.index, lower.y(), ratio, std::abs(upper.x()) / (0.3 * -upper.y()),
+        step["rigid_motion"]["rotation"].get<double>(), rec.solves, rec.newton_iterations);
     if (rec.index == 1) continue;
     EXPECT_GT(step["rigid_motion"]["rotation"].get<double>(), 0.0);  // counter-clockwise, with the couple
     EXPECT_LT(lower.x(), 0.0);  // the lower flat resists along -x, the upper along +x
@@ -212,9 +213,10 @@ TEST(HeldByContactHard, UzawaTurnsTheFiniteDisc) {
   ASSERT_TRUE(s.run.completed) << s.run.reason;
   expect_disc_balanced(s);
   const auto [forces, displacements] = expect_same_answer(cev, s);
-  std::printf("uzawa against cev default: forces within %.2e of the largest normal force, displacements within "
-              "%.2e mm\n",
-              forces, displacements);
+  std::printf(
+      "uzawa against cev default: forces within %.2e of the largest normal force, displacements within "
+      "%.2e mm\n",
+      forces, displacements);
   print_work("uzawa, finite disc turned between two flats", s);
 }
 

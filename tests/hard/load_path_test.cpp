@@ -32,9 +32,9 @@ std::vector<size_t> stage_ends(const Solved& s) {
 // on the cylinder while loading it slides back while unloading, so some point that presses at
 // both ends carries a friction force of the opposite sign (each at least a tenth of its bound).
 TEST(LoadPath, UnloadingReversesTheFrictionOnTheCylinder) {
-  const Solved s = solve_scene(with_stages(beam_on_cylinder(0.2), json::array({
-                                               {{"steps", 10}, {"factors", {{"main", 1.0}}}},
-                                               {{"steps", 6}, {"factors", {{"main", 0.7}}}}})));
+  const Solved s = solve_scene(with_stages(
+      beam_on_cylinder(0.2),
+      json::array({{{"steps", 10}, {"factors", {{"main", 1.0}}}}, {{"steps", 6}, {"factors", {{"main", 0.7}}}}})));
   print_work("beam on cylinder, load then unload", s);
   expect_hard_case_sound(s);
   ASSERT_TRUE(s.run.completed) << s.run.reason;
@@ -82,9 +82,9 @@ TEST(LoadPath, ShearingBackReversesTheFrictionOnTheBlock) {
 // elastic) the displacements equal those of the same beam loaded straight to -50 kgf with the
 // cylinder out of reach.
 TEST(LoadPath, ContactThenFullSeparation) {
-  const Solved s = solve_scene(with_stages(beam_on_cylinder(0.2), json::array({
-                                               {{"steps", 10}, {"factors", {{"main", 1.0}}}},
-                                               {{"steps", 10}, {"factors", {{"main", -0.1}}}}})));
+  const Solved s = solve_scene(with_stages(
+      beam_on_cylinder(0.2),
+      json::array({{{"steps", 10}, {"factors", {{"main", 1.0}}}}, {{"steps", 10}, {"factors", {{"main", -0.1}}}}})));
   print_work("beam on cylinder, load then lift off", s);
   expect_hard_case_sound(s);
   ASSERT_TRUE(s.run.completed) << s.run.reason;
@@ -122,8 +122,8 @@ TEST(LoadPath, OneStepReachesTheTwentyStepAnswerWithoutFriction) {
     const StepRecord &ra = a.run.steps.back(), &rb = b.run.steps.back();
     const double dq = (ra.state.q - rb.state.q).lpNorm<Eigen::Infinity>() / rb.state.q.lpNorm<Eigen::Infinity>();
     const double dp = (ra.p - rb.p).lpNorm<Eigen::Infinity>() / rb.p.lpNorm<Eigen::Infinity>();
-    std::printf("mu %g: one step (%d cuts) vs 20 steps: displacements differ by %.3g, forces by %.3g\n", mu,
-                ra.cuts, dq, dp);
+    std::printf("mu %g: one step (%d cuts) vs 20 steps: displacements differ by %.3g, forces by %.3g\n", mu, ra.cuts,
+                dq, dp);
     if (mu == 0.0) {
       EXPECT_LT(dq, 1e-7);
       EXPECT_LT(dp, 1e-5);

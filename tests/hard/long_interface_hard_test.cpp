@@ -30,8 +30,10 @@ constexpr double kLength = 150.0, kDepth = 0.01;  // mm
 
 json long_block_on_foundation() {
   json j = example_scene("block-on-foundation");
-  j["bodies"][0]["mesh"]["rectangle"] = {{"origin", {-kLength / 2, 0}}, {"size", {kLength, 4}}, {"divisions", {1050, 3}}};
-  j["bodies"][1]["mesh"]["rectangle"] = {{"origin", {-kLength / 2, -6}}, {"size", {kLength, 6}}, {"divisions", {1500, 6}}};
+  j["bodies"][0]["mesh"]["rectangle"] = {
+      {"origin", {-kLength / 2, 0}}, {"size", {kLength, 4}}, {"divisions", {1050, 3}}};
+  j["bodies"][1]["mesh"]["rectangle"] = {
+      {"origin", {-kLength / 2, -6}}, {"size", {kLength, 6}}, {"divisions", {1500, 6}}};
   return j;
 }
 
@@ -59,10 +61,11 @@ TEST(LongInterfaceHard, FifteenHundredSlavePointsCarryAUniformPressure) {
   }
   mean /= read;
   const double load = -body_resultant(s.scene.problem, 0, rec.reactions).y() / kLength;
-  std::printf("%d slave nodes, %d press; away from the right end (%d): mean %.4f MPa (exact %.4f, %+.4f %%), largest "
-              "departure %.3f %%; load %.4f MPa (%+.4f %%); %d real solves, %d Newton\n",
-              nodes, pressing, read, mean, exact, 100 * (mean / exact - 1), 100 * spread, load, 100 * (load / exact - 1),
-              rec.solves, rec.newton_iterations);
+  std::printf(
+      "%d slave nodes, %d press; away from the right end (%d): mean %.4f MPa (exact %.4f, %+.4f %%), largest "
+      "departure %.3f %%; load %.4f MPa (%+.4f %%); %d real solves, %d Newton\n",
+      nodes, pressing, read, mean, exact, 100 * (mean / exact - 1), 100 * spread, load, 100 * (load / exact - 1),
+      rec.solves, rec.newton_iterations);
   EXPECT_EQ(nodes, 1501);
   EXPECT_GE(pressing, read);
   EXPECT_LT(spread, 0.01);  // the 1 % of the 10 mm patch test (two_bodies_test.cpp)

@@ -33,8 +33,8 @@ void expect_each_node_carries_its_load(double mu) {
       worst = std::max(worst, std::abs(-rec.p[c.eta] - load));
       if (c.xi >= 0) friction = std::max(friction, std::abs(rec.p[c.xi]));
     }
-    std::printf("step %d: largest nodal force error %.3g, largest friction %.3g (load per node %.3g)\n",
-                rec.index, worst, friction, per_node * rec.load_factor);
+    std::printf("step %d: largest nodal force error %.3g, largest friction %.3g (load per node %.3g)\n", rec.index,
+                worst, friction, per_node * rec.load_factor);
     EXPECT_LT(worst, 1e-5 * per_node);
     EXPECT_LT(friction, 1e-5 * per_node);
     EXPECT_NEAR(rec.reactions[TimoshenkoBeam::node_dof(0, 1)], 0.0, 1e-5 * per_node);

@@ -33,10 +33,10 @@ Ratio stick_ratio(const nlohmann::json& scene) {
   const SpenceReading r = read_spence(s, s.run.steps.back(), kMu);
   EXPECT_TRUE(r.found && r.c > 0);
   const double size = scene["body"]["mesh"]["rectangle"]["refine"]["size"];
-  std::printf("a %.4f (%+.2f %% of Hertz's), c %.4f, c/a %.4f (0.99 rule %.4f), peak %.4f p0; %ld real solves, "
-              "%.1f s\n",
-              r.a, 100 * (r.a / r.hertz.a - 1), r.c, r.c / r.a, r.c_rule / r.a, r.peak, s.run.counters.solves,
-              s.run.seconds);
+  std::printf(
+      "a %.4f (%+.2f %% of Hertz's), c %.4f, c/a %.4f (0.99 rule %.4f), peak %.4f p0; %ld real solves, "
+      "%.1f s\n",
+      r.a, 100 * (r.a / r.hertz.a - 1), r.c, r.c / r.a, r.c_rule / r.a, r.peak, s.run.counters.solves, s.run.seconds);
   return {r.c / r.a, size / r.a};
 }
 
@@ -54,10 +54,11 @@ TEST(SpenceSlow, StickZoneConvergesInTheMeshAndKeepsToTheHalfPlane) {
   const Ratio c40_20 = stick_ratio(spence_block(coarse, 20, kMu));
   const Ratio deep = stick_ratio(spence_block(coarse, 10, kMu, 1000));
   const Ratio shallow = stick_ratio(spence_block(coarse, 10, kMu, 30));
-  std::printf("model %.4f, relation %.4f; a/h 40: %.4f, a/h 80: %.4f (%+.2f %% of a from the model, %+.2f %% from "
-              "the relation); 20 steps %.4f; depth 1000: %.4f; depth 30: %.4f\n",
-              reference, relation, c40.c_over_a, c80.c_over_a, 100 * (c80.c_over_a - reference),
-              100 * (c80.c_over_a - relation), c40_20.c_over_a, deep.c_over_a, shallow.c_over_a);
+  std::printf(
+      "model %.4f, relation %.4f; a/h 40: %.4f, a/h 80: %.4f (%+.2f %% of a from the model, %+.2f %% from "
+      "the relation); 20 steps %.4f; depth 1000: %.4f; depth 30: %.4f\n",
+      reference, relation, c40.c_over_a, c80.c_over_a, 100 * (c80.c_over_a - reference),
+      100 * (c80.c_over_a - relation), c40_20.c_over_a, deep.c_over_a, shallow.c_over_a);
   for (const Ratio& r : {c80, c40_20, deep}) {
     EXPECT_NEAR(r.c_over_a, reference, 0.03);
     EXPECT_NEAR(r.c_over_a, c40.c_over_a, r.spacing + c40.spacing);

@@ -56,7 +56,8 @@ TEST(SsnCone, BeamOnCylinderWithMuFiveConverges) {
   for (size_t k = 0; k < cev.run.steps.size(); ++k) {
     const StepRecord &a = cev.run.steps[k], &b = ssn.run.steps[k];
     same_path = same_path && a.cuts == 0 && b.cuts == 0;
-    const double d = (a.p - b.p).lpNorm<Eigen::Infinity>() / std::max(1e-300, largest_normal_force(cev.scene.problem, a));
+    const double d =
+        (a.p - b.p).lpNorm<Eigen::Infinity>() / std::max(1e-300, largest_normal_force(cev.scene.problem, a));
     std::printf("step %zu: cuts cev %d ssn %d, forces differ by %.3g of the largest normal force%s\n", k + 1, a.cuts,
                 b.cuts, d, same_path ? "" : " (another load path)");
     if (same_path) EXPECT_LT(d, 1e-3) << "step " << k + 1;

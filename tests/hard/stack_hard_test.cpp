@@ -118,7 +118,9 @@ json stack(double P) {
   json base = continuum("base", 200000, 0.3, {{"half_disc", half_disc({0, -2 * kRadius}, true)}}, "arc_refined");
   base["supports"] = json::array({{{"set", "diameter"}, {"fix", {"x", "y"}}}});
   return {{"bodies", {top, disc, base}},
-          {"contacts", {{{"slave", "top.arc_refined"}, {"master", "disc.top"}}, {{"slave", "disc.bottom"}, {"master", "base.arc_refined"}}}},
+          {"contacts",
+           {{{"slave", "top.arc_refined"}, {"master", "disc.top"}},
+            {{"slave", "disc.bottom"}, {"master", "base.arc_refined"}}}},
           {"steps", 1},
           {"solver", {{"contact", {{"method", "cev"}, {"tolerance", 1e-10}}}}}};
 }
@@ -161,10 +163,10 @@ TEST(StackHard, ThreeCylindersHeldByContactCarryTheForceAndMatchHertz) {
     const double a = std::sqrt(4 * load * R * inverse_E / std::numbers::pi), p0 = 2 * load / (std::numbers::pi * a);
     for (int o : {0, 1}) {
       const EllipseFit fit = fit_semi_ellipse(contact_profile(problem, rec, o));
-      std::printf("step %d, pair %d: P %.0f N/mm, a %.4f mm (fit %+.3f %%), p0 %.1f MPa (fit %+.3f %%); %d real solves, "
-                  "%d Newton\n",
-                  rec.index, o, load, a, 100 * (fit.a / a - 1), p0, 100 * (fit.p0 / p0 - 1), rec.solves,
-                  rec.newton_iterations);
+      std::printf(
+          "step %d, pair %d: P %.0f N/mm, a %.4f mm (fit %+.3f %%), p0 %.1f MPa (fit %+.3f %%); %d real solves, "
+          "%d Newton\n",
+          rec.index, o, load, a, 100 * (fit.a / a - 1), p0, 100 * (fit.p0 / p0 - 1), rec.solves, rec.newton_iterations);
       EXPECT_NEAR(fit.a, a, 0.01 * a) << "step " << rec.index << " pair " << o;
       EXPECT_NEAR(fit.p0, p0, 0.01 * p0) << "step " << rec.index << " pair " << o;
     }

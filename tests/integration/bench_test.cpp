@@ -3,9 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <map>
 #include <mutex>
 #include <thread>
-#include <map>
 
 #include "server/http_server.hpp"
 #include "server/job_service.hpp"
@@ -42,9 +42,10 @@ TEST(Bench, ThroughputOfSmallJobs) {
   const double submit_s = std::chrono::duration<double>(Clock::now() - t0).count();
   for (const auto& id : ids) ASSERT_EQ(api.wait_status(id, {"successful", "failed"})["status"], "successful");
   const double total_s = std::chrono::duration<double>(Clock::now() - t0).count();
-  std::printf("[ bench ] %d jobs (beam, 10 elements, 3 steps) from %d clients: submitted in %.3f s, "
-              "all successful after %.3f s: %.0f jobs/s\n",
-              kJobs, kClients, submit_s, total_s, kJobs / total_s);
+  std::printf(
+      "[ bench ] %d jobs (beam, 10 elements, 3 steps) from %d clients: submitted in %.3f s, "
+      "all successful after %.3f s: %.0f jobs/s\n",
+      kJobs, kClients, submit_s, total_s, kJobs / total_s);
 }
 
 TEST(Bench, DelayFromIterationToClient) {
@@ -97,11 +98,11 @@ TEST(Bench, DelayFromIterationToClient) {
   listener.join();
   service.shutdown(std::chrono::milliseconds(0));
   ASSERT_FALSE(delays_ms.empty());
-  std::printf("[ bench ] iteration -> SSE client delay over %zu live iteration events: median %.3f ms, "
-              "p95 %.3f ms, max %.3f ms (each event committed to SQLite, WAL, before "
-              "it is sent)\n",
-              delays_ms.size(), percentile(delays_ms, 0.5), percentile(delays_ms, 0.95),
-              percentile(delays_ms, 1.0));
+  std::printf(
+      "[ bench ] iteration -> SSE client delay over %zu live iteration events: median %.3f ms, "
+      "p95 %.3f ms, max %.3f ms (each event committed to SQLite, WAL, before "
+      "it is sent)\n",
+      delays_ms.size(), percentile(delays_ms, 0.5), percentile(delays_ms, 0.95), percentile(delays_ms, 1.0));
 }
 
 }  // namespace

@@ -57,10 +57,9 @@ class TempDir {
 // `grip serve --host 127.0.0.1 --port 0 --db DB ARGS...`, its output in a log file.
 class ServerProcess {
  public:
-  ServerProcess(const fs::path& db, std::vector<std::string> args, const fs::path& log)
-      : log_(log) {
-    std::vector<std::string> argv = {GRIP_BINARY, "serve", "--host", "127.0.0.1", "--port", "0",
-                                     "--db", db.string(), "--heartbeat", "1"};
+  ServerProcess(const fs::path& db, std::vector<std::string> args, const fs::path& log) : log_(log) {
+    std::vector<std::string> argv = {GRIP_BINARY, "serve", "--host",    "127.0.0.1",   "--port",
+                                     "0",         "--db",  db.string(), "--heartbeat", "1"};
     argv.insert(argv.end(), args.begin(), args.end());
     const std::streamoff start = fs::exists(log) ? static_cast<std::streamoff>(fs::file_size(log)) : 0;
     pid_ = fork();
@@ -138,8 +137,7 @@ class ServerProcess {
 // A client of one server; every call opens its own connection (thread-safe by copy).
 class Api {
  public:
-  explicit Api(int port, std::optional<std::string> token = std::nullopt)
-      : port_(port), token_(std::move(token)) {}
+  explicit Api(int port, std::optional<std::string> token = std::nullopt) : port_(port), token_(std::move(token)) {}
 
   httplib::Client client(int read_timeout_s = 30) const {
     httplib::Client c("127.0.0.1", port_);
@@ -150,11 +148,8 @@ class Api {
     return c;
   }
 
-  httplib::Result get(const std::string& path, const httplib::Headers& h = {}) const {
-    return client().Get(path, h);
-  }
-  httplib::Result post_json(const std::string& path, const std::string& body,
-                            const httplib::Headers& h = {}) const {
+  httplib::Result get(const std::string& path, const httplib::Headers& h = {}) const { return client().Get(path, h); }
+  httplib::Result post_json(const std::string& path, const std::string& body, const httplib::Headers& h = {}) const {
     return client().Post(path, h, body, "application/json");
   }
   httplib::Result del(const std::string& path) const { return client().Delete(path); }
@@ -290,7 +285,8 @@ inline json beam_scene(int elements, int steps) {
 inline json reference_result(const json& scene, const fs::path& dir, const std::string& name) {
   const fs::path in = dir / (name + ".scene.json"), out = dir / (name + ".result.json");
   std::ofstream(in) << scene.dump();
-  const std::string cmd = std::string(GRIP_BINARY) + " solve " + in.string() + " --out " + out.string() + " > /dev/null";
+  const std::string cmd =
+      std::string(GRIP_BINARY) + " solve " + in.string() + " --out " + out.string() + " > /dev/null";
   if (std::system(cmd.c_str()) != 0) throw std::runtime_error("grip solve failed for " + name);
   return json::parse(read_text(out));
 }

@@ -2,8 +2,8 @@
 // come from the environment; the compose defaults otherwise): a request cut by a replica is
 // retried on another when it is safe to replay, HAProxy's own 503 is grip's problem document
 // with Retry-After, every request is logged, and SIGTERM stops it at once.
-#include <gtest/gtest.h>
 #include <arpa/inet.h>
+#include <gtest/gtest.h>
 #include <netinet/in.h>
 #include <poll.h>
 #include <sys/socket.h>
@@ -64,8 +64,9 @@ class CuttingReplica {
           head.append(buf, static_cast<size_t>(n));
         }
         if (head.rfind("GET /v1/ready ", 0) == 0) {
-          const std::string ok = ready_ ? "HTTP/1.1 200 OK\r\nContent-Length: 0\r\nConnection: close\r\n\r\n"
-                                        : "HTTP/1.1 503 Service Unavailable\r\nContent-Length: 0\r\nConnection: close\r\n\r\n";
+          const std::string ok =
+              ready_ ? "HTTP/1.1 200 OK\r\nContent-Length: 0\r\nConnection: close\r\n\r\n"
+                     : "HTTP/1.1 503 Service Unavailable\r\nContent-Length: 0\r\nConnection: close\r\n\r\n";
           ::send(c, ok.data(), ok.size(), MSG_NOSIGNAL);
         } else if (!head.empty()) {
           ++cuts_;
@@ -184,7 +185,8 @@ TEST(HaproxyFront, RetriesSafeRequestsAnswersProblemJson503LogsAndStopsAtOnce) {
   }
   EXPECT_EQ(other, 0);
   EXPECT_EQ(bad_gateway, cutting.cuts() - cuts_before)  // each cut POST: one 502, not retried
-      << "created " << created << "; haproxy's log:\n" << read_text(dir.path() / "haproxy.log");
+      << "created " << created << "; haproxy's log:\n"
+      << read_text(dir.path() / "haproxy.log");
   const json jobs = json::parse(Api(grip.port()).get("/v1/jobs?limit=100")->body)["jobs"];
   EXPECT_EQ(static_cast<int>(jobs.size()), created);
 
@@ -208,8 +210,13 @@ TEST(HaproxyFront, RetriesSafeRequestsAnswersProblemJson503LogsAndStopsAtOnce) {
   EXPECT_EQ(retry_after, "5");
   EXPECT_EQ(json::parse(body, nullptr, false).value("type", std::string()), "urn:grip:problem:no-replica-ready");
 
-  // Logged: one line per request, with its method, path and status.
-  const std::string log = read_text(dir.path() / "haproxy.log");
+  // Logged: one line per request, with its method, path and status. HAProxy writes its log
+  // line after the response has gone out, so the last one may land a moment later.
+  std::string log = read_text(dir.path() / "haproxy.log");
+  for (int i = 0; i < 100 && log.find(" 503 ") == std::string::npos; ++i) {
+    std::this_thread::sleep_for(50ms);
+    log = read_text(dir.path() / "haproxy.log");
+  }
   EXPECT_NE(log.find("\"GET /v1/health HTTP/1.1\""), std::string::npos) << log.substr(0, 2000);
   EXPECT_NE(log.find(" 503 "), std::string::npos) << log;
 

@@ -6,9 +6,9 @@
 // all of 127/8 to lo) than the well-behaved client (127.0.0.1), as they would from other
 // hosts; none of them reaches the limit per address, so it is the deadlines and the thread per
 // connection that keep the service answering, not that limit.
-#include <gtest/gtest.h>
 #include <arpa/inet.h>
 #include <fcntl.h>
+#include <gtest/gtest.h>
 #include <netinet/in.h>
 #include <poll.h>
 #include <sys/socket.h>
@@ -28,9 +28,7 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-double ms_since(Clock::time_point t) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
-}
+double ms_since(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
 
 // A connection from `source` (a loopback address) to the server; -1 on failure.
 int connect_from(const std::string& source, int port) {
@@ -103,9 +101,7 @@ std::string read_now(int fd, bool& closed) {
   }
 }
 
-std::string attacker(int i) {
-  return "127.0.1." + std::to_string(1 + i % 200);
-}
+std::string attacker(int i) { return "127.0.1." + std::to_string(1 + i % 200); }
 
 json problem_of(const std::string& answer) {
   const size_t at = answer.find("\r\n\r\n");
@@ -205,12 +201,12 @@ TEST(HostileClients, SlowAndIdleConnectionsStarveNeitherHealthNorJobs) {
 
   std::sort(health_ms.begin(), health_ms.end());
   const auto finished = [&](const json& d) { return d.value("finished", std::string()); };
-  std::printf("[ info ] /v1/health under attack: %zu requests, median %.1f ms, max %.1f ms\n",
-              health_ms.size(), health_ms[health_ms.size() / 2], health_ms.back());
+  std::printf("[ info ] /v1/health under attack: %zu requests, median %.1f ms, max %.1f ms\n", health_ms.size(),
+              health_ms[health_ms.size() / 2], health_ms.back());
   std::printf("[ info ] job submitted at %.0f ms: solve %.3f s, created %s, finished %s\n", submitted_ms,
               doc.value("solve_seconds", 0.0), doc.value("created", std::string()).c_str(), finished(doc).c_str());
-  std::printf("[ info ] slow heads: %d answered 408, %d closed otherwise; %d connections reopened\n",
-              answered_408, closed_without_408, reopened);
+  std::printf("[ info ] slow heads: %d answered 408, %d closed otherwise; %d connections reopened\n", answered_408,
+              closed_without_408, reopened);
   EXPECT_EQ(health_ok, static_cast<int>(health_ms.size()));
   EXPECT_EQ(doc["status"], "successful");
   // 7 s of attack against a 2 s head deadline: the first wave of slow heads was cut, most with
@@ -330,8 +326,8 @@ TEST(HostileClients, FaviconIsNoContentNotNotFound) {
 // (cpp-httplib alone freed about 20 of the 32 at once, the others at the heartbeat.)
 TEST(HostileClients, DroppedStreamsOnAQuietJobFreeTheirSlotsAtOnce) {
   TempDir dir;
-  ServerProcess server(dir.path() / "grip.sqlite",
-                       {"--workers", "1", "--streams", "32", "--heartbeat", "15"}, dir.path() / "server.log");
+  ServerProcess server(dir.path() / "grip.sqlite", {"--workers", "1", "--streams", "32", "--heartbeat", "15"},
+                       dir.path() / "server.log");
   const Api api(server.port());
   // Some 50 s of solving (10,000 slide steps; dismissed at the end) holds the only worker.
   json long_job = json::parse(read_text(fs::path(GRIP_SOURCE_DIR) / "tests/load/small-job.json"));

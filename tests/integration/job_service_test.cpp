@@ -1,14 +1,18 @@
 // The job API without sockets: JobService over a SQLite store in a temporary folder.
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <condition_variable>
 #include <mutex>
 #include <thread>
 
 // Eigen (through the solver) before httplib.h, whose <resolv.h> defines `_res`.
+#include "server/compression.hpp"
 #include "server/job_service.hpp"
 #include "server/sqlite_store.hpp"
+#include "server/util.hpp"
 #include "solver/io/scene.hpp"
 // clang-format off
 #include "grip_process.hpp"
@@ -102,7 +106,7 @@ nlohmann::json failed_job_result(const nlohmann::json& scene, const std::string&
     ADD_FAILURE() << "no result stored for the failed job";
     return nlohmann::json::object();
   }
-  return nlohmann::json::parse(*result);
+  return nlohmann::json::parse(server::stored_text(*result));  // stored compressed
 }
 
 // A body held only by contact under a shear load above mu N
@@ -121,8 +125,7 @@ TEST(JobService, AShearLoadAboveWhatFrictionHoldsFailsTheJobWithItsReason) {
 // says why, with the two steps solved before it in its result, and no fields for the failed step.
 TEST(JobService, ACoupleAboveWhatFrictionHoldsFailsTheJobWithItsReason) {
   const nlohmann::json r = failed_job_result(
-      turned_beyond_the_limit(),
-      "step 3 failed: the couple exceeds what friction can hold: M / (mu sum N r) = 1.06");
+      turned_beyond_the_limit(), "step 3 failed: the couple exceeds what friction can hold: M / (mu sum N r) = 1.06");
   ASSERT_EQ(r["steps"].size(), 3u);
   for (int k = 0; k < 2; ++k) EXPECT_TRUE(r["steps"][k]["converged"].get<bool>());
   EXPECT_FALSE(r["steps"][2]["converged"].get<bool>());
@@ -258,28 +261,53 @@ TEST(JobService, RetryAfterIsTheTimeUntilAWorkerFreesNotTheTimeToDrainTheQueue) 
 }
 
 // The lease thread renews the leases it saw a moment before; a job claimed meanwhile was not
-// among them and must not be taken for lost (issue 34: 14 of 16,500 small jobs were abandoned
-// that way and rerun only when their lease expired). A short lease renews every 100 ms, so
-// hundreds of claims fall between a snapshot and its renewal: every job must run once.
-TEST(JobService, ARenewalNeverTakesAJobOfItsOwnReplicaForLost) {
+// among them and must not be taken for lost (issue 34: 14 of 16,500 small jobs from 8 clients
+// were abandoned that way and ran again only when their 10 s lease expired). A 1 s lease
+// renews every 333 ms, 30 times as often per job as the 10 s default, so thousands of claims
+// fall near a renewal: every job must run once (a job abandoned by its own replica runs a
+// second time, after its lease expires). The time from submission to end beyond the solve is
+// printed, not judged: alone it stays under 0.1 s, but a full parallel test run on the shared
+// 2 cores held some jobs 1.6 s in the queue, longer than a 1 s lease's expiry would. The
+// 20,000 jobs of the load run: bench/lease_race.py, bench/results/hostile-clients.md.
+TEST(JobService, ThousandsOfShortJobsFromEightClientsWithAShortLeaseEachRunOnce) {
   TempDir dir;
   SqliteStore store((dir.path() / "grip.sqlite").string());
   ServiceOptions options;
   options.workers = 2;
-  options.queue_capacity = 1000;
-  options.lease_seconds = 0.3;
+  options.queue_capacity = 100;
+  options.lease_seconds = 1.0;
   JobService service(store, options);
   service.start();
   const nlohmann::json scene = beam_scene(4, 1);
-  std::vector<std::string> ids;
-  for (int i = 0; i < 400; ++i) ids.push_back(service.submit(scene).job.record.id);
-  for (const auto& id : ids) events_to_end(service, id);
-  int rerun = 0;
-  for (const auto& id : ids) {
-    const auto record = service.job(id)->record;
-    EXPECT_EQ(record.status, JobStatus::successful) << id << ": " << record.message;
-    if (record.attempts != 1) ++rerun;
-  }
+  constexpr int kClients = 8, kJobs = 3000;
+  std::atomic<int> next{0};
+  std::vector<std::vector<std::string>> ids(kClients);
+  std::vector<std::thread> clients;
+  for (int c = 0; c < kClients; ++c)
+    clients.emplace_back([&, c] {
+      while (next.fetch_add(1) < kJobs) {  // each client: submit, follow to the end, again
+        ids[c].push_back(service.submit(scene).job.record.id);
+        events_to_end(service, ids[c].back());
+      }
+    });
+  for (auto& t : clients) t.join();
+  int rerun = 0, delayed = 0, jobs = 0;
+  double worst = 0;
+  for (const auto& client : ids)
+    for (const auto& id : client) {
+      ++jobs;
+      const auto record = service.job(id)->record;
+      EXPECT_EQ(record.status, JobStatus::successful) << id << ": " << record.message;
+      if (record.attempts != 1) ++rerun;
+      const auto created = server::parse_iso8601(record.created), finished = server::parse_iso8601(record.finished);
+      ASSERT_TRUE(created && finished) << record.created << " " << record.finished;
+      const double beyond = std::chrono::duration<double>(*finished - *created).count() - record.solve_seconds;
+      worst = std::max(worst, beyond);
+      if (beyond >= options.lease_seconds) ++delayed;
+    }
+  std::printf("[ info ] %d jobs, 8 clients: at most %.3f s from submission to end beyond the solve, %d over %.0f s\n",
+              jobs, worst, delayed, options.lease_seconds);
+  EXPECT_EQ(jobs, kJobs);
   EXPECT_EQ(rerun, 0) << "jobs run more than once (abandoned as lost, rerun after their lease expired)";
 }
 

@@ -3,8 +3,8 @@
 // {pointer, detail}) and, where a field is at fault, that field's JSON pointer. After every
 // request the server must answer /v1/health; at the end the jobs solved before the table are
 // still there, successful, with the same stored result, and no malformed request made a job.
-#include <gtest/gtest.h>
 #include <arpa/inet.h>
+#include <gtest/gtest.h>
 #include <netinet/in.h>
 #include <sys/socket.h>
 #include <unistd.h>
@@ -126,8 +126,10 @@ TEST(MalformedRequests, TableOfBadRequestsGetTheirProblemAndHarmNothing) {
       {"empty body", 400, "", "POST", "/v1/jobs", ""},
       {"whitespace only", 400, "", "POST", "/v1/jobs", " \n\t "},
       {"NaN as a bare word (young: NaN)", 400, "", "POST", "/v1/jobs", replaced(beam_text, "210000", "NaN")},
-      {"Infinity as a bare word (young: -Infinity)", 400, "", "POST", "/v1/jobs", replaced(beam_text, "210000", "-Infinity")},
-      {"number out of double range (young: 1e400)", 400, "", "POST", "/v1/jobs", replaced(beam_text, "210000", "1e400")},
+      {"Infinity as a bare word (young: -Infinity)", 400, "", "POST", "/v1/jobs",
+       replaced(beam_text, "210000", "-Infinity")},
+      {"number out of double range (young: 1e400)", 400, "", "POST", "/v1/jobs",
+       replaced(beam_text, "210000", "1e400")},
       {"bad UTF-8 in a string (0xFF)", 400, "", "POST", "/v1/jobs", replaced(beam_text, "beam-on", "beam-\xff-on")},
       {"overlong UTF-8 (0xC0 0xAF)", 400, "", "POST", "/v1/jobs", replaced(beam_text, "beam-on", "beam-\xc0\xaf-on")},
       {"lone surrogate escape \\ud800", 400, "", "POST", "/v1/jobs", replaced(beam_text, "beam-on", "beam-\\ud800-on")},
@@ -141,7 +143,13 @@ TEST(MalformedRequests, TableOfBadRequestsGetTheirProblemAndHarmNothing) {
        replaced(beam_text, "210000", repeat("[", 100000) + repeat("]", 100000))},
       {"100000 nested objects", 400, "", "POST", "/v1/jobs", repeat("{\"a\":", 100000) + "1" + repeat("}", 100000)},
       {"1000000 unclosed [", 400, "", "POST", "/v1/jobs", repeat("[", 1000000)},
-      {"Idempotency-Key of 300 characters", 400, "", "POST", "/v1/jobs", beam_text, "application/json",
+      {"Idempotency-Key of 300 characters",
+       400,
+       "",
+       "POST",
+       "/v1/jobs",
+       beam_text,
+       "application/json",
        {{"Idempotency-Key", std::string(300, 'k')}}},
       // 413, 415
       {"100 MB body with a Content-Length", 413, "", "POST", "/v1/jobs", "", "application/json", {}, 100'000'000},
@@ -171,13 +179,25 @@ TEST(MalformedRequests, TableOfBadRequestsGetTheirProblemAndHarmNothing) {
       {"beam elements 1000000", 422, "/body/mesh/elements", "POST", "/v1/jobs",
        edited(beam, [](json& s) { s["body"]["mesh"]["elements"] = 1000000; })},
       {"rectangle divisions [1000, 1000] (1e6 nodes)", 422, "/body/mesh", "POST", "/v1/jobs",
-       edited(block, [](json& s) { s["body"]["mesh"]["rectangle"]["divisions"] = {1000, 1000}; })},
+       edited(block,
+              [](json& s) {
+                s["body"]["mesh"]["rectangle"]["divisions"] = {1000, 1000};
+              })},
       {"rectangle divisions [-20, 10]", 422, "/body/mesh/rectangle/divisions/0", "POST", "/v1/jobs",
-       edited(block, [](json& s) { s["body"]["mesh"]["rectangle"]["divisions"] = {-20, 10}; })},
+       edited(block,
+              [](json& s) {
+                s["body"]["mesh"]["rectangle"]["divisions"] = {-20, 10};
+              })},
       {"rectangle size [-20, 10]", 422, "/body/mesh/rectangle/size/0", "POST", "/v1/jobs",
-       edited(block, [](json& s) { s["body"]["mesh"]["rectangle"]["size"] = {-20, 10}; })},
+       edited(block,
+              [](json& s) {
+                s["body"]["mesh"]["rectangle"]["size"] = {-20, 10};
+              })},
       {"200000 equal membrane nodes (errors listed up to 100)", 422, "/body/mesh/nodes/1", "POST", "/v1/jobs",
-       edited(sheet, [](json& s) { s["body"]["mesh"] = {{"nodes", json(200000, json::array({0, 0}))}}; })},
+       edited(sheet,
+              [](json& s) {
+                s["body"]["mesh"] = {{"nodes", json(200000, json::array({0, 0}))}};
+              })},
       {"steps -3", 422, "/steps", "POST", "/v1/jobs", edited(beam, [](json& s) { s["steps"] = -3; })},
       {"steps 1000000000", 422, "/steps", "POST", "/v1/jobs", edited(beam, [](json& s) { s["steps"] = 1000000000; })},
       {"steps 20000 (over --max-steps 10000)", 422, "/steps", "POST", "/v1/jobs",
@@ -209,16 +229,28 @@ TEST(MalformedRequests, TableOfBadRequestsGetTheirProblemAndHarmNothing) {
       {"solver.start names a missing obstacle", 422, "/solver/start/obstacle", "POST", "/v1/jobs",
        edited(sheet, [](json& s) { s["solver"]["start"]["obstacle"] = "nope"; })},
       {"stage factors name a missing load case", 422, "/stages/1/factors/nope", "POST", "/v1/jobs",
-       edited(block, [](json& s) { s["stages"][1]["factors"] = {{"nope", 1}}; })},
+       edited(block,
+              [](json& s) {
+                s["stages"][1]["factors"] = {{"nope", 1}};
+              })},
       {"stage friction names a missing obstacle", 422, "/stages/1/friction/nowhere", "POST", "/v1/jobs",
-       edited(block, [](json& s) { s["stages"][1]["friction"] = {{"nowhere", 0.1}}; })},
+       edited(block,
+              [](json& s) {
+                s["stages"][1]["friction"] = {{"nowhere", 0.1}};
+              })},
       {"obstacles an object", 422, "/obstacles", "POST", "/v1/jobs",
-       edited(beam, [](json& s) { s["obstacles"] = {{"a", 1}}; })},
+       edited(beam,
+              [](json& s) {
+                s["obstacles"] = {{"a", 1}};
+              })},
       {"body an array", 422, "/body", "POST", "/v1/jobs", edited(beam, [](json& s) { s["body"] = {1}; })},
       {"loads[0] a number", 422, "/body/loads/0", "POST", "/v1/jobs",
        edited(beam, [](json& s) { s["body"]["loads"][0] = 5; })},
       {"force with 3 components", 422, "/body/loads/0/force", "POST", "/v1/jobs",
-       edited(beam, [](json& s) { s["body"]["loads"][0]["force"] = {0, -500, 1}; })},
+       edited(beam,
+              [](json& s) {
+                s["body"]["loads"][0]["force"] = {0, -500, 1};
+              })},
       {"unknown top-level field", 422, "/colour", "POST", "/v1/jobs",
        edited(beam, [](json& s) { s["colour"] = "red"; })},
       {"unknown nested field", 422, "/body/material/colour", "POST", "/v1/jobs",
@@ -227,8 +259,14 @@ TEST(MalformedRequests, TableOfBadRequestsGetTheirProblemAndHarmNothing) {
        beam_text.substr(0, beam_text.size() - 1) + ",\"steps\":-1}"},
       {"OGC execute with inputs.scene = 5", 422, "/inputs/scene", "POST", "/processes/contact2d/execution",
        "{\"inputs\": {\"scene\": 5}}"},
-      {"Idempotency-Key reused with another scene", 422, "", "POST", "/v1/jobs",
-       edited(small_block, [](json& s) { s["name"] = "another"; }), "application/json", {{"Idempotency-Key", "good-1"}}},
+      {"Idempotency-Key reused with another scene",
+       422,
+       "",
+       "POST",
+       "/v1/jobs",
+       edited(small_block, [](json& s) { s["name"] = "another"; }),
+       "application/json",
+       {{"Idempotency-Key", "good-1"}}},
       // GET /v1/jobs parameters
       {"GET /v1/jobs?limit=-1", 400, "", "GET", "/v1/jobs?limit=-1"},
       {"GET /v1/jobs?limit=abc", 400, "", "GET", "/v1/jobs?limit=abc"},
@@ -249,7 +287,13 @@ TEST(MalformedRequests, TableOfBadRequestsGetTheirProblemAndHarmNothing) {
       // events and result of a real job
       {"events with Last-Event-ID: abc", 400, "", "GET", job + "/events", "", "", {{"Last-Event-ID", "abc"}}},
       {"events with Last-Event-ID: -1", 400, "", "GET", job + "/events", "", "", {{"Last-Event-ID", "-1"}}},
-      {"events with Last-Event-ID: 99999999999999999999", 400, "", "GET", job + "/events", "", "",
+      {"events with Last-Event-ID: 99999999999999999999",
+       400,
+       "",
+       "GET",
+       job + "/events",
+       "",
+       "",
        {{"Last-Event-ID", "99999999999999999999"}}},
       {"events?after=x", 400, "", "GET", job + "/events?after=x"},
       {"events?format=xml", 400, "", "GET", job + "/events?format=xml"},

@@ -33,13 +33,15 @@ TEST(Restart, KillNineLosesNoAcceptedJobAndResultsEqualAnUninterruptedRun) {
   }
   ServerProcess server(db, {"--workers", "2"}, log);
   const Api api(server.port());
-  for (const auto& id : ids) EXPECT_EQ(api.wait_status(id, {"successful", "failed", "dismissed"})["status"], "successful") << id;
+  for (const auto& id : ids)
+    EXPECT_EQ(api.wait_status(id, {"successful", "failed", "dismissed"})["status"], "successful") << id;
   // A result finished before the crash is intact, byte for byte.
   EXPECT_EQ(api.get("/v1/jobs/" + ids[0] + "/result")->body, finished_before_kill);
   // Every result equals an uninterrupted run's.
   for (size_t i = 0; i < ids.size(); ++i) {
     const json got = json::parse(api.get("/v1/jobs/" + ids[i] + "/result")->body);
-    EXPECT_EQ(without_timings(got), without_timings(reference_result(scenes[i], dir.path(), "scene" + std::to_string(i))))
+    EXPECT_EQ(without_timings(got),
+              without_timings(reference_result(scenes[i], dir.path(), "scene" + std::to_string(i))))
         << "job " << i;
   }
   // The interrupted job ran again: its events are the new run's, numbered above every id a

@@ -14,8 +14,8 @@
 // server share the machine's clock). Only live events count: those whose estimated time is
 // after the stream was opened (replayed ones are not a delay).
 #include <httplib.h>
-#include <nlohmann/json.hpp>
 #include <unistd.h>
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <atomic>
@@ -97,8 +97,8 @@ double percentile(std::vector<double> v, double q) {
 std::optional<Wall::time_point> parse_iso(const std::string& s) {
   std::tm tm{};
   int ms = 0;
-  if (std::sscanf(s.c_str(), "%d-%d-%dT%d:%d:%d.%dZ", &tm.tm_year, &tm.tm_mon, &tm.tm_mday,
-                  &tm.tm_hour, &tm.tm_min, &tm.tm_sec, &ms) != 7)
+  if (std::sscanf(s.c_str(), "%d-%d-%dT%d:%d:%d.%dZ", &tm.tm_year, &tm.tm_mon, &tm.tm_mday, &tm.tm_hour, &tm.tm_min,
+                  &tm.tm_sec, &ms) != 7)
     return std::nullopt;
   tm.tm_year -= 1900;
   tm.tm_mon -= 1;
@@ -109,7 +109,8 @@ std::optional<Wall::time_point> parse_iso(const std::string& s) {
 int expected_steps(const json& scene) {
   if (scene.contains("stages")) {
     int n = 0;
-    for (const auto& st : scene["stages"]) n += st["steps"].is_array() ? static_cast<int>(st["steps"].size()) : st["steps"].get<int>();
+    for (const auto& st : scene["stages"])
+      n += st["steps"].is_array() ? static_cast<int>(st["steps"].size()) : st["steps"].get<int>();
     return n;
   }
   const json& s = scene.at("steps");
@@ -142,22 +143,22 @@ struct Run {
 
   std::atomic<int> next_job{0};
   std::atomic<int> submitters_left{0};
-  std::atomic<long> rejected_503{0};       // queue full: retried after Retry-After
-  std::atomic<long> stream_503{0};         // too many streams: retried after Retry-After
-  std::atomic<long> transport_errors{0};   // no response; retried (same Idempotency-Key)
-  std::atomic<long> other_status{0};       // any other answer to a submission
-  std::atomic<long> replays{0};            // Idempotent-Replayed answers
+  std::atomic<long> rejected_503{0};      // queue full: retried after Retry-After
+  std::atomic<long> stream_503{0};        // too many streams: retried after Retry-After
+  std::atomic<long> transport_errors{0};  // no response; retried (same Idempotency-Key)
+  std::atomic<long> other_status{0};      // any other answer to a submission
+  std::atomic<long> replays{0};           // Idempotent-Replayed answers
 
   std::mutex m;
   std::condition_variable cv;
-  std::vector<std::string> accepted;       // every job acknowledged with 201
-  std::vector<std::string> to_follow;      // accepted, not yet followed (newest at the back)
-  std::vector<double> submit_ms;           // latency of the accepted attempt
-  std::vector<double> delay_ms;            // live iteration events
+  std::vector<std::string> accepted;   // every job acknowledged with 201
+  std::vector<std::string> to_follow;  // accepted, not yet followed (newest at the back)
+  std::vector<double> submit_ms;       // latency of the accepted attempt
+  std::vector<double> delay_ms;        // live iteration events
   long events_received = 0;
   long live_iterations = 0;
   long streams_followed = 0;
-  long streams_incomplete = 0;             // no terminal event, or ids not consecutive
+  long streams_incomplete = 0;  // no terminal event, or ids not consecutive
   std::vector<std::string> problems;
 
   httplib::Client client(int read_timeout_s = 30) const {
@@ -322,8 +323,8 @@ void streamer(Run& run) {
       for (const auto& it : f.iterations) {
         const auto s = step_start.find(it.step);
         if (s == step_start.end()) continue;
-        const Wall::time_point produced =
-            s->second + std::chrono::duration_cast<Wall::duration>(std::chrono::duration<double, std::milli>(it.elapsed_ms));
+        const Wall::time_point produced = s->second + std::chrono::duration_cast<Wall::duration>(
+                                                          std::chrono::duration<double, std::milli>(it.elapsed_ms));
         if (produced < f.opened) continue;  // replayed, not live
         delays.push_back(std::chrono::duration<double, std::milli>(it.received - produced).count());
       }
@@ -376,8 +377,7 @@ void verify(Run& run, const std::vector<std::string>& ids, Verified& v, std::mut
       if (r && r->status == 200) result = json::parse(r->body, nullptr, false);
       if (!result.is_object() || !result.contains("steps") || !result["steps"].is_array() ||
           static_cast<int>(result["steps"].size()) != run.steps ||
-          result["summary"].value("completed", false) != true ||
-          result["summary"].value("steps", -1) != run.steps)
+          result["summary"].value("completed", false) != true || result["summary"].value("steps", -1) != run.steps)
         bad = "incomplete";
       else
         for (const auto& st : result["steps"]) bad = st.value("converged", false) ? bad : "incomplete";
@@ -409,7 +409,8 @@ int main(int argc, char** argv) {
     run.scene_body = scene.dump();
     run.steps = expected_steps(scene);
   }
-  run.deadline = Steady::now() + std::chrono::duration_cast<Steady::duration>(std::chrono::duration<double>(o.timeout_s));
+  run.deadline =
+      Steady::now() + std::chrono::duration_cast<Steady::duration>(std::chrono::duration<double>(o.timeout_s));
   if (auto r = run.client().Get("/v1/health"); !r || r->status != 200) {
     std::fprintf(stderr, "grip_load: no healthy server on %s:%d\n", o.host.c_str(), o.port);
     return 2;
@@ -451,32 +452,31 @@ int main(int argc, char** argv) {
   const long accepted = static_cast<long>(run.accepted.size());
   const double server_span_s =
       v.last_finished > v.first_created ? std::chrono::duration<double>(v.last_finished - v.first_created).count() : 0;
-  const bool all_ok = accepted == o.jobs && v.successful == accepted && run.other_status == 0 &&
-                      run.streams_incomplete == 0;
+  const bool all_ok =
+      accepted == o.jobs && v.successful == accepted && run.other_status == 0 && run.streams_incomplete == 0;
 
   char buf[4096];
-  std::snprintf(
-      buf, sizeof buf,
-      "| jobs submitted / accepted / successful with a complete result | %d / %ld / %ld |\n"
-      "| failed / unfinished / missing / incomplete result | %ld / %ld / %ld / %ld |\n"
-      "| clients, event streams | %d, %d |\n"
-      "| steps per job | %d |\n"
-      "| throughput (server: first created to last finished) | %.1f jobs/s (%.2f s) |\n"
-      "| throughput (client: first submit to last verified) | %.1f jobs/s (%.2f s) |\n"
-      "| submit latency p50 / p99 / max (accepted attempts) | %.1f / %.1f / %.1f ms |\n"
-      "| 503 answers: queue full / stream cap (each retried after Retry-After) | %ld / %ld |\n"
-      "| other submit answers, transport errors, idempotent replays | %ld, %ld, %ld |\n"
-      "| streams followed to the end (incomplete) | %ld (%ld) |\n"
-      "| events received, live iteration events measured | %ld, %ld |\n"
-      "| iteration -> event delay p50 / p99 / max (upper bound, see below) | %.1f / %.1f / %.1f ms |\n"
-      "| server peak memory VmHWM (max VmRSS sampled) | %.1f MiB (%.1f MiB) |\n",
-      o.jobs, accepted, v.successful, v.failed, v.unfinished, v.missing, v.incomplete, o.clients,
-      o.streams, run.steps, server_span_s > 0 ? accepted / server_span_s : 0.0, server_span_s,
-      accepted / done_s, done_s, percentile(run.submit_ms, 0.5), percentile(run.submit_ms, 0.99),
-      percentile(run.submit_ms, 1.0), run.rejected_503.load(), run.stream_503.load(),
-      run.other_status.load(), run.transport_errors.load(), run.replays.load(), run.streams_followed,
-      run.streams_incomplete, run.events_received, run.live_iterations, percentile(run.delay_ms, 0.5),
-      percentile(run.delay_ms, 0.99), percentile(run.delay_ms, 1.0), hwm_kib / 1024.0, rss_max_kib / 1024.0);
+  std::snprintf(buf, sizeof buf,
+                "| jobs submitted / accepted / successful with a complete result | %d / %ld / %ld |\n"
+                "| failed / unfinished / missing / incomplete result | %ld / %ld / %ld / %ld |\n"
+                "| clients, event streams | %d, %d |\n"
+                "| steps per job | %d |\n"
+                "| throughput (server: first created to last finished) | %.1f jobs/s (%.2f s) |\n"
+                "| throughput (client: first submit to last verified) | %.1f jobs/s (%.2f s) |\n"
+                "| submit latency p50 / p99 / max (accepted attempts) | %.1f / %.1f / %.1f ms |\n"
+                "| 503 answers: queue full / stream cap (each retried after Retry-After) | %ld / %ld |\n"
+                "| other submit answers, transport errors, idempotent replays | %ld, %ld, %ld |\n"
+                "| streams followed to the end (incomplete) | %ld (%ld) |\n"
+                "| events received, live iteration events measured | %ld, %ld |\n"
+                "| iteration -> event delay p50 / p99 / max (upper bound, see below) | %.1f / %.1f / %.1f ms |\n"
+                "| server peak memory VmHWM (max VmRSS sampled) | %.1f MiB (%.1f MiB) |\n",
+                o.jobs, accepted, v.successful, v.failed, v.unfinished, v.missing, v.incomplete, o.clients, o.streams,
+                run.steps, server_span_s > 0 ? accepted / server_span_s : 0.0, server_span_s, accepted / done_s, done_s,
+                percentile(run.submit_ms, 0.5), percentile(run.submit_ms, 0.99), percentile(run.submit_ms, 1.0),
+                run.rejected_503.load(), run.stream_503.load(), run.other_status.load(), run.transport_errors.load(),
+                run.replays.load(), run.streams_followed, run.streams_incomplete, run.events_received,
+                run.live_iterations, percentile(run.delay_ms, 0.5), percentile(run.delay_ms, 0.99),
+                percentile(run.delay_ms, 1.0), hwm_kib / 1024.0, rss_max_kib / 1024.0);
   const std::string table = std::string("| | |\n|---|---|\n") + buf;
   std::printf("%s", table.c_str());
   std::printf("submission phase %.2f s; all %s\n", submit_s, all_ok ? "successful" : "NOT successful");

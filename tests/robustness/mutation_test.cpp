@@ -63,9 +63,10 @@ void run_variant(const Variant& v, Counts& n) {
 }
 
 void report(const Counts& n) {
-  std::printf("[mutation] solves %d: completed %d, failed with a reason %d, rejected %d; steps converged %d "
-              "(failing the checks: %d), failed %d\n",
-              n.solves, n.completed, n.failed, n.rejected, n.converged_steps, n.unsound_steps, n.failed_steps);
+  std::printf(
+      "[mutation] solves %d: completed %d, failed with a reason %d, rejected %d; steps converged %d "
+      "(failing the checks: %d), failed %d\n",
+      n.solves, n.completed, n.failed, n.rejected, n.converged_steps, n.unsound_steps, n.failed_steps);
   for (const auto& [why, count] : n.reasons) std::printf("[mutation]   %3d x %s\n", count, why.c_str());
 }
 

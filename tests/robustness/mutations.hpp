@@ -89,14 +89,20 @@ inline std::vector<Change> single_changes() {
       return true;
     };
   };
-  auto tolerance = [contact](double t) { return [contact, t](json& j) { contact(j)["tolerance"] = t; return true; }; };
+  auto tolerance = [contact](double t) {
+    return [contact, t](json& j) {
+      contact(j)["tolerance"] = t;
+      return true;
+    };
+  };
   auto loads = [](double f) { return [f](json& j) { return scale_keys(j, {"force", "traction", "moment"}, f); }; };
   auto stiffness = [](double f) { return [f](json& j) { return scale_keys(j, {"young"}, f); }; };
   // Prescribed displacements and obstacle motions (the membrane's start-up depth with them).
   auto indentation = [](double f) {
     return [f](json& j) {
       bool changed = scale_keys(j, {"values", "translation"}, f);
-      if (j.contains("solver") && j["solver"].contains("start")) changed |= scale_keys(j["solver"]["start"], {"value"}, f);
+      if (j.contains("solver") && j["solver"].contains("start"))
+        changed |= scale_keys(j["solver"]["start"], {"value"}, f);
       return changed;
     };
   };
@@ -116,7 +122,10 @@ inline std::vector<Change> single_changes() {
       {"passes", method("cev", {{"friction_loop", "passes"}})},
       {"uzawa", method("uzawa", {{"max_iterations", 200}})},
       // The force unit N -> kN: every force and stress / 1000 (the displacements are the same).
-      {"kN", [](json& j) { return scale_keys(j, {"force", "traction", "moment", "young", "H"}, 1e-3); }},
+      {"kN",
+       [](json& j) {
+         return scale_keys(j, {"force", "traction", "moment", "young", "H"}, 1e-3);
+       }},
       {"E_x1e6", stiffness(1e6)},
       {"E_x1e-2", stiffness(1e-2)},
       {"load_x1e-6", loads(1e-6)},

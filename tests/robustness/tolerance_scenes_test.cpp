@@ -100,12 +100,15 @@ void expect_held_in_balance(const std::string& name) {
     const Vec2 load = load_resultant(s.scene.problem, rec), contact = contact_resultant(s.scene.problem, rec);
     const double size = load.cwiseAbs().maxCoeff();
     EXPECT_LT((load + contact).cwiseAbs().maxCoeff(), 1e-7 * size)
-        << name << " step " << rec.index << ": load (" << load.transpose() << "), contact (" << contact.transpose() << ")";
+        << name << " step " << rec.index << ": load (" << load.transpose() << "), contact (" << contact.transpose()
+        << ")";
     EXPECT_TRUE(converged_step_sound(s, rec)) << name;
   }
 }
 
-TEST(RobustnessTolerance, HeldBlockWithEx1e6BalancesItsLoads) { expect_held_in_balance("block-held-by-friction__E1e6"); }
+TEST(RobustnessTolerance, HeldBlockWithEx1e6BalancesItsLoads) {
+  expect_held_in_balance("block-held-by-friction__E1e6");
+}
 
 TEST(RobustnessTolerance, FreeBeamUnderTinyLoadsBalancesItsPush) {
   expect_held_in_balance("beam-on-cylinder__freebeam_load1e-6");

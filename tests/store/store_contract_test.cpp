@@ -179,7 +179,7 @@ TEST_P(StoreContract, AnExpiredLeaseIsTakenOverAndTheOldRunIsFencedOut) {
   EXPECT_EQ(store->requeue_expired("2025-01-01T00:00:02.000Z"), 1);
   auto j = store->job("job-a", false);
   EXPECT_EQ(j->status, JobStatus::accepted);
-  EXPECT_EQ(j->last_seq, 3);  // ids given out stay given out
+  EXPECT_EQ(j->last_seq, 3);                                  // ids given out stay given out
   EXPECT_TRUE(store->events_after("job-a", 0, 100).empty());  // the interrupted run's events
 
   const auto run2 = store->claim_job("alive", "2025-01-01T00:00:03.000Z", 30);
@@ -347,6 +347,87 @@ TEST_P(StoreContract, AReopenedStoreKeepsEverythingAndFreesWhatTheDeadProcessHel
   EXPECT_EQ(again->id, "running");  // still the oldest
   EXPECT_EQ(again->generation, generation + 1);
   EXPECT_EQ(again->attempts, 2);
+}
+
+// Runs job `id` to its end: claimed, `events` events, finished as `status` at `finished` with
+// `result` (dismissed: dismissed first while running).
+void run_to_end(Store& store, const std::string& id, JobStatus status, const std::string& finished,
+                std::optional<std::string> result, int events = 2) {
+  JobRecord r = new_job(id);
+  store.insert_job(r);
+  const auto run = store.claim_job("me", finished, 30);
+  ASSERT_TRUE(run);
+  ASSERT_EQ(run->id, id);
+  std::vector<NewEvent> list;
+  for (int e = 1; e <= events; ++e) list.push_back(event(*run, e));
+  store.append_events(list);
+  if (status == JobStatus::dismissed) store.dismiss_job(id, finished);
+  JobOutcome o = success(events + 1);
+  o.status = status == JobStatus::dismissed ? JobStatus::successful : status;
+  o.finished = finished;
+  o.result = std::move(result);
+  ASSERT_TRUE(store.finish_job({id, run->generation}, o));
+}
+
+TEST_P(StoreContract, ResultsAreStoredAsBytesAndEachFinishedJobCountsItsStoredBytes) {
+  auto store = open();
+  // Compressed results hold any byte, 0 included.
+  std::string bytes = "\x1f\x8b";
+  for (int i = 0; i < 256; ++i) bytes += static_cast<char>(i);
+  run_to_end(*store, "job-a", JobStatus::successful, "2025-01-01T00:00:02.000Z", bytes);
+  EXPECT_EQ(store->result("job-a"), bytes);
+  const auto j = store->job("job-a", true);
+  ASSERT_TRUE(j);
+  // Its scene, its 2 events and terminal event, its result.
+  const std::int64_t expected =
+      static_cast<std::int64_t>(j->scene.size() + event(*j, 1).event.data.size() + event(*j, 2).event.data.size() +
+                                success(3).terminal.data.size() + bytes.size());
+  EXPECT_EQ(j->stored_bytes, expected);
+  EXPECT_GT(store->disk_bytes(), 0);
+}
+
+TEST_P(StoreContract, RetentionRemovesTheFinishedJobsBeyondItsBoundsDismissedFirst) {
+  auto store = open();
+  // 6 finished jobs a second apart (a2 dismissed), one still accepted.
+  const std::vector<std::pair<std::string, JobStatus>> jobs = {
+      {"a0", JobStatus::successful}, {"a1", JobStatus::failed},     {"a2", JobStatus::dismissed},
+      {"a3", JobStatus::successful}, {"a4", JobStatus::successful}, {"a5", JobStatus::successful}};
+  for (size_t i = 0; i < jobs.size(); ++i)
+    run_to_end(*store, jobs[i].first, jobs[i].second, "2025-01-01T00:00:0" + std::to_string(i) + ".000Z",
+               std::string(1000, 'r'));
+  JobRecord waiting = new_job("waiting");
+  store->insert_job(waiting);
+  auto ids = [&] {
+    std::set<std::string> out;
+    for (const JobRecord& r : store->list_jobs(std::nullopt, 100, std::nullopt).jobs) out.insert(r.id);
+    return out;
+  };
+  EXPECT_EQ(store->prune(Retention{}, "2025-01-01T01:00:00.000Z"), 0);  // no bound: nothing
+  // At most 4 finished jobs: the dismissed one goes first, then the oldest.
+  EXPECT_EQ(store->prune(Retention{0, 4, 0}, "2025-01-01T00:00:10.000Z"), 2);
+  EXPECT_EQ(ids(), (std::set<std::string>{"a1", "a3", "a4", "a5", "waiting"}));
+  EXPECT_FALSE(store->result("a0"));
+  EXPECT_TRUE(store->events_after("a0", 0, 100).empty());
+  // Finished more than 4.5 s before 00:00:08 (before 00:03.5): a1 (00:01) and a3 (00:03).
+  EXPECT_EQ(store->prune(Retention{4.5, 0, 0}, "2025-01-01T00:00:08.000Z"), 2);
+  EXPECT_EQ(ids(), (std::set<std::string>{"a4", "a5", "waiting"}));
+  // Room for one job's stored bytes: the newest stays.
+  const std::int64_t one = store->job("a5", false)->stored_bytes;
+  EXPECT_EQ(store->prune(Retention{0, 0, one + 10}, "2025-01-01T00:00:08.000Z"), 1);
+  EXPECT_EQ(ids(), (std::set<std::string>{"a5", "waiting"}));
+  EXPECT_EQ(store->count_accepted(), 1);  // unfinished jobs are never removed
+}
+
+TEST_P(StoreContract, PruningHandsTheSpaceBackToTheFileSystem) {
+  if (shared()) GTEST_SKIP() << "PostgreSQL's space is its autovacuum's (reused, not returned)";
+  auto store = open();
+  const std::string big(200000, 'x');  // incompressible to SQLite: 200 KB a job
+  for (int i = 0; i < 50; ++i)
+    run_to_end(*store, "job-" + std::to_string(i), JobStatus::successful, "2025-01-01T00:00:00.000Z", big);
+  const std::int64_t full = store->disk_bytes();
+  EXPECT_GT(full, 50 * 200000);
+  EXPECT_EQ(store->prune(Retention{0, 5, 0}, "2025-01-01T00:00:01.000Z"), 45);
+  EXPECT_LT(store->disk_bytes(), full / 5);
 }
 
 INSTANTIATE_TEST_SUITE_P(Stores, StoreContract, ::testing::Values(Kind::sqlite, Kind::postgresql),

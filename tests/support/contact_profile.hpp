@@ -63,8 +63,8 @@ inline HertzContact hertz_contact(const nlohmann::json& body, double P, double r
 }
 
 struct ContactNode {
-  double x = 0.0;                  // reference abscissa
-  double p_n = 0.0, p_t = 0.0;     // forces (p_n <= 0 presses)
+  double x = 0.0;                       // reference abscissa
+  double p_n = 0.0, p_t = 0.0;          // forces (p_n <= 0 presses)
   double sigma_n = 0.0, sigma_t = 0.0;  // force / tributary area
   ContactState state = ContactState::open;
 };
@@ -111,15 +111,13 @@ struct Zone {
   // half an element either side of its node, so a closed-form edge is resolved to within half
   // of it beyond the bracket: brackets(w, 0.5 * edge_element()).
   double edge_element() const { return std::max(right.outer - right.inner, left.inner - left.outer); }
-  double midpoint_half_width() const {
-    return 0.25 * ((right.inner + right.outer) - (left.inner + left.outer));
-  }
+  double midpoint_half_width() const { return 0.25 * ((right.inner + right.outer) - (left.inner + left.outer)); }
   // Does a zone of half-width w, centred like this one, end between the nodes on both sides
   // (within `slack`)?
   bool brackets(double w, double slack) const {
     const double centre = 0.5 * (left.edge + right.edge);
-    return centre + w >= right.inner - slack && centre + w <= right.outer + slack &&
-           centre - w <= left.inner + slack && centre - w >= left.outer - slack;
+    return centre + w >= right.inner - slack && centre + w <= right.outer + slack && centre - w <= left.inner + slack &&
+           centre - w >= left.outer - slack;
   }
 };
 
@@ -177,15 +175,16 @@ inline EllipseFit fit_semi_ellipse(const std::vector<ContactNode>& nodes) {
 
 // The contact zone: nodes that press; the pressure vanishes like sqrt(a - |x|) at its edges.
 inline Zone contact_zone(const std::vector<ContactNode>& nodes) {
-  return zone_of(nodes, [](const ContactNode& n) { return n.p_n < 0; },
-                 [](const ContactNode& n) { return n.sigma_n; });
+  return zone_of(
+      nodes, [](const ContactNode& n) { return n.p_n < 0; }, [](const ContactNode& n) { return n.sigma_n; });
 }
 
 // The stick zone: nodes that stick; the margin mu |sigma_n| - |sigma_t| vanishes like
 // sqrt(c - |x|) at a Cattaneo-Mindlin stick-slip boundary.
 inline Zone stick_zone(const std::vector<ContactNode>& nodes, double mu) {
-  return zone_of(nodes, [](const ContactNode& n) { return n.state == ContactState::stick; },
-                 [mu](const ContactNode& n) { return mu * std::abs(n.sigma_n) - std::abs(n.sigma_t); });
+  return zone_of(
+      nodes, [](const ContactNode& n) { return n.state == ContactState::stick; },
+      [mu](const ContactNode& n) { return mu * std::abs(n.sigma_n) - std::abs(n.sigma_t); });
 }
 
 // expect_every_step_sound with the Coulomb cone held only to `tau_relative` of the largest
@@ -216,8 +215,8 @@ inline StrategyRuns expect_strategies_agree(const nlohmann::json& scene, double 
   StrategyRuns runs{solve_scene(scene), solve_scene(u)};
   expect_every_step_sound(runs.cev);
   expect_every_step_sound_within(runs.uzawa, 1e-3);
-  std::printf("real solves: cev %ld (%.3f s), uzawa %ld (%.3f s)\n", runs.cev.run.counters.solves,
-              runs.cev.run.seconds, runs.uzawa.run.counters.solves, runs.uzawa.run.seconds);
+  std::printf("real solves: cev %ld (%.3f s), uzawa %ld (%.3f s)\n", runs.cev.run.counters.solves, runs.cev.run.seconds,
+              runs.uzawa.run.counters.solves, runs.uzawa.run.seconds);
   if (!runs.cev.run.completed || !runs.uzawa.run.completed) return runs;
   for (size_t k = 0; k < runs.cev.run.steps.size(); ++k) {
     const Vector& a = runs.cev.run.steps[k].p;

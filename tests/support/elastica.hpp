@@ -25,7 +25,9 @@ struct Rod {
 inline Rod march(double alpha, double k, int steps = 4000) {
   Rod r{0.0, k, 0.0, 0.0};
   const double h = 1.0 / steps;
-  auto rate = [alpha](const Rod& a) { return Rod{a.kappa, -alpha * std::cos(a.theta), std::cos(a.theta), std::sin(a.theta)}; };
+  auto rate = [alpha](const Rod& a) {
+    return Rod{a.kappa, -alpha * std::cos(a.theta), std::cos(a.theta), std::sin(a.theta)};
+  };
   auto add = [](const Rod& a, const Rod& b, double f) {
     return Rod{a.theta + f * b.theta, a.kappa + f * b.kappa, a.x + f * b.x, a.y + f * b.y};
   };

@@ -20,7 +20,8 @@ inline nlohmann::json flat_block(int nodes, int rows, double mu = 0.3) {
         {"material", {{"young", 200000}, {"poisson", 0.3}}},
         {"mesh", {{"rectangle", {{"origin", {0, 0}}, {"size", {1, height}}, {"divisions", {nx, rows}}}}}},
         {"supports", {{{"set", "top"}, {"fix", {"x", "y"}}, {"values", {{"y", -1e-4 * height}}}}}}}},
-      {"obstacles", {{{"name", "flat"}, {"shape", {{"type", "segment"}, {"from", {2, 0}}, {"to", {-1, 0}}}}, {"friction", mu}}}},
+      {"obstacles",
+       {{{"name", "flat"}, {"shape", {{"type", "segment"}, {"from", {2, 0}}, {"to", {-1, 0}}}}, {"friction", mu}}}},
       {"steps", 4},
   };
 }

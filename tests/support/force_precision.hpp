@@ -159,7 +159,8 @@ inline double agreement_bound(const Solved& s, size_t k, const Solved& cev) {
   }
   const double own = force_precision(s.scene, rec);
   const double settle =
-      passes ? static_cast<double>(s.scene.problem.candidates.size()) * mu * std::max(cp.tau_tolerance * p_max, own) : 0.0;
+      passes ? static_cast<double>(s.scene.problem.candidates.size()) * mu * std::max(cp.tau_tolerance * p_max, own)
+             : 0.0;
   return 1e-9 * p_max + errors + settle;
 }
 

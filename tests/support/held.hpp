@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "solver/model/body_set.hpp"
-#include "solver/equilibrium/rigid_equilibrium.hpp"
+#include "solver/problem/rigid_modes.hpp"
 #include "tests/support/contact_profile.hpp"
 #include "tests/support/result_checks.hpp"
 #include "tests/support/two_bodies.hpp"

@@ -23,8 +23,7 @@ class PostgresCluster {
     std::optional<fs::path> best;
     std::error_code ec;
     for (const auto& e : fs::directory_iterator("/usr/lib/postgresql", ec))
-      if (fs::exists(e.path() / "bin" / "initdb") && (!best || e.path() > best->parent_path()))
-        best = e.path() / "bin";
+      if (fs::exists(e.path() / "bin" / "initdb") && (!best || e.path() > best->parent_path())) best = e.path() / "bin";
     return best;
   }
 
@@ -61,18 +60,18 @@ class PostgresCluster {
   // A fresh database on this cluster; its URL.
   std::string new_database() {
     const std::string name = "t" + std::to_string(++databases_);
-    run(bin_ / "createdb", "-h 127.0.0.1 -p " + std::to_string(port_) + " -U grip " + name + " >> " +
-                               log("createdb") + " 2>&1");
+    run(bin_ / "createdb",
+        "-h 127.0.0.1 -p " + std::to_string(port_) + " -U grip " + name + " >> " + log("createdb") + " 2>&1");
     return url(name);
   }
   std::string url(const std::string& database) const {
     return "postgresql://grip@127.0.0.1:" + std::to_string(port_) + "/" + database;
   }
   void start() {
-    run(bin_ / "pg_ctl", "-D " + data() + " -l " + log("server") + " -w -t 60 -o \"-p " +
-                             std::to_string(port_) + " -k " + dir_.string() +
-                             " -c listen_addresses=127.0.0.1 -c max_connections=300\" start > " +
-                             log("pg_ctl") + " 2>&1");
+    run(bin_ / "pg_ctl", "-D " + data() + " -l " + log("server") + " -w -t 60 -o \"-p " + std::to_string(port_) +
+                             " -k " + dir_.string() +
+                             " -c listen_addresses=127.0.0.1 -c max_connections=300\" start > " + log("pg_ctl") +
+                             " 2>&1");
     running_ = true;
   }
   // `fast` disconnects every client at once (what an outage looks like to them).

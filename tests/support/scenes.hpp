@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "solver/io/scene.hpp"
+#include "tests/support/contact_checks.hpp"
 
 namespace grip::testing {
 
@@ -57,19 +58,24 @@ inline nlohmann::json disc_between_flats(int n, double delta) {
     }
   for (int k = 0; k < n; ++k)
     for (int i = 0; i < n; ++i) elements.push_back({id(i, k), id(i + 1, k), id(i + 1, k + 1), id(i, k + 1)});
-  json j = {
-      {"body",
-       {{"model", "continuum"}, {"kinematics", "linear"}, {"analysis", "plane_strain"}, {"element", "q4_bbar"},
-        {"thickness", 1}, {"material", {{"young", 200000}, {"poisson", 0.49}}},
-        {"mesh", {{"nodes", nodes}, {"elements", elements}, {"sets", {{"rim", rim}}}}},
-        {"contact_set", "rim"}}},
-      {"obstacles",
-       json::array({{{"name", "lower"}, {"shape", {{"type", "segment"}, {"from", {40, -10}}, {"to", {-40, -10}}}},
-                     {"friction", 0.3}},
-                    {{"name", "upper"}, {"shape", {{"type", "segment"}, {"from", {-40, 10}}, {"to", {40, 10}}}},
-                     {"friction", 0.3}, {"motion", {{"translation", {0, -delta}}}}}})},
-      {"steps", 1},
-      {"solver", {{"contact", {{"method", "cev"}, {"tolerance", 1e-8}, {"reach", 1.0}}}}}};
+  json j = {{"body",
+             {{"model", "continuum"},
+              {"kinematics", "linear"},
+              {"analysis", "plane_strain"},
+              {"element", "q4_bbar"},
+              {"thickness", 1},
+              {"material", {{"young", 200000}, {"poisson", 0.49}}},
+              {"mesh", {{"nodes", nodes}, {"elements", elements}, {"sets", {{"rim", rim}}}}},
+              {"contact_set", "rim"}}},
+            {"obstacles", json::array({{{"name", "lower"},
+                                        {"shape", {{"type", "segment"}, {"from", {40, -10}}, {"to", {-40, -10}}}},
+                                        {"friction", 0.3}},
+                                       {{"name", "upper"},
+                                        {"shape", {{"type", "segment"}, {"from", {-40, 10}}, {"to", {40, 10}}}},
+                                        {"friction", 0.3},
+                                        {"motion", {{"translation", {0, -delta}}}}}})},
+            {"steps", 1},
+            {"solver", {{"contact", {{"method", "cev"}, {"tolerance", 1e-8}, {"reach", 1.0}}}}}};
   return j;
 }
 
@@ -84,10 +90,14 @@ inline nlohmann::json beam_lying_on_a_flat(const std::string& kinematics) {
     loads.push_back({{"node", n}, {"force", {0.0, n == 0 || n == 20 ? -5.0 : -10.0}}, {"case", "press"}});
   loads.push_back({{"node", 0}, {"force", {20.0, 0.0}}, {"case", "push"}});
   json j = {{"body",
-             {{"model", "timoshenko_beam"}, {"kinematics", kinematics}, {"material", {{"young", 210000}, {"poisson", 0.3}}},
-              {"section", {{"width", 2}, {"depth", 2}}}, {"mesh", {{"origin", {0, 0}}, {"length", 20}, {"elements", 20}}},
+             {{"model", "timoshenko_beam"},
+              {"kinematics", kinematics},
+              {"material", {{"young", 210000}, {"poisson", 0.3}}},
+              {"section", {{"width", 2}, {"depth", 2}}},
+              {"mesh", {{"origin", {0, 0}}, {"length", 20}, {"elements", 20}}},
               {"loads", loads}}},
-            {"obstacles", json::array({{{"name", "flat"}, {"shape", {{"type", "segment"}, {"from", {100, -1}}, {"to", {-100, -1}}}},
+            {"obstacles", json::array({{{"name", "flat"},
+                                        {"shape", {{"type", "segment"}, {"from", {100, -1}}, {"to", {-100, -1}}}},
                                         {"friction", 0.3}}})},
             {"stages", json::array({{{"steps", 1}, {"factors", {{"press", 1}}}},
                                     {{"steps", 3}, {"factors", {{"press", 1}, {"push", 2.5}}}},
@@ -97,9 +107,19 @@ inline nlohmann::json beam_lying_on_a_flat(const std::string& kinematics) {
   return j;
 }
 
+// Solved, with the step checks of every converged step held to their limits (issue 33.1).
 inline Solved solve_scene(const nlohmann::json& j) {
   Solved s{read_scene(j), {}};
   s.run = run_load_steps(s.scene.problem, s.scene.steps, s.scene.params);
+  const ContactParams& c = s.scene.params.contact;
+  const bool moving_bound =
+      c.method == ContactMethod::ssn ||
+      (c.method == ContactMethod::cev && c.loop == ContactLoop::inner && c.friction_loop == FrictionLoop::inner);
+  for (const StepRecord& rec : s.run.steps)
+    if (rec.converged)
+      EXPECT_TRUE(step_checks_within_limits(s.scene.problem, rec,
+                                            c.tolerance * s.scene.problem.body->characteristic_length(),
+                                            moving_bound ? 1e-9 : c.tau_tolerance));
   return s;
 }
 

@@ -106,8 +106,8 @@ inline SpenceReading read_spence(const Solved& s, const StepRecord& rec, double 
   const nlohmann::json& shape = s.scene.effective["obstacles"][0]["shape"];
   const double radius = shape["type"] == "circle" ? shape["radius"].get<double>() : 0.0;
   SpenceReading r;
-  r.hertz = hertz_contact(body, std::abs(reaction_resultant(s.scene.problem, rec).y()) / body["thickness"].get<double>(),
-                          radius);
+  r.hertz = hertz_contact(
+      body, std::abs(reaction_resultant(s.scene.problem, rec).y()) / body["thickness"].get<double>(), radius);
   const auto nodes = contact_profile(s.scene.problem, rec);
   const Zone contact = contact_zone(nodes);
   if (!contact.found) return r;

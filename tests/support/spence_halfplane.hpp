@@ -18,15 +18,14 @@
 namespace grip::testing {
 
 struct HalfPlaneSpence {
-  double a = 0;       // contact half-width (outer edge of the last element that presses)
-  double c_stick = 0; // stick half-width: between the last sticking element and the next
-  double c_rule = 0;  // the same by the rule |q| < 0.99 mu p
-  double peak = 0;    // largest pressure over Hertz's p0
-  int iterations = 0; // active-set iterations of the last increment (200: not settled)
+  double a = 0;        // contact half-width (outer edge of the last element that presses)
+  double c_stick = 0;  // stick half-width: between the last sticking element and the next
+  double c_rule = 0;   // the same by the rule |q| < 0.99 mu p
+  double peak = 0;     // largest pressure over Hertz's p0
+  int iterations = 0;  // active-set iterations of the last increment (200: not settled)
 };
 
-inline HalfPlaneSpence spence_half_plane(double mu, double nu, int per_a, int increments, bool coupled,
-                                         double Rc = 0) {
+inline HalfPlaneSpence spence_half_plane(double mu, double nu, int per_a, int increments, bool coupled, double Rc = 0) {
   using Eigen::MatrixXd;
   using Eigen::VectorXd;
   const double pi = std::numbers::pi;

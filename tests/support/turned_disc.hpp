@@ -106,7 +106,8 @@ inline void expect_disc_balanced(const Solved& s) {
       EXPECT_LT(std::abs(b.moment), 1e-9 * b.force_size * kDiscRadius)
           << "step " << rec.index << " about (" << o.x() << ", " << o.y() << ")";
       std::printf("step %d: force unbalance %.2e, moment unbalance about (%g, %g) %.2e (of the forces' size)\n",
-                  rec.index, b.force.norm() / b.force_size, o.x(), o.y(), std::abs(b.moment) / (b.force_size * kDiscRadius));
+                  rec.index, b.force.norm() / b.force_size, o.x(), o.y(),
+                  std::abs(b.moment) / (b.force_size * kDiscRadius));
     }
   }
 }
@@ -144,9 +145,9 @@ inline std::pair<double, double> expect_same_answer(const Solved& a, const Solve
       errors += largest_force(problem, e.own) + largest_force(problem, e.carried) + e.rounding;
     for (const Solved* s : {&a, &b}) {
       const ContactParams& c = s->scene.params.contact;
-      const bool passes = c.method == ContactMethod::uzawa ||
-                          (c.method == ContactMethod::cev &&
-                           (c.loop == ContactLoop::paper || c.friction_loop == FrictionLoop::passes));
+      const bool passes =
+          c.method == ContactMethod::uzawa ||
+          (c.method == ContactMethod::cev && (c.loop == ContactLoop::paper || c.friction_loop == FrictionLoop::passes));
       if (passes) settle += mu * c.tau_tolerance * p_max;
       newton += (1 + c.newton_fraction) * c.tolerance * problem.body->characteristic_length();
     }
@@ -155,9 +156,10 @@ inline std::pair<double, double> expect_same_answer(const Solved& a, const Solve
     const double length_bound = newton;
     EXPECT_LT(dp, force_bound) << "step " << k + 1;
     EXPECT_LT(dq, length_bound) << "step " << k + 1;
-    std::printf("step %zu: forces differ by %.2e (bound %.2e, ratio %.2f, of max |p_n| %.1f), displacements by %.2e "
-                "(bound %.2e)\n",
-                k + 1, dp, force_bound, dp / force_bound, p_max, dq, length_bound);
+    std::printf(
+        "step %zu: forces differ by %.2e (bound %.2e, ratio %.2f, of max |p_n| %.1f), displacements by %.2e "
+        "(bound %.2e)\n",
+        k + 1, dp, force_bound, dp / force_bound, p_max, dq, length_bound);
     worst.first = std::max(worst.first, dp / p_max);
     worst.second = std::max(worst.second, dq);
   }
@@ -195,8 +197,9 @@ inline double limit_drift(const Problem& problem, const StepRecord& now, const S
     if (now.p[c.eta] < 0 || (geometry && ref.p[c.eta] < 0))
       drift += std::abs(now.state.s[c.eta] - (geometry ? ref.state.s[c.eta] : 0.0)) / kDiscRadius / 2;
   for (const int node : {disc_node(32, 32, 16), disc_node(32, 0, 16)})
-    drift += (now.state.q.segment<2>(2 * node) - (geometry ? Vec2(ref.state.q.segment<2>(2 * node)) : Vec2::Zero())).norm() /
-             kDiscRadius / 2;
+    drift +=
+        (now.state.q.segment<2>(2 * node) - (geometry ? Vec2(ref.state.q.segment<2>(2 * node)) : Vec2::Zero())).norm() /
+        kDiscRadius / 2;
   return drift;
 }
 
@@ -238,9 +241,10 @@ inline double expect_turned_beyond_the_limit(const Solved& s) {
   const double drift = limit_drift(s.scene.problem, failed, before, false);
   EXPECT_GT(ratio, 1.0);
   EXPECT_NEAR(ratio, closed, drift * closed + 1e-6);
-  std::printf("beyond the limit: M / (mu sum N r) = %.6f, closed form %.6f (P %.3f of the previous step, %.3f at the "
-              "state reached; bound %.2e); failed step: %d real solves, %d Newton, %d cuts\n",
-              ratio, closed, P, P_now, drift * closed, failed.solves, failed.newton_iterations, failed.cuts);
+  std::printf(
+      "beyond the limit: M / (mu sum N r) = %.6f, closed form %.6f (P %.3f of the previous step, %.3f at the "
+      "state reached; bound %.2e); failed step: %d real solves, %d Newton, %d cuts\n",
+      ratio, closed, P, P_now, drift * closed, failed.solves, failed.newton_iterations, failed.cuts);
   return ratio;
 }
 

@@ -103,10 +103,11 @@ inline void expect_pairs_balanced(const Solved& s, const StepRecord& rec) {
   double scale = 0.0;
   for (size_t i = 0; i < problem.candidates.size(); ++i) scale += std::abs(rec.p[problem.candidates[i].eta]);
   Vec2 total = Vec2::Zero();
-  for (int b = 0; b < body_set(problem).count(); ++b) {
+  for (int b = 0; b < body_set(problem).part_count(); ++b) {
     const Vec2 on_body = body_resultant(problem, b, f);
     total += on_body;
-    const Vec2 reaction = body_resultant(problem, b, rec.reactions) + body_resultant(problem, b, problem.load(rec.factors));
+    const Vec2 reaction =
+        body_resultant(problem, b, rec.reactions) + body_resultant(problem, b, problem.load(rec.factors));
     EXPECT_LT((on_body + reaction).norm(), 1e-7 * scale) << "body " << b << " step " << rec.index;
   }
   EXPECT_LT(total.norm(), 1e-12 * scale) << "step " << rec.index;
@@ -139,18 +140,21 @@ struct CylinderReading {
 
 inline CylinderReading read_cylinders(const Solved& s, const StepRecord& rec) {
   const nlohmann::json& scene = s.scene.effective;
-  const double P = -body_resultant(s.scene.problem, 0, rec.reactions).y() / scene["bodies"][0]["thickness"].get<double>();
+  const double P =
+      -body_resultant(s.scene.problem, 0, rec.reactions).y() / scene["bodies"][0]["thickness"].get<double>();
   CylinderReading r{combined_hertz(scene, P), fit_semi_ellipse(contact_profile(s.scene.problem, rec)), {}};
   const int master = scene["contacts"][0]["master"].get<std::string>().rfind("lower", 0) == 0 ? 1 : 0;
   const nlohmann::json& disc = scene["bodies"][master]["mesh"]["half_disc"];
   const Vec2 centre(disc["centre"][0].get<double>(), disc["centre"][1].get<double>());
-  r.master_nodal = fit_semi_ellipse(master_profile(s.scene.problem, rec, master, [&](const Vec2& x) { return Vec2((x - centre).normalized()); }));
+  r.master_nodal = fit_semi_ellipse(
+      master_profile(s.scene.problem, rec, master, [&](const Vec2& x) { return Vec2((x - centre).normalized()); }));
   r.master = fit_semi_ellipse(master_field_profile(s.scene.problem, rec, 0));
-  std::printf("step %d: P %.2f N/mm, a %.4f mm (slave %+.2f %%, master %+.2f %%, master nodal forces %+.2f %%), "
-              "p0 %.1f MPa (slave %+.2f %%, master %+.2f %%, master nodal forces %+.2f %%)\n",
-              rec.index, P, r.closed.a, 100 * (r.slave.a / r.closed.a - 1), 100 * (r.master.a / r.closed.a - 1),
-              100 * (r.master_nodal.a / r.closed.a - 1), r.closed.p0, 100 * (r.slave.p0 / r.closed.p0 - 1),
-              100 * (r.master.p0 / r.closed.p0 - 1), 100 * (r.master_nodal.p0 / r.closed.p0 - 1));
+  std::printf(
+      "step %d: P %.2f N/mm, a %.4f mm (slave %+.2f %%, master %+.2f %%, master nodal forces %+.2f %%), "
+      "p0 %.1f MPa (slave %+.2f %%, master %+.2f %%, master nodal forces %+.2f %%)\n",
+      rec.index, P, r.closed.a, 100 * (r.slave.a / r.closed.a - 1), 100 * (r.master.a / r.closed.a - 1),
+      100 * (r.master_nodal.a / r.closed.a - 1), r.closed.p0, 100 * (r.slave.p0 / r.closed.p0 - 1),
+      100 * (r.master.p0 / r.closed.p0 - 1), 100 * (r.master_nodal.p0 / r.closed.p0 - 1));
   return r;
 }
 

@@ -101,7 +101,7 @@ TEST(AccelerationLevels, AutoLevelPicksSmallestReachingTarget) {
     }
   }
   EXPECT_EQ(auto_level(1.0), 1);
-  EXPECT_EQ(auto_level(1e-3), 7);  // 1.0723 <= 1.1 < 1.7012
+  EXPECT_EQ(auto_level(1e-3), 7);           // 1.0723 <= 1.1 < 1.7012
   EXPECT_EQ(auto_level(1e-12, 1.1, 5), 5);  // capped
   // docs/algorithm.md#the-accelerated-multiplier-update: about log4(cond) + 2 levels.
   EXPECT_NEAR(auto_level(1e-7), std::log(1e7) / std::log(4.0) + 2.0, 1.0);
@@ -250,8 +250,8 @@ TEST(AccelerationIteration, ContractionMatchesEq27) {
     const std::size_t last = history.size() - 1, mid = last / 2;
     ASSERT_GT(last - mid, 2u);
     const double measured = std::pow(history[last] / history[mid], 1.0 / double(last - mid));
-    std::printf("[ rate     ] lo %g n %d kappa_n %.6g eq.27 %.6f spectral %.6f measured %.6f (%zu iterations)\n",
-                c.lo, c.n, level_conditions(eps1, c.n).back(), predicted, rho, measured, last);
+    std::printf("[ rate     ] lo %g n %d kappa_n %.6g eq.27 %.6f spectral %.6f measured %.6f (%zu iterations)\n", c.lo,
+                c.n, level_conditions(eps1, c.n).back(), predicted, rho, measured, last);
     EXPECT_NEAR(measured, predicted, 0.03 * predicted) << "lo " << c.lo << " n " << c.n;
     // The convergence speed too, not only the rate (which is ~1 for small n). Looser: in
     // a finite run, modes just inside the interval still weigh in.
@@ -299,8 +299,8 @@ TEST(AccelerationWarmup, KnownRatios) {
   EXPECT_NEAR(warmup_epsilon(norms, alpha), (1.0 - 0.999) / alpha, 1e-12);
   EXPECT_NEAR(warmup_epsilon(norms, alpha, 3, 5), (1.0 - 0.995) / alpha, 1e-12);
   // A history that stops at m = 5 uses m = 3..5.
-  EXPECT_NEAR(warmup_epsilon(std::vector<double>(norms.begin(), norms.begin() + 6), alpha),
-              (1.0 - 0.995) / alpha, 1e-12);
+  EXPECT_NEAR(warmup_epsilon(std::vector<double>(norms.begin(), norms.begin() + 6), alpha), (1.0 - 0.995) / alpha,
+              1e-12);
   // A ratio >= 1 inside the window: no contraction seen, the floor.
   EXPECT_EQ(warmup_epsilon(norms, alpha, 1, 10), kMinEpsilon);
   EXPECT_EQ(warmup_epsilon(norms, alpha, 3, 11), kMinEpsilon);

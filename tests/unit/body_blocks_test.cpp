@@ -7,8 +7,8 @@
 #include <algorithm>
 #include <atomic>
 
-#include "solver/io/scene.hpp"
 #include "solver/equilibrium/free_block_solver.hpp"
+#include "solver/io/scene.hpp"
 #include "solver/stepping/load_stepping.hpp"
 
 namespace grip {

@@ -38,14 +38,13 @@ PlaneMesh distorted_patch(QuadShape shape) {
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> shift(-0.06, 0.06);
   for (Vec2& x : mesh.nodes) {
-    const bool boundary = std::abs(x.x()) < 1e-12 || std::abs(x.x() - 2) < 1e-12 ||
-                          std::abs(x.y()) < 1e-12 || std::abs(x.y() - 1) < 1e-12;
+    const bool boundary = std::abs(x.x()) < 1e-12 || std::abs(x.x() - 2) < 1e-12 || std::abs(x.y()) < 1e-12 ||
+                          std::abs(x.y() - 1) < 1e-12;
     if (!boundary) x += Vec2(shift(rng), shift(rng));
   }
   if (shape == QuadShape::q9)  // mid-side and centre nodes back to the middle of straight sides
     for (const auto& el : mesh.elements) {
-      for (int m = 0; m < 4; ++m)
-        mesh.nodes[el[4 + m]] = 0.5 * (mesh.nodes[el[m]] + mesh.nodes[el[(m + 1) % 4]]);
+      for (int m = 0; m < 4; ++m) mesh.nodes[el[4 + m]] = 0.5 * (mesh.nodes[el[m]] + mesh.nodes[el[(m + 1) % 4]]);
       mesh.nodes[el[8]] = 0.25 * (mesh.nodes[el[0]] + mesh.nodes[el[1]] + mesh.nodes[el[2]] + mesh.nodes[el[3]]);
     }
   return mesh;
@@ -275,7 +274,8 @@ TEST(PlaneMaterial, TangentIsTheDerivativeOfTheStress) {
   for (auto analysis : {PlaneAnalysis::plane_strain, PlaneAnalysis::plane_stress}) {
     const NeoHookeMaterial neo(210.0, 0.45, analysis);
     const HookeMaterial hooke(210.0, 0.45, analysis);
-    for (const PlaneMaterial* law : {static_cast<const PlaneMaterial*>(&neo), static_cast<const PlaneMaterial*>(&hooke)}) {
+    for (const PlaneMaterial* law :
+         {static_cast<const PlaneMaterial*>(&neo), static_cast<const PlaneMaterial*>(&hooke)}) {
       const Mat2 E = random_strain(11, 0.15);
       const MaterialResponse r = law->response(E);
       const double h = 1e-7;
@@ -353,8 +353,8 @@ TEST(ContinuumLocking, MeanDilatationAndNineNodesDoNotLock) {
   const double q4 = tip(ContinuumElement::q4, 20, 4);
   const double bbar = tip(ContinuumElement::q4_bbar, 20, 4);
   const double q9 = tip(ContinuumElement::q9, 20, 4);
-  std::cout << "tip deflection / beam theory: q4 " << q4 / expected << ", q4_bbar " << bbar / expected
-            << ", q9 " << q9 / expected << "\n";
+  std::cout << "tip deflection / beam theory: q4 " << q4 / expected << ", q4_bbar " << bbar / expected << ", q9 "
+            << q9 / expected << "\n";
   EXPECT_LT(q4, 0.2 * expected);  // locked
   EXPECT_NEAR(bbar, expected, 0.08 * expected);
   EXPECT_NEAR(q9, expected, 0.08 * expected);
@@ -365,9 +365,9 @@ TEST(ContinuumLocking, MeanDilatationAndNineNodesDoNotLock) {
 TEST(ContinuumBodyMesh, RejectsAFaultyMeshWithAllItsIssues) {
   PlaneMesh mesh = distorted_patch(QuadShape::q4);
   const std::vector<int> bottom = mesh.sets.at("bottom");
-  mesh.elements[0][2] = 999;                  // a node that does not exist
+  mesh.elements[0][2] = 999;                            // a node that does not exist
   std::swap(mesh.elements[1][1], mesh.elements[1][3]);  // clockwise
-  mesh.nodes.push_back({9, 9});               // in no element
+  mesh.nodes.push_back({9, 9});                         // in no element
   const std::vector<MeshIssue> expected = check_mesh(mesh, QuadShape::q4);
   ASSERT_EQ(expected.size(), 3u);
   try {

@@ -5,8 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numbers>
 #include <cstdio>
+#include <numbers>
 #include <set>
 
 #include "solver/elements/corner_angles.hpp"
@@ -78,7 +78,8 @@ TEST(RectangleMesh, AreaSetsAndOrientation) {
     bool found = false;
     for (size_t k = 1; k < top.size(); ++k) {
       const Vec2 a = mesh.nodes[top[k - 1]], b = mesh.nodes[top[k]];
-      if (std::abs(std::max(a.x(), b.x()) - 0.5) < 1e-12) found = std::abs(std::abs(a.x() - b.x()) - (shape == QuadShape::q4 ? 0.1 : 0.05)) < 1e-12;
+      if (std::abs(std::max(a.x(), b.x()) - 0.5) < 1e-12)
+        found = std::abs(std::abs(a.x() - b.x()) - (shape == QuadShape::q4 ? 0.1 : 0.05)) < 1e-12;
     }
     EXPECT_TRUE(found);
   }
@@ -186,8 +187,8 @@ TEST(HalfDiscMesh, UniformDivisionsAreValidAndWellShaped) {
     EXPECT_TRUE(check_mesh(mesh, QuadShape::q4).empty()) << ns << " x " << nt;
     EXPECT_EQ(static_cast<int>(mesh.sets.at("arc").size()), ns + 1);
     const ElementQuality q = element_quality(mesh);
-    std::printf("[%d, %d]: %d elements, angles %.1f-%.1f, aspect %.2f\n", ns, nt, q.elements, q.min_angle,
-                q.max_angle, q.max_aspect_ratio);
+    std::printf("[%d, %d]: %d elements, angles %.1f-%.1f, aspect %.2f\n", ns, nt, q.elements, q.min_angle, q.max_angle,
+                q.max_aspect_ratio);
     EXPECT_GT(q.min_angle, 40.0) << ns << " x " << nt;
     EXPECT_LT(q.max_angle, 140.0) << ns << " x " << nt;
   }
@@ -278,7 +279,7 @@ TEST(CheckMesh, NamesTheFaultyElementOrNode) {
   EXPECT_EQ(issues[0].element, 0);
   EXPECT_NE(issues[0].detail.find("node 99"), std::string::npos);
   EXPECT_EQ(issues[1].element, 3);
-  EXPECT_EQ(issues[2].node, 9);  // the extra node belongs to no element
+  EXPECT_EQ(issues[2].node, 9);                           // the extra node belongs to no element
   EXPECT_FALSE(check_mesh(mesh, QuadShape::q9).empty());  // four nodes are not a q9
 }
 

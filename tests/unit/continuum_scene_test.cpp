@@ -89,8 +89,10 @@ TEST(ContinuumScene, ExplicitMeshSetsAndTraction) {
       "elements": [[0, 1, 2, 3], [1, 4, 5, 2]], "sets": {"base": [4, 0, 1], "lid": [3, 2, 5]}})");
   j["body"]["contact_set"] = "base";
   j["body"]["thickness"] = 2.0;
-  j["body"]["supports"] = json::parse(R"([{"set": "lid", "fix": ["y"], "values": {"y": -0.01}}, {"node": 3, "fix": ["x"]}])");
-  j["body"]["loads"] = json::parse(R"([{"set": "lid", "traction": [0.5, 0]}, {"node": 5, "force": [0, -1], "case": "extra"}])");
+  j["body"]["supports"] =
+      json::parse(R"([{"set": "lid", "fix": ["y"], "values": {"y": -0.01}}, {"node": 3, "fix": ["x"]}])");
+  j["body"]["loads"] =
+      json::parse(R"([{"set": "lid", "traction": [0.5, 0]}, {"node": 5, "force": [0, -1], "case": "extra"}])");
   const Scene s = read_scene(j);
   const Body& body = *s.problem.body;
   ASSERT_EQ(body.site_count(), 3);
@@ -174,13 +176,14 @@ TEST(ContinuumScene, SupportErrors) {
     j["body"]["supports"].push_back(json::parse(support));
     return issues_of(j);
   };
-  EXPECT_TRUE(has_issue(with_support(R"({"set": "lid", "fix": ["x"]})"), "/body/supports/1/set",
-                        "\"lid\" names no node set"));
+  EXPECT_TRUE(
+      has_issue(with_support(R"({"set": "lid", "fix": ["x"]})"), "/body/supports/1/set", "\"lid\" names no node set"));
   EXPECT_TRUE(has_issue(with_support(R"({"node": 14, "fix": ["y"], "values": {"y": 0.2}})"), "/body/supports/1/fix/0",
                         "prescribes y of node 14, which /body/supports/0 fixes already"));
   EXPECT_TRUE(has_issue(with_support(R"({"node": 14, "fix": ["z"]})"), "/body/supports/1/fix/0",
                         "\"z\" is not one of \"x\", \"y\""));
-  EXPECT_TRUE(has_issue(with_support(R"({"node": 99, "fix": ["x"]})"), "/body/supports/1/node", "99 is outside [0, 14]"));
+  EXPECT_TRUE(
+      has_issue(with_support(R"({"node": 99, "fix": ["x"]})"), "/body/supports/1/node", "99 is outside [0, 14]"));
   // The same zero support twice (a corner in two sets) is accepted.
   json k = block();
   k["body"]["supports"].push_back(json::parse(R"({"set": "right", "fix": ["x"]})"));

@@ -7,8 +7,8 @@
 #include <random>
 
 #include "solver/elements/timoshenko_beam.hpp"
-#include "solver/io/scene.hpp"
 #include "solver/equilibrium/equilibrium.hpp"
+#include "solver/io/scene.hpp"
 #include "tests/support/scenes.hpp"
 
 namespace grip {
@@ -20,8 +20,7 @@ Problem beam_over(std::unique_ptr<Obstacle> shape, double friction) {
   for (int i = 0; i <= 6; ++i) x.push_back(i * 1.0);
   const double E = 1000, b = 1, d = 0.4;
   auto beam = std::make_unique<TimoshenkoBeam>(
-      x, 0.0, BeamSection{E * b * d, E * b * d * d * d / 12, 0.8 * E / 2.6 * b * d, d / 2, b},
-      Kinematics::von_karman);
+      x, 0.0, BeamSection{E * b * d, E * b * d * d * d / 12, 0.8 * E / 2.6 * b * d, d / 2, b}, Kinematics::von_karman);
   problem.loads = {Vector::Zero(beam->dof_count())};
   problem.constraints.push_back({0, 0.0});
   problem.body = std::move(beam);

@@ -16,9 +16,20 @@ json two_quads() {
   for (int i = 0; i < 6; ++i)
     step["nodes"].push_back({{"node", i}, {"x", i % 3}, {"y", i / 3}, {"ux", 0.1 * i}, {"uy", -0.2 * i}});
   step["elements"] = {{{"element", 0}, {"sxx", 1.5}}, {{"element", 1}, {"sxx", 2.5}}};
-  step["contact_points"] = {
-      {{"node", 0}, {"obstacle", "punch"}, {"p_n", -2.0}, {"p_t", 0.5}, {"gap", 0.0}, {"state", "stick"}, {"pair", {0.0, -0.1}}},
-      {{"node", 1}, {"obstacle", "die, upper"}, {"p_n", 0.0}, {"p_t", 0.0}, {"gap", 0.3}, {"state", "open"}, {"pair", {1.0, -0.4}}}};
+  step["contact_points"] = {{{"node", 0},
+                             {"obstacle", "punch"},
+                             {"p_n", -2.0},
+                             {"p_t", 0.5},
+                             {"gap", 0.0},
+                             {"state", "stick"},
+                             {"pair", {0.0, -0.1}}},
+                            {{"node", 1},
+                             {"obstacle", "die, upper"},
+                             {"p_n", 0.0},
+                             {"p_t", 0.0},
+                             {"gap", 0.3},
+                             {"state", "open"},
+                             {"pair", {1.0, -0.4}}}};
   step["history"] = {{{"pass", 1}, {"m", 0}, {"v2", 1e-3}}, {{"pass", 1}, {"m", 1}, {"v2", 1e-9}}};
   step["obstacles"] = {{{"name", "punch"}, {"offset", {0.0, -1.0}}}};
   return {{"mesh", {{"cells", {{0, 1, 4, 3}, {1, 2, 5, 4}}}}}, {"steps", {step}}};
@@ -44,15 +55,29 @@ TEST(ExportCsv, LongTablesWithIdentifyingColumnsFirst) {
 TEST(ExportCsv, MasterPointsTable) {
   json r = two_quads();
   EXPECT_EQ(result_csv(r, "master_points"), "\n");
-  r["steps"][0]["master_points"] = {
-      {{"node", 4}, {"body", "lower"}, {"obstacle", "pair"}, {"x", 1.0}, {"y", 0.0}, {"p_n", -1.5}, {"p_t", 0.0},
-       {"sigma_n", -3.0}, {"sigma_t", 0.25}},
-      {{"node", 5}, {"body", "lower"}, {"obstacle", "pair"}, {"x", 2.0}, {"y", 0.0}, {"p_n", 0.0}, {"p_t", 0.0},
-       {"sigma_n", 0.0}, {"sigma_t", 0.0}}};
+  r["steps"][0]["master_points"] = {{{"node", 4},
+                                     {"body", "lower"},
+                                     {"obstacle", "pair"},
+                                     {"x", 1.0},
+                                     {"y", 0.0},
+                                     {"p_n", -1.5},
+                                     {"p_t", 0.0},
+                                     {"sigma_n", -3.0},
+                                     {"sigma_t", 0.25}},
+                                    {{"node", 5},
+                                     {"body", "lower"},
+                                     {"obstacle", "pair"},
+                                     {"x", 2.0},
+                                     {"y", 0.0},
+                                     {"p_n", 0.0},
+                                     {"p_t", 0.0},
+                                     {"sigma_n", 0.0},
+                                     {"sigma_t", 0.0}}};
   const std::string points = result_csv(r, "master_points");
   const std::string header = points.substr(0, points.find('\n'));
   EXPECT_EQ(header.substr(0, std::string("step,load_factor,body,node").size()), "step,load_factor,body,node");
-  for (const char* column : {"body", "obstacle", "sigma_n", "sigma_t"}) EXPECT_NE(header.find(column), std::string::npos);
+  for (const char* column : {"body", "obstacle", "sigma_n", "sigma_t"})
+    EXPECT_NE(header.find(column), std::string::npos);
   EXPECT_EQ(std::count(points.begin(), points.end(), '\n'), 3);
   EXPECT_NE(points.find("-3"), std::string::npos);
 }
@@ -76,8 +101,7 @@ TEST(ExportVtk, QuadrilateralsWithPointAndCellArrays) {
   EXPECT_EQ(files[0].name, "run_0001.vtu");
   EXPECT_EQ(files[1].name, "run_0001.vtk");
   EXPECT_EQ(files[2].name, "run.pvd");
-  EXPECT_NE(files[2].content.find("timestep=\"0.5\" group=\"\" part=\"0\" file=\"run_0001.vtu\""),
-            std::string::npos);
+  EXPECT_NE(files[2].content.find("timestep=\"0.5\" group=\"\" part=\"0\" file=\"run_0001.vtu\""), std::string::npos);
 }
 
 TEST(ExportVtk, StepsWithoutNodeFieldsAreSkipped) {

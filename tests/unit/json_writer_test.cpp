@@ -42,7 +42,8 @@ void expect_round_trip(double v) {
   EXPECT_EQ(std::bit_cast<uint64_t>(parsed.get<double>()), std::bit_cast<uint64_t>(v)) << text;
   char shortest[64];
   char* end = std::to_chars(shortest, shortest + sizeof shortest, v, std::chars_format::scientific).ptr;
-  EXPECT_EQ(significant_digits(text), significant_digits(std::string(shortest, static_cast<size_t>(end - shortest)))) << text;
+  EXPECT_EQ(significant_digits(text), significant_digits(std::string(shortest, static_cast<size_t>(end - shortest))))
+      << text;
 }
 
 TEST(JsonNumbers, EveryBitPatternSampledReadsBackAsItself) {
@@ -84,9 +85,14 @@ TEST(JsonNumbers, EdgeValuesAndTheirForms) {
 }
 
 TEST(JsonWriter, SmallValuesReadBackAsTheDocument) {
-  const nlohmann::json doc = {{"b", {1, -2, 3.25, 1e-7}}, {"a", "plain"}, {"c", "quote \" and \\ and \n"},
-                              {"d", nullptr}, {"e", true}, {"f", {{"z", 0.1}, {"y", std::vector<int>{}}}},
-                              {"g", 18446744073709551615ull}, {"h", "\u00e9t\u00e9"}};
+  const nlohmann::json doc = {{"b", {1, -2, 3.25, 1e-7}},
+                              {"a", "plain"},
+                              {"c", "quote \" and \\ and \n"},
+                              {"d", nullptr},
+                              {"e", true},
+                              {"f", {{"z", 0.1}, {"y", std::vector<int>{}}}},
+                              {"g", 18446744073709551615ull},
+                              {"h", "\u00e9t\u00e9"}};
   std::ostringstream out;
   {
     JsonWriter w(out);

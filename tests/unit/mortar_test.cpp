@@ -14,8 +14,8 @@
 
 #include <cmath>
 
-#include "solver/model/body_set.hpp"
 #include "solver/equilibrium/equilibrium.hpp"
+#include "solver/model/body_set.hpp"
 #include "tests/support/scenes.hpp"
 
 namespace grip {
@@ -60,7 +60,9 @@ void expect_consistent_loads(const json& scene) {
   EXPECT_NEAR(total, -10.0, 1e-12);
 }
 
-TEST(Mortar, TheFinerSlaveHandsTheMasterConsistentLoads) { expect_consistent_loads(example_scene("block-on-foundation")); }
+TEST(Mortar, TheFinerSlaveHandsTheMasterConsistentLoads) {
+  expect_consistent_loads(example_scene("block-on-foundation"));
+}
 
 TEST(Mortar, TheCoarserSlaveHandsTheMasterConsistentLoads) {
   json j = example_scene("block-on-foundation");
@@ -86,8 +88,9 @@ void expect_stiffness_is_the_derivative(json scene) {
   for (int site = 0; site < all.site_count(); ++site) {
     const SurfacePoint sp = all.surface_point(q0, site, 0);
     const double x = sp.x.x();
-    const Vec2 u = all.body_of_site(site) == 0 ? Vec2(0.13 + 0.02 * std::sin(x), -0.01 + 0.03 * std::cos(0.4 * x))
-                                               : Vec2(0.01 * std::cos(x), 0.02 * std::cos(0.4 * x) + 0.005 * std::sin(2 * x));
+    const Vec2 u = all.body_of_site(site) == 0
+                       ? Vec2(0.13 + 0.02 * std::sin(x), -0.01 + 0.03 * std::cos(0.4 * x))
+                       : Vec2(0.01 * std::cos(x), 0.02 * std::cos(0.4 * x) + 0.005 * std::sin(2 * x));
     for (const auto& j : sp.jacobian) q[j.dof] = j.dx.dot(u);
   }
   Equilibrium eq(problem, NewtonParams{});

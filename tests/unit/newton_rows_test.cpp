@@ -35,10 +35,8 @@ NewtonRows kinds(const std::vector<int>& pressing, int slipping, unsigned seed) 
   for (size_t k = 0; k < pressing.size(); ++k) {
     const int eta = 2 * pressing[k], xi = eta + 1;
     rows.active.push_back(eta);
-    if (static_cast<int>(k) < slipping)
-      rows.slip.push_back({xi, eta, (gen() % 2 ? 0.3 : -0.3)});
-    else
-      rows.active.push_back(xi);
+    if (static_cast<int>(k) < slipping) rows.slip.push_back({xi, eta, (gen() % 2 ? 0.3 : -0.3)});
+    else rows.active.push_back(xi);
   }
   return rows;
 }

@@ -45,9 +45,7 @@ void expect_derivatives_match(const Obstacle& obstacle, const Vec2& x, double h 
     dnormal_fd.col(j) = (plus.normal - minus.normal) / (2 * h);
     dzeta_fd(j) = obstacle.zeta_difference(plus.zeta, minus.zeta) / (2 * h);
   }
-  EXPECT_LE((p.dnormal_dx - dnormal_fd).norm(), 1e-7) << "analytic\n"
-                                                      << p.dnormal_dx << "\nfd\n"
-                                                      << dnormal_fd;
+  EXPECT_LE((p.dnormal_dx - dnormal_fd).norm(), 1e-7) << "analytic\n" << p.dnormal_dx << "\nfd\n" << dnormal_fd;
   const Eigen::RowVector2d dzeta = p.zeta_rate * p.tangent.transpose();
   EXPECT_LE((dzeta - dzeta_fd).norm(), 1e-7) << "analytic " << dzeta << " fd " << dzeta_fd;
 }
@@ -370,8 +368,7 @@ TEST(ProfileProjection, ConcaveCornerFromInsideTheSolid) {
 TEST(ProfileProjection, HugeAndDegenerateQueriesStayFinite) {
   for (const auto& pieces : {die_pieces(), punch_pieces(), groove_pieces(), bowl_pieces(), nose_pieces()}) {
     const auto obstacle = make_profile(pieces);
-    for (const Vec2& q :
-         {Vec2(1e300, -1e300), Vec2(-1e306, 3e305), Vec2(0, 0), Vec2(59.18, -6.85), Vec2(1e-320, 0)})
+    for (const Vec2& q : {Vec2(1e300, -1e300), Vec2(-1e306, 3e305), Vec2(0, 0), Vec2(59.18, -6.85), Vec2(1e-320, 0)})
       expect_consistent(obstacle->project(q), q);
   }
   // The centre of an arc: every point of the arc is equally near.
@@ -387,8 +384,7 @@ TEST(ProfileZeta, ContinuousAcrossJointsAndCumulative) {
     Vec2 point, normal, tangent;
     double zeta;
   };
-  const Joint joints[] = {{{59.18, -0.5}, {0, 1}, {-1, 0}, 40.0},
-                          {{52.83, -6.85}, {-1, 0}, {0, -1}, kDieShoulderEnd}};
+  const Joint joints[] = {{{59.18, -0.5}, {0, 1}, {-1, 0}, 40.0}, {{52.83, -6.85}, {-1, 0}, {0, -1}, kDieShoulderEnd}};
   for (const Joint& j : joints) {
     for (const double offset : {0.0, 0.3, -0.3}) {
       const Vec2 on = j.point + offset * j.normal;
@@ -459,8 +455,8 @@ TEST(ProfileValidation, RejectsBadPieces) {
     return "no exception";
   };
   // A gap between pieces 1 and 2 names piece 2.
-  const std::string gap = message_of(
-      {SegmentPiece{{0, 0}, {1, 0}}, SegmentPiece{{1, 0}, {1, 1}}, SegmentPiece{{1, 1.001}, {0, 1}}});
+  const std::string gap =
+      message_of({SegmentPiece{{0, 0}, {1, 0}}, SegmentPiece{{1, 0}, {1, 1}}, SegmentPiece{{1, 1.001}, {0, 1}}});
   EXPECT_NE(gap.find("piece 2"), std::string::npos) << gap;
   EXPECT_NE(message_of({SegmentPiece{{0, 0}, {0, 0}}}).find("piece 0"), std::string::npos);
   EXPECT_NE(message_of({SegmentPiece{{0, 0}, {1, 0}}, ArcPiece{{1, 1}, 0.0, -kPi / 2, 0}}).find("piece 1"),

@@ -8,7 +8,7 @@
 #include <cmath>
 
 #include "solver/io/scene.hpp"
-#include "solver/equilibrium/rigid_equilibrium.hpp"
+#include "solver/problem/rigid_modes.hpp"
 
 namespace grip {
 namespace {
@@ -19,7 +19,8 @@ using nlohmann::json;
 Scene block(const char* kinematics) {
   return read_scene(json::parse(std::string(R"({
     "body": {
-      "model": "continuum", "kinematics": ")") + kinematics + R"(", "element": "q4",
+      "model": "continuum", "kinematics": ")") +
+                                kinematics + R"(", "element": "q4",
       "material": {"young": 1000},
       "mesh": {"rectangle": {"origin": [1, 2], "size": [4, 1], "divisions": [4, 2]}},
       "loads": [{"node": 0, "force": [0, -1]}]

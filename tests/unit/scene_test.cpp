@@ -14,6 +14,7 @@
 #include "apps/result_writer.hpp"
 #include "solver/io/json_writer.hpp"
 #include "solver/io/result.hpp"
+#include "solver/io/schema_validation.hpp"
 #include "tests/support/scenes.hpp"
 
 namespace grip {
@@ -45,7 +46,7 @@ TEST(SceneReader, CollectsEveryErrorWithItsPointer) {
   j["obstacles"][0]["friction"] = -0.1;
   j["steps"] = 0;
   const auto issues = issues_of(j);
-  EXPECT_TRUE(has(issues, "/body/material/poisson", "0.62")) ;
+  EXPECT_TRUE(has(issues, "/body/material/poisson", "0.62"));
   EXPECT_TRUE(has(issues, "/body/section/depth", "not positive"));
   EXPECT_TRUE(has(issues, "/obstacles/0/shape/radius", "not a number"));
   EXPECT_TRUE(has(issues, "/obstacles/0/friction", "negative"));
@@ -104,17 +105,17 @@ TEST(SceneReader, StagesNameKnownCasesAndObstacles) {
 // A body the reader stops at (a bad mesh, a negative thickness) must not drag a "names no
 // load case" error with it for the cases its unread supports would have named (issue 34).
 TEST(SceneReader, ABadBodyDoesNotMakeItsStagesNameUnknownCases) {
-  for (const auto& [pointer, value] : std::vector<std::pair<std::string, json>>{
-           {"/body/mesh/rectangle/divisions", json::array({0, 10})},
-           {"/body/mesh/rectangle/divisions", json::array({2.5, 10})},
-           {"/body/thickness", -1}}) {
+  for (const auto& [pointer, value] :
+       std::vector<std::pair<std::string, json>>{{"/body/mesh/rectangle/divisions", json::array({0, 10})},
+                                                 {"/body/mesh/rectangle/divisions", json::array({2.5, 10})},
+                                                 {"/body/thickness", -1}}) {
     json j = example_scene("sliding-block");
     j[json::json_pointer(pointer)] = value;
     const auto issues = issues_of(j);
     ASSERT_FALSE(issues.empty()) << pointer;
     for (const auto& issue : issues) {
-      EXPECT_EQ(issue.pointer.rfind("/body", 0), 0u) << pointer << " = " << value.dump() << " also gave "
-                                                    << issue.pointer << ": " << issue.detail;
+      EXPECT_EQ(issue.pointer.rfind("/body", 0), 0u)
+          << pointer << " = " << value.dump() << " also gave " << issue.pointer << ": " << issue.detail;
     }
   }
 }
@@ -122,7 +123,8 @@ TEST(SceneReader, ABadBodyDoesNotMakeItsStagesNameUnknownCases) {
 TEST(SceneReader, StagesRampTheirCasesFromWherePreviousStagesLeftThem) {
   json j = example_scene("beam-on-cylinder");
   j.erase("steps");
-  j["stages"] = json::array({{{"steps", 2}, {"factors", {{"main", 1}}}}, {{"steps", 4}, {"factors", {{"main", 0}}}, {"friction", {{"cylinder", 0.5}}}}});
+  j["stages"] = json::array({{{"steps", 2}, {"factors", {{"main", 1}}}},
+                             {{"steps", 4}, {"factors", {{"main", 0}}}, {"friction", {{"cylinder", 0.5}}}}});
   const Scene s = read_scene(j);
   ASSERT_EQ(s.steps.size(), 6u);
   const std::vector<double> expected = {0.5, 1.0, 0.75, 0.5, 0.25, 0.0};
@@ -249,16 +251,27 @@ TEST(SceneEffects, StreamedResultReadsBackAsTheBuiltOne) {
   ASSERT_FALSE(built["steps"][1]["elements"].empty());
   const json read = json::parse(streamed.str());
   EXPECT_EQ(read, built);
-  // Every table number is the solver's double to the bit (the writer's shortest round trip).
+  // Every table number is the solver's double in kFieldDigits (7) significant digits: the
+  // writer's shortest round trip of it, within half a unit of the 7th digit of the double.
   for (size_t k = 0; k < s.run.steps.size(); ++k)
-    for (const auto& [key, table] : {std::pair{"nodes", &s.run.steps[k].site_fields},
-                                     std::pair{"elements", &s.run.steps[k].element_fields}}) {
+    for (const auto& [key, table] :
+         {std::pair{"nodes", &s.run.steps[k].site_fields}, std::pair{"elements", &s.run.steps[k].element_fields}}) {
       ASSERT_EQ(read["steps"][k][key].size(), table->rows.size());
       for (size_t i = 0; i < table->rows.size(); ++i)
         for (size_t c = 0; c < table->names.size(); ++c)
-          if (table->names[c] != "node" && table->names[c] != "element")
-            ASSERT_EQ(read["steps"][k][key][i][table->names[c]].get<double>(), table->rows[i][c])
-                << key << " row " << i << " " << table->names[c];
+          if (table->names[c] != "node" && table->names[c] != "element") {
+            const double v = table->rows[i][c];
+            const json& written = read["steps"][k][key][i][table->names[c]];
+            ASSERT_EQ(written.get<double>(), field_value(v)) << key << " row " << i << " " << table->names[c];
+            ASSERT_LE(std::abs(written.get<double>() - v), 5e-7 * std::abs(v)) << key << " row " << i;
+            char text[kMaxNumberChars];
+            std::string digits(text, write_number(text, written.get<double>()));  // as the result has it
+            digits = digits.substr(0, digits.find_first_of("eE"));                // the mantissa
+            digits.erase(std::remove_if(digits.begin(), digits.end(), [](char ch) { return !std::isdigit(ch); }),
+                         digits.end());
+            digits.erase(0, digits.find_first_not_of('0'));
+            ASSERT_LE(digits.find_last_not_of('0') + 1, 7u) << written.dump();  // significant digits
+          }
     }
 }
 
@@ -394,6 +407,13 @@ TEST(SceneEffects, AnExceptionDuringAStepFailsThatStepAndKeepsTheStepsBefore) {
   EXPECT_EQ(r, result_json(scene, run));
   EXPECT_EQ(r["steps"].size(), 2u);
   EXPECT_EQ(r["summary"]["completed"], false);
+  // Its kind, for a program (failure_kinds_test.cpp produces the others).
+  EXPECT_EQ(run.failure, FailureKind::exception);
+  EXPECT_EQ(run.failure_step, 2);
+  EXPECT_EQ(r["summary"]["failure"], json({{"kind", "exception"}, {"message", run.reason}, {"step", 2}}));
+  EXPECT_EQ(r["steps"][1]["failure"]["kind"], "exception");
+  const auto issues = validate_against(r, SchemaName::result);
+  EXPECT_TRUE(issues.empty()) << issues.front().pointer << ": " << issues.front().detail;
   std::filesystem::remove(path);
 }
 

@@ -8,8 +8,8 @@
 #include <random>
 
 #include "solver/contact/newton_rows.hpp"
-#include "solver/io/scene.hpp"
 #include "solver/equilibrium/equilibrium.hpp"
+#include "solver/io/scene.hpp"
 #include "tests/support/flat_block.hpp"
 
 namespace grip {
@@ -26,10 +26,8 @@ NewtonRows kinds(const Problem& problem, const Compliance& C, const std::vector<
     const Candidate& c = problem.candidates[usable[i]];
     const int eta = C.position[c.eta], xi = C.position[c.xi];
     rows.active.push_back(eta);
-    if (i - first < slipping)
-      rows.slip.push_back({xi, eta, i % 2 ? 0.3 : -0.3});
-    else
-      rows.active.push_back(xi);
+    if (i - first < slipping) rows.slip.push_back({xi, eta, i % 2 ? 0.3 : -0.3});
+    else rows.active.push_back(xi);
   }
   return rows;
 }
@@ -49,7 +47,8 @@ TEST(SparseCompliance, ProductsDiagonalAndNewtonStepsEqualTheDenseForm) {
     if (state.enabled[a]) all.push_back(a);
   std::vector<int> usable;  // candidates with both components free
   for (size_t i = 0; i < problem.candidates.size(); ++i)
-    if (state.enabled[problem.candidates[i].eta] && problem.candidates[i].xi >= 0 && state.enabled[problem.candidates[i].xi])
+    if (state.enabled[problem.candidates[i].eta] && problem.candidates[i].xi >= 0 &&
+        state.enabled[problem.candidates[i].xi])
       usable.push_back(static_cast<int>(i));
   ASSERT_GE(usable.size(), 40u);
   const Compliance dense = eq.compliance(state, all);  // a copy: the form of today

@@ -29,7 +29,11 @@ TEST(ThreadTeam, EveryTaskOnceCallAfterCall) {
 
 TEST(ThreadTeam, AnExceptionReachesTheCallerAndNestedCallsRunSerially) {
   ThreadTeam team(2);
-  EXPECT_THROW(team.run(2, [](int k) { if (k == 1) throw std::runtime_error("task 1"); }), std::runtime_error);
+  EXPECT_THROW(team.run(2,
+                        [](int k) {
+                          if (k == 1) throw std::runtime_error("task 1");
+                        }),
+               std::runtime_error);
   std::atomic<int> inner{0};
   team.run(2, [&](int) { team.run(3, [&](int) { ++inner; }); });
   EXPECT_EQ(inner.load(), 6);

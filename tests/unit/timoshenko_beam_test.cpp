@@ -13,8 +13,7 @@ namespace {
 
 BeamSection section(double E, double nu, double width, double depth) {
   const double G = E / (2 * (1 + nu));
-  return {E * width * depth, E * width * depth * depth * depth / 12, 5.0 / 6.0 * G * width * depth,
-          depth / 2, width};
+  return {E * width * depth, E * width * depth * depth * depth / 12, 5.0 / 6.0 * G * width * depth, depth / 2, width};
 }
 
 std::vector<double> uniform(double length, int elements) {
@@ -82,7 +81,7 @@ TEST(TimoshenkoBeam, LinearRigidRotationGivesNoForce) {
   Vector q = Vector::Zero(beam.dof_count());
   for (int k = 0; k < beam.node_count(); ++k) {
     q[TimoshenkoBeam::node_dof(k, 1)] = a * 10.0 * k / 5;  // w = a x
-    q[TimoshenkoBeam::node_dof(k, 2)] = -a;                 // theta = -dw/dx
+    q[TimoshenkoBeam::node_dof(k, 2)] = -a;                // theta = -dw/dx
   }
   // Compare with the force of a pure bending state of the same size.
   Vector bend = Vector::Zero(beam.dof_count());
@@ -95,8 +94,7 @@ TEST(TimoshenkoBeam, CantileverTipDeflectionMatchesClosedForm) {
   for (const double depth : {0.2, 4.0}) {  // slender (bending) and stubby (shear matters)
     const double L = 10;
     Problem problem;
-    auto beam = std::make_unique<TimoshenkoBeam>(uniform(L, 10), 0.0, section(1e4, 0.3, 1, depth),
-                                                 Kinematics::linear);
+    auto beam = std::make_unique<TimoshenkoBeam>(uniform(L, 10), 0.0, section(1e4, 0.3, 1, depth), Kinematics::linear);
     const BeamSection s = beam->section();
     const double P = 0.03 * s.EI / (L * L);  // a bending deflection of L / 100
     problem.loads = {Vector::Zero(beam->dof_count())};

@@ -147,7 +147,8 @@ TEST(TwoBodiesScene, ResultValidatesAndNamesTheBodies) {
     const json& body = r["bodies"][b];
     const int first = body["first_node"], count = body["nodes"], cells = body["elements"];
     const std::string piece = between(at, "<Piece ", ">");
-    EXPECT_EQ(piece, "NumberOfPoints=\"" + std::to_string(count) + "\" NumberOfCells=\"" + std::to_string(cells) + "\"");
+    EXPECT_EQ(piece,
+              "NumberOfPoints=\"" + std::to_string(count) + "\" NumberOfCells=\"" + std::to_string(cells) + "\"");
     const std::vector<double> body_index = numbers(between(at, "Name=\"body\" format=\"ascii\">", "</DataArray>"));
     ASSERT_EQ(body_index.size(), static_cast<size_t>(cells));
     for (double v : body_index) EXPECT_EQ(v, static_cast<double>(b));
@@ -157,7 +158,8 @@ TEST(TwoBodiesScene, ResultValidatesAndNamesTheBodies) {
       EXPECT_EQ(xyz[3 * n], r["steps"][0]["nodes"][first + n]["x"].get<double>());
       EXPECT_EQ(xyz[3 * n + 1], r["steps"][0]["nodes"][first + n]["y"].get<double>());
     }
-    const std::vector<double> connectivity = numbers(between(at, "Name=\"connectivity\" format=\"ascii\">", "</DataArray>"));
+    const std::vector<double> connectivity =
+        numbers(between(at, "Name=\"connectivity\" format=\"ascii\">", "</DataArray>"));
     ASSERT_FALSE(connectivity.empty());
     EXPECT_EQ(*std::min_element(connectivity.begin(), connectivity.end()), 0.0);
     EXPECT_EQ(*std::max_element(connectivity.begin(), connectivity.end()), count - 1.0);
@@ -177,7 +179,8 @@ TEST(TwoBodiesScene, OnlyPairsThatCanMeetHaveUnknowns) {
   const int pair = read_scene(example_scene("two-cylinders")).problem.component_count;
   EXPECT_GT(pair, 0);
   json wall = example_scene("block-on-foundation");
-  wall["obstacles"] = json::parse(R"([{"name": "wall", "shape": {"type": "segment", "from": [6, 10], "to": [6, -10]}}])");
+  wall["obstacles"] =
+      json::parse(R"([{"name": "wall", "shape": {"type": "segment", "from": [6, 10], "to": [6, -10]}}])");
   const Scene everyone = read_scene(wall);
   wall["contacts"].push_back({{"slave", "block.bottom"}, {"master", "wall"}});
   const Scene named = read_scene(wall);

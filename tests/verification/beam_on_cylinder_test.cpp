@@ -70,10 +70,8 @@ TEST(BeamOnCylinder, CevNeedsAFifthOfUzawasSolves) {
   std::cout << "cev " << cev.run.counters.solves << " solves; uzawa "
             << (uzawa.run.completed ? "converged" : "failed: " + uzawa.run.reason) << " after "
             << uzawa.run.counters.solves << " solves\n";
-  if (uzawa.run.completed)
-    EXPECT_GE(uzawa.run.counters.solves, 5 * cev.run.counters.solves);
-  else
-    EXPECT_GE(uzawa.run.counters.solves, 400);  // it stopped at its limit, not on an error
+  if (uzawa.run.completed) EXPECT_GE(uzawa.run.counters.solves, 5 * cev.run.counters.solves);
+  else EXPECT_GE(uzawa.run.counters.solves, 400);  // it stopped at its limit, not on an error
 }
 
 }  // namespace

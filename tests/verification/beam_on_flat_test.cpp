@@ -11,20 +11,19 @@ namespace {
 nlohmann::json beam_on_flat(const std::string& kinematics) {
   nlohmann::json loads = nlohmann::json::array();
   for (int i = 1; i <= 20; ++i) loads.push_back({{"node", i}, {"force", {0, i == 20 ? -0.5 : -1.0}}});
-  return {
-      {"body",
-       {{"model", "timoshenko_beam"},
-        {"kinematics", kinematics},
-        {"material", {{"young", 2e5}, {"poisson", 0.3}}},
-        {"section", {{"width", 1}, {"depth", 0.5}}},
-        {"mesh", {{"length", 10}, {"elements", 20}}},
-        {"supports", {{{"node", 0}, {"fix", {"u", "w", "theta"}}}}},
-        {"loads", loads}}},
-      {"obstacles",
-       {{{"name", "flat"},
-         {"shape", {{"type", "segment"}, {"from", {12, -0.25}}, {"to", {-2, -0.25}}}},
-         {"friction", 0.3}}}},
-      {"steps", 4}};
+  return {{"body",
+           {{"model", "timoshenko_beam"},
+            {"kinematics", kinematics},
+            {"material", {{"young", 2e5}, {"poisson", 0.3}}},
+            {"section", {{"width", 1}, {"depth", 0.5}}},
+            {"mesh", {{"length", 10}, {"elements", 20}}},
+            {"supports", {{{"node", 0}, {"fix", {"u", "w", "theta"}}}}},
+            {"loads", loads}}},
+          {"obstacles",
+           {{{"name", "flat"},
+             {"shape", {{"type", "segment"}, {"from", {12, -0.25}}, {"to", {-2, -0.25}}}},
+             {"friction", 0.3}}}},
+          {"steps", 4}};
 }
 
 TEST(BeamOnFlat, ContactAndSupportCarryTheUniformLoad) {

@@ -43,15 +43,16 @@ json beam(const std::vector<double>& forces) {
 json beam_on_foundation(const std::vector<double>& forces, double E, bool beam_master = false) {
   json b = beam(forces);
   b["name"] = "beam";
-  json foundation = {{"name", "foundation"},
-                     {"model", "continuum"},
-                     {"kinematics", "linear"},
-                     {"analysis", "plane_strain"},
-                     {"element", "q4"},
-                     {"material", {{"young", E}, {"poisson", 0.33}}},
-                     {"mesh", {{"rectangle", {{"origin", {-kLength / 2, -4}}, {"size", {kLength, 4}}, {"divisions", {13, 4}}}}}},
-                     {"contact_set", "top"},
-                     {"supports", {{{"set", "left"}, {"fix", {"x"}}}, {{"set", "bottom"}, {"fix", {"y"}}}}}};
+  json foundation = {
+      {"name", "foundation"},
+      {"model", "continuum"},
+      {"kinematics", "linear"},
+      {"analysis", "plane_strain"},
+      {"element", "q4"},
+      {"material", {{"young", E}, {"poisson", 0.33}}},
+      {"mesh", {{"rectangle", {{"origin", {-kLength / 2, -4}}, {"size", {kLength, 4}}, {"divisions", {13, 4}}}}}},
+      {"contact_set", "top"},
+      {"supports", {{{"set", "left"}, {"fix", {"x"}}}, {{"set", "bottom"}, {"fix", {"y"}}}}}};
   json pair = {{"slave", "beam.lower"}, {"master", "foundation.top"}};
   if (beam_master) pair = {{"slave", "foundation.top"}, {"master", "beam.lower"}};
   return {{"bodies", {b, foundation}},
@@ -133,9 +134,10 @@ TEST(BeamOnFoundation, PointLoadsApproachTheRigidFlatAsTheFoundationStiffens) {
     ASSERT_EQ(nodes.size(), f.size());
     double departure = 0.0;
     for (size_t n = 0; n < f.size(); ++n) departure = std::max(departure, std::abs(-nodes[n].p_n - f[n]) / f[5]);
-    std::printf("foundation E = %.0e MPa: largest departure of a nodal force from the rigid flat's %.4f of the "
-                "largest load; %d real solves\n",
-                E, departure, s.run.steps.back().solves);
+    std::printf(
+        "foundation E = %.0e MPa: largest departure of a nodal force from the rigid flat's %.4f of the "
+        "largest load; %d real solves\n",
+        E, departure, s.run.steps.back().solves);
     EXPECT_LT(departure, 0.6 * previous);
     previous = departure;
   }

@@ -25,8 +25,8 @@ json cattaneo(double size) { return with_pole_elements(example_scene("cattaneo-m
 struct CattaneoReading {
   double mu = 0, P = 0, Q = 0, a = 0, p0 = 0, c = 0;  // closed form at the computed loads
   Zone stick;
-  double c_fe = 0;       // where the stick margin mu |sigma_n| - |sigma_t| vanishes
-  double c_nodes = 0;    // midway between the last sticking and the first slipping node
+  double c_fe = 0;            // where the stick margin mu |sigma_n| - |sigma_t| vanishes
+  double c_nodes = 0;         // midway between the last sticking and the first slipping node
   double traction_error = 0;  // RMS of sigma_t - q(x) over the contact, / (mu p0)
   double contact_force = 0;   // sum of the tangential contact forces
 };
@@ -67,11 +67,12 @@ CattaneoReading read_cattaneo(const Solved& s, const StepRecord& rec) {
 }
 
 void print(const CattaneoReading& r, int step) {
-  std::printf("step %d: P %.1f, Q %.1f, Q/(mu P) %.3f, a %.4f, c %.4f (c/a %.3f); stick zone c %.4f "
-              "(error %+.2f %% of a), between nodes %.4f (%+.2f %% of a); shear traction RMS error "
-              "%.2f %% of mu p0\n",
-              step, r.P, r.Q, r.Q / (r.mu * r.P), r.a, r.c, r.c / r.a, r.c_fe, 100 * (r.c_fe - r.c) / r.a,
-              r.c_nodes, 100 * (r.c_nodes - r.c) / r.a, 100 * r.traction_error);
+  std::printf(
+      "step %d: P %.1f, Q %.1f, Q/(mu P) %.3f, a %.4f, c %.4f (c/a %.3f); stick zone c %.4f "
+      "(error %+.2f %% of a), between nodes %.4f (%+.2f %% of a); shear traction RMS error "
+      "%.2f %% of mu p0\n",
+      step, r.P, r.Q, r.Q / (r.mu * r.P), r.a, r.c, r.c / r.a, r.c_fe, 100 * (r.c_fe - r.c) / r.a, r.c_nodes,
+      100 * (r.c_nodes - r.c) / r.a, 100 * r.traction_error);
 }
 
 // The shipped scene: nu = 0.49, q4_bbar, a / h = 20 near the contact.
@@ -82,8 +83,8 @@ TEST(CattaneoMindlin, StickZoneMatchesTheClosedFormNearIncompressibility) {
   const int pressed = 2;  // the frictionless stage
   const CattaneoReading press = read_cattaneo(s, s.run.steps[pressed - 1]);
   EXPECT_EQ(press.contact_force, 0.0);
-  std::printf("solves %ld, Newton iterations %ld, %.3f s\n", s.run.counters.solves,
-              s.run.counters.newton_iterations, s.run.seconds);
+  std::printf("solves %ld, Newton iterations %ld, %.3f s\n", s.run.counters.solves, s.run.counters.newton_iterations,
+              s.run.seconds);
   for (size_t k = pressed; k < s.run.steps.size(); ++k) {
     const StepRecord& rec = s.run.steps[k];
     const CattaneoReading r = read_cattaneo(s, rec);
@@ -127,9 +128,10 @@ TEST(CattaneoMindlin, CompressibleCaseIsReportedBesideIt) {
   ASSERT_TRUE(pressed.run.completed);
   const CattaneoReading r = read_cattaneo(pressed, pressed.run.steps.back());
   ASSERT_TRUE(r.stick.found);
-  std::printf("nu = 0.3, pressed with friction 0.3: central stick zone of half-width %.3f a "
-              "(net tangential force %.2g of P)\n",
-              r.c_fe / r.a, r.contact_force / r.P);
+  std::printf(
+      "nu = 0.3, pressed with friction 0.3: central stick zone of half-width %.3f a "
+      "(net tangential force %.2g of P)\n",
+      r.c_fe / r.a, r.contact_force / r.P);
 }
 
 // The two strategies converge to the same contact forces and states (one press step, one

@@ -45,9 +45,10 @@ TEST(HeldByContactFinite, TurnedDiscBalancesAboutItsDeformedShape) {
   for (const StepRecord& rec : s.run.steps) {
     const Vec2 lower = flat_resultant(s.scene.problem, rec, 0), upper = flat_resultant(s.scene.problem, rec, 1);
     const json step = step_json(s.scene.problem, rec, s.scene.output);
-    std::printf("finite disc, step %d: P = %.4f, Q lower %.6f upper %.6f N/mm, rotation %.3e; %d real solves, %d Newton\n",
-                rec.index, lower.y(), lower.x(), upper.x(), step["rigid_motion"]["rotation"].get<double>(), rec.solves,
-                rec.newton_iterations);
+    std::printf(
+        "finite disc, step %d: P = %.4f, Q lower %.6f upper %.6f N/mm, rotation %.3e; %d real solves, %d Newton\n",
+        rec.index, lower.y(), lower.x(), upper.x(), step["rigid_motion"]["rotation"].get<double>(), rec.solves,
+        rec.newton_iterations);
     // The couple turns the disc counter-clockwise, its bottom along +x and its top along -x;
     // the flats' friction resists: the lower flat pushes along -x, the upper along +x.
     EXPECT_GT(step["rigid_motion"]["rotation"].get<double>(), 0.0);
@@ -83,9 +84,10 @@ TEST(HeldByContactFinite, SmallLoadAgreesWithSmallStrain) {
   const StepRecord &fr = f.run.steps.back(), &lr = l.run.steps.back();
   const Vec2 pf = flat_resultant(f.scene.problem, fr, 0), pl = flat_resultant(l.scene.problem, lr, 0);
   const double gradient = largest_gradient(l.scene.problem, lr.state.q);
-  std::printf("small load: P finite %.6f, linear %.6f (%+.3e), Q finite %.6f, linear %.6f (%+.3e); largest "
-              "gradient %.3e; real solves finite %d, linear %d\n",
-              pf.y(), pl.y(), pf.y() / pl.y() - 1, pf.x(), pl.x(), pf.x() / pl.x() - 1, gradient, fr.solves, lr.solves);
+  std::printf(
+      "small load: P finite %.6f, linear %.6f (%+.3e), Q finite %.6f, linear %.6f (%+.3e); largest "
+      "gradient %.3e; real solves finite %d, linear %d\n",
+      pf.y(), pl.y(), pf.y() / pl.y() - 1, pf.x(), pl.x(), pf.x() / pl.x() - 1, gradient, fr.solves, lr.solves);
   EXPECT_LT(std::abs(pf.y() / pl.y() - 1), gradient);
   EXPECT_LT(std::abs(pf.x() / pl.x() - 1), gradient);
 }
@@ -116,10 +118,11 @@ TEST(HeldByContactFinite, TurnedDiscByForceMatchesDisplacementControl) {
   const double q_diff = (q - dr.state.q).lpNorm<Eigen::Infinity>(), q_max = q.lpNorm<Eigen::Infinity>();
   const Vec2 reaction = reaction_resultant(d.scene.problem, dr);
   const double P = flat_resultant(f.scene.problem, fr, 0).y();
-  std::printf("by force: %d real solves, %d Newton; by displacement: %d real solves, %d Newton; forces differ by "
-              "%.2e, displacements by %.2e (relative), support reaction %.2e of P\n",
-              fr.solves, fr.newton_iterations, dr.solves, dr.newton_iterations, p_diff / p_max, q_diff / q_max,
-              reaction.norm() / P);
+  std::printf(
+      "by force: %d real solves, %d Newton; by displacement: %d real solves, %d Newton; forces differ by "
+      "%.2e, displacements by %.2e (relative), support reaction %.2e of P\n",
+      fr.solves, fr.newton_iterations, dr.solves, dr.newton_iterations, p_diff / p_max, q_diff / q_max,
+      reaction.norm() / P);
   EXPECT_LT(p_diff, 1e-6 * p_max);
   EXPECT_LT(q_diff, 1e-6 * q_max);
   EXPECT_LT(reaction.norm(), 1e-6 * P);
@@ -193,13 +196,17 @@ TEST(HeldByContactFinite, RotationNoContactResistsIsRejected) {
       elements.push_back({a, a + around, b + around, b});  // counter-clockwise: out, along, in
     }
   json j = {{"body",
-             {{"model", "continuum"}, {"kinematics", "finite"}, {"analysis", "plane_strain"}, {"element", "q4"},
-              {"thickness", 1}, {"material", {{"young", 200000}, {"poisson", 0.3}}},
+             {{"model", "continuum"},
+              {"kinematics", "finite"},
+              {"analysis", "plane_strain"},
+              {"element", "q4"},
+              {"thickness", 1},
+              {"material", {{"young", 200000}, {"poisson", 0.3}}},
               {"mesh", {{"nodes", nodes}, {"elements", elements}, {"sets", {{"bore", inner}}}}},
               {"contact_set", "bore"},
               {"loads", json::array({{{"node", 3 * around + around / 4}, {"force", {0.0, -100.0}}}})}}},
-            {"obstacles", json::array({{{"name", "shaft"},
-                                        {"shape", {{"type", "circle"}, {"centre", {0, 0}}, {"radius", 4.99}}}}})},
+            {"obstacles",
+             json::array({{{"name", "shaft"}, {"shape", {{"type", "circle"}, {"centre", {0, 0}}, {"radius", 4.99}}}}})},
             {"steps", 1}};
   const std::string issues = scene_issues(j);
   EXPECT_NE(issues.find("/body/supports: leave the body free to rotate about (0, 0), and no obstacle within reach "

@@ -27,7 +27,7 @@ struct HertzReading {
   double peak = 0;              // largest nodal contact stress
   Zone zone;                    // the nodes where contact ends
   int nodes_in_contact = 0;
-  bool set_ends_open = false;   // the contact set reaches beyond the contact zone
+  bool set_ends_open = false;  // the contact set reaches beyond the contact zone
   double a_error() const { return fit.a / a - 1; }
   double p0_error() const { return fit.p0 / p0 - 1; }
   double peak_error() const { return peak / p0 - 1; }
@@ -35,7 +35,8 @@ struct HertzReading {
 
 HertzReading read_hertz(const Solved& s, const StepRecord& rec) {
   const json& body = s.scene.effective["body"];
-  const HertzContact closed = hertz_contact(body, -reaction_resultant(s.scene.problem, rec).y() / body["thickness"].get<double>());
+  const HertzContact closed =
+      hertz_contact(body, -reaction_resultant(s.scene.problem, rec).y() / body["thickness"].get<double>());
   HertzReading h;
   h.P = closed.P;
   h.a = closed.a;
@@ -63,10 +64,10 @@ TEST(Hertz, MatchesTheClosedFormOnAModerateMesh) {
     double contact = 0.0;
     for (const auto& n : contact_profile(s.scene.problem, rec)) contact -= n.p_n;
     EXPECT_NEAR(h.P, contact, 1e-8 * h.P);
-    std::printf("step %d: P = %.2f N/mm; a = %.4f mm, fitted %+.2f %%; p0 = %.1f MPa, fitted %+.2f %%, "
-                "peak %+.2f %%; %d nodes touch\n",
-                rec.index, h.P, h.a, 100 * h.a_error(), h.p0, 100 * h.p0_error(), 100 * h.peak_error(),
-                h.nodes_in_contact);
+    std::printf(
+        "step %d: P = %.2f N/mm; a = %.4f mm, fitted %+.2f %%; p0 = %.1f MPa, fitted %+.2f %%, "
+        "peak %+.2f %%; %d nodes touch\n",
+        rec.index, h.P, h.a, 100 * h.a_error(), h.p0, 100 * h.p0_error(), 100 * h.peak_error(), h.nodes_in_contact);
     EXPECT_LT(std::abs(h.a_error()), 0.02);
     EXPECT_LT(std::abs(h.p0_error()), 0.02);
     EXPECT_LT(std::abs(h.peak_error()), 0.02);
@@ -85,8 +86,8 @@ TEST(Hertz, MatchesTheClosedFormOnAModerateMesh) {
 // the pressure over half an element either side of it.
 TEST(Hertz, ErrorFallsAsTheMeshIsRefined) {
   std::vector<HertzReading> r;
-  std::printf("%7s %6s %9s %8s %9s %9s %9s %9s %7s %8s\n", "size", "a/h", "P", "a", "a err %", "p0",
-              "p0 err %", "peak err %", "solves", "seconds");
+  std::printf("%7s %6s %9s %8s %9s %9s %9s %9s %7s %8s\n", "size", "a/h", "P", "a", "a err %", "p0", "p0 err %",
+              "peak err %", "solves", "seconds");
   for (const double size : {0.1, 0.05, 0.025}) {
     const Solved s = solve_scene(hertz(size));
     expect_every_step_sound(s);
@@ -156,7 +157,8 @@ TEST(Hertz, SmallestAcceptedDivisionsMatchTheClosedForm) {
   }
   std::printf("smallest accepted: [%d, %d]; one fewer: %s\n", ns, ns / 2, refusal.c_str());
   EXPECT_NE(refusal.find("give at least " + std::to_string(ns)), std::string::npos) << refusal;
-  EXPECT_EQ(j["body"]["mesh"]["half_disc"]["divisions"], example_scene("hertz")["body"]["mesh"]["half_disc"]["divisions"]);
+  EXPECT_EQ(j["body"]["mesh"]["half_disc"]["divisions"],
+            example_scene("hertz")["body"]["mesh"]["half_disc"]["divisions"]);
   const Solved s = solve_scene(j);
   expect_every_step_sound(s);
   ASSERT_TRUE(s.run.completed);
@@ -168,8 +170,7 @@ TEST(Hertz, SmallestAcceptedDivisionsMatchTheClosedForm) {
   ASSERT_TRUE(r.run.completed);
   const double P_refined = read_hertz(r, r.run.steps.back()).P;
   std::printf("P = %.1f N/mm (refined mesh %.1f, %+.2f %%); a fitted %+.2f %%; p0 fitted %+.2f %%, peak %+.2f %%\n",
-              h.P, P_refined, 100 * (h.P / P_refined - 1), 100 * h.a_error(), 100 * h.p0_error(),
-              100 * h.peak_error());
+              h.P, P_refined, 100 * (h.P / P_refined - 1), 100 * h.a_error(), 100 * h.p0_error(), 100 * h.peak_error());
   EXPECT_NEAR(h.P, P_refined, 0.01 * P_refined);
   EXPECT_LT(std::abs(h.a_error()), 0.01);
   EXPECT_LT(std::abs(h.p0_error()), 0.01);
@@ -184,8 +185,8 @@ TEST(Hertz, ComplianceReuseKeepsTheAnswer) {
   json j = with_pole_elements(example_scene("hertz"), 0.1);
   j["body"]["kinematics"] = "finite";
   j["obstacles"][0]["friction"] = 0.3;
-  j["body"]["supports"] = json::parse(
-      R"([{"set": "diameter", "fix": ["y"], "values": {"y": -0.05}}, {"set": "centre", "fix": ["x"]}])");
+  j["body"]["supports"] =
+      json::parse(R"([{"set": "diameter", "fix": ["y"], "values": {"y": -0.05}}, {"set": "centre", "fix": ["x"]}])");
   j["steps"] = 4;
   Solved reused{read_scene(j), {}}, fresh{read_scene(j), {}};
   reused.scene.params.contact.reuse_compliance = true;
@@ -211,10 +212,11 @@ TEST(Hertz, ComplianceReuseKeepsTheAnswer) {
     dp = std::max(dp, step_dp);
   }
   const EquilibriumCounters &cr = reused.run.counters, &cf = fresh.run.counters;
-  std::printf("reused: %ld G formed, %ld real solves, %ld factorizations; fresh: %ld, %ld, %ld; "
-              "|dq| %.3g (tolerance %.3g), |dp| %.3g of %.3g (pinned to %.3g)\n",
-              cr.compliance_forms, cr.solves, cr.factorizations, cf.compliance_forms, cf.solves,
-              cf.factorizations, dq, tol, dp, p_scale, pinned);
+  std::printf(
+      "reused: %ld G formed, %ld real solves, %ld factorizations; fresh: %ld, %ld, %ld; "
+      "|dq| %.3g (tolerance %.3g), |dp| %.3g of %.3g (pinned to %.3g)\n",
+      cr.compliance_forms, cr.solves, cr.factorizations, cf.compliance_forms, cf.solves, cf.factorizations, dq, tol, dp,
+      p_scale, pinned);
   EXPECT_LT(dq, tol);
   EXPECT_LT(cr.compliance_forms, cf.compliance_forms);
 }

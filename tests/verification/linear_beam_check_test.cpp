@@ -17,17 +17,14 @@ Problem section8_problem() {
   Problem problem;
   std::vector<double> x;
   for (int i = 0; i <= 40; ++i) x.push_back(10.0 * i / 40);
-  auto beam = std::make_unique<TimoshenkoBeam>(x, 0.0, BeamSection{1e4, 1e2, 1e6, 0.0, 1.0},
-                                               Kinematics::linear);
+  auto beam = std::make_unique<TimoshenkoBeam>(x, 0.0, BeamSection{1e4, 1e2, 1e6, 0.0, 1.0}, Kinematics::linear);
   problem.loads = {Vector::Zero(beam->dof_count())};
-  for (int i = 1; i <= 40; ++i)
-    problem.loads[0][TimoshenkoBeam::node_dof(i, 1)] = -2.0 * (i == 40 ? 0.125 : 0.25);
+  for (int i = 1; i <= 40; ++i) problem.loads[0][TimoshenkoBeam::node_dof(i, 1)] = -2.0 * (i == 40 ? 0.125 : 0.25);
   problem.loads[0][TimoshenkoBeam::node_dof(40, 0)] = 30.0;
   for (int c = 0; c < 3; ++c) problem.constraints.push_back({TimoshenkoBeam::node_dof(0, c), 0.0});
   problem.body = std::move(beam);
   // The flat y = -0.002 x, solid below: travelled right to left.
-  problem.obstacles.push_back(
-      {"flat", make_profile({SegmentPiece{{12, -0.024}, {-2, 0.004}}}), 0.3, true, {}});
+  problem.obstacles.push_back({"flat", make_profile({SegmentPiece{{12, -0.024}, {-2, 0.004}}}), 0.3, true, {}});
   add_candidates(problem);
   return problem;
 }
@@ -70,8 +67,8 @@ TEST(LinearBeamCheck, PaperLoopCountsAreOfTheOrderOfTheTable) {
     c.epsilon = k.eps;
     const RunResult run = solve(problem, c);
     expect_sound(problem, run, c);
-    std::cout << "paper loop n=" << k.n << (k.eps == EpsilonSource::exact ? " exact" : " warmup")
-              << ": " << run.counters.solves << " solves (table: " << k.table << ")\n";
+    std::cout << "paper loop n=" << k.n << (k.eps == EpsilonSource::exact ? " exact" : " warmup") << ": "
+              << run.counters.solves << " solves (table: " << k.table << ")\n";
     // Same order of magnitude as the table: this literal loop spends most of its solves in
     // the second tau pass, halving alpha while stuck points are clipped at their new bounds
     // one by one (measured 116, 226 and 678 against 59, 45 and 527).
@@ -85,8 +82,7 @@ TEST(LinearBeamCheck, DefaultLoopNeedsFarFewerSolves) {
   const ContactParams c;
   const RunResult run = solve(problem, c);
   expect_sound(problem, run, c);
-  std::cout << "default loop: " << run.counters.solves << " solves, "
-            << run.steps.front().passes << " tau passes\n";
+  std::cout << "default loop: " << run.counters.solves << " solves, " << run.steps.front().passes << " tau passes\n";
   EXPECT_LE(run.counters.solves, 45 / 2);  // well below the best literal variant (45)
 }
 

@@ -44,27 +44,29 @@ json distorted_block(QuadShape shape) {
     }
   json nodes = json::array();
   for (const Vec2& x : mesh.nodes) nodes.push_back({x.x(), x.y()});
-  return {{"nodes", nodes}, {"elements", mesh.elements},
-          {"sets", {{"bottom", mesh.sets["bottom"]}, {"top", mesh.sets["top"]}, {"corner", {mesh.sets["top"].back()}}}}};
+  return {
+      {"nodes", nodes},
+      {"elements", mesh.elements},
+      {"sets", {{"bottom", mesh.sets["bottom"]}, {"top", mesh.sets["top"]}, {"corner", {mesh.sets["top"].back()}}}}};
 }
 
-json patch_scene(const std::string& element, const std::string& kinematics, const std::string& analysis,
-                 double delta) {
+json patch_scene(const std::string& element, const std::string& kinematics, const std::string& analysis, double delta) {
   const QuadShape shape = element == "q9" ? QuadShape::q9 : QuadShape::q4;
-  return {{"body",
-           {{"model", "continuum"},
-            {"kinematics", kinematics},
-            {"analysis", analysis},
-            {"element", element},
-            {"thickness", 0.5},
-            {"material", {{"young", kYoung}, {"poisson", kPoisson}}},
-            {"mesh", distorted_block(shape)},
-            {"contact_set", "bottom"},
-            {"supports",
-             {{{"set", "top"}, {"fix", {"y"}}, {"values", {{"y", -delta}}}}, {{"set", "corner"}, {"fix", {"x"}}}}}}},
-          {"obstacles",
-           {{{"name", "flat"}, {"shape", {{"type", "segment"}, {"from", {10, 0}}, {"to", {-10, 0}}}}, {"friction", 0}}}},
-          {"steps", 2}};
+  return {
+      {"body",
+       {{"model", "continuum"},
+        {"kinematics", kinematics},
+        {"analysis", analysis},
+        {"element", element},
+        {"thickness", 0.5},
+        {"material", {{"young", kYoung}, {"poisson", kPoisson}}},
+        {"mesh", distorted_block(shape)},
+        {"contact_set", "bottom"},
+        {"supports",
+         {{{"set", "top"}, {"fix", {"y"}}, {"values", {{"y", -delta}}}}, {{"set", "corner"}, {"fix", {"x"}}}}}}},
+      {"obstacles",
+       {{{"name", "flat"}, {"shape", {{"type", "segment"}, {"from", {10, 0}}, {"to", {-10, 0}}}}, {"friction", 0}}}},
+      {"steps", 2}};
 }
 
 // The nominal compressive stress of the homogeneous state, by the closed forms above.
@@ -95,10 +97,10 @@ TEST(ContactPatch, UniformCompressionGivesUniformPressure) {
     const char* kinematics;
     const char* analysis;
   };
-  const Case cases[] = {{"q4", "linear", "plane_strain"},   {"q4", "linear", "plane_stress"},
+  const Case cases[] = {{"q4", "linear", "plane_strain"},      {"q4", "linear", "plane_stress"},
                         {"q4_bbar", "linear", "plane_strain"}, {"q9", "linear", "plane_strain"},
-                        {"q4", "finite", "plane_strain"},   {"q4", "finite", "plane_stress"},
-                        {"q9", "finite", "plane_strain"},   {"q9", "finite", "plane_stress"}};
+                        {"q4", "finite", "plane_strain"},      {"q4", "finite", "plane_stress"},
+                        {"q9", "finite", "plane_strain"},      {"q9", "finite", "plane_stress"}};
   for (const Case& c : cases) {
     SCOPED_TRACE(std::string(c.element) + " " + c.kinematics + " " + c.analysis);
     // Finite strain at 5 % compression; the linear cases are exact at any size.
@@ -126,10 +128,10 @@ TEST(ContactPatch, UniformCompressionGivesUniformPressure) {
       pinned_total += std::abs(dp[cand.eta]);
       mean += sigma / problem.candidates.size();
     }
-    std::printf("%-8s %-7s %-13s sigma_n %.9g, closed form %.9g, largest deviation %.2e relative (pinned to %.2e; "
-                "corrected %.2e)\n",
-                c.element, c.kinematics, c.analysis, mean, expected, worst / expected, pinned / expected,
-                corrected / expected);
+    std::printf(
+        "%-8s %-7s %-13s sigma_n %.9g, closed form %.9g, largest deviation %.2e relative (pinned to %.2e; "
+        "corrected %.2e)\n",
+        c.element, c.kinematics, c.analysis, mean, expected, worst / expected, pinned / expected, corrected / expected);
     EXPECT_LT(worst, 1e-9 * expected + pinned);
     EXPECT_LT(corrected, 1e-9 * expected);
     // The reactions carry the same: sigma times the bottom's area, to the sum of the |dp|.

@@ -74,7 +74,7 @@ TEST(SheetStretching, StrainPeaksBeyondThePunchContact) {
   const int peak = static_cast<int>(std::max_element(strain.begin(), strain.end()) - strain.begin());
   EXPECT_GE(peak, edge - 1);
   EXPECT_NEAR(strain[edge], strain[peak], 0.005 * strain[peak]);  // just beyond the edge
-  EXPECT_LT(strain[edge - 3], 0.95 * strain[peak]);                 // rising along the punch
+  EXPECT_LT(strain[edge - 3], 0.95 * strain[peak]);               // rising along the punch
   EXPECT_LT(strain.front(), 0.6 * strain[peak]);
   EXPECT_LT(strain.back(), 0.7 * strain[peak]);
 }

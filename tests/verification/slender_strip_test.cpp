@@ -25,7 +25,9 @@ using testing::strip_tip;
 
 // The shooting solution reproduces Mattiasson's (1981) table of the elastica.
 TEST(Elastica, ReproducesMattiassonsTable) {
-  struct Row { double alpha, v, u, theta; };
+  struct Row {
+    double alpha, v, u, theta;
+  };
   for (const Row& row : {Row{1, 0.30172, 0.05643, 0.46135}, Row{2, 0.49346, 0.16064, 0.78175},
                          Row{5, 0.71379, 0.38763, 1.21537}, Row{10, 0.81061, 0.55500, 1.43029}}) {
     const ElasticaTip tip = elastica_tip(row.alpha);
@@ -49,9 +51,10 @@ TEST(SlenderStrip, CantileverFollowsTheElastica) {
     EXPECT_EQ(rec.cuts, 0) << "step " << k + 1;
     const ElasticaTip exact = elastica_tip(spec.alpha * rec.load_factor);
     const ElasticaTip tip = strip_tip(s, spec, k);
-    std::printf("F L^2/EI = %4.1f: %2d Newton; tip deflection %+.2e, shortening %+.2e (of L), rotation %+.2e (relative)\n",
-                spec.alpha * rec.load_factor, rec.newton_iterations, tip.deflection - exact.deflection,
-                tip.shortening - exact.shortening, tip.rotation / exact.rotation - 1);
+    std::printf(
+        "F L^2/EI = %4.1f: %2d Newton; tip deflection %+.2e, shortening %+.2e (of L), rotation %+.2e (relative)\n",
+        spec.alpha * rec.load_factor, rec.newton_iterations, tip.deflection - exact.deflection,
+        tip.shortening - exact.shortening, tip.rotation / exact.rotation - 1);
     EXPECT_NEAR(tip.deflection, exact.deflection, 3e-3) << "step " << k + 1;
     EXPECT_NEAR(tip.shortening, exact.shortening, 3e-3) << "step " << k + 1;
     EXPECT_NEAR(tip.rotation, exact.rotation, 3e-3 * exact.rotation) << "step " << k + 1;
@@ -165,7 +168,8 @@ TEST(SlenderStrip, WrapsOntoACylinderWithFriction) {
 TEST(VonKarmanBeam, WarnsWhereItLeavesTheElastica) {
   nlohmann::json j = testing::example_scene("beam-on-cylinder");
   j["body"]["section"]["depth"] = 0.5;
-  const double EI = 210000.0 * 2 * 0.125 / 12.0, L = 30.0, alpha = 0.9;  // tip rotations 0.045 k: none on the 0.15 limit
+  const double EI = 210000.0 * 2 * 0.125 / 12.0, L = 30.0,
+               alpha = 0.9;  // tip rotations 0.045 k: none on the 0.15 limit
   j["body"]["loads"] = {{{"node", 40}, {"force", {0.0, -alpha * EI / (L * L)}}}};
   j["obstacles"][0]["shape"]["centre"] = {0, -500};
   j["steps"] = 10;
@@ -175,7 +179,8 @@ TEST(VonKarmanBeam, WarnsWhereItLeavesTheElastica) {
   for (const StepRecord& rec : s.run.steps) {
     const double theta = std::abs(rec.state.q[TimoshenkoBeam::node_dof(40, 2)]);
     const ElasticaTip exact = elastica_tip(alpha * rec.load_factor);
-    const double error = std::abs(-rec.state.q[TimoshenkoBeam::node_dof(40, 1)] / L - exact.deflection) / exact.deflection;
+    const double error =
+        std::abs(-rec.state.q[TimoshenkoBeam::node_dof(40, 1)] / L - exact.deflection) / exact.deflection;
     std::printf("step %d: tip rotation %.4f rad, deflection %.3f %% off the elastica\n", rec.index, theta, 100 * error);
     EXPECT_LE(error, 0.5 * theta * theta + 1e-3) << "step " << rec.index;
     EXPECT_EQ(!rec.warning.empty(), theta > 0.15) << "step " << rec.index << ": " << rec.warning;

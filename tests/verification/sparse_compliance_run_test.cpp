@@ -37,8 +37,8 @@ TEST(SparseCompliance, FlatWith250ContactNodesEqualsTheDenseRun) {
     ASSERT_GT(p_max, 0.0);
     const double dp = (a.p - b.p).cwiseAbs().maxCoeff() / p_max;
     const double dq = (a.state.q - b.state.q).cwiseAbs().maxCoeff();
-    std::printf("step %zu: forces differ by %.3g of the largest, displacements by %.3g (tolerance %.3g)\n", k + 1,
-                dp, dq, tolerance);
+    std::printf("step %zu: forces differ by %.3g of the largest, displacements by %.3g (tolerance %.3g)\n", k + 1, dp,
+                dq, tolerance);
     EXPECT_LT(dp, 1e-9) << "step " << k + 1;
     EXPECT_LT(dq, tolerance) << "step " << k + 1;
     int slipping = 0;

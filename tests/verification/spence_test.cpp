@@ -17,7 +17,7 @@ namespace {
 using namespace grip::testing;
 
 constexpr double kNu = 0.3, kMu = 0.3, kSize = 0.025;  // a / h = 41 at the last step
-constexpr int kPerA = 40;                             // the half-plane model's a / h
+constexpr int kPerA = 40;                              // the half-plane model's a / h
 
 double relation() { return spence_stick_ratio((1 - 2 * kNu) / (2 * (1 - kNu)) / kMu); }
 
@@ -27,9 +27,10 @@ double relation() { return spence_stick_ratio((1 - 2 * kNu) / (2 * (1 - kNu)) / 
 TEST(Spence, HalfPlaneModelWithoutCouplingGivesTheRelation) {
   const HalfPlaneSpence u = spence_half_plane(kMu, kNu, kPerA, 50, false);
   const HalfPlaneSpence c = spence_half_plane(kMu, kNu, kPerA, 50, true);
-  std::printf("relation %.4f; half-plane model, a/h %d: uncoupled c/a %.4f, coupled c/a %.4f (a %.4f, peak %.4f of "
-              "Hertz's)\n",
-              relation(), kPerA, u.c_stick / u.a, c.c_stick / c.a, c.a, c.peak);
+  std::printf(
+      "relation %.4f; half-plane model, a/h %d: uncoupled c/a %.4f, coupled c/a %.4f (a %.4f, peak %.4f of "
+      "Hertz's)\n",
+      relation(), kPerA, u.c_stick / u.a, c.c_stick / c.a, c.a, c.peak);
   EXPECT_NEAR(u.c_stick / u.a, relation(), 1.0 / kPerA);
   EXPECT_LT(c.c_stick / c.a, relation() - 1.0 / kPerA);
 }
@@ -71,17 +72,18 @@ TEST(Spence, StickZoneMatchesTheHalfPlaneSolution) {
   for (size_t k = f.run.steps.size() / 2; k < f.run.steps.size(); ++k) {
     const SpenceReading r = read_spence(f, f.run.steps[k], kMu);
     ASSERT_TRUE(r.found && r.c > 0);
-    std::printf("step %zu: a %.4f (a/h %.1f, %+.2f %% of Hertz's), c/a %.4f (0.99 rule %.4f), peak %+.2f %% over "
-                "Hertz's p0\n",
-                k + 1, r.a, r.a / kSize, 100 * (r.a / r.hertz.a - 1), r.c / r.a, r.c_rule / r.a, 100 * (r.peak - 1));
+    std::printf(
+        "step %zu: a %.4f (a/h %.1f, %+.2f %% of Hertz's), c/a %.4f (0.99 rule %.4f), peak %+.2f %% over "
+        "Hertz's p0\n",
+        k + 1, r.a, r.a / kSize, 100 * (r.a / r.hertz.a - 1), r.c / r.a, r.c_rule / r.a, 100 * (r.peak - 1));
     EXPECT_NEAR(r.c / r.a, reference, 0.03) << "step " << k + 1;
   }
   const SpenceReading last = read_spence(f, f.run.steps.back(), kMu);
-  std::printf("c/a %.4f: half-plane model %.4f (%+.2f %% of a), relation %.4f (%+.2f %%); a %.4f, peak %.4f of "
-              "Hertz's (model: %.4f, %.4f); %ld real solves, %.2f s\n",
-              last.c / last.a, reference, 100 * (last.c / last.a - reference), relation(),
-              100 * (last.c / last.a - relation()), last.a / last.hertz.a, last.peak, model.a, model.peak,
-              f.run.counters.solves, f.run.seconds);
+  std::printf(
+      "c/a %.4f: half-plane model %.4f (%+.2f %% of a), relation %.4f (%+.2f %%); a %.4f, peak %.4f of "
+      "Hertz's (model: %.4f, %.4f); %ld real solves, %.2f s\n",
+      last.c / last.a, reference, 100 * (last.c / last.a - reference), relation(), 100 * (last.c / last.a - relation()),
+      last.a / last.hertz.a, last.peak, model.a, model.peak, f.run.counters.solves, f.run.seconds);
   EXPECT_NEAR(last.a / last.hertz.a, model.a, 0.5 * kSize / last.a + 0.5 / kPerA);
   EXPECT_NEAR(last.peak, model.peak, 0.01);
 }

@@ -42,9 +42,7 @@ void expect_cylinders_hertz(const json& scene) {
 // resolves the edge to a fraction of the node spacing, up to about 0.11 h / a (-1.04 % at
 // a / h 10.5): within 1 % at every step needs a / h above 11, so the pair is meshed at
 // h 0.025 mm (a / h 14 and 21 at the two steps; the shipped h 0.05 has a / h 7 at the first).
-TEST(TwoBodies, CylindersOfUnequalMaterialsMatchHertz) {
-  expect_cylinders_hertz(cylinders_with_pole_elements(0.025));
-}
+TEST(TwoBodies, CylindersOfUnequalMaterialsMatchHertz) { expect_cylinders_hertz(cylinders_with_pole_elements(0.025)); }
 
 // Swapping slave and master (the soft lower cylinder's nodes as slaves) moves the load by
 // 0.02 %, far less than the discretization error of the readings (0.3-0.8 %); a and p0 read
@@ -100,10 +98,12 @@ BlockReading read_block(const json& scene) {
     if (n.p_n < 0) sigma.push_back(-n.sigma_n);
   for (double v : sigma) r.mean += v / sigma.size();
   for (double v : sigma) r.spread = std::max(r.spread, std::abs(v / r.mean - 1));
-  r.load = -body_resultant(s.scene.problem, 0, rec.reactions).y() / bodies[0]["mesh"]["rectangle"]["size"][0].get<double>();
-  std::printf("slave %s: %zu nodes press, mean %.3f MPa (exact %.3f, %+.3f %%), spread %.2f %%, load %.3f MPa (%+.3f %%)\n",
-              s.scene.effective["contacts"][0]["slave"].get<std::string>().c_str(), sigma.size(), r.mean, r.exact,
-              100 * (r.mean / r.exact - 1), 100 * r.spread, r.load, 100 * (r.load / r.exact - 1));
+  r.load =
+      -body_resultant(s.scene.problem, 0, rec.reactions).y() / bodies[0]["mesh"]["rectangle"]["size"][0].get<double>();
+  std::printf(
+      "slave %s: %zu nodes press, mean %.3f MPa (exact %.3f, %+.3f %%), spread %.2f %%, load %.3f MPa (%+.3f %%)\n",
+      s.scene.effective["contacts"][0]["slave"].get<std::string>().c_str(), sigma.size(), r.mean, r.exact,
+      100 * (r.mean / r.exact - 1), 100 * r.spread, r.load, 100 * (r.load / r.exact - 1));
   return r;
 }
 
@@ -151,9 +151,11 @@ json two_cylinders_sheared() {
   lower["mesh"]["half_disc"]["facing"] = "up";
   lower["supports"] = {{{"set", "diameter"}, {"fix", {"x", "y"}}}};
   json j = {{"bodies", {upper, lower}},
-            {"contacts", {{{"slave", "upper.arc_refined"}, {"master", "lower.arc_refined"}, {"name", "pair"}, {"friction", 0.3}}}},
-            {"stages", {{{"steps", 2}, {"factors", {{"press", 1}}}, {"friction", {{"pair", 0}}}},
-                        {{"steps", 2}, {"factors", {{"shear", 1}}}}}},
+            {"contacts",
+             {{{"slave", "upper.arc_refined"}, {"master", "lower.arc_refined"}, {"name", "pair"}, {"friction", 0.3}}}},
+            {"stages",
+             {{{"steps", 2}, {"factors", {{"press", 1}}}, {"friction", {{"pair", 0}}}},
+              {{"steps", 2}, {"factors", {{"shear", 1}}}}}},
             {"solver", {{"contact", {{"method", "cev"}, {"tolerance", 1e-8}}}}}};
   return j;
 }
@@ -174,10 +176,11 @@ TEST(TwoBodies, CattaneoMindlinStickZoneBetweenIdenticalCylinders) {
     const auto nodes = contact_profile(s.scene.problem, rec);
     const Zone stick = stick_zone(nodes, mu);
     ASSERT_TRUE(stick.found);
-    std::printf("step %d: P %.1f, Q/(mu P) %.3f, a %.4f, c %.4f (c/a %.3f); stick zone %.4f (%+.2f %% of a), "
-                "between nodes %.4f (%+.2f %% of a)\n",
-                rec.index, P, Q / (mu * P), a, c, c / a, stick.half_width(), 100 * (stick.half_width() - c) / a,
-                stick.midpoint_half_width(), 100 * (stick.midpoint_half_width() - c) / a);
+    std::printf(
+        "step %d: P %.1f, Q/(mu P) %.3f, a %.4f, c %.4f (c/a %.3f); stick zone %.4f (%+.2f %% of a), "
+        "between nodes %.4f (%+.2f %% of a)\n",
+        rec.index, P, Q / (mu * P), a, c, c / a, stick.half_width(), 100 * (stick.half_width() - c) / a,
+        stick.midpoint_half_width(), 100 * (stick.midpoint_half_width() - c) / a);
     EXPECT_GT(Q, 0.2 * mu * P);
     EXPECT_LT(Q, mu * P);
     EXPECT_LT(std::abs(stick.half_width() - c), 0.03 * a);

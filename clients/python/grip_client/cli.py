@@ -21,6 +21,32 @@ from .client import Client, GripError, Job
 
 EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
 
+# What to do about a failure, by its kind (schemas/result.schema.json#/definitions/failure).
+FAILURE_ADVICE = {
+    "friction_limit": "the load exceeds what friction can hold: no finer load steps help",
+    "no_equilibrium": "no static equilibrium carries this load: add a support or a contact",
+    "newton_diverged": "an equilibrium solve diverged: try more, smaller load steps",
+    "invalid_state": "the body reached a state its model refuses: try smaller load steps",
+    "contact_budget": "raise solver.contact.max_iterations, or take smaller load steps",
+    "contact_stalled": "the contact iteration stalled: try smaller load steps or another method",
+    "check_failed": "the solution failed the solver's own physics checks: take smaller load steps",
+    "missed_contact": "a node outside the contact set entered an obstacle: widen body.contact_set",
+    "penalty_inexact": "penalty could not meet the tolerance: raise its stiffness or use cev",
+    "job_limit": "a limit of this service: ask its operator, or split the scene",
+    "dismissed": "the job was dismissed",
+    "invalid_scene": "the stored scene could not be read: submit it again",
+    "exception": "an internal error: report it with the job id",
+}
+
+
+def failure_text(failure: Optional[dict], reason: str = "") -> str:
+    """`reason [kind: advice]` for a failure member (or the reason alone without one)."""
+    if not failure:
+        return reason
+    kind = failure.get("kind", "")
+    advice = FAILURE_ADVICE.get(kind)
+    return f"{failure.get('message', reason)} [{kind}" + (f": {advice}]" if advice else "]")
+
 PAPER_SCENES = ("sheet-stretching", "beam-on-cylinder")
 # File stems of the paper's figures (documented in clients/python/README.md).
 PAPER_NAMES = {
@@ -215,7 +241,8 @@ class Watcher:
         elif ev.type == "step_finished":
             if d.get("converged"):
                 self.done += 1
-            status = "converged" if d.get("converged") else f"FAILED: {d.get('reason', '')}"
+            status = ("converged" if d.get("converged")
+                      else f"FAILED: {failure_text(d.get('failure'), d.get('reason', ''))}")
             self._line(f"{progress_bar(self.done, self.total)}  step {d.get('step')} {status}: "
                        f"{d.get('contact_iterations')} contact iterations, "
                        f"{d.get('newton_iterations')} Newton, {d.get('seconds', 0):.3g} s",
@@ -223,7 +250,9 @@ class Watcher:
         elif ev.type == "job_finished":
             self._line(f"job finished: {self.done} of {self.total} steps", final=True)
         elif ev.type == "job_failed":
-            self._line(f"job failed: {d.get('reason', '')}", final=True)
+            failure = d.get("failure") or {}
+            what = "job dismissed" if failure.get("kind") == "dismissed" else "job failed"
+            self._line(f"{what}: {failure_text(failure, d.get('reason', ''))}", final=True)
 
 
 def watch_job(job: Job, out: TextIO, raw: bool = False, live: Optional[bool] = None) -> int:
@@ -261,9 +290,12 @@ def cmd_watch(client: Client, args, out: TextIO) -> int:
 
 
 def describe_job(doc: dict) -> List[List[Any]]:
-    keys = ["jobID", "status", "progress", "message", "steps", "nodes", "created", "started",
-            "finished", "iterations", "solve_seconds", "attempts"]
-    return [[k, doc[k]] for k in keys if k in doc]
+    keys = ["jobID", "status", "progress", "message", "steps", "steps_completed", "nodes", "created",
+            "started", "finished", "iterations", "solve_seconds", "attempts"]
+    rows = [[k, doc[k]] for k in keys if k in doc]
+    if doc.get("failure"):
+        rows.append(["failure", failure_text(doc["failure"])])
+    return rows
 
 
 def cmd_status(client: Client, args, out: TextIO) -> int:
@@ -281,9 +313,10 @@ def cmd_list(client: Client, args, out: TextIO) -> int:
     if args.json:
         out.write(json.dumps([j.doc for j in jobs], indent=2) + "\n")
         return EXIT_OK
-    rows = [[j.id, j.doc.get("status"), f"{j.doc.get('progress', 0)}%", j.doc.get("created"),
-             j.doc.get("message")] for j in jobs]
-    table(rows, ["jobID", "status", "progress", "created", "message"], out)
+    rows = [[j.id, j.doc.get("status"), f"{j.doc.get('steps_completed', 0)} of {j.doc.get('steps')}",
+             (j.doc.get("failure") or {}).get("kind", ""), j.doc.get("created"), j.doc.get("message")]
+            for j in jobs]
+    table(rows, ["jobID", "status", "steps", "failure", "created", "message"], out)
     return EXIT_OK
 
 

@@ -74,11 +74,12 @@ class Event:
     """One event of a job: `id` (the per-job sequence, SSE id), `type`, `data` (dict).
 
     Types (schemas/event.schema.json): step_started {step, load_factor}; iteration {step,
-    pass, m, n, alpha, v2 and v_inf (||v||_2 and ||v||_inf of the contact error vector, in the
-    scene's length unit), open, stick, slip (contact point counts), newton_iterations,
-    elapsed_ms (milliseconds since the step began)}; step_finished {step, load_factor,
-    converged, contact_iterations, newton_iterations, seconds, ...}; job_finished; job_failed
-    {reason}."""
+    pass, m, trials (real solves: their sum is the job's contact iterations), n, alpha, v2 and
+    v_inf (||v||_2 and ||v||_inf of the contact error vector, in the scene's length unit), open,
+    stick, slip (contact point counts), newton_iterations, elapsed_ms (milliseconds since the
+    step began)}; step_finished {step, load_factor, converged, contact_iterations,
+    newton_iterations, seconds, reason and failure when not converged, ...}; job_finished;
+    job_failed {reason, failure: {kind, message, step}}."""
 
     __slots__ = ("id", "type", "data")
 
@@ -286,6 +287,13 @@ class Job:
     @property
     def finished(self) -> bool:
         return self.doc.get("status") in FINISHED_STATUSES
+
+    @property
+    def failure(self) -> Optional[dict]:
+        """Why the job failed or was dismissed, from the last job document seen: {kind, message,
+        step} (schemas/result.schema.json#/definitions/failure); None otherwise. Branch on
+        failure["kind"], never on the message's text."""
+        return self.doc.get("failure")
 
     def events(self, last_event_id: Optional[int] = None, reconnect: bool = True,
                max_reconnects: int = 20, read_timeout: float = 60.0) -> Iterator[Event]:

@@ -55,9 +55,14 @@ class Cli(unittest.TestCase):
         p = support.cli("submit", self.failing, "--watch")
         self.assertEqual(p.returncode, 1, p.stdout + p.stderr)
         self.assertIn("job failed", p.stdout)
+        # The reason with its kind and what to do about it (cli.FAILURE_ADVICE, by kind).
+        self.assertRegex(p.stdout, r"job failed: step \d+ failed: .* \[[a-z_]+: [^\]]+\]")
         job_id = p.stdout.splitlines()[0].strip()
         self.assertEqual(support.cli("watch", job_id).returncode, 1)
-        self.assertEqual(support.cli("status", job_id).returncode, 1)
+        status = support.cli("status", job_id)
+        self.assertEqual(status.returncode, 1)
+        self.assertRegex(status.stdout, r"(?m)^failure +.* \[[a-z_]+: ")
+        self.assertRegex(status.stdout, r"(?m)^steps_completed +\d+$")
 
     def test_invalid_scene_exits_2_with_pointers(self):
         scene = support.small_beam()

@@ -119,8 +119,13 @@ class Plots(PlotCase):
                 self.assertEqual(floats(line.get_xdata()), [p["x"] for p in nodes])
                 self.assertEqual(floats(line.get_ydata()), [p["y"] for p in nodes])
             ku, kv = ("u", "w") if name == "beam-on-cylinder" else ("ux", "uy")
-            first = result["steps"][0]["nodes"]
+            # Drawn from the first step shown: its positions less its displacements (both in
+            # 7 digits, so each step gives the undeformed mesh to within some 1e-6 of its own).
+            first = result["steps"][min(data["steps"]) - 1]["nodes"]
             self.assertEqual(floats(lines["initial"].get_xdata()), [p["x"] - p[ku] for p in first])
+            zero = result["steps"][0]["nodes"]
+            for drawn, p in zip(floats(lines["initial"].get_xdata()), zero):
+                self.assertAlmostEqual(drawn, p["x"] - p[ku], delta=1e-6 * max(1.0, abs(p["x"])))
         sheet = self.results["sheet-stretching"]
         # The punch is drawn where the result puts it: 5 mm further down every five steps.
         _, data = self.plots.shapes(sheet)

@@ -1,24 +1,11 @@
-#include "solver/equilibrium/rigid_equilibrium.hpp"
+#include "solver/problem/rigid_modes.hpp"
 
 #include <Eigen/LU>
 #include <Eigen/QR>
 #include <cmath>
-#include <cstdio>
-
-#include "solver/model/body_set.hpp"
-#include "solver/elements/timoshenko_beam.hpp"
 
 namespace grip {
 namespace {
-
-// Whether the body's translation along d lies in the span of its free rigid modes.
-bool translation_free(const Problem& problem, const Vec2& d) {
-  const Matrix& R = problem.rigid.modes;
-  if (R.cols() == 0) return false;
-  const Vector t = problem.body->rigid_translation(d);
-  const Vector c = R.colPivHouseholderQr().solve(t);
-  return (R * c - t).norm() <= 1e-9 * t.norm();
-}
 
 // Every dof a translation, x and y of one node one after the other (the continuum).
 bool translation_pairs(const Body& body) {
@@ -42,13 +29,8 @@ bool translation_pairs(const Body& body) {
 //   abscissa, as the model's contact points do), but it is the model's exact null motion.
 Vector rotation_at(const Body& body, const Vector& q) {
   if (body.traits().constant_tangent) return {};
+  if (Vector own = body.own_rotation_at(q); own.size()) return own;  // the beam's (TimoshenkoBeam)
   Vector rot = body.rigid_rotation();
-  if (const auto* beam = dynamic_cast<const TimoshenkoBeam*>(&body)) {
-    for (int k = 0; k < beam->node_count(); ++k)
-      rot[TimoshenkoBeam::node_dof(k, 0)] -= q[TimoshenkoBeam::node_dof(k, 1)];
-    for (int e = 0; e < beam->element_count(); ++e) rot[beam->mid_dof(e, 0)] -= q[beam->mid_dof(e, 1)];
-    return rot;
-  }
   if (!translation_pairs(body)) return {};
   for (int d = 0; d < rot.size(); d += 2) {
     rot[d] -= q[d + 1];
@@ -65,12 +47,8 @@ std::string finite_rotation_refusal(const Body& body, const std::vector<int>& fi
   if (!has_finite_rotation(body))
     return "a free rotation is held by contact only with linear kinematics or a model whose strain a finite "
            "rotation leaves unchanged (the continuum with finite kinematics, the von Karman beam)";
-  // The node of a dof: a beam's three (u, w, theta; each element's mid values one more), the
-  // continuum's two.
-  const bool beam = dynamic_cast<const TimoshenkoBeam*>(&body) != nullptr;
-  auto node = [&](int d) { return beam ? d / 3 : d / 2; };
   for (int d : fixed)
-    if (node(d) != node(fixed.front()))
+    if (body.dof_node(d) != body.dof_node(fixed.front()))
       return "with finite kinematics a rotation is free only about a single supported node: supports at several "
              "nodes leave it free to first order and stop it at any finite angle";
   return "";
@@ -84,7 +62,6 @@ template <class F>
 void for_each_turning_body(const Problem& problem, F f) {
   const RigidModes& rigid = problem.rigid;
   const Body& whole = *problem.body;
-  const auto* set = dynamic_cast<const BodySet*>(&whole);
   std::vector<char> done(rigid.count(), 0);
   for (int k = 0; k < rigid.count(); ++k) {
     if (done[k]) continue;
@@ -95,9 +72,9 @@ void for_each_turning_body(const Problem& problem, F f) {
         own.push_back(j);
         done[j] = 1;
       }
-    const Body& body = set ? set->part(b) : whole;
+    const Body& body = whole.part(b);
     if (!has_finite_rotation(body)) continue;
-    const int offset = set ? set->dof_offset(b) : 0, m = body.dof_count();
+    const int offset = whole.dof_offset(b), m = body.dof_count();
     // Translations only (the supports hold the rotation): the same motions at every state.
     Matrix T(m, 2);
     T << body.rigid_translation(Vec2::UnitX()), body.rigid_translation(Vec2::UnitY());
@@ -145,68 +122,19 @@ Matrix rigid_modes_at(const Problem& problem, const Vector& q) {
   return modes;
 }
 
-std::string load_factors_text(const Problem& problem, const LoadFactors& factors) {
-  std::string text;
-  int shown = 0;
-  for (size_t k = 0; k < factors.size(); ++k) {
-    if (factors[k] == 0.0) continue;
-    char value[32];
-    std::snprintf(value, sizeof value, "%.6g", factors[k]);
-    const std::string name = k < problem.case_names.size() ? problem.case_names[k] + " " : "";
-    text += (shown++ ? ", " : "") + name + value;
-  }
-  return (shown > 1 ? "at load factors " : "at load factor ") + (shown ? text : std::string("0"));
-}
-
-std::string unreachable_equilibrium(const Problem& problem, const EquilibriumState& paired,
-                                    const LoadFactors& factors) {
-  if (problem.rigid.count() == 0 || problem.candidates.empty()) return "";
-  // One direction n for every contact point, and one friction coefficient.
-  const Vec2 n = -paired.points.front().eta;
-  const double mu = problem.obstacles[problem.candidates.front().obstacle].friction;
-  for (size_t i = 0; i < problem.candidates.size(); ++i)
-    if ((-paired.points[i].eta - n).norm() > 1e-9 ||
-        problem.obstacles[problem.candidates[i].obstacle].friction != mu)
-      return "";
-  const Vec2 t(-n.y(), n.x());
-  const Vector load = problem.load(factors);
-  const Body& body = *problem.body;
-  const Vec2 resultant(body.rigid_translation(Vec2::UnitX()).dot(load),
-                       body.rigid_translation(Vec2::UnitY()).dot(load));
-  const double scale = resultant.norm();
-  if (scale == 0.0) return "";
-  const double N = -resultant.dot(n), Q = std::abs(resultant.dot(t));
-  const std::string at = load_factors_text(problem, factors);
-  if (translation_free(problem, n) && N <= 1e-12 * scale)
-    return "the load pulls the body off every obstacle: contact can only push, and the load's resultant (" +
-           std::to_string(resultant.x()) + ", " + std::to_string(resultant.y()) + ") points away from the obstacles " +
-           at + "; no static equilibrium exists";
-  if (translation_free(problem, t) && Q > 0 && N > 0 && Q >= mu * N * (1 - 1e-12)) {
-    char ratio[32];
-    std::snprintf(ratio, sizeof ratio, "%.6g", mu > 0 ? Q / (mu * N) : INFINITY);
-    return std::string(Q > mu * N * (1 + 1e-12) ? "the shear load exceeds what friction can hold"
-                                                 : "the shear load reaches what friction can hold, so nothing "
-                                                   "fixes how far the body slides") +
-           ": Q / (mu N) = " + ratio + " " + at + " (Q = " + std::to_string(Q) + ", N = " + std::to_string(N) +
-           ", mu = " + std::to_string(mu) + "); no static equilibrium exists";
-  }
-  return "";
-}
-
 Vector amplitudes_following_supports(const Problem& problem, const LoadFactors& from, const LoadFactors& to) {
   const RigidModes& rigid = problem.rigid;
   Vector change = Vector::Zero(rigid.count());
   if (rigid.count() == 0 || rigid.scale <= 0) return change;
   const Body& whole = *problem.body;
-  const auto* set = dynamic_cast<const BodySet*>(&whole);
   const int n = whole.dof_count();
   auto factor = [](const LoadFactors& f, int c) { return c < static_cast<int>(f.size()) ? f[c] : 0.0; };
   std::vector<char> done(rigid.count(), 0);
   for (int k = 0; k < rigid.count(); ++k) {
     if (done[k]) continue;
     const int b = rigid.body[k];
-    const Body& body = set ? set->part(b) : whole;
-    const int offset = set ? set->dof_offset(b) : 0, m = body.dof_count();
+    const Body& body = whole.part(b);
+    const int offset = whole.dof_offset(b), m = body.dof_count();
     // The body's rigid motions (translations x, y, rotation) on the whole problem's dofs.
     std::vector<Vector> modes = {body.rigid_translation(Vec2::UnitX()), body.rigid_translation(Vec2::UnitY())};
     if (const Vector rot = body.rigid_rotation(); rot.size()) modes.push_back(rot / body.characteristic_length());

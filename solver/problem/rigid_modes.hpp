@@ -1,25 +1,13 @@
 #pragma once
-// Whether contact can hold a body whose supports leave rigid motions free (ALGORITHM.md 7):
-// the contact forces must balance the applied load on those motions, pressing and inside
-// Coulomb's cone. Checked before a step is solved, so that a load no static equilibrium can
-// carry fails its step with the reason in words instead of a drifting solve.
+// The rigid motions that supports leave free and contact holds (problem.rigid, RigidModes in
+// problem.hpp): their form at a state, the amplitudes fitted to a state, and which a model can
+// hold. What contact must do to hold them: solver/contact/held_by_contact.hpp.
 #include <string>
 #include <vector>
 
-#include "solver/equilibrium/equilibrium.hpp"
+#include "solver/problem/problem.hpp"
 
 namespace grip {
-
-// Why the applied load at the step's factors cannot be held, or "" where it may be. Decided
-// where every contact point faces one direction n (a flat, or obstacles parallel to it): the
-// contact resultant N n + Q t must equal minus the load's resultant on the free translations,
-// with N > 0 where translation along n is free and |Q| < mu N where translation along t is.
-// Other arrangements are left to the solve.
-std::string unreachable_equilibrium(const Problem& problem, const EquilibriumState& paired,
-                                    const LoadFactors& factors);
-
-// "at load factor 1.05", or "at load factors press 1, shear 1.05" (the non-zero ones, named).
-std::string load_factors_text(const Problem& problem, const LoadFactors& factors);
 
 // The change of the rigid amplitudes (problem.rigid, in their unit) that follows the supports
 // from load factors `from` to `to`: for each body with free rigid motions, the rigid motion that
@@ -30,15 +18,15 @@ Vector amplitudes_following_supports(const Problem& problem, const LoadFactors& 
 
 // Why a free rotation of `body` cannot be held by contact with finite kinematics ("" where it
 // can), its supported dofs `fixed` (the body's own numbering): the model must have a finite
-// rotation of its own (the continuum, the von Karman beam: rigid_equilibrium.cpp), and the
+// rotation of its own (the continuum, the von Karman beam: rigid_modes.cpp), and the
 // supports may hold at most one node, about which the rotation then turns at any angle
 // (supports at several nodes leave it free to first order only).
 std::string finite_rotation_refusal(const Body& body, const std::vector<int>& fixed);
 
 // The free rigid motions of problem.rigid at the state q, 1 at their own pin and 0 at the other
 // pins. For a body with finite kinematics left free to rotate: the translations and the rotation
-// at q (the continuum's about its current shape, the von Karman beam's own: rigid_equilibrium.cpp),
-// zero at its supports (ALGORITHM.md 7): the internal forces of a deformed body do no work along
+// at q (the continuum's about its current shape, the von Karman beam's own: rigid_modes.cpp),
+// zero at its supports (docs/algorithm.md#bodies-held-only-by-contact): the internal forces of a deformed body do no work along
 // it, so that is where the contact forces and the load must balance too. Elsewhere
 // problem.rigid.modes itself (a constant tangent, or translations only: the same at every state).
 Matrix rigid_modes_at(const Problem& problem, const Vector& q);

@@ -1,0 +1,47 @@
+#pragma once
+// An equilibrium solve's answer: the state, its pairing and s, and the solver's counters.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "solver/model/failure.hpp"
+#include "solver/problem/problem.hpp"
+
+namespace grip {
+
+// The kinematics of one candidate at a state.
+struct PairedPoint {
+  SurfacePoint point;
+  Projection projection;  // in the obstacle's moved frame: point already translated
+  Vec2 eta, xi;           // eta = -normal (into the obstacle), xi = tangent
+};
+
+struct EquilibriumState {
+  Vector q;
+  Vector p;  // the contact forces in equilibrium (given, or from the penalty law)
+  Vector s;  // (s_eta, s_xi) per component
+  std::vector<PairedPoint> points;
+  // Per obstacle: the master surface of a pair of bodies in this state's configuration (null
+  // for a rigid obstacle); its force_derivative() is the pair's stiffness.
+  std::vector<std::shared_ptr<const DeformedMaster>> masters;
+  std::vector<char> enabled;  // component has a non-zero column of T on the free dofs
+  int newton_iterations = 0;
+  bool converged = false;
+  // Converged at the round-off floor (not by the correction or residual test); then the
+  // last correction (length units) is the noise of the displacements.
+  bool at_floor = false;
+  double noise = 0.0;
+  double relative_residual = 0.0;           // final free residual over the force scale
+  std::string reason;                       // why Newton failed
+  FailureKind failure = FailureKind::none;  // newton_diverged, or invalid_state (the body refuses q)
+};
+
+struct EquilibriumCounters {
+  long solves = 0;  // calls of solve(): real equilibrium solves
+  long newton_iterations = 0;
+  long factorizations = 0;
+  long compliance_forms = 0;    // G formed afresh (each on a factorization of its own)
+  long compliance_columns = 0;  // columns of G solved for, all forms together
+};
+
+}  // namespace grip

@@ -1,0 +1,339 @@
+// Newton's method for the equilibrium at given contact forces (or the penalty law's): the
+// iteration, its stopping tests, the line search and the low-rank step of a constant tangent.
+#include "solver/equilibrium/equilibrium.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <limits>
+
+#include "solver/model/number_text.hpp"
+#include "solver/problem/rigid_modes.hpp"
+
+namespace grip {
+
+// The largest residual over the free dofs in force units: a rotation's (moment) residual is
+// divided by its dof's length scale, so that the stopping test does not depend on the unit of
+// length (the iteration counts of a scene stay the same when its lengths are rescaled).
+double Equilibrium::scaled_free_max(const Vector& r) const {
+  double largest = 0.0;
+  for (int i = 0; i < r.size(); ++i)
+    if (free_index_[i] >= 0) largest = std::max(largest, std::abs(r[i] / length_scales_[i]));
+  return largest;
+}
+
+// The Euclidean norm of a displacement change over the free dofs in length units (rotations
+// times their dof's length scale): the line search's measure, independent of the length unit.
+double Equilibrium::free_length_norm(const Vector& dq) const {
+  double norm = 0.0;
+  for (int i = 0; i < dq.size(); ++i)
+    if (free_index_[i] >= 0) norm += (dq[i] * length_scales_[i]) * (dq[i] * length_scales_[i]);
+  return std::sqrt(norm);
+}
+
+namespace {
+
+// |K|_inf over the free block in force / length units (moments over the length scale of
+// their dof, rotations times it), from the tangent's triplets.
+double free_row_sum_norm(const Triplets& triplets, const std::vector<int>& free_index, int free_count,
+                         const Vector& length_scales) {
+  Vector rows = Vector::Zero(free_count);
+  for (const auto& t : triplets)
+    if (free_index[t.row()] >= 0 && free_index[t.col()] >= 0)
+      rows[free_index[t.row()]] += std::abs(t.value()) / (length_scales[t.row()] * length_scales[t.col()]);
+  return free_count ? rows.maxCoeff() : 0.0;
+}
+
+// y solving (I + B) y = c by GMRES (Arnoldi with modified Gram-Schmidt, Givens rotations, no
+// restart), `apply` giving B v: stops where the residual is below `tolerance` |c|, or after
+// `most` iterations (then the least-residual iterate of that space).
+Vector gmres(const std::function<Vector(const Vector&)>& apply, const Vector& c, double tolerance, int most) {
+  const int m = static_cast<int>(c.size());
+  const double c_norm = c.norm();
+  if (c_norm == 0.0 || m == 0) return Vector::Zero(m);
+  most = std::min(most, m);
+  Matrix V(m, most + 1), H = Matrix::Zero(most + 1, most);
+  Vector cs(most), sn(most), g = Vector::Zero(most + 1);
+  V.col(0) = c / c_norm;
+  g[0] = c_norm;
+  int k = 0;
+  while (k < most) {
+    Vector w = V.col(k) + apply(V.col(k));
+    for (int i = 0; i <= k; ++i) {
+      H(i, k) = V.col(i).dot(w);
+      w -= H(i, k) * V.col(i);
+    }
+    const double next = w.norm();  // zero: the space is invariant, the iterate exact
+    H(k + 1, k) = next;
+    if (next > 0.0) V.col(k + 1) = w / next;
+    for (int i = 0; i < k; ++i) {
+      const double a = H(i, k), b = H(i + 1, k);
+      H(i, k) = cs[i] * a + sn[i] * b;
+      H(i + 1, k) = -sn[i] * a + cs[i] * b;
+    }
+    const double r = std::hypot(H(k, k), H(k + 1, k));
+    cs[k] = r > 0.0 ? H(k, k) / r : 1.0;
+    sn[k] = r > 0.0 ? H(k + 1, k) / r : 0.0;
+    H(k, k) = r;
+    H(k + 1, k) = 0.0;
+    g[k + 1] = -sn[k] * g[k];
+    g[k] *= cs[k];
+    ++k;
+    if (std::abs(g[k]) <= tolerance * c_norm || next == 0.0) break;
+  }
+  const Vector z = H.topLeftCorner(k, k).triangularView<Eigen::Upper>().solve(g.head(k));
+  return V.leftCols(k) * z;
+}
+
+}  // namespace
+
+// Newton's step for the constant body tangent K plus the pair's stiffness A (the `contact`
+// triplets, on the m free dofs P where A is not zero: the pressing points' and their master
+// segments'): (K + P A P^T) dq = b with dq = z + K^-1 P y, z = K^-1 b, and y solving
+// (I + A G) y = -A P^T z, G = P^T K^-1 P, by GMRES with one body solve per product G v, or
+// with the compliance's G where it has these rows (A is
+// small beside K near an answer: 5-6 iterations to 1e-15 at 1501 slave points; the same forces
+// to every printed digit as the Woodbury form). Nothing of size m^2: a dense G and the LU of
+// I + G A (the Woodbury form) cost 5100^2 doubles and two m^3 products per Newton iteration at
+// 1501 slave points (250 s, 1.2 GB).
+Vector Equilibrium::low_rank_step(const Triplets& contact, const Vector& rhs) const {
+  const Vector z = body_lu_.solve(rhs);
+  std::vector<int> slot(free_count_, -1);  // free index -> row of A
+  std::vector<int> rows;
+  Triplets a_local;
+  for (const auto& t : contact) {
+    const int i = free_index_[t.row()], j = free_index_[t.col()];
+    if (i < 0 || j < 0 || t.value() == 0.0) continue;
+    for (int f : {i, j})
+      if (slot[f] < 0) {
+        slot[f] = static_cast<int>(rows.size());
+        rows.push_back(f);
+      }
+    a_local.emplace_back(slot[i], slot[j], t.value());
+  }
+  const int m = static_cast<int>(rows.size());
+  if (m == 0) return z;
+  Eigen::SparseMatrix<double> A(m, m);
+  A.setFromTriplets(a_local.begin(), a_local.end());
+  Vector zs(m);
+  for (int k = 0; k < m; ++k) zs[k] = z[rows[k]];
+  Vector spread = Vector::Zero(free_count_);
+  auto scatter = [&](const Vector& v) {  // P v on the free dofs
+    for (int k = 0; k < m; ++k) spread[rows[k]] = v[k];
+    return spread;
+  };
+  // G v from the compliance's G where it covers every row (the same constant K; its dense form
+  // is formed for small contact zones anyway): m^2 a product instead of a body solve (the
+  // refined two cylinders: 2.5e9 -> 3.5e9 instructions with the solves).
+  const bool from_g = g_valid_ && std::all_of(rows.begin(), rows.end(), [&](int f) {
+                        return f < static_cast<int>(surface_row_.size()) && surface_row_[f] >= 0;
+                      });
+  Matrix g;
+  if (from_g) {
+    g.resize(m, m);
+    for (int b = 0; b < m; ++b)
+      for (int a = 0; a < m; ++a) g(a, b) = g_(surface_row_[rows[a]], surface_row_[rows[b]]);
+  }
+  const Vector y = gmres(
+      [&](const Vector& v) {
+        if (from_g) return Vector(A * (g * v));
+        const Vector x = body_lu_.solve(scatter(v));
+        Vector gv(m);
+        for (int k = 0; k < m; ++k) gv[k] = x[rows[k]];
+        return Vector(A * gv);
+      },
+      Vector(-(A * zs)), kLowRankTolerance, kLowRankIterations);
+  return z + body_lu_.solve(scatter(y));
+}
+
+EquilibriumState Equilibrium::solve(const Vector& q_guess, const Vector& p) {
+  ++counters_.solves;
+  return newton(q_guess, p);
+}
+
+void Equilibrium::continue_solve(EquilibriumState& state, const Vector& p) {
+  const int before = state.newton_iterations;
+  state = newton(state.q, p);
+  state.newton_iterations += before;
+}
+
+EquilibriumState Equilibrium::newton(const Vector& q_guess, const Vector& p) {
+  EquilibriumState state;
+  state.q = q_guess;
+  for (const Constraint& c : problem_.constraints)
+    state.q[c.dof] = c.load_case < static_cast<int>(factors_.size()) ? factors_[c.load_case] * c.value : 0.0;
+  for (const Constraint& c : extra_) state.q[c.dof] = c.value;
+  const RigidModes& rigid = problem_.rigid;
+  if (!pins_free_)
+    for (int k = 0; k < rigid.count(); ++k) state.q[rigid.pins[k]] = rigid.scale * p[rigid.first + k];
+  const double body_length = problem_.body->characteristic_length();
+  constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
+  // The penalty law adds stiffness that changes with the contact state: no reuse then.
+  const bool reuse = constant_tangent_ && !penalty_;
+  // A pair of bodies adds its stiffness, which moves with the pairing, on a few surface dofs:
+  // kept as a low-rank correction of the constant body tangent (low_rank_step).
+  const bool low_rank = reuse && has_pairs_;
+  Triplets triplets;
+  double last_step = 0.0;
+  std::vector<signed char> signs;  // the penalty law's trial signs at the last iterate
+  for (int it = 1; it <= params_.max_iterations + 1; ++it) {
+    pair(state.q, state);
+    triplets.clear();
+    // A penalty point whose trial tangential force changed sign since the last iterate has
+    // crossed the cone's interior, its stick band (width 2 mu |p_eta| / k_t, a few 1e-6 of the
+    // body when k_t is 1e3 x its stiffness): Newton from either slip branch predicts the other
+    // one (no tangential stiffness there), so it cycles between them. The step is taken on the
+    // stick branch instead (trial force and spring), which puts such a point in its band; the
+    // stopping tests always use the law itself.
+    std::vector<char> branch;
+    stick_branch_.clear();
+    if (penalty_) {
+      std::vector<signed char> now = trial_signs(state);
+      for (size_t i = 0; i < signs.size(); ++i)
+        if (now[i] * signs[i] < 0) {
+          branch.resize(now.size(), 0);
+          branch[i] = 1;
+        }
+      signs = std::move(now);
+    }
+    double force_scale = 0.0;
+    // low_rank: the contact terms only (the body's are in its kept factorization).
+    const Vector r = residual(state.q, state, p, reuse && !low_rank ? nullptr : &triplets, &force_scale, !low_rank);
+    const double r_max = scaled_free_max(r);
+    state.relative_residual = force_scale > 0 ? r_max / force_scale : 0.0;
+    if (!std::isfinite(r_max)) {
+      state.reason = "Newton produced a non-finite residual";
+      state.failure = FailureKind::newton_diverged;
+      return state;
+    }
+    const bool residual_met = r_max <= params_.residual_tolerance * force_scale;
+    // The round-off floor only matters where the residual test fails (|K| costs a pass over
+    // the triplets: 6 % of the beam's time when taken at every iterate).
+    bool at_floor = false;
+    if (!residual_met && it > 1) {
+      double k_norm = body_tangent_norm_;
+      if (!reuse) k_norm = free_row_sum_norm(triplets, free_index_, free_count_, length_scales_);
+      const double q_size = (state.q.array() * length_scales_.array()).abs().maxCoeff();
+      at_floor = r_max <= params_.floor_factor * kEpsilon * (k_norm * q_size + force_scale);
+    }
+    if (residual_met || at_floor) {
+      state.at_floor = at_floor && !residual_met;
+      state.noise = state.at_floor ? last_step : 0.0;
+      return penalty_ ? finish_penalty(state) : finish(state, p);
+    }
+    if (it > params_.max_iterations) break;
+    Vector r_step;
+    if (!branch.empty()) {
+      stick_branch_ = std::move(branch);
+      triplets.clear();
+      r_step = residual(state.q, state, p, reuse && !low_rank ? nullptr : &triplets, nullptr, !low_rank);
+    }
+    const Vector& r_newton = stick_branch_.empty() ? r : r_step;
+    if (reuse) {
+      if (!factorize_body_tangent(state.q)) {
+        state.reason = "singular stiffness: the supports do not hold the body";
+        state.failure = FailureKind::newton_diverged;
+        return state;
+      }
+    } else {
+      ++counters_.factorizations;
+      if (!lu_.factorize(triplets, free_index_, free_count_, 1e-4)) {
+        state.reason = "singular tangent stiffness in Newton iteration " + std::to_string(it);
+        state.failure = FailureKind::newton_diverged;
+        return state;
+      }
+    }
+    Vector r_free(free_count_);
+    for (int i = 0; i < r.size(); ++i)
+      if (free_index_[i] >= 0) r_free[free_index_[i]] = r_newton[i];
+    const Vector dq_free = low_rank ? low_rank_step(triplets, Vector(-r_free))
+                           : reuse  ? body_lu_.solve(Vector(-r_free))
+                                    : lu_.solve(Vector(-r_free));
+    state.newton_iterations = it;
+    ++counters_.newton_iterations;
+    Vector dq = Vector::Zero(state.q.size());
+    for (int i = 0; i < state.q.size(); ++i)
+      if (free_index_[i] >= 0) dq[i] = dq_free[free_index_[i]];
+    const double step = (dq.array() * length_scales_.array()).abs().maxCoeff();
+    if (!std::isfinite(step)) {
+      state.reason = "Newton produced a non-finite displacement";
+      state.failure = FailureKind::newton_diverged;
+      return state;
+    }
+    if (step > params_.divergence_lengths * body_length) {
+      state.reason = "Newton diverged (correction of " + number_text(step) + " length units)";
+      state.failure = FailureKind::newton_diverged;
+      return state;
+    }
+    last_step = step;
+    if (step <= params_.displacement_tolerance && stick_branch_.empty()) {
+      state.q += dq;
+      pair(state.q, state);
+      return penalty_ ? finish_penalty(state) : finish(state, p);
+    }
+    state.q += line_search(state.q, dq, p, reuse ? body_lu_ : lu_) * dq;
+    stick_branch_.clear();
+  }
+  pair(state.q, state);
+  state.failure = FailureKind::newton_diverged;
+  state.reason = "Newton did not converge in " + std::to_string(params_.max_iterations) +
+                 " iterations (free residual " + number_text(state.relative_residual) + " of the force scale)";
+  return state;
+}
+
+EquilibriumState& Equilibrium::finish(EquilibriumState& state, const Vector& p) const {
+  state.reason = problem_.body->inadmissible(state.q);
+  state.converged = state.reason.empty();
+  state.failure = state.converged ? FailureKind::none : FailureKind::invalid_state;
+  state.p = p;
+  const RigidModes& rigid = problem_.rigid;
+  if (pins_free_)  // the amplitudes were solved for: they are the pins' displacements
+    for (int k = 0; k < rigid.count(); ++k) state.p[rigid.first + k] = state.q[rigid.pins[k]] / rigid.scale;
+  if (rigid.count()) {
+    const Vector applied = applied_forces(state, state.p);
+    const Matrix modes = rigid_modes_at(problem_, state.q);
+    for (int k = 0; k < rigid.count(); ++k) state.s[rigid.first + k] = rigid.scale * modes.col(k).dot(applied);
+  }
+  return state;
+}
+
+double Equilibrium::line_search(const Vector& q, const Vector& dq, const Vector& p,
+                                const FreeBlockSolver& solver) const {
+  // Deuflhard's natural monotonicity test: the simplified correction K^-1 R(q + a dq), with
+  // the factorization already at hand, must be shorter than (1 - a/4) |dq|. It measures the
+  // distance to the solution in the tangent's metric, so a large rigid rotation with small
+  // strains is a full step, where the residual norm would grow and refuse it.
+  const double dq_norm = free_length_norm(dq);
+  double a = problem_.body->newton_step_fraction(q, dq);
+  for (int k = 0; k < params_.max_backtracks; ++k, a *= 0.5) {
+    const Vector qa = q + a * dq;
+    EquilibriumState paired;
+    pair(qa, paired);
+    const Vector r = residual(qa, paired, p, nullptr);
+    Vector r_free(free_count_);
+    for (int i = 0; i < r.size(); ++i)
+      if (free_index_[i] >= 0) r_free[free_index_[i]] = r[i];
+    const Vector simplified = solver.solve(r_free);
+    Vector full = Vector::Zero(q.size());
+    for (int i = 0; i < q.size(); ++i)
+      if (free_index_[i] >= 0) full[i] = simplified[free_index_[i]];
+    const double norm = free_length_norm(full);
+    if (std::isfinite(norm) && norm <= (1.0 - 0.25 * a) * dq_norm) return a;
+  }
+  return a;
+}
+
+bool Equilibrium::factorize_body_tangent(const Vector& q) {
+  if (constant_tangent_ && body_factorized_) return body_lu_.ok();
+  Triplets triplets;
+  Vector force = Vector::Zero(q.size());
+  problem_.body->internal_force(q, force, &triplets);
+  ++counters_.factorizations;
+  body_factorized_ = true;
+  // Read by Newton only for a constant tangent (a changing one has its own triplets).
+  if (constant_tangent_) body_tangent_norm_ = free_row_sum_norm(triplets, free_index_, free_count_, length_scales_);
+  return body_lu_.factorize(triplets, free_index_, free_count_);
+}
+
+}  // namespace grip
