@@ -118,7 +118,7 @@ double StepSolver::bound_at(const EquilibriumState& s, double* scale, bool* roun
   const double relative = params_.tolerance * d;
   if (scale) *scale = d;
   if (round_off) *round_off = rounding > relative;
-  return std::min(std::max(relative, rounding), params_.tolerance * L);
+  return std::min(std::max(relative, rounding), ceiling());
 }
 
 double StepSolver::unbalance(const ContactError& e) const {
@@ -390,7 +390,7 @@ bool StepSolver::line_search(const Vector& pl, const Vector& du, int& trials) {
 }
 
 bool StepSolver::reached_precision() {
-  if (error_.norm2 > params_.tolerance * problem_.body->characteristic_length() || unbalance(error_) > balance_tol_)
+  if (error_.norm2 > ceiling() || unbalance(error_) > balance_tol_)
     return false;
   tol_ = error_.norm2;
   at_round_off_ = true;
