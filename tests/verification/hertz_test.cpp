@@ -178,6 +178,30 @@ TEST(Hertz, SmallestAcceptedDivisionsMatchTheClosedForm) {
   EXPECT_TRUE(h.zone.brackets(h.a, 1e-9)) << "a = " << h.a;
 }
 
+// The shipped scene on quadratic triangles (element t6: each q9 of the generator split in two,
+// nodes a / 20 apart near the pole, contact sites at the corners and mid-sides of the arc's
+// curved sides): a and p0 within 1 % of the closed form, as the q4 scene at its smallest
+// divisions, and the edge between the nodes where contact ends.
+TEST(Hertz, QuadraticTrianglesMatchTheClosedForm) {
+  json j = example_scene("hertz");
+  j["body"]["element"] = "t6";
+  const Solved s = solve_scene(j);
+  expect_every_step_sound(s);
+  ASSERT_TRUE(s.run.completed);
+  for (const StepRecord& rec : s.run.steps) {
+    const HertzReading h = read_hertz(s, rec);
+    ASSERT_TRUE(h.zone.found);
+    EXPECT_TRUE(h.set_ends_open);
+    std::printf("t6 step %d: P = %.2f N/mm; a = %.4f mm, fitted %+.3f %%; p0 = %.1f MPa, fitted %+.3f %%, peak %+.3f %%; "
+                "%d nodes touch\n",
+                rec.index, h.P, h.a, 100 * h.a_error(), h.p0, 100 * h.p0_error(), 100 * h.peak_error(),
+                h.nodes_in_contact);
+    EXPECT_LT(std::abs(h.a_error()), 0.01);
+    EXPECT_LT(std::abs(h.p0_error()), 0.01);
+    EXPECT_TRUE(h.zone.brackets(h.a, 1e-9)) << "a = " << h.a;
+  }
+}
+
 // A tangent that changes (finite kinematics) with friction: the compliance's G reused across
 // real solves and steps changes the path, not the answer (to what the contact
 // tolerance pins it), and forms G fewer times than a fresh G at every update.
