@@ -27,7 +27,8 @@ const char* element_name(ContinuumElement element) {
 
 ContinuumBody::ContinuumBody(PlaneMesh mesh, const std::vector<int>& contact_set,
                              std::shared_ptr<const PlaneMaterial> material, ContinuumOptions options)
-    : mesh_(std::move(mesh)), options_(options), shape_(element_shape(options.element)), material_(std::move(material)) {
+    : mesh_(std::move(mesh)), options_(options), shape_(element_shape(options.element)),
+      material_(std::move(material)) {
   if (options_.element == ContinuumElement::q4_bbar && options_.kinematics == ContinuumKinematics::finite)
     throw std::invalid_argument("q4_bbar is implemented for linear kinematics (use q9 for finite strain)");
   if (!(options_.thickness > 0)) throw std::invalid_argument("thickness must be positive");

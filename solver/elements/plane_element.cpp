@@ -59,9 +59,7 @@ int element_node_count(ElementShape shape) {
   return n[static_cast<int>(shape)];
 }
 
-int element_corner_count(ElementShape shape) {
-  return shape == ElementShape::t3 || shape == ElementShape::t6 ? 3 : 4;
-}
+int element_corner_count(ElementShape shape) { return shape == ElementShape::t3 || shape == ElementShape::t6 ? 3 : 4; }
 
 bool is_quadratic(ElementShape shape) { return shape != ElementShape::t3 && shape != ElementShape::q4; }
 
@@ -173,7 +171,8 @@ const std::vector<GaussPoint>& gauss_rule(ElementShape shape) {
   }
 }
 
-ElementPoint element_point(ElementShape shape, const ShapeGradients& X, double xi, double eta, double weight_thickness) {
+ElementPoint element_point(ElementShape shape, const ShapeGradients& X, double xi, double eta,
+                           double weight_thickness) {
   ElementPoint p;
   ShapeGradients dN_nat;
   shape_functions(shape, xi, eta, p.N, dN_nat);

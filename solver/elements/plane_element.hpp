@@ -50,8 +50,7 @@ struct ElementPoint {
 };
 
 // X holds the element's node coordinates, one row per node.
-ElementPoint element_point(ElementShape shape, const ShapeGradients& X, double xi, double eta,
-                           double weight_thickness);
+ElementPoint element_point(ElementShape shape, const ShapeGradients& X, double xi, double eta, double weight_thickness);
 std::vector<ElementPoint> element_points(ElementShape shape, const ShapeGradients& X, double thickness);
 
 // The volume average of dN/dX over the element: the gradient of the mean dilatation.

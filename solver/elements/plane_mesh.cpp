@@ -202,9 +202,11 @@ PlaneMesh quads_as(PlaneMesh quads, ElementShape shape) {
       if (along_13) out.elements.insert(out.elements.end(), {{e[0], e[1], e[3]}, {e[1], e[2], e[3]}});
       else out.elements.insert(out.elements.end(), {{e[0], e[1], e[2]}, {e[0], e[2], e[3]}});
     } else if (along_13) {  // t6: corners, then the mid-sides (q9 node 8 on the diagonal)
-      out.elements.insert(out.elements.end(), {{e[0], e[1], e[3], e[4], e[8], e[7]}, {e[1], e[2], e[3], e[5], e[6], e[8]}});
+      out.elements.insert(out.elements.end(),
+                          {{e[0], e[1], e[3], e[4], e[8], e[7]}, {e[1], e[2], e[3], e[5], e[6], e[8]}});
     } else {
-      out.elements.insert(out.elements.end(), {{e[0], e[1], e[2], e[4], e[5], e[8]}, {e[0], e[2], e[3], e[8], e[6], e[7]}});
+      out.elements.insert(out.elements.end(),
+                          {{e[0], e[1], e[2], e[4], e[5], e[8]}, {e[0], e[2], e[3], e[8], e[6], e[7]}});
     }
   }
   return out;
@@ -372,7 +374,8 @@ BoundaryPart boundary_part(const PlaneMesh& mesh, ElementShape shape, const std:
   std::vector<char> has_previous(nodes, 0), on_side(nodes, 0);
   std::vector<double> length(nodes, 0.0);
   for (auto& side : boundary_sides_within(mesh, shape, &in)) {
-    if (!std::all_of(side.begin(), side.end(), [&](int a) { return in[a] != 0; })) continue;  // a quadratic side's middle
+    if (!std::all_of(side.begin(), side.end(), [&](int a) { return in[a] != 0; }))
+      continue;  // a quadratic side's middle
     const std::array<double, 3> w = side_weights(mesh, side);
     for (size_t a = 0; a < side.size(); ++a) {
       length[side[a]] += w[a];

@@ -22,8 +22,7 @@ struct Variant {
 };
 
 std::string name_of(const Variant& v) {
-  return std::string(element_name(v.element)) +
-         (v.kinematics == ContinuumKinematics::linear ? "_linear" : "_finite") +
+  return std::string(element_name(v.element)) + (v.kinematics == ContinuumKinematics::linear ? "_linear" : "_finite") +
          (v.analysis == PlaneAnalysis::plane_strain ? "_strain" : "_stress");
 }
 

@@ -367,7 +367,7 @@ TEST(CheckMesh, NamesTheFaultyElementOrNode) {
   EXPECT_EQ(issues[0].element, 0);
   EXPECT_NE(issues[0].detail.find("node 99"), std::string::npos);
   EXPECT_EQ(issues[1].element, 3);
-  EXPECT_EQ(issues[2].node, 9);                           // the extra node belongs to no element
+  EXPECT_EQ(issues[2].node, 9);                              // the extra node belongs to no element
   EXPECT_FALSE(check_mesh(mesh, ElementShape::q9).empty());  // four nodes are not a q9
 }
 

@@ -88,14 +88,12 @@ TEST(ContactPatch, UniformCompressionGivesUniformPressure) {
     const char* kinematics;
     const char* analysis;
   };
-  const Case cases[] = {{"q4", "linear", "plane_strain"},      {"q4", "linear", "plane_stress"},
-                        {"q4_bbar", "linear", "plane_strain"}, {"q9", "linear", "plane_strain"},
-                        {"q4", "finite", "plane_strain"},      {"q4", "finite", "plane_stress"},
-                        {"q9", "finite", "plane_strain"},      {"q9", "finite", "plane_stress"},
-                        {"t3", "linear", "plane_strain"},      {"t6", "linear", "plane_stress"},
-                        {"q8", "linear", "plane_strain"},      {"t3", "finite", "plane_strain"},
-                        {"t6", "finite", "plane_strain"},      {"t6", "finite", "plane_stress"},
-                        {"q8", "finite", "plane_strain"}};
+  const Case cases[] = {
+      {"q4", "linear", "plane_strain"}, {"q4", "linear", "plane_stress"}, {"q4_bbar", "linear", "plane_strain"},
+      {"q9", "linear", "plane_strain"}, {"q4", "finite", "plane_strain"}, {"q4", "finite", "plane_stress"},
+      {"q9", "finite", "plane_strain"}, {"q9", "finite", "plane_stress"}, {"t3", "linear", "plane_strain"},
+      {"t6", "linear", "plane_stress"}, {"q8", "linear", "plane_strain"}, {"t3", "finite", "plane_strain"},
+      {"t6", "finite", "plane_strain"}, {"t6", "finite", "plane_stress"}, {"q8", "finite", "plane_strain"}};
   for (const Case& c : cases) {
     SCOPED_TRACE(std::string(c.element) + " " + c.kinematics + " " + c.analysis);
     // Finite strain at 5 % compression; the linear cases are exact at any size.
