@@ -11,6 +11,11 @@
 #include <unordered_map>
 #include <utility>
 
+#include <fcntl.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 namespace grip {
 
 const char* element_kind_name(GmshElementKind kind) {
@@ -683,6 +688,9 @@ std::vector<int> compact(const Cursor& c, Reading& r) {
   for (auto& [tag, nodes] : r.points)
     for (int n : nodes) mark(n);
   std::vector<int> number(r.tags.size(), -1);
+  const auto kept = r.tags.size() - std::count(use.begin(), use.end(), 0);
+  m.nodes.reserve(kept);
+  m.node_tags.reserve(kept);
   int next = 0;
   for (char level : {2, 1})
     for (std::size_t i = 0; i < use.size(); ++i)
@@ -857,28 +865,36 @@ GmshMesh read_gmsh_mesh(std::string_view bytes, const std::string& source) {
 }
 
 GmshMesh read_gmsh_file(const std::string& path) {
-  std::FILE* file = std::fopen(path.c_str(), "rb");
-  if (!file) throw GmshError(path + ": cannot open: " + std::strerror(errno));
-  std::string bytes;
-  char buffer[1 << 16];
-  if (std::fseek(file, 0, SEEK_END) == 0) {
-    const long size = std::ftell(file);
-    if (size > 0) bytes.reserve(static_cast<std::size_t>(size));
-    std::fseek(file, 0, SEEK_SET);
+  // Mapped, not copied: no second copy of a large file, and its pages come in one go.
+  const int fd = ::open(path.c_str(), O_RDONLY);
+  if (fd < 0) throw GmshError(path + ": cannot open: " + std::strerror(errno));
+  struct stat info {};
+  if (::fstat(fd, &info) != 0 || !S_ISREG(info.st_mode)) {
+    ::close(fd);
+    throw GmshError(path + ": not a readable file");
   }
-  for (std::size_t n; (n = std::fread(buffer, 1, sizeof buffer, file)) > 0;) bytes.append(buffer, n);
-  const bool failed = std::ferror(file);
-  std::fclose(file);
-  if (failed) throw GmshError(path + ": cannot read");
-  return read_gmsh_mesh(bytes, path);
+  const auto size = static_cast<std::size_t>(info.st_size);
+  if (size == 0) {
+    ::close(fd);
+    return read_gmsh_mesh({}, path);
+  }
+  void* data = ::mmap(nullptr, size, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
+  ::close(fd);
+  if (data == MAP_FAILED) throw GmshError(path + ": cannot read: " + std::strerror(errno));
+  struct Unmap {
+    void* data;
+    std::size_t size;
+    ~Unmap() { ::munmap(data, size); }
+  } unmap{data, size};
+  return read_gmsh_mesh(std::string_view(static_cast<const char*>(data), size), path);
 }
 
 nlohmann::json gmsh_mesh_summary(const GmshMesh& mesh) {
+  std::array<int, 5> per_kind{};
+  for (auto kind : mesh.element_kinds) ++per_kind[static_cast<int>(kind)];
   nlohmann::json elements = nlohmann::json::object();
-  for (auto kind : mesh.element_kinds) {
-    auto& n = elements[element_kind_name(kind)];
-    n = n.is_null() ? 1 : n.get<int>() + 1;
-  }
+  for (int k = 0; k < 5; ++k)
+    if (per_kind[k] > 0) elements[element_kind_name(static_cast<GmshElementKind>(k))] = per_kind[k];
   nlohmann::json groups = nlohmann::json::array();
   for (const auto& [name, s] : mesh.surfaces) {
     std::vector<char> seen(mesh.nodes.size(), 0);

@@ -191,6 +191,16 @@ TEST(GmshMeshRefuses, TruncatedFiles) {
     EXPECT_NE(message.find("elements cannot fit in the rest of the file (truncated?)"), std::string::npos) << message;
   }
   EXPECT_EQ(refusal(""), "part.msh: the file is empty");
+  EXPECT_THROW(
+      {
+        try {
+          read_gmsh_file(kData + "no_such.msh");
+        } catch (const GmshError& e) {
+          EXPECT_NE(std::string(e.what()).find("no_such.msh: cannot open: "), std::string::npos);
+          throw;
+        }
+      },
+      GmshError);
 }
 
 TEST(GmshMeshRefuses, SolidElementsWithTheirTag) {
