@@ -274,6 +274,11 @@ struct Reading {
   std::map<int, std::vector<int>> points;
 };
 
+// A line in ASCII, a byte offset in binary data.
+[[noreturn]] void fail_at(const Cursor& c, const Reading& r, std::size_t at, const std::string& what) {
+  r.binary ? c.fail_byte(at, what) : c.fail_line(at, what);
+}
+
 constexpr std::size_t kMaxIndex = static_cast<std::size_t>(std::numeric_limits<int>::max() - 1);
 
 void read_format(Cursor& c, Reading& r) {
@@ -347,7 +352,7 @@ void read_entities(Cursor& c, Reading& r) {
 void add_node(Cursor& c, Reading& r, std::size_t tag, double x, double y, double z, std::size_t at) {
   if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(z)) {
     const std::string what = "node " + std::to_string(tag) + " has a coordinate that is not a finite number";
-    r.binary ? c.fail_byte(at, what) : c.fail_line(at, what);
+    fail_at(c, r, at, what);
   }
   r.tags.push_back(tag);
   r.xy.emplace_back(x, y);
@@ -387,6 +392,8 @@ void read_nodes(Cursor& c, Reading& r) {
       }
     }
   } else {
+    if (!r.binary) c.skip_space();
+    const auto head_at = c.pos();
     std::array<std::size_t, 4> head{};  // blocks, nodes, min tag, max tag
     for (auto& h : head) h = r.binary ? c.bin<std::uint64_t>("the $Nodes counts") : c.count("a $Nodes count");
     reserve_nodes(c, r, head[1], r.binary ? 32 : 8);
@@ -410,7 +417,7 @@ void read_nodes(Cursor& c, Reading& r) {
       if (dimension < 0 || dimension > 3 || (parametric != 0 && parametric != 1)) {
         const std::string what = "node block with entity dimension " + std::to_string(dimension) +
                                  " and parametric flag " + std::to_string(parametric);
-        r.binary ? c.fail_byte(block_at, what) : c.fail_line(block_at, what);
+        fail_at(c, r, block_at, what);
       }
       const std::size_t values = 3 + (parametric ? dimension : 0);  // x y z, then u [v [w]]
       if (r.binary) {
@@ -436,8 +443,9 @@ void read_nodes(Cursor& c, Reading& r) {
       }
     }
     if (r.tags.size() != head[1])
-      c.fail_line(c.pos(), "$Nodes declares " + std::to_string(head[1]) + " nodes, its blocks hold " +
-                               std::to_string(r.tags.size()));
+      fail_at(
+          c, r, head_at,
+          "$Nodes declares " + std::to_string(head[1]) + " nodes, its blocks hold " + std::to_string(r.tags.size()));
   }
   if (r.tags.size() > kMaxIndex) c.fail("more nodes than grip numbers (" + std::to_string(r.tags.size()) + ")");
   if (const auto [twice, tag] = r.index.build(r.tags); twice)
@@ -482,7 +490,7 @@ void resolve(Cursor& c, const Reading& r, std::size_t element, const Tag* tags, 
     if (out[k] < 0) {
       const std::string what = "element " + std::to_string(element) + " refers to node " +
                                std::to_string(static_cast<std::int64_t>(tags[k])) + ", which is not in $Nodes";
-      r.binary ? c.fail_byte(at, what) : c.fail_line(at, what);
+      fail_at(c, r, at, what);
     }
   }
 }
@@ -491,7 +499,7 @@ TypeInfo checked_type(Cursor& c, const Reading& r, std::int64_t type, std::size_
   const auto info = type_info(type);
   if (info.dimension < 0) {
     const std::string what = "element " + std::to_string(element) + " " + refused_type(type);
-    r.binary ? c.fail_byte(at, what) : c.fail_line(at, what);
+    fail_at(c, r, at, what);
   }
   return info;
 }
@@ -556,6 +564,8 @@ void read_elements_v2(Cursor& c, Reading& r) {
 
 void read_elements_v4(Cursor& c, Reading& r) {
   if (r.binary) c.end_line();
+  if (!r.binary) c.skip_space();
+  const auto head_at = c.pos();
   std::array<std::size_t, 4> head{};  // blocks, elements, min tag, max tag
   for (auto& h : head) h = r.binary ? c.bin<std::uint64_t>("the $Elements counts") : c.count("an $Elements count");
   std::array<int, 9> nodes{};
@@ -589,7 +599,7 @@ void read_elements_v4(Cursor& c, Reading& r) {
       const std::string what = "element block of gmsh type " + std::to_string(type) + " (dimension " +
                                std::to_string(info.dimension) + ") on an entity of dimension " +
                                std::to_string(dimension);
-      r.binary ? c.fail_byte(block_at, what) : c.fail_line(block_at, what);
+      fail_at(c, r, block_at, what);
     }
     const auto found = r.entity_groups.find({dimension, entity});
     const auto& groups = found == r.entity_groups.end() ? none : found->second;
@@ -617,8 +627,8 @@ void read_elements_v4(Cursor& c, Reading& r) {
     total += n;
   }
   if (total != head[1])
-    c.fail_line(c.pos(), "$Elements declares " + std::to_string(head[1]) + " elements, its blocks hold " +
-                             std::to_string(total));
+    fail_at(c, r, head_at,
+            "$Elements declares " + std::to_string(head[1]) + " elements, its blocks hold " + std::to_string(total));
 }
 
 void read_elements(Cursor& c, Reading& r) {
@@ -822,12 +832,15 @@ void make_groups(const Cursor& c, Reading& r, const std::vector<int>& number) {
     order_curve(curve);
     m.curves.emplace(name, std::move(curve));
   }
+  std::vector<int> in_group(m.nodes.size(), 0);  // the last point group that listed each node
+  int group = 0;
   for (auto& [tag, nodes] : r.points) {
     const auto name = name_of(0, tag);
     claim(0, tag, name, true);
     GmshPoints set{tag, {}};
+    ++group;
     for (int n : nodes)
-      if (std::find(set.nodes.begin(), set.nodes.end(), number[n]) == set.nodes.end()) set.nodes.push_back(number[n]);
+      if (std::exchange(in_group[number[n]], group) != group) set.nodes.push_back(number[n]);
     m.points.emplace(name, std::move(set));
   }
 }
@@ -896,11 +909,13 @@ nlohmann::json gmsh_mesh_summary(const GmshMesh& mesh) {
   for (int k = 0; k < 5; ++k)
     if (per_kind[k] > 0) elements[element_kind_name(static_cast<GmshElementKind>(k))] = per_kind[k];
   nlohmann::json groups = nlohmann::json::array();
+  std::vector<int> in_group(mesh.nodes.size(), -1);  // the last surface that counted each node
+  int group = 0;
   for (const auto& [name, s] : mesh.surfaces) {
-    std::vector<char> seen(mesh.nodes.size(), 0);
     int nodes = 0;
     for (int e : s.elements)
-      for (int n : mesh.element(e)) nodes += !seen[n], seen[n] = 1;
+      for (int n : mesh.element(e)) nodes += std::exchange(in_group[n], group) != group;
+    ++group;
     groups.push_back(
         {{"name", name}, {"dimension", 2}, {"tag", s.tag}, {"elements", s.elements.size()}, {"nodes", nodes}});
   }

@@ -37,6 +37,8 @@ std::string refusal(const std::string& text) {
   return "";
 }
 
+std::string kPlate22ForBranch() { return file_text(kData + "plate_v22_ascii.msh"); }
+
 std::string replaced(std::string text, const std::string& from, const std::string& to) {
   const auto at = text.find(from);
   EXPECT_NE(at, std::string::npos) << from;
@@ -164,6 +166,17 @@ TEST(GmshMesh, SummaryCountsKindsGroupsAndBox) {
   EXPECT_EQ(groups["corner"]["dimension"], 0);
 }
 
+TEST(GmshMesh, BranchedCurvesKeepTheirNodesInOrderOfAppearance) {
+  // The right side's line moved into the bottom as a branch at node 20: no chain; "right" stays, empty.
+  const auto m = read_gmsh_mesh(replaced(kPlate22ForBranch(), "6 1 2 13 2 30 40", "6 1 2 11 2 20 50"), "t.msh");
+  const auto& bottom = m.curves.at("bottom");
+  EXPECT_FALSE(bottom.chain);
+  EXPECT_EQ(bottom.edges, (std::vector<std::vector<int>>{{0, 1}, {1, 2}, {1, 4}}));
+  EXPECT_EQ(bottom.nodes, (std::vector<int>{0, 1, 2, 4}));
+  EXPECT_TRUE(m.curves.at("right").edges.empty());
+  EXPECT_TRUE(m.curves.at("right").nodes.empty());
+}
+
 // ---- refusals: each names the file's line (ASCII) or the tag at fault.
 
 const std::string kPlate22 = file_text(kData + "plate_v22_ascii.msh");
@@ -191,6 +204,16 @@ TEST(GmshMeshRefuses, TruncatedFiles) {
     EXPECT_NE(message.find("elements cannot fit in the rest of the file (truncated?)"), std::string::npos) << message;
   }
   EXPECT_EQ(refusal(""), "part.msh: the file is empty");
+  // Counts no file could hold.
+  EXPECT_EQ(refusal(replaced(kPlate41, "$Nodes\n1 9 10 90\n2 1 0 9", "$Nodes\n1 9 10 90\n2 1 0 99999999999999")),
+            "part.msh:43: expected a node tag, read '1.5'");
+  EXPECT_EQ(refusal(replaced(kPlate22, "$Elements\n11", "$Elements\n18446744073709551615")),
+            "part.msh:41: expected an element tag, read '$EndElements'");
+  auto binary = file_text(kData + "plate_v41_binary.msh");
+  const auto nodes = binary.find("$Nodes\n") + 7;
+  binary.replace(nodes, 16, std::string("\x01\0\0\0\0\0\0\0\xff\xff\xff\xff\xff\xff\xff\x7f", 16));
+  EXPECT_EQ(refusal(binary), "part.msh: byte " + std::to_string(nodes) +
+                                 ": $Nodes declares 9223372036854775807 nodes, its blocks hold 9");
   EXPECT_THROW(
       {
         try {
