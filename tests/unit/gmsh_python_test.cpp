@@ -1,7 +1,8 @@
 // grip's .msh reader against gmsh itself: where Debian's gmsh Python module (python3-gmsh) is
 // importable by /usr/bin/python3, tests/data/gmsh/gmsh_reference.py meshes a plate (quads
 // beside triangles, a tool line, physical surfaces, curves and a point) at order 1, 2 and 2
-// incomplete, writes each in the four variants of the format and reports what gmsh's API
+// incomplete, writes each in the four variants of the format (4.1 also with parametric
+// coordinates) and reports what gmsh's API
 // holds; every file must read to the same nodes, elements and groups.
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -68,7 +69,8 @@ TEST(GmshPython, GripReadsWhatGmshWroteAsGmshReportsIt) {
       gmsh_by_tag[e[1].get<std::size_t>()] = element;
       body.insert(element.second.begin(), element.second.end());
     }
-    for (const std::string v : {"v22_ascii", "v22_binary", "v41_ascii", "v41_binary"}) {
+    for (const std::string v :
+         {"v22_ascii", "v22_binary", "v41_ascii", "v41_binary", "v41_parametric_ascii", "v41_parametric_binary"}) {
       SCOPED_TRACE(c + "_" + v);
       const auto m = read_gmsh_file(out + "/" + c + "_" + v + ".msh");
       // Nodes: the 2D elements' first, with gmsh's coordinates (ASCII keeps 16 digits).

@@ -4,7 +4,7 @@
 meshes a plate (a quad-meshed square beside a triangle-meshed one, a tool line above them,
 physical surfaces, curves and a point) with Debian's gmsh Python module at order 1, at order
 2 (t6, q9) and at order 2 incomplete (t6, q8); writes each as OUTDIR/<case>_<variant>.msh in
-the four variants (2.2 and 4.1, ASCII and binary) and what gmsh's API reports as
+the four variants (2.2 and 4.1, ASCII and binary; 4.1 also with parametric coordinates) and what gmsh's API reports as
 OUTDIR/<case>.json. Exit code 77 when the module is not importable."""
 import json
 import os
@@ -16,7 +16,9 @@ except ImportError:
     sys.exit(77)
 
 CASES = {"linear": (1, 0), "quadratic": (2, 0), "serendipity": (2, 1)}
-VARIANTS = {"v22_ascii": (2.2, 0), "v22_binary": (2.2, 1), "v41_ascii": (4.1, 0), "v41_binary": (4.1, 1)}
+# The last two with the nodes' parametric coordinates (Mesh.SaveParametric), which grip skips.
+VARIANTS = {"v22_ascii": (2.2, 0, 0), "v22_binary": (2.2, 1, 0), "v41_ascii": (4.1, 0, 0), "v41_binary": (4.1, 1, 0),
+            "v41_parametric_ascii": (4.1, 0, 1), "v41_parametric_binary": (4.1, 1, 1)}
 
 
 def plate():
@@ -73,9 +75,10 @@ def main():
         gmsh.option.setNumber("Mesh.SecondOrderIncomplete", incomplete)
         gmsh.model.mesh.generate(2)
         gmsh.model.mesh.setOrder(order)
-        for variant, (version, binary) in VARIANTS.items():
+        for variant, (version, binary, parametric) in VARIANTS.items():
             gmsh.option.setNumber("Mesh.MshFileVersion", version)
             gmsh.option.setNumber("Mesh.Binary", binary)
+            gmsh.option.setNumber("Mesh.SaveParametric", parametric)
             gmsh.write(os.path.join(out, "%s_%s.msh" % (case, variant)))
         with open(os.path.join(out, case + ".json"), "w") as f:
             json.dump(report(), f)
