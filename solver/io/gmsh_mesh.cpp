@@ -217,7 +217,7 @@ class Cursor {
 // else a hash map.
 class TagIndex {
  public:
-  // Returns the tag that appears twice, or 0 with none... as a flag pair.
+  // Indexes the tags; {true, tag} for a tag that appears twice.
   std::pair<bool, std::size_t> build(const std::vector<std::size_t>& tags) {
     std::size_t max = 0;
     for (auto t : tags) max = std::max(max, t);
