@@ -1,9 +1,10 @@
 // Hertz on each element kind: the error of a and p0 against the wall time, at elements of a
 // given size near the pole (bench/results/elements.md). Run by hand:
 //   build/tests/bench/grip_elements_bench [kinds, default q9,t6] [runs per timing, default 3]
-// Prints one markdown row per kind and size: a/h by element size, nodes on the contact set's
-// half-width, dofs, the median wall time of reading the scene (mesh generation and checks) and
-// solving it, and the errors of the fitted a and p0 and of the peak nodal stress.
+// Prints one markdown row per kind and size: a/h by element size, the nodes that touch,
+// dofs, the median wall time of reading the scene (mesh generation and checks) and solving it,
+// the last run's solving time and real solves, and the errors of the fitted a and p0 and of
+// the peak nodal stress.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -25,8 +26,10 @@ int main(int argc, char** argv) {
     for (std::string k; std::getline(list, k, ',');) kinds.push_back(k);
   }
   const int runs = argc > 2 ? std::max(1, std::atoi(argv[2])) : 3;
-  std::printf("| kind | size mm | a/h | nodes in contact | dofs | seconds | a err %% | p0 err %% | peak err %% |\n");
-  std::printf("|---|---|---|---|---|---|---|---|---|\n");
+  std::printf(
+      "| kind | size mm | a/h | nodes in contact | dofs | seconds | of which solving | real solves | a err %% | p0 err "
+      "%% | peak err %% |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (const double size : {0.1, 0.05, 0.025, 0.01325})
     for (const std::string& kind : kinds) {
       json j = with_pole_elements(example_scene("hertz"), size);
@@ -60,9 +63,10 @@ int main(int argc, char** argv) {
         peak = std::max(peak, -n.sigma_n);
         touching += n.p_n < 0;
       }
-      std::printf("| %s | %g | %.0f | %d | %d | %.3f | %+.3f | %+.3f | %+.3f |\n", kind.c_str(), size, closed.a / size,
-                  touching, s.scene.problem.body->dof_count(), seconds[seconds.size() / 2],
-                  100 * (fit.a / closed.a - 1), 100 * (fit.p0 / closed.p0 - 1), 100 * (peak / closed.p0 - 1));
+      std::printf("| %s | %g | %.0f | %d | %d | %.3f | %.3f | %ld | %+.3f | %+.3f | %+.3f |\n", kind.c_str(), size,
+                  closed.a / size, touching, s.scene.problem.body->dof_count(), seconds[seconds.size() / 2],
+                  s.run.seconds, static_cast<long>(s.run.counters.solves), 100 * (fit.a / closed.a - 1),
+                  100 * (fit.p0 / closed.p0 - 1), 100 * (peak / closed.p0 - 1));
       std::fflush(stdout);
     }
 }
