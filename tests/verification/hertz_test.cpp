@@ -204,6 +204,32 @@ TEST(Hertz, QuadraticTrianglesMatchTheClosedForm) {
   }
 }
 
+// t6 under the other strategies (mid-side nodes are sites like the corners): uzawa and ssn
+// give cev's contact forces within what each run's contact error pins them to
+// (agreement_bound, force_precision.hpp).
+TEST(Hertz, QuadraticTrianglesUnderEveryStrategy) {
+  json j = hertz(0.1);
+  j["body"]["element"] = "t6";
+  const Solved cev = solve_scene(j);
+  expect_every_step_sound(cev);
+  ASSERT_TRUE(cev.run.completed);
+  for (const char* method : {"uzawa", "ssn"}) {
+    json other = j;
+    other["solver"]["contact"]["method"] = method;
+    other["solver"]["contact"]["max_iterations"] = 5000;
+    const Solved s = solve_scene(other);
+    expect_every_step_sound_within(s, 1e-3);
+    ASSERT_TRUE(s.run.completed) << method;
+    for (size_t k = 0; k < s.run.steps.size(); ++k) {
+      const double diff = force_difference(s.scene.problem, s.run.steps[k], cev.run.steps[k]);
+      const double bound = agreement_bound(s, k, cev);
+      std::printf("%s step %zu: %ld real solves; forces differ from cev's by %.6g (bound %.6g)\n", method, k + 1,
+                  s.run.counters.solves, diff, bound);
+      EXPECT_LT(diff, bound) << method << " step " << k + 1;
+    }
+  }
+}
+
 // A tangent that changes (finite kinematics) with friction: the compliance's G reused across
 // real solves and steps changes the path, not the answer (to what the contact
 // tolerance pins it), and forms G fewer times than a fresh G at every update.
