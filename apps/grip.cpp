@@ -2,6 +2,7 @@
 //   grip solve SCENE.json [--out RESULT.json] [--events EVENTS.ndjson] [--threads N]
 //   grip serve [options]        the HTTP/JSON service (grip serve --help)
 //   grip healthcheck [--host H] [--port P]
+//   grip mesh-info MESH.msh     what a gmsh mesh holds, as JSON (the service's answer to an upload)
 // serve and healthcheck run grip-server (apps/grip_server.cpp) from grip's own directory, so
 // that solving does not load the service's libraries.
 // Exit codes of solve: 0 solved, 1 a step failed, 2 usage or scene error.
@@ -28,6 +29,7 @@
 #include "apps/process_tuning.hpp"
 #include "apps/result_writer.hpp"
 #include "apps/thread_team.hpp"
+#include "solver/io/gmsh_mesh.hpp"
 #include "solver/io/result.hpp"
 #include "solver/io/schema_validation.hpp"
 
@@ -37,7 +39,8 @@ int usage() {
   std::fprintf(stderr,
                "usage: grip solve SCENE.json [--out RESULT.json] [--events EVENTS.ndjson] [--threads N]\n"
                "       grip serve [options]   (grip serve --help)\n"
-               "       grip healthcheck [--host H] [--port P]\n");
+               "       grip healthcheck [--host H] [--port P]\n"
+               "       grip mesh-info MESH.msh\n");
   return 2;
 }
 
@@ -145,6 +148,18 @@ int solve(int argc, char** argv) {
   std::_Exit(run.completed ? 0 : 1);
 }
 
+// mesh-info: gmsh_mesh_summary of a .msh file on stdout; a file grip cannot read: its reason, exit code 2.
+int mesh_info(int argc, char** argv) {
+  if (argc != 3) return usage();
+  try {
+    std::cout << grip::gmsh_mesh_summary(grip::read_gmsh_file(argv[2])).dump(2) << '\n';
+    return 0;
+  } catch (const grip::GmshError& e) {
+    std::fprintf(stderr, "grip mesh-info: %s\n", e.what());
+    return 2;
+  }
+}
+
 // serve and healthcheck: grip-server next to this executable, with the same arguments.
 int run_server(char** argv) {
   char self[PATH_MAX];
@@ -168,5 +183,6 @@ int main(int argc, char** argv) {
     return solve(argc, argv);
   }
   if (command == "serve" || command == "healthcheck") return run_server(argv);
+  if (command == "mesh-info") return mesh_info(argc, argv);
   return usage();
 }
