@@ -109,11 +109,13 @@ inline std::vector<Change> single_changes() {
   return {
       {"mu0", [](json& j) { return set_keys(j, "friction", 0.0); }},
       {"mu0.1", [](json& j) { return set_keys(j, "friction", 0.1); }},
+      {"mu0.3", [](json& j) { return set_keys(j, "friction", 0.3); }},
       {"mu0.6", [](json& j) { return set_keys(j, "friction", 0.6); }},
       {"steps_x2", [](json& j) { return scale_steps(j, 2.0); }},
       {"steps_half", [](json& j) { return scale_steps(j, 0.5); }},
       {"tol1e-4", tolerance(1e-4)},
       {"tol1e-6", tolerance(1e-6)},
+      {"tol1e-9", tolerance(1e-9)},
       {"tol1e-11", tolerance(1e-11)},
       {"ssn", method("ssn")},
       {"ssn_r0.01", method("ssn", {{"augmentation", 0.01}})},
@@ -127,6 +129,7 @@ inline std::vector<Change> single_changes() {
          return scale_keys(j, {"force", "traction", "moment", "young", "H"}, 1e-3);
        }},
       {"E_x1e6", stiffness(1e6)},
+      {"E_x1e3", stiffness(1e3)},
       {"E_x1e-2", stiffness(1e-2)},
       {"load_x1e-6", loads(1e-6)},
       {"load_x1e-3", loads(1e-3)},
