@@ -390,8 +390,7 @@ bool StepSolver::line_search(const Vector& pl, const Vector& du, int& trials) {
 }
 
 bool StepSolver::reached_precision() {
-  if (error_.norm2 > ceiling() || unbalance(error_) > balance_tol_)
-    return false;
+  if (error_.norm2 > ceiling() || unbalance(error_) > balance_tol_) return false;
   tol_ = error_.norm2;
   at_round_off_ = true;
   return true;
