@@ -143,14 +143,15 @@ class StepSolver {
   // alone left the moment unbalanced by up to 3e-7 of the forces (a disc turned between two
   // flats), where elsewhere the model's rows hold to rounding.
   bool error_met(const ContactError& e) const { return e.norm2 <= tol_ && unbalance(e) <= balance_tol_; }
-  // A trial is better than the accepted state with error v0: a smaller ||v||, or, within
-  // tolerance x L (ceiling), a smaller unbalance on the free motions (error_met's second test).
+  // A trial is better than the accepted state with error v0: a smaller ||v||, or, within the
+  // bound (tolerance x L, ceiling, where the free motions follow the state: strict_balance_), a
+  // smaller unbalance on the free motions (error_met's second test).
   // Not within the bound tol_ alone: where it is far below tolerance x L (the turned disc, D =
   // the 0.1 mm squeeze, L = 28.3 mm: 1e-9 against 2.8e-7), the update that balanced the moment
   // raised ||v|| from 1.3e-9 to 2.5e-9 before the next brought it to 3e-11; refused, every
   // trial after it stalled (cev_passes, 5 cuts).
   bool improves(const ContactError& e, double v0) const {
-    return e.norm2 < v0 || (e.norm2 <= ceiling() && unbalance(e) < unbalance(error_));
+    return e.norm2 < v0 || (e.norm2 <= (strict_balance_ ? ceiling() : tol_) && unbalance(e) < unbalance(error_));
   }
   // tolerance x L: the bound before it moved with the displacement, never exceeded (bound_at).
   double ceiling() const { return params_.tolerance * problem_.body->characteristic_length(); }
