@@ -6,13 +6,29 @@
 
 namespace grip {
 
-QuadShape quad_shape(ContinuumElement element) {
-  return element == ContinuumElement::q9 ? QuadShape::q9 : QuadShape::q4;
+ElementShape element_shape(ContinuumElement element) {
+  switch (element) {
+    case ContinuumElement::t3:
+      return ElementShape::t3;
+    case ContinuumElement::t6:
+      return ElementShape::t6;
+    case ContinuumElement::q8:
+      return ElementShape::q8;
+    case ContinuumElement::q9:
+      return ElementShape::q9;
+    default:
+      return ElementShape::q4;  // q4 and q4_bbar
+  }
+}
+
+const char* element_name(ContinuumElement element) {
+  return element == ContinuumElement::q4_bbar ? "q4_bbar" : shape_name(element_shape(element));
 }
 
 ContinuumBody::ContinuumBody(PlaneMesh mesh, const std::vector<int>& contact_set,
                              std::shared_ptr<const PlaneMaterial> material, ContinuumOptions options)
-    : mesh_(std::move(mesh)), options_(options), shape_(quad_shape(options.element)), material_(std::move(material)) {
+    : mesh_(std::move(mesh)), options_(options), shape_(element_shape(options.element)),
+      material_(std::move(material)) {
   if (options_.element == ContinuumElement::q4_bbar && options_.kinematics == ContinuumKinematics::finite)
     throw std::invalid_argument("q4_bbar is implemented for linear kinematics (use q9 for finite strain)");
   if (!(options_.thickness > 0)) throw std::invalid_argument("thickness must be positive");
@@ -30,12 +46,13 @@ ContinuumBody::ContinuumBody(PlaneMesh mesh, const std::vector<int>& contact_set
 const ContinuumBody::Integration& ContinuumBody::integration() const {
   std::call_once(integration_once_, [this] {
     auto in = std::make_unique<Integration>();
-    const int n = quad_node_count(shape_);
+    const int n = element_node_count(shape_);
     for (const auto& el : mesh_.elements) {
       ShapeGradients X(n, 2);
       for (int a = 0; a < n; ++a) X.row(a) = mesh_.nodes[el[a]].transpose();
-      in->points.push_back(quad_points(shape_, X, options_.thickness));
-      in->centroids.push_back(quad_point(shape_, X, 0.0, 0.0, 0.0));
+      in->points.push_back(element_points(shape_, X, options_.thickness));
+      const Vec2 c = centre_natural(shape_);
+      in->centroids.push_back(element_point(shape_, X, c.x(), c.y(), 0.0));
       if (options_.element == ContinuumElement::q4_bbar) in->mean_dN.push_back(mean_gradients(in->points.back()));
     }
     if (options_.kinematics == ContinuumKinematics::linear) {
@@ -169,7 +186,8 @@ std::vector<int> ContinuumBody::add_sites(const std::vector<int>& nodes) {
 
 std::vector<std::vector<int>> ContinuumBody::cells() const {
   std::vector<std::vector<int>> c;
-  for (const auto& el : mesh_.elements) c.push_back({el[0], el[1], el[2], el[3]});
+  const int corners = element_corner_count(shape_);
+  for (const auto& el : mesh_.elements) c.push_back(std::vector<int>(el.begin(), el.begin() + corners));
   return c;
 }
 
@@ -184,7 +202,7 @@ FieldTable ContinuumBody::site_fields(const Vector& q) const {
 
 Eigen::Vector4d ContinuumBody::centroid_stress(const Vector& q, int e) const {
   const ShapeGradients u = element_displacements(q, e);
-  const QuadPoint& c = integration().centroids[e];
+  const ElementPoint& c = integration().centroids[e];
   if (options_.kinematics == ContinuumKinematics::linear) {
     const MaterialResponse r = material_->small_strain();
     Vector ue(2 * u.rows());

@@ -1,11 +1,11 @@
 #pragma once
-// A plane continuum body: isoparametric quadrilaterals (quad_element.hpp) in plane strain or
-// plane stress, with an elastic law (plane_material.hpp).
+// A plane continuum body: isoparametric triangles and quadrilaterals (plane_element.hpp) in
+// plane strain or plane stress, with an elastic law (plane_material.hpp).
 //   linear: small strain, sigma = D eps; K is constant, assembled once and reused (traits()
 //   says so, and the equilibrium oracle then factorizes it once).
 //   finite: total Lagrangian, S(E) of the law, exact tangent.
-// Elements: q4 (2 x 2 Gauss), q4_bbar (q4 with the mean dilatation of B-bar: for nu -> 1/2
-// in plane strain, linear kinematics), q9 (3 x 3 Gauss).
+// Elements: t3 (1 Gauss point), t6 (6 points), q4 (2 x 2 Gauss), q4_bbar (q4 with the mean
+// dilatation of B-bar: for nu -> 1/2 in plane strain, linear kinematics), q8 and q9 (3 x 3).
 //
 // Dofs: (ux, uy) per node, node after node. Contact sites are the nodes of the contact set
 // in order along the boundary (counter-clockwise round the body): a SUBSET of the nodes.
@@ -13,7 +13,8 @@
 // them), so a site's row in site_fields is site_node(site). A site's surface point is the
 // node itself (no offset; `side` is ignored) and its contact force acts on the node's two
 // dofs. Tributary area = integral of the node's shape function over the contact sides x
-// thickness (half the adjacent side lengths for q4).
+// thickness (half the adjacent side lengths for t3 and q4). A quadratic side (t6, q8, q9) is
+// two contact segments, corner - mid-side - corner: its mid-side node is a site like the corners.
 #include <memory>
 #include <mutex>
 #include <vector>
@@ -23,7 +24,7 @@
 
 namespace grip {
 
-enum class ContinuumElement { q4, q4_bbar, q9 };
+enum class ContinuumElement { q4, q4_bbar, q9, t3, t6, q8 };
 enum class ContinuumKinematics { linear, finite };
 
 struct ContinuumOptions {
@@ -33,7 +34,8 @@ struct ContinuumOptions {
   double thickness = 1.0;  // out-of-plane depth (plane strain: the length the results are per)
 };
 
-QuadShape quad_shape(ContinuumElement element);
+ElementShape element_shape(ContinuumElement element);
+const char* element_name(ContinuumElement element);  // as the scene names it: "q4_bbar", ...
 
 class ContinuumBody final : public Body {
  public:
@@ -51,7 +53,7 @@ class ContinuumBody final : public Body {
   int site_node(int site) const override { return contact_.nodes[site]; }
   Vec2 site_reference(int site) const override { return mesh_.nodes[contact_.nodes[site]]; }
   SurfacePoint surface_point(const VectorRef& q, int site, int side) const override;
-  // The contact sides, a q9 side as its two halves.
+  // The contact sides, a quadratic side (t6, q8, q9) as its two halves.
   std::vector<std::array<int, 2>> surface_segments() const override;
   std::vector<int> nodes_without_site() const override;
   Vec2 node_position(const VectorRef& q, int node) const override {
@@ -65,7 +67,7 @@ class ContinuumBody final : public Body {
   Vector rigid_rotation() const override;
   Traits traits() const override;
   std::optional<ElementQuality> element_quality() const override { return grip::element_quality(mesh_); }
-  std::vector<std::vector<int>> cells() const override;  // element corners (node ids)
+  std::vector<std::vector<int>> cells() const override;  // element corners (node ids): 3 or 4
   // Per node: x, y (deformed), ux, uy.
   FieldTable site_fields(const Vector& q) const override;
   // Per element, at its centroid: Cauchy stress sxx, syy, sxy, szz.
@@ -89,8 +91,8 @@ class ContinuumBody final : public Body {
   // constructor, so that reading and validating a large scene stays cheap (the service reads
   // every submission on its HTTP thread and builds the body again on a worker).
   struct Integration {
-    std::vector<std::vector<QuadPoint>> points;  // per element, reference configuration
-    std::vector<QuadPoint> centroids;
+    std::vector<std::vector<ElementPoint>> points;  // per element, reference configuration
+    std::vector<ElementPoint> centroids;
     std::vector<ShapeGradients> mean_dN;  // per element (q4_bbar)
     Triplets linear_tangent;              // linear kinematics: the constant K
     Eigen::SparseMatrix<double> linear_K;
@@ -99,7 +101,7 @@ class ContinuumBody final : public Body {
 
   PlaneMesh mesh_;
   ContinuumOptions options_;
-  QuadShape shape_;
+  ElementShape shape_;
   std::shared_ptr<const PlaneMaterial> material_;
   BoundaryPart contact_;
   double length_ = 0.0;

@@ -92,16 +92,16 @@ std::vector<double> even(int n) {
   return out;
 }
 
-// The elements of a block of node ids [i][j] (every node for q4; corners at even i, j for q9),
-// counter-clockwise whichever way the block's i and j turn.
-void add_block_elements(PlaneMesh& mesh, QuadShape shape, const std::vector<std::vector<int>>& ids) {
-  const int step = shape == QuadShape::q4 ? 1 : 2;
+// The q4 or q9 elements of a block of node ids [i][j] (every node for q4; corners at even i, j
+// for q9), counter-clockwise whichever way the block's i and j turn.
+void add_block_elements(PlaneMesh& mesh, ElementShape shape, const std::vector<std::vector<int>>& ids) {
+  const int step = shape == ElementShape::q4 ? 1 : 2;
   const int ni = static_cast<int>(ids.size()) - 1, nj = static_cast<int>(ids[0].size()) - 1;
   const size_t first = mesh.elements.size();
   for (int i = 0; i < ni; i += step)
     for (int j = 0; j < nj; j += step) {
       const int I = i + step, J = j + step;
-      if (shape == QuadShape::q4) mesh.elements.push_back({ids[i][j], ids[I][j], ids[I][J], ids[i][J]});
+      if (shape == ElementShape::q4) mesh.elements.push_back({ids[i][j], ids[I][j], ids[I][J], ids[i][J]});
       else
         mesh.elements.push_back({ids[i][j], ids[I][j], ids[I][J], ids[i][J], ids[i + 1][j], ids[I][j + 1],
                                  ids[i + 1][J], ids[i][j + 1], ids[i + 1][j + 1]});
@@ -112,7 +112,8 @@ void add_block_elements(PlaneMesh& mesh, QuadShape shape, const std::vector<std:
     for (size_t k = first; k < mesh.elements.size(); ++k) reverse_element(mesh.elements[k], shape);
 }
 
-PlaneMesh build_half_disc(const HalfDiscSpec& spec, QuadShape shape) {
+// The half-disc of q4 or q9 elements.
+PlaneMesh build_half_disc(const HalfDiscSpec& spec, ElementShape shape) {
   using std::numbers::pi;
   if (spec.ns < 4 || spec.ns % 2)
     throw std::invalid_argument("ns must be even (a node sits at the pole) and at least 4");
@@ -230,16 +231,16 @@ bool well_shaped(const PlaneMesh& mesh) { return corner_angles_within(mesh, 90 -
 
 }  // namespace
 
-PlaneMesh half_disc_mesh(const HalfDiscSpec& spec, QuadShape shape) {
-  PlaneMesh mesh = build_half_disc(spec, shape);
-  if (well_shaped(mesh)) return mesh;
+PlaneMesh half_disc_mesh(const HalfDiscSpec& spec, ElementShape shape) {
+  PlaneMesh mesh = build_half_disc(spec, grid_shape(shape));
+  if (well_shaped(mesh)) return quads_as(std::move(mesh), shape);
   // Name the fewest arc divisions that shape the elements well (more arc divisions, more ring
   // rows, fewer pole block rows).
   std::string hint = "give fewer divisions from the pole to the centre";
   HalfDiscSpec more = spec;
   for (more.ns = spec.ns + 2; more.ns <= 2000; more.ns += 2) {
     try {
-      if (!well_shaped(build_half_disc(more, QuadShape::q4))) continue;
+      if (!well_shaped(build_half_disc(more, ElementShape::q4))) continue;
     } catch (const std::invalid_argument&) {
       continue;
     }

@@ -16,11 +16,8 @@
 namespace grip {
 namespace {
 
-const std::vector<std::vector<int>>& local_sides(QuadShape shape) {
-  static const std::vector<std::vector<int>> q4{{0, 1}, {1, 2}, {2, 3}, {3, 0}};
-  static const std::vector<std::vector<int>> q9{{0, 4, 1}, {1, 5, 2}, {2, 6, 3}, {3, 7, 0}};
-  return shape == QuadShape::q4 ? q4 : q9;
-}
+// The corners of an element of `nodes` nodes: 3 for t3 and t6, 4 for q4, q8 and q9.
+int corners_of(size_t nodes) { return nodes == 3 || nodes == 6 ? 3 : 4; }
 
 std::string point_text(const Vec2& p) {
   std::ostringstream os;
@@ -104,11 +101,11 @@ std::vector<double> one_sided(double length, double fine_length, int n_fine, int
   return x;
 }
 
-// A structured mesh of ni x nj elements on a grid of (m ni + 1) x (m nj + 1) nodes (m = 1 for
-// q4, 2 for q9), node (I, J) at `at(I, J)`, I along the first and J along the second
-// direction (a right-handed pair gives counter-clockwise elements).
-PlaneMesh grid_mesh(int ni, int nj, QuadShape shape, const std::function<Vec2(int, int)>& at) {
-  const int m = shape == QuadShape::q4 ? 1 : 2, NI = m * ni + 1, NJ = m * nj + 1;
+// A structured mesh of ni x nj q4 or q9 elements on a grid of (m ni + 1) x (m nj + 1) nodes
+// (m = 1 for q4, 2 for q9), node (I, J) at `at(I, J)`, I along the first and J along the
+// second direction (a right-handed pair gives counter-clockwise elements).
+PlaneMesh grid_mesh(int ni, int nj, ElementShape shape, const std::function<Vec2(int, int)>& at) {
+  const int m = shape == ElementShape::q4 ? 1 : 2, NI = m * ni + 1, NJ = m * nj + 1;
   PlaneMesh mesh;
   for (int J = 0; J < NJ; ++J)
     for (int I = 0; I < NI; ++I) mesh.nodes.push_back(at(I, J));
@@ -116,7 +113,7 @@ PlaneMesh grid_mesh(int ni, int nj, QuadShape shape, const std::function<Vec2(in
   for (int j = 0; j < nj; ++j)
     for (int i = 0; i < ni; ++i) {
       const int I = m * i, J = m * j;
-      if (shape == QuadShape::q4) mesh.elements.push_back({id(I, J), id(I + 1, J), id(I + 1, J + 1), id(I, J + 1)});
+      if (shape == ElementShape::q4) mesh.elements.push_back({id(I, J), id(I + 1, J), id(I + 1, J + 1), id(I, J + 1)});
       else
         mesh.elements.push_back({id(I, J), id(I + 2, J), id(I + 2, J + 2), id(I, J + 2), id(I + 1, J), id(I + 2, J + 1),
                                  id(I + 1, J + 2), id(I, J + 1), id(I + 1, J + 1)});
@@ -146,8 +143,8 @@ int coarse_needed(double h, double rest, double growth) {
 
 }  // namespace
 
-std::vector<double> refine_for(QuadShape shape, const std::vector<double>& v) {
-  if (shape == QuadShape::q4) return v;
+std::vector<double> refine_for(ElementShape shape, const std::vector<double>& v) {
+  if (!is_quadratic(shape)) return v;
   std::vector<double> out;
   for (size_t i = 0; i + 1 < v.size(); ++i) {
     out.push_back(v[i]);
@@ -157,17 +154,67 @@ std::vector<double> refine_for(QuadShape shape, const std::vector<double>& v) {
   return out;
 }
 
-void reverse_element(std::vector<int>& element, QuadShape shape) {
-  std::swap(element[1], element[3]);
-  if (shape == QuadShape::q9) {
+void reverse_element(std::vector<int>& element, ElementShape shape) {
+  if (element_corner_count(shape) == 3) {  // 0, 2, 1 and the mid-sides of 0-2, 2-1, 1-0
+    std::swap(element[1], element[2]);
+    if (shape == ElementShape::t6) std::swap(element[3], element[5]);
+    return;
+  }
+  std::swap(element[1], element[3]);  // 0, 3, 2, 1 and the mid-sides of 0-3, 3-2, 2-1, 1-0
+  if (is_quadratic(shape)) {
     std::swap(element[4], element[7]);
     std::swap(element[5], element[6]);
   }
 }
 
+ElementShape grid_shape(ElementShape shape) { return is_quadratic(shape) ? ElementShape::q9 : ElementShape::q4; }
+
+PlaneMesh quads_as(PlaneMesh quads, ElementShape shape) {
+  if (shape == ElementShape::q4 || shape == ElementShape::q9) return quads;
+  PlaneMesh out;
+  if (shape == ElementShape::q8) {
+    // Drop the centre nodes: number the others in their order.
+    std::vector<int> id(quads.nodes.size(), 0);
+    for (const auto& el : quads.elements) id[el[8]] = -1;
+    for (size_t i = 0; i < id.size(); ++i)
+      if (id[i] == 0) {
+        id[i] = static_cast<int>(out.nodes.size());
+        out.nodes.push_back(quads.nodes[i]);
+      }
+    for (const auto& el : quads.elements) {
+      std::vector<int> q8;
+      for (int a = 0; a < 8; ++a) q8.push_back(id[el[a]]);
+      out.elements.push_back(std::move(q8));
+    }
+    for (const auto& [name, set] : quads.sets) {
+      std::vector<int>& renumbered = out.sets[name];
+      for (int i : set)
+        if (id[i] >= 0) renumbered.push_back(id[i]);
+    }
+    return out;
+  }
+  out.nodes = std::move(quads.nodes);
+  out.sets = std::move(quads.sets);
+  for (const auto& e : quads.elements) {
+    const double d02 = (out.nodes[e[2]] - out.nodes[e[0]]).norm(), d13 = (out.nodes[e[3]] - out.nodes[e[1]]).norm();
+    const bool along_13 = d13 < (1 - 1e-9) * d02;
+    if (shape == ElementShape::t3) {
+      if (along_13) out.elements.insert(out.elements.end(), {{e[0], e[1], e[3]}, {e[1], e[2], e[3]}});
+      else out.elements.insert(out.elements.end(), {{e[0], e[1], e[2]}, {e[0], e[2], e[3]}});
+    } else if (along_13) {  // t6: corners, then the mid-sides (q9 node 8 on the diagonal)
+      out.elements.insert(out.elements.end(),
+                          {{e[0], e[1], e[3], e[4], e[8], e[7]}, {e[1], e[2], e[3], e[5], e[6], e[8]}});
+    } else {
+      out.elements.insert(out.elements.end(),
+                          {{e[0], e[1], e[2], e[4], e[5], e[8]}, {e[0], e[2], e[3], e[8], e[6], e[7]}});
+    }
+  }
+  return out;
+}
+
 namespace {
 
-// det of J = X^T dN (as quad_point's detJ) for an element of N nodes x with the natural
+// det of J = X^T dN (as element_point's detJ) for an element of N nodes x with the natural
 // derivatives dN at one point, summed node by node in plain doubles (check_mesh for the 11,520
 // elements of Hertz a/h 40: 10.8 M instructions with Eigen's dynamic-size rows and a sort of
 // each element's ids, 8.6 M so).
@@ -183,22 +230,37 @@ double det_j(const Vec2* x, const Vec2* dN) {
   return j00 * j11 - j10 * j01;
 }
 
+double det_j(int n, const Vec2* x, const Vec2* dN) {
+  switch (n) {
+    case 3:
+      return det_j<3>(x, dN);
+    case 4:
+      return det_j<4>(x, dN);
+    case 6:
+      return det_j<6>(x, dN);
+    case 8:
+      return det_j<8>(x, dN);
+    default:
+      return det_j<9>(x, dN);
+  }
+}
+
 }  // namespace
 
-std::vector<MeshIssue> check_mesh(const PlaneMesh& mesh, QuadShape shape) {
+std::vector<MeshIssue> check_mesh(const PlaneMesh& mesh, ElementShape shape) {
   std::vector<MeshIssue> issues;
-  const int n = quad_node_count(shape), nodes = static_cast<int>(mesh.nodes.size());
+  const int n = element_node_count(shape), nodes = static_cast<int>(mesh.nodes.size());
   // det J at the element's nodes and Gauss points, from the shape functions' natural
   // derivatives there (the same for every element: computed once, not per element).
   std::vector<Vec2> checks;
-  for (int a = 0; a < n; ++a) checks.push_back(quad_node_natural(shape, a));
-  for (const GaussPoint& g : quad_gauss_rule(shape)) checks.push_back({g.xi, g.eta});
+  for (int a = 0; a < n; ++a) checks.push_back(node_natural(shape, a));
+  for (const GaussPoint& g : gauss_rule(shape)) checks.push_back({g.xi, g.eta});
   // dN[c * n + a]: node a's natural derivatives at check point c.
   std::vector<Vec2> dN(checks.size() * n);
   Vector N;
   ShapeGradients dN_c;
   for (size_t c = 0; c < checks.size(); ++c) {
-    quad_shape_functions(shape, checks[c].x(), checks[c].y(), N, dN_c);
+    shape_functions(shape, checks[c].x(), checks[c].y(), N, dN_c);
     for (int a = 0; a < n; ++a) dN[c * n + a] = dN_c.row(a).transpose();
   }
   std::vector<char> used(mesh.nodes.size(), 0);
@@ -207,8 +269,8 @@ std::vector<MeshIssue> check_mesh(const PlaneMesh& mesh, QuadShape shape) {
     const auto& el = mesh.elements[e];
     if (static_cast<int>(el.size()) != n) {
       issues.push_back({e, -1,
-                        "has " + std::to_string(el.size()) + " nodes; a " + (shape == QuadShape::q4 ? "q4" : "q9") +
-                            " element has " + std::to_string(n)});
+                        "has " + std::to_string(el.size()) + " nodes; a " + shape_name(shape) + " element has " +
+                            std::to_string(n)});
       continue;
     }
     bool ids_ok = true;
@@ -235,7 +297,7 @@ std::vector<MeshIssue> check_mesh(const PlaneMesh& mesh, QuadShape shape) {
     }
     const double size2 = (hi - lo).squaredNorm();
     for (size_t c = 0; c < checks.size(); ++c) {
-      const double det = n == 4 ? det_j<4>(x, &dN[c * n]) : det_j<9>(x, &dN[c * n]);
+      const double det = det_j(n, x, &dN[c * n]);
       if (!(det > 1e-12 * size2)) {
         issues.push_back(
             {e, -1,
@@ -260,7 +322,7 @@ namespace {
 
 // The boundary sides (boundary_sides) whose end nodes both have (*in)[node] set (all sides
 // without `in`), in the order of their sorted end nodes.
-std::vector<std::vector<int>> boundary_sides_within(const PlaneMesh& mesh, QuadShape shape,
+std::vector<std::vector<int>> boundary_sides_within(const PlaneMesh& mesh, ElementShape shape,
                                                     const std::vector<char>* in) {
   // Every element side by its end nodes, sorted (a vector, not a map); the sides that appear
   // once. Whether a side is on the boundary depends on its end nodes only, so the sides outside
@@ -270,7 +332,7 @@ std::vector<std::vector<int>> boundary_sides_within(const PlaneMesh& mesh, QuadS
     std::pair<int, int> key;
     int element, local;
   };
-  const auto& locals = local_sides(shape);
+  const auto& locals = element_sides(shape);
   std::vector<Side> all;
   if (!in) all.reserve(mesh.elements.size() * locals.size());
   for (int e = 0; e < static_cast<int>(mesh.elements.size()); ++e)
@@ -296,11 +358,11 @@ std::vector<std::vector<int>> boundary_sides_within(const PlaneMesh& mesh, QuadS
 
 }  // namespace
 
-std::vector<std::vector<int>> boundary_sides(const PlaneMesh& mesh, QuadShape shape) {
+std::vector<std::vector<int>> boundary_sides(const PlaneMesh& mesh, ElementShape shape) {
   return boundary_sides_within(mesh, shape, nullptr);
 }
 
-BoundaryPart boundary_part(const PlaneMesh& mesh, QuadShape shape, const std::vector<int>& set) {
+BoundaryPart boundary_part(const PlaneMesh& mesh, ElementShape shape, const std::vector<int>& set) {
   const size_t nodes = mesh.nodes.size();
   std::vector<char> in(nodes, 0);
   for (int i : set) in.at(i) = 1;
@@ -312,7 +374,8 @@ BoundaryPart boundary_part(const PlaneMesh& mesh, QuadShape shape, const std::ve
   std::vector<char> has_previous(nodes, 0), on_side(nodes, 0);
   std::vector<double> length(nodes, 0.0);
   for (auto& side : boundary_sides_within(mesh, shape, &in)) {
-    if (!std::all_of(side.begin(), side.end(), [&](int a) { return in[a] != 0; })) continue;  // a q9 side's middle
+    if (!std::all_of(side.begin(), side.end(), [&](int a) { return in[a] != 0; }))
+      continue;  // a quadratic side's middle
     const std::array<double, 3> w = side_weights(mesh, side);
     for (size_t a = 0; a < side.size(); ++a) {
       length[side[a]] += w[a];
@@ -354,9 +417,10 @@ ElementQuality element_quality(const PlaneMesh& mesh) {
   const double degrees = 180.0 / std::acos(-1.0);
   for (const auto& el : mesh.elements) {
     double shortest = std::numeric_limits<double>::infinity(), longest = 0.0;
-    for (int a = 0; a < 4; ++a) {
+    const int n = corners_of(el.size());
+    for (int a = 0; a < n; ++a) {
       const Vec2& here = mesh.nodes[el[a]];
-      const Vec2 next = mesh.nodes[el[(a + 1) % 4]] - here, previous = mesh.nodes[el[(a + 3) % 4]] - here;
+      const Vec2 next = mesh.nodes[el[(a + 1) % n]] - here, previous = mesh.nodes[el[(a + n - 1) % n]] - here;
       shortest = std::min(shortest, next.norm());
       longest = std::max(longest, next.norm());
       const double angle = std::atan2(std::abs(next.x() * previous.y() - next.y() * previous.x()), next.dot(previous));
@@ -377,9 +441,9 @@ bool corner_angles_within(const PlaneMesh& mesh, double lo, double hi) {
   const Vec2 lo_dir(std::cos(lo / degrees), std::sin(lo / degrees)),
       hi_dir(std::cos(hi / degrees), std::sin(hi / degrees));
   for (const auto& el : mesh.elements)
-    for (int a = 0; a < 4; ++a) {
+    for (int a = 0, n = corners_of(el.size()); a < n; ++a) {
       const Vec2& here = mesh.nodes[el[a]];
-      const Vec2 next = mesh.nodes[el[(a + 1) % 4]] - here, previous = mesh.nodes[el[(a + 3) % 4]] - here;
+      const Vec2 next = mesh.nodes[el[(a + 1) % n]] - here, previous = mesh.nodes[el[(a + n - 1) % n]] - here;
       const Vec2 corner(next.dot(previous), std::abs(next.x() * previous.y() - next.y() * previous.x()));
       const double above_lo = lo_dir.x() * corner.y() - lo_dir.y() * corner.x();
       const double above_hi = hi_dir.x() * corner.y() - hi_dir.y() * corner.x();
@@ -514,19 +578,19 @@ std::vector<double> graded_divisions(double lo, double hi, int n, std::optional<
   return x;
 }
 
-PlaneMesh rectangle_mesh(const RectangleSpec& spec, QuadShape shape) {
+PlaneMesh rectangle_mesh(const RectangleSpec& spec, ElementShape shape) {
   const Vec2 o = spec.origin, s = spec.size;
   const std::vector<double> x =
       refine_for(shape, graded_divisions(o.x(), o.x() + s.x(), spec.nx, spec.towards.x(), spec.refine));
   const std::vector<double> y =
       refine_for(shape, graded_divisions(o.y(), o.y() + s.y(), spec.ny, spec.towards.y(), spec.refine));
-  PlaneMesh mesh = grid_mesh(spec.nx, spec.ny, shape, [&](int I, int J) { return Vec2(x[I], y[J]); });
+  PlaneMesh mesh = grid_mesh(spec.nx, spec.ny, grid_shape(shape), [&](int I, int J) { return Vec2(x[I], y[J]); });
   const int NI = static_cast<int>(x.size()), NJ = static_cast<int>(y.size());
   mesh.sets["bottom"] = grid_line(NI, 0, 0, 1, 0, NI);
   mesh.sets["right"] = grid_line(NI, NI - 1, 0, 0, 1, NJ);
   mesh.sets["top"] = grid_line(NI, NI - 1, NJ - 1, -1, 0, NI);
   mesh.sets["left"] = grid_line(NI, 0, NJ - 1, 0, -1, NJ);
-  return mesh;
+  return quads_as(std::move(mesh), shape);
 }
 
 }  // namespace grip

@@ -1,9 +1,9 @@
-// body.model "continuum": plane quadrilaterals (solver/elements/continuum.hpp).
+// body.model "continuum": plane triangles and quadrilaterals (solver/elements/continuum.hpp).
 //   "kinematics": "finite" (default) | "linear";  "analysis": "plane_strain" | "plane_stress"
-//   "element": "q4" | "q4_bbar" | "q9";  "thickness" (default 1)
+//   "element": "t3" | "t6" | "q4" | "q4_bbar" | "q8" | "q9";  "thickness" (default 1)
 //   "material": {"young", "poisson", "law": "neo_hookean" | "saint_venant_kirchhoff"}
 //   "mesh": one of
-//     {"nodes": [[x, y], ...], "elements": [[n0, n1, n2, n3(, ...9)], ...], "sets": {name: [ids]}}
+//     {"nodes": [[x, y], ...], "elements": [[n0, n1, n2(, ...9)], ...], "sets": {name: [ids]}}
 //     {"rectangle": {"origin", "size", "divisions": [nx, ny], "refine": {"towards", "size", "extent"}}}
 //     {"half_disc": {"centre", "radius", "divisions": [ns (arc), nt (pole to centre)], "facing": "down" | "up",
 //                    "refine": {"size", "extent"}}}
@@ -93,7 +93,7 @@ std::optional<PlaneMesh> read_explicit_mesh(Reader& r, json& mesh, const std::st
   return m;  // checked by the body's constructor (report_mesh_issues)
 }
 
-std::optional<PlaneMesh> read_generated_mesh(Reader& r, json& mesh, const std::string& ptr, QuadShape shape,
+std::optional<PlaneMesh> read_generated_mesh(Reader& r, json& mesh, const std::string& ptr, ElementShape shape,
                                              const std::string& kind) {
   const std::string gp = ptr + "/" + kind;
   json* gen = r.object(mesh, ptr, kind.c_str(), true);
@@ -240,7 +240,7 @@ void read_continuum_supports(Reader& r, json& body, const std::string& ptr, cons
   });
 }
 
-void read_continuum_loads(Reader& r, json& body, const std::string& ptr, const PlaneMesh& mesh, QuadShape shape,
+void read_continuum_loads(Reader& r, json& body, const std::string& ptr, const PlaneMesh& mesh, ElementShape shape,
                           Problem& problem, double thickness) {
   for_each_object(r, body, ptr, "loads", [&](json& l, const std::string& lp) {
     const auto nodes = read_target(r, l, lp, mesh);
@@ -287,13 +287,13 @@ void read_continuum(Reader& r, json& body, Problem& problem, const std::string& 
   }
   const std::string kin = r.choice(body, ptr, "kinematics", {"finite", "linear"}, "finite");
   const std::string analysis = r.choice(body, ptr, "analysis", {"plane_strain", "plane_stress"}, "plane_strain");
-  const std::string element = r.choice(body, ptr, "element", {"q4", "q4_bbar", "q9"}, "q4");
+  const std::string element = r.choice(body, ptr, "element", {"t3", "t6", "q4", "q4_bbar", "q8", "q9"}, "q4");
   ContinuumOptions options;
   options.kinematics = kin == "linear" ? ContinuumKinematics::linear : ContinuumKinematics::finite;
   options.analysis = analysis == "plane_stress" ? PlaneAnalysis::plane_stress : PlaneAnalysis::plane_strain;
-  options.element = element == "q9"        ? ContinuumElement::q9
-                    : element == "q4_bbar" ? ContinuumElement::q4_bbar
-                                           : ContinuumElement::q4;
+  for (ContinuumElement e : {ContinuumElement::t3, ContinuumElement::t6, ContinuumElement::q4,
+                             ContinuumElement::q4_bbar, ContinuumElement::q8, ContinuumElement::q9})
+    if (element == element_name(e)) options.element = e;
   options.thickness = r.positive(body, ptr, "thickness", 1.0);
   if (options.element == ContinuumElement::q4_bbar) {
     if (options.kinematics == ContinuumKinematics::finite)
@@ -303,7 +303,7 @@ void read_continuum(Reader& r, json& body, Problem& problem, const std::string& 
     if (options.analysis == PlaneAnalysis::plane_stress)
       r.error(ptr + "/element", "\"q4_bbar\" is for plane strain: plane stress does not lock, use \"q4\"");
   }
-  const QuadShape shape = quad_shape(options.element);
+  const ElementShape shape = element_shape(options.element);
 
   std::shared_ptr<const PlaneMaterial> material;
   if (json* mat = r.object(body, ptr, "material", true)) {

@@ -17,7 +17,8 @@ using VectorRef = Eigen::Ref<const Vector>;
 inline Vec2 rot90(const Vec2& a) { return {-a.y(), a.x()}; }
 
 // Shape of a plane mesh's elements, from their corners: the longest over the shortest side
-// of each element, and its interior angles in degrees (90 for a rectangle). The result's
+// of each element (1 for a square or an equilateral triangle), and its interior angles in
+// degrees (90 for a rectangle, 60 for an equilateral triangle). The result's
 // effects block reports it, so that a badly shaped generated mesh does not go unnoticed.
 struct ElementQuality {
   int elements = 0;

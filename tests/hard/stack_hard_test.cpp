@@ -49,9 +49,9 @@ json disc_mesh(const Vec2& centre) {
   spec.ns = divisions[0];
   spec.nt = divisions[1];
   spec.refine = Refinement{kSize, kExtent};
-  const PlaneMesh lower = half_disc_mesh(spec, QuadShape::q4);
+  const PlaneMesh lower = half_disc_mesh(spec, ElementShape::q4);
   spec.facing_up = true;
-  const PlaneMesh upper = half_disc_mesh(spec, QuadShape::q4);
+  const PlaneMesh upper = half_disc_mesh(spec, ElementShape::q4);
   PlaneMesh m = lower;
   std::vector<int> id(upper.nodes.size(), -1);
   for (size_t i = 0; i < upper.nodes.size(); ++i) {
@@ -105,7 +105,7 @@ json stack(double P) {
   spec.ns = generated["divisions"][0];
   spec.nt = generated["divisions"][1];
   spec.refine = Refinement{kSize, kExtent};
-  const PlaneMesh mesh = half_disc_mesh(spec, QuadShape::q4);
+  const PlaneMesh mesh = half_disc_mesh(spec, ElementShape::q4);
   int axis = -1;
   for (size_t n = 0; n < mesh.nodes.size(); ++n)
     if (std::abs(mesh.nodes[n].x()) < 1e-9 &&

@@ -34,7 +34,7 @@ inline void refine_pole(nlohmann::json& disc, double size) {
     spec.ns = 2 * (fine + coarse);
     spec.nt = fine + coarse;
     try {
-      half_disc_mesh(spec, QuadShape::q4);
+      half_disc_mesh(spec, ElementShape::q4);
       disc["divisions"] = {spec.ns, spec.nt};
       return;
     } catch (const std::invalid_argument&) {

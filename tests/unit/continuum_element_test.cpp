@@ -10,6 +10,7 @@
 #include <random>
 
 #include "solver/elements/continuum.hpp"
+#include "tests/support/distorted_mesh.hpp"
 
 namespace grip {
 namespace {
@@ -21,33 +22,18 @@ struct Variant {
 };
 
 std::string name_of(const Variant& v) {
-  const char* e[] = {"q4", "q4_bbar", "q9"};
-  return std::string(e[static_cast<int>(v.element)]) +
-         (v.kinematics == ContinuumKinematics::linear ? "_linear" : "_finite") +
+  return std::string(element_name(v.element)) + (v.kinematics == ContinuumKinematics::linear ? "_linear" : "_finite") +
          (v.analysis == PlaneAnalysis::plane_strain ? "_strain" : "_stress");
 }
 
 // A 3 x 2 patch of a 2 x 1 rectangle whose interior nodes are moved off the grid (the edges
-// stay straight, so that a linear field is representable on q9 too).
-PlaneMesh distorted_patch(QuadShape shape) {
+// stay straight, so that a linear field is representable on the quadratic kinds too).
+PlaneMesh distorted_patch(ElementShape shape) {
   RectangleSpec spec;
   spec.size = {2.0, 1.0};
   spec.nx = 3;
   spec.ny = 2;
-  PlaneMesh mesh = rectangle_mesh(spec, shape);
-  std::mt19937 rng(3);
-  std::uniform_real_distribution<double> shift(-0.06, 0.06);
-  for (Vec2& x : mesh.nodes) {
-    const bool boundary = std::abs(x.x()) < 1e-12 || std::abs(x.x() - 2) < 1e-12 || std::abs(x.y()) < 1e-12 ||
-                          std::abs(x.y() - 1) < 1e-12;
-    if (!boundary) x += Vec2(shift(rng), shift(rng));
-  }
-  if (shape == QuadShape::q9)  // mid-side and centre nodes back to the middle of straight sides
-    for (const auto& el : mesh.elements) {
-      for (int m = 0; m < 4; ++m) mesh.nodes[el[4 + m]] = 0.5 * (mesh.nodes[el[m]] + mesh.nodes[el[(m + 1) % 4]]);
-      mesh.nodes[el[8]] = 0.25 * (mesh.nodes[el[0]] + mesh.nodes[el[1]] + mesh.nodes[el[2]] + mesh.nodes[el[3]]);
-    }
-  return mesh;
+  return testing::distorted_rectangle(spec, shape, 0.06, 3);
 }
 
 std::shared_ptr<const PlaneMaterial> material(PlaneAnalysis analysis, double nu = 0.3) {
@@ -55,7 +41,7 @@ std::shared_ptr<const PlaneMaterial> material(PlaneAnalysis analysis, double nu 
 }
 
 ContinuumBody body_of(const Variant& v, double nu = 0.3) {
-  const PlaneMesh mesh = distorted_patch(quad_shape(v.element));
+  const PlaneMesh mesh = distorted_patch(element_shape(v.element));
   ContinuumOptions options{v.element, v.kinematics, v.analysis, 0.5};
   return ContinuumBody(mesh, mesh.sets.at("bottom"), material(v.analysis, nu), options);
 }
@@ -225,14 +211,15 @@ TEST_P(ContinuumFinite, AgreesWithLinearForSmallStrain) {
   }
 }
 
-// q4 and q9 in both analyses and kinematics; q4_bbar (linear plane strain only).
+// t3, t6, q4, q8 and q9 in both analyses and kinematics; q4_bbar (linear plane strain only).
 std::vector<Variant> variants(bool linear, bool finite) {
   std::vector<Variant> v;
   for (auto a : {PlaneAnalysis::plane_strain, PlaneAnalysis::plane_stress})
     for (auto k : {ContinuumKinematics::linear, ContinuumKinematics::finite}) {
       if (!(k == ContinuumKinematics::linear ? linear : finite)) continue;
-      v.push_back({ContinuumElement::q4, k, a});
-      v.push_back({ContinuumElement::q9, k, a});
+      for (auto e : {ContinuumElement::t3, ContinuumElement::t6, ContinuumElement::q4, ContinuumElement::q8,
+                     ContinuumElement::q9})
+        v.push_back({e, k, a});
     }
   if (linear) v.push_back({ContinuumElement::q4_bbar, ContinuumKinematics::linear, PlaneAnalysis::plane_strain});
   return v;
@@ -324,14 +311,14 @@ TEST(ContinuumLocking, MeanDilatationAndNineNodesDoNotLock) {
     spec.size = {L, H};
     spec.nx = nx;
     spec.ny = ny;
-    const PlaneMesh mesh = rectangle_mesh(spec, quad_shape(element));
+    const PlaneMesh mesh = rectangle_mesh(spec, element_shape(element));
     ContinuumOptions options{element, ContinuumKinematics::linear, PlaneAnalysis::plane_strain, 1.0};
     const ContinuumBody body(mesh, mesh.sets.at("bottom"), material(PlaneAnalysis::plane_strain, nu), options);
     const Matrix K = tangent(body, Vector::Zero(body.dof_count()));
     // Clamp the left end; shear the right end by a parabolic traction (consistent loads).
     std::vector<char> fixed(body.dof_count(), 0);
     for (int k : mesh.sets.at("left")) fixed[2 * k] = fixed[2 * k + 1] = 1;
-    const BoundaryPart right = boundary_part(mesh, quad_shape(element), mesh.sets.at("right"));
+    const BoundaryPart right = boundary_part(mesh, element_shape(element), mesh.sets.at("right"));
     Vector f = Vector::Zero(body.dof_count());
     for (size_t k = 0; k < right.nodes.size(); ++k) f[2 * right.nodes[k] + 1] = -P / H * right.lengths[k];
     std::vector<int> free;
@@ -363,12 +350,12 @@ TEST(ContinuumLocking, MeanDilatationAndNineNodesDoNotLock) {
 // The body's constructor is where a mesh is checked (the scene reader reads the issues off
 // its exception): every issue check_mesh finds, the first in what().
 TEST(ContinuumBodyMesh, RejectsAFaultyMeshWithAllItsIssues) {
-  PlaneMesh mesh = distorted_patch(QuadShape::q4);
+  PlaneMesh mesh = distorted_patch(ElementShape::q4);
   const std::vector<int> bottom = mesh.sets.at("bottom");
   mesh.elements[0][2] = 999;                            // a node that does not exist
   std::swap(mesh.elements[1][1], mesh.elements[1][3]);  // clockwise
   mesh.nodes.push_back({9, 9});                         // in no element
-  const std::vector<MeshIssue> expected = check_mesh(mesh, QuadShape::q4);
+  const std::vector<MeshIssue> expected = check_mesh(mesh, ElementShape::q4);
   ASSERT_EQ(expected.size(), 3u);
   try {
     ContinuumBody(mesh, bottom, material(PlaneAnalysis::plane_strain), ContinuumOptions{});

@@ -17,12 +17,12 @@ namespace {
 
 using std::numbers::pi;
 
-double area(const PlaneMesh& mesh, QuadShape shape) {
+double area(const PlaneMesh& mesh, ElementShape shape) {
   double a = 0.0;
   for (const auto& el : mesh.elements) {
     ShapeGradients X(el.size(), 2);
     for (size_t k = 0; k < el.size(); ++k) X.row(k) = mesh.nodes[el[k]].transpose();
-    for (const QuadPoint& p : quad_points(shape, X, 1.0)) a += p.dV;
+    for (const ElementPoint& p : element_points(shape, X, 1.0)) a += p.dV;
   }
   return a;
 }
@@ -55,8 +55,13 @@ TEST(GradedDivisions, FineZoneThenGeometricGrowth) {
   EXPECT_THROW(graded_divisions(-2.0, 3.0, 20, 0.0, r), std::invalid_argument);  // 20 fine + 2 coarse needed
 }
 
+constexpr ElementShape kShapes[] = {ElementShape::t3, ElementShape::t6, ElementShape::q4, ElementShape::q8,
+                                    ElementShape::q9};
+
 TEST(RectangleMesh, AreaSetsAndOrientation) {
-  for (QuadShape shape : {QuadShape::q4, QuadShape::q9}) {
+  for (ElementShape shape : kShapes) {
+    SCOPED_TRACE(shape_name(shape));
+    const bool linear = !is_quadratic(shape), triangles = element_corner_count(shape) == 3;
     RectangleSpec spec;
     spec.origin = {-1, 2};
     spec.size = {3, 1.5};
@@ -66,22 +71,77 @@ TEST(RectangleMesh, AreaSetsAndOrientation) {
     spec.towards = {0.5, 3.5};
     const PlaneMesh mesh = rectangle_mesh(spec, shape);
     EXPECT_TRUE(check_mesh(mesh, shape).empty());
-    EXPECT_EQ(mesh.elements.size(), 60u);
+    EXPECT_EQ(mesh.elements.size(), triangles ? 120u : 60u);
+    // Nodes: the grid's (without q9's 60 centres for q8).
+    EXPECT_EQ(mesh.nodes.size(), linear ? 77u : shape == ElementShape::q8 ? 21u * 13 - 60 : 21u * 13);
     EXPECT_NEAR(area(mesh, shape), 4.5, 1e-12);
     for (int k : mesh.sets.at("bottom")) EXPECT_DOUBLE_EQ(mesh.nodes[k].y(), 2.0);
     for (int k : mesh.sets.at("top")) EXPECT_DOUBLE_EQ(mesh.nodes[k].y(), 3.5);
     for (int k : mesh.sets.at("left")) EXPECT_DOUBLE_EQ(mesh.nodes[k].x(), -1.0);
     for (int k : mesh.sets.at("right")) EXPECT_DOUBLE_EQ(mesh.nodes[k].x(), 2.0);
-    EXPECT_EQ(mesh.sets.at("bottom").size(), shape == QuadShape::q4 ? 11u : 21u);
+    EXPECT_EQ(mesh.sets.at("bottom").size(), linear ? 11u : 21u);
     // Refined toward (0.5, 3.5): sides of 0.1 next to that point.
     const auto& top = mesh.sets.at("top");
     bool found = false;
     for (size_t k = 1; k < top.size(); ++k) {
       const Vec2 a = mesh.nodes[top[k - 1]], b = mesh.nodes[top[k]];
       if (std::abs(std::max(a.x(), b.x()) - 0.5) < 1e-12)
-        found = std::abs(std::abs(a.x() - b.x()) - (shape == QuadShape::q4 ? 0.1 : 0.05)) < 1e-12;
+        found = std::abs(std::abs(a.x() - b.x()) - (linear ? 0.1 : 0.05)) < 1e-12;
     }
     EXPECT_TRUE(found);
+  }
+}
+
+// t6 from q9: each q9 split along a diagonal through its centre, the two t6 made of the q9's
+// nodes; q8: the q9 without its centre. Same corner positions, same boundary sets.
+TEST(RectangleMesh, TrianglesAndSerendipityFromTheQuadrilaterals) {
+  RectangleSpec spec;
+  spec.size = {2, 1};
+  spec.nx = 2;
+  spec.ny = 1;
+  const PlaneMesh q9 = rectangle_mesh(spec, ElementShape::q9), t6 = rectangle_mesh(spec, ElementShape::t6);
+  const PlaneMesh q8 = rectangle_mesh(spec, ElementShape::q8);
+  ASSERT_EQ(t6.elements.size(), 4u);
+  EXPECT_EQ(t6.nodes, q9.nodes);
+  for (size_t e = 0; e < q9.elements.size(); ++e) {
+    std::vector<int> both = t6.elements[2 * e];
+    both.insert(both.end(), t6.elements[2 * e + 1].begin(), t6.elements[2 * e + 1].end());
+    std::sort(both.begin(), both.end());
+    both.erase(std::unique(both.begin(), both.end()), both.end());
+    std::vector<int> nine = q9.elements[e];
+    std::sort(nine.begin(), nine.end());
+    EXPECT_EQ(both, nine);
+  }
+  ASSERT_EQ(q8.nodes.size(), q9.nodes.size() - 2);
+  for (size_t e = 0; e < q9.elements.size(); ++e)
+    for (int a = 0; a < 8; ++a) EXPECT_EQ(q8.nodes[q8.elements[e][a]], q9.nodes[q9.elements[e][a]]);
+  for (const auto& [name, set] : q9.sets)
+    for (size_t k = 0; k < set.size(); ++k) EXPECT_EQ(q8.nodes[q8.sets.at(name)[k]], q9.nodes[set[k]]) << name;
+}
+
+// Reversing an element turns it clockwise (check_mesh: inverted); reversing again restores it.
+TEST(ReverseElement, TurnsEveryKindInsideOut) {
+  RectangleSpec spec;
+  spec.nx = spec.ny = 2;
+  for (ElementShape shape : kShapes) {
+    SCOPED_TRACE(shape_name(shape));
+    const PlaneMesh mesh = rectangle_mesh(spec, shape);
+    PlaneMesh reversed = mesh;
+    for (auto& el : reversed.elements) reverse_element(el, shape);
+    const auto issues = check_mesh(reversed, shape);
+    ASSERT_EQ(issues.size(), mesh.elements.size());
+    for (size_t e = 0; e < issues.size(); ++e) {
+      EXPECT_EQ(issues[e].element, static_cast<int>(e));
+      EXPECT_NE(issues[e].detail.find("inverted"), std::string::npos);
+    }
+    // The reversed sides are the same sides, run the other way.
+    auto sides = boundary_sides(mesh, shape), back = boundary_sides(reversed, shape);
+    for (auto& side : back) std::reverse(side.begin(), side.end());
+    std::sort(sides.begin(), sides.end());
+    std::sort(back.begin(), back.end());
+    EXPECT_EQ(sides, back);
+    for (auto& el : reversed.elements) reverse_element(el, shape);
+    EXPECT_EQ(reversed.elements, mesh.elements);
   }
 }
 
@@ -92,12 +152,38 @@ TEST(ElementQuality, AspectRatioAndCornerAngles) {
   PlaneMesh mesh;
   mesh.nodes = {{0, 0}, {2, 0}, {2, 1}, {0, 1}, {3, 0}, {4, 1}, {3, 1}};
   mesh.elements = {{0, 1, 2, 3}, {1, 4, 5, 6}};
-  ASSERT_TRUE(check_mesh(mesh, QuadShape::q4).empty());
+  ASSERT_TRUE(check_mesh(mesh, ElementShape::q4).empty());
   const ElementQuality q = element_quality(mesh);
   EXPECT_EQ(q.elements, 2);
   EXPECT_NEAR(q.max_aspect_ratio, 2.0, 1e-12);
   EXPECT_NEAR(q.min_angle, 45.0, 1e-12);
   EXPECT_NEAR(q.max_angle, 135.0, 1e-12);
+}
+
+// Triangles by the same measures, from their corners (a t6's mid-sides are not looked at): a
+// right isosceles triangle (45, 45, 90 degrees, sides 1, 1, sqrt 2) beside an equilateral one.
+TEST(ElementQuality, TrianglesOnTheSameScale) {
+  PlaneMesh mesh;
+  mesh.nodes = {{0, 0}, {1, 0}, {0, 1}, {2, 0}, {1.5, std::sqrt(0.75)}};
+  mesh.elements = {{0, 1, 2}, {1, 3, 4}};
+  ASSERT_TRUE(check_mesh(mesh, ElementShape::t3).empty());
+  ElementQuality q = element_quality(mesh);
+  EXPECT_EQ(q.elements, 2);
+  EXPECT_NEAR(q.max_aspect_ratio, std::sqrt(2.0), 1e-12);
+  EXPECT_NEAR(q.min_angle, 45.0, 1e-12);
+  EXPECT_NEAR(q.max_angle, 90.0, 1e-12);
+  mesh.elements = {{1, 3, 4}};
+  q = element_quality(mesh);
+  EXPECT_NEAR(q.max_aspect_ratio, 1.0, 1e-12);  // as a square's
+  EXPECT_NEAR(q.min_angle, 60.0, 1e-12);
+  EXPECT_NEAR(q.max_angle, 60.0, 1e-12);
+  // The same for t6 (mid-sides added, one of them off its side).
+  PlaneMesh t6;
+  t6.nodes = {{1, 0}, {2, 0}, {1.5, std::sqrt(0.75)}, {1.5, 0.05}, {1.75, 0.4}, {1.25, 0.4}};
+  t6.elements = {{0, 1, 2, 3, 4, 5}};
+  ASSERT_TRUE(check_mesh(t6, ElementShape::t6).empty());
+  EXPECT_NEAR(element_quality(t6).min_angle, 60.0, 1e-12);
+  EXPECT_NEAR(element_quality(t6).max_aspect_ratio, 1.0, 1e-12);
 }
 
 // corner_angles_within decides by the sign of a cross product, with atan2 only near a limit:
@@ -109,7 +195,7 @@ TEST(ElementQuality, CornerAnglesWithinAgreesWithTheExtremeAngles) {
   spec.size = {3, 2};
   spec.nx = 30;
   spec.ny = 20;
-  const PlaneMesh grid = rectangle_mesh(spec, QuadShape::q4);
+  const PlaneMesh grid = rectangle_mesh(spec, ElementShape::q4);
   PlaneMesh moved = grid;
   unsigned state = 12345;
   for (Vec2& x : moved.nodes) {
@@ -123,7 +209,7 @@ TEST(ElementQuality, CornerAnglesWithinAgreesWithTheExtremeAngles) {
   disc.ns = 60;
   disc.nt = 30;
   disc.refine = Refinement{0.1, 1.0};
-  for (const PlaneMesh& mesh : {grid, moved, half_disc_mesh(disc, QuadShape::q4)}) {
+  for (const PlaneMesh& mesh : {grid, moved, half_disc_mesh(disc, ElementShape::q4)}) {
     const ElementQuality q = element_quality(mesh);
     for (double lo : {q.min_angle - 1e-6, std::nextafter(q.min_angle, 0.0), q.min_angle,
                       std::nextafter(q.min_angle, 180.0), q.min_angle + 1e-6})
@@ -153,7 +239,7 @@ TEST(HalfDiscMesh, EveryElementIsValidAndWellShapedOverARangeOfRefinements) {
             spec.ns = 2 * (fine + c);
             spec.nt = fine + c;
             try {
-              mesh = half_disc_mesh(spec, QuadShape::q4);
+              mesh = half_disc_mesh(spec, ElementShape::q4);
             } catch (const std::invalid_argument& e) {
               ASSERT_NE(std::string(e.what()).find("give at least"), std::string::npos) << e.what();
               continue;
@@ -161,10 +247,10 @@ TEST(HalfDiscMesh, EveryElementIsValidAndWellShapedOverARangeOfRefinements) {
             if (extra == 0) break;
             spec.ns += 2 * extra;
             spec.nt += extra;
-            mesh = half_disc_mesh(spec, QuadShape::q4);
+            mesh = half_disc_mesh(spec, ElementShape::q4);
             break;
           }
-          const auto issues = check_mesh(mesh, QuadShape::q4);
+          const auto issues = check_mesh(mesh, ElementShape::q4);
           EXPECT_TRUE(issues.empty()) << "size " << size << " extent " << extent << " extra " << extra << ": "
                                       << (issues.empty() ? "" : issues[0].detail);
           const ElementQuality q = element_quality(mesh);
@@ -183,8 +269,8 @@ TEST(HalfDiscMesh, UniformDivisionsAreValidAndWellShaped) {
     spec.radius = 3;
     spec.ns = ns;
     spec.nt = nt;
-    const PlaneMesh mesh = half_disc_mesh(spec, QuadShape::q4);
-    EXPECT_TRUE(check_mesh(mesh, QuadShape::q4).empty()) << ns << " x " << nt;
+    const PlaneMesh mesh = half_disc_mesh(spec, ElementShape::q4);
+    EXPECT_TRUE(check_mesh(mesh, ElementShape::q4).empty()) << ns << " x " << nt;
     EXPECT_EQ(static_cast<int>(mesh.sets.at("arc").size()), ns + 1);
     const ElementQuality q = element_quality(mesh);
     std::printf("[%d, %d]: %d elements, angles %.1f-%.1f, aspect %.2f\n", ns, nt, q.elements, q.min_angle, q.max_angle,
@@ -199,7 +285,7 @@ TEST(HalfDiscMesh, UniformDivisionsAreValidAndWellShaped) {
   uneven.ns = 8;
   uneven.nt = 20;
   try {
-    half_disc_mesh(uneven, QuadShape::q4);
+    half_disc_mesh(uneven, ElementShape::q4);
     ADD_FAILURE() << "[8, 20] accepted";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("give at least"), std::string::npos) << e.what();
@@ -208,8 +294,10 @@ TEST(HalfDiscMesh, UniformDivisionsAreValidAndWellShaped) {
 
 TEST(HalfDiscMesh, AreaArcAndRefinement) {
   const double R = 2.0;
-  for (QuadShape shape : {QuadShape::q4, QuadShape::q9})
+  for (ElementShape shape : kShapes)
     for (bool up : {false, true}) {
+      SCOPED_TRACE(shape_name(shape));
+      const bool linear = !is_quadratic(shape);
       HalfDiscSpec spec;
       spec.centre = {1, -1};
       spec.radius = R;
@@ -219,17 +307,17 @@ TEST(HalfDiscMesh, AreaArcAndRefinement) {
       spec.refine = Refinement{0.03, 0.2};
       const PlaneMesh mesh = half_disc_mesh(spec, shape);
       ASSERT_TRUE(check_mesh(mesh, shape).empty()) << check_mesh(mesh, shape)[0].detail;
-      // q4: the half-disc less the segments that the chords of the arc cut off; q9 follows
-      // the arc to high order.
+      // t3, q4: the half-disc less the segments that the chords of the arc cut off; the
+      // quadratic kinds follow the arc to high order.
       double segments = 0.0;
       const auto& arc = mesh.sets.at("arc");
-      for (size_t k = 1; k < arc.size(); k += (shape == QuadShape::q4 ? 1 : 2)) {
+      for (size_t k = 1; k < arc.size(); k += (linear ? 1 : 2)) {
         const Vec2 a = mesh.nodes[arc[k - 1]] - spec.centre;
-        const Vec2 b = mesh.nodes[arc[shape == QuadShape::q4 ? k : k + 1]] - spec.centre;
+        const Vec2 b = mesh.nodes[arc[linear ? k : k + 1]] - spec.centre;
         const double theta = std::acos(std::clamp(a.dot(b) / (R * R), -1.0, 1.0));
         segments += 0.5 * R * R * (theta - std::sin(theta));
       }
-      if (shape == QuadShape::q4) EXPECT_NEAR(area(mesh, shape), pi * R * R / 2 - segments, 1e-12);
+      if (linear) EXPECT_NEAR(area(mesh, shape), pi * R * R / 2 - segments, 1e-12);
       else EXPECT_LT(std::abs(area(mesh, shape) - pi * R * R / 2), 0.01 * segments);
       for (int k : mesh.sets.at("arc")) EXPECT_NEAR((mesh.nodes[k] - spec.centre).norm(), R, 1e-12);
       for (int k : mesh.sets.at("diameter")) EXPECT_NEAR(mesh.nodes[k].y(), -1.0, 1e-12);
@@ -238,7 +326,7 @@ TEST(HalfDiscMesh, AreaArcAndRefinement) {
       EXPECT_NEAR((mesh.nodes[mesh.sets.at("centre")[0]] - spec.centre).norm(), 0.0, 1e-12);
       // Near the pole the arc is divided at the requested size.
       const auto& near = mesh.sets.at("arc_refined");
-      const int fine = shape == QuadShape::q4 ? 1 : 2;
+      const int fine = linear ? 1 : 2;
       EXPECT_EQ(static_cast<int>(near.size()), 2 * fine * 7 + 1);  // 0.2 / 0.03 -> 7 each side
       for (int k : near) EXPECT_LE((mesh.nodes[k] - pole).norm(), 0.2 + 1e-9);
       // Every arc node appears once.
@@ -247,40 +335,71 @@ TEST(HalfDiscMesh, AreaArcAndRefinement) {
     }
   HalfDiscSpec odd;
   odd.ns = 5;
-  EXPECT_THROW(half_disc_mesh(odd, QuadShape::q4), std::invalid_argument);
+  EXPECT_THROW(half_disc_mesh(odd, ElementShape::q4), std::invalid_argument);
 }
 
 PlaneMesh unit_square(int n) {
   RectangleSpec spec;
   spec.nx = spec.ny = n;
-  return rectangle_mesh(spec, QuadShape::q4);
+  return rectangle_mesh(spec, ElementShape::q4);
 }
 
 TEST(CheckMesh, NamesTheFaultyElementOrNode) {
   PlaneMesh mesh = unit_square(2);
-  EXPECT_TRUE(check_mesh(mesh, QuadShape::q4).empty());
+  EXPECT_TRUE(check_mesh(mesh, ElementShape::q4).empty());
   PlaneMesh inverted = mesh;
   std::swap(inverted.elements[1][1], inverted.elements[1][3]);  // clockwise
-  auto issues = check_mesh(inverted, QuadShape::q4);
+  auto issues = check_mesh(inverted, ElementShape::q4);
   ASSERT_EQ(issues.size(), 1u);
   EXPECT_EQ(issues[0].element, 1);
   EXPECT_NE(issues[0].detail.find("inverted"), std::string::npos);
   PlaneMesh flat = mesh;
   flat.nodes[flat.elements[2][2]] = flat.nodes[flat.elements[2][1]];  // collapses element 2 (and 3)
-  issues = check_mesh(flat, QuadShape::q4);
+  issues = check_mesh(flat, ElementShape::q4);
   ASSERT_FALSE(issues.empty());
   EXPECT_EQ(issues[0].element, 2);
   PlaneMesh bad = mesh;
   bad.elements[0][2] = 99;
   bad.elements[3][1] = bad.elements[3][0];
   bad.nodes.push_back({5, 5});
-  issues = check_mesh(bad, QuadShape::q4);
+  issues = check_mesh(bad, ElementShape::q4);
   ASSERT_EQ(issues.size(), 3u);
   EXPECT_EQ(issues[0].element, 0);
   EXPECT_NE(issues[0].detail.find("node 99"), std::string::npos);
   EXPECT_EQ(issues[1].element, 3);
-  EXPECT_EQ(issues[2].node, 9);                           // the extra node belongs to no element
-  EXPECT_FALSE(check_mesh(mesh, QuadShape::q9).empty());  // four nodes are not a q9
+  EXPECT_EQ(issues[2].node, 9);                              // the extra node belongs to no element
+  EXPECT_FALSE(check_mesh(mesh, ElementShape::q9).empty());  // four nodes are not a q9
+}
+
+// A clockwise triangle is inverted, one with its corners on a line has zero area, a t6 whose
+// mid-side node lies beyond its side's end folds over: each named by its element.
+TEST(CheckMesh, RefusesClockwiseAndDegenerateTriangles) {
+  RectangleSpec spec;
+  spec.nx = spec.ny = 2;
+  const PlaneMesh t3 = rectangle_mesh(spec, ElementShape::t3);
+  ASSERT_TRUE(check_mesh(t3, ElementShape::t3).empty());
+  PlaneMesh clockwise = t3;
+  std::swap(clockwise.elements[5][1], clockwise.elements[5][2]);
+  auto issues = check_mesh(clockwise, ElementShape::t3);
+  ASSERT_EQ(issues.size(), 1u);
+  EXPECT_EQ(issues[0].element, 5);
+  EXPECT_NE(issues[0].detail.find("inverted or its nodes are not counter-clockwise"), std::string::npos);
+  PlaneMesh flat;
+  flat.nodes = {{0, 0}, {1, 0}, {1, 1}, {2, 2}};
+  flat.elements = {{0, 1, 2}, {0, 2, 3}};  // 0, 2, 3 on the line y = x
+  issues = check_mesh(flat, ElementShape::t3);
+  ASSERT_EQ(issues.size(), 1u);
+  EXPECT_EQ(issues[0].element, 1);
+  EXPECT_NE(issues[0].detail.find("zero area"), std::string::npos) << issues[0].detail;
+  EXPECT_EQ(InvalidMesh(issues).what(), "element 1 " + issues[0].detail);
+  PlaneMesh t6 = rectangle_mesh(spec, ElementShape::t6);
+  ASSERT_TRUE(check_mesh(t6, ElementShape::t6).empty());
+  const auto& e = t6.elements[2];
+  t6.nodes[e[3]] = t6.nodes[e[0]] + 1.2 * (t6.nodes[e[1]] - t6.nodes[e[0]]);  // mid-side of 0-1 beyond 1
+  issues = check_mesh(t6, ElementShape::t6);
+  ASSERT_FALSE(issues.empty());
+  EXPECT_EQ(issues[0].element, 2);
+  EXPECT_FALSE(check_mesh(t6, ElementShape::q8).empty());  // six nodes are not a q8
 }
 
 TEST(BoundaryPart, OrderedCounterClockwiseWithTributaryLengths) {
@@ -288,7 +407,8 @@ TEST(BoundaryPart, OrderedCounterClockwiseWithTributaryLengths) {
   spec.size = {4, 1};
   spec.nx = 4;
   spec.ny = 1;
-  for (QuadShape shape : {QuadShape::q4, QuadShape::q9}) {
+  for (ElementShape shape : kShapes) {
+    SCOPED_TRACE(shape_name(shape));
     const PlaneMesh mesh = rectangle_mesh(spec, shape);
     // The bottom, given in a scrambled order, comes back left to right.
     std::vector<int> set = mesh.sets.at("bottom");
@@ -301,7 +421,7 @@ TEST(BoundaryPart, OrderedCounterClockwiseWithTributaryLengths) {
     double total = 0.0;
     for (double l : part.lengths) total += l;
     EXPECT_NEAR(total, 4.0, 1e-12);
-    if (shape == QuadShape::q4) {
+    if (!is_quadratic(shape)) {
       EXPECT_NEAR(part.lengths.front(), 0.5, 1e-12);
       EXPECT_NEAR(part.lengths[1], 1.0, 1e-12);
     } else {  // Simpson's weights: 1/6, 2/3, 1/6 of each side
@@ -313,8 +433,8 @@ TEST(BoundaryPart, OrderedCounterClockwiseWithTributaryLengths) {
     const BoundaryPart top = boundary_part(mesh, shape, mesh.sets.at("top"));
     EXPECT_GT(mesh.nodes[top.nodes.front()].x(), mesh.nodes[top.nodes.back()].x());
   }
-  const PlaneMesh mesh = rectangle_mesh(spec, QuadShape::q4);
-  EXPECT_THROW(boundary_part(mesh, QuadShape::q4, {0, 2}), std::invalid_argument);  // no side between them
+  const PlaneMesh mesh = rectangle_mesh(spec, ElementShape::q4);
+  EXPECT_THROW(boundary_part(mesh, ElementShape::q4, {0, 2}), std::invalid_argument);  // no side between them
 }
 
 // boundary_part sorts only the sides whose end nodes are in the set: its sides must be those
@@ -326,7 +446,7 @@ TEST(BoundaryPart, SidesAreTheBoundarySidesWithinTheSet) {
   disc.ns = 40;
   disc.nt = 20;
   disc.refine = Refinement{0.2, 1.5};
-  for (QuadShape shape : {QuadShape::q4, QuadShape::q9}) {
+  for (ElementShape shape : kShapes) {
     const PlaneMesh mesh = half_disc_mesh(disc, shape);
     const auto all = boundary_sides(mesh, shape);
     for (const char* name : {"arc", "arc_refined", "diameter"}) {
@@ -366,6 +486,15 @@ TEST(FreeRigidMotion, NamesTheMotionsTheSupportsLeave) {
   for (int k = 0; k < 9; ++k) first[2 * k] = first[2 * k + 1] = 1;
   EXPECT_EQ(free_rigid_motion(two, first),
             "the part containing node 9 can translate along x, translate along y and rotate about (3.5, 0.5)");
+  // Triangles: the same square as t3 (the same nodes) and t6, its bottom held vertically.
+  RectangleSpec spec;
+  spec.nx = spec.ny = 2;
+  for (ElementShape shape : {ElementShape::t3, ElementShape::t6}) {
+    const PlaneMesh tri = rectangle_mesh(spec, shape);
+    std::vector<char> held(2 * tri.nodes.size(), 0);
+    for (int k : tri.sets.at("bottom")) held[2 * k + 1] = 1;
+    EXPECT_EQ(free_rigid_motion(tri, held), "translate along x") << shape_name(shape);
+  }
 }
 
 }  // namespace

@@ -178,6 +178,58 @@ TEST(Hertz, SmallestAcceptedDivisionsMatchTheClosedForm) {
   EXPECT_TRUE(h.zone.brackets(h.a, 1e-9)) << "a = " << h.a;
 }
 
+// The shipped scene on quadratic triangles (element t6: each q9 of the generator split in two,
+// nodes a / 20 apart near the pole, contact sites at the corners and mid-sides of the arc's
+// curved sides): a and p0 within 1 % of the closed form, as the q4 scene at its smallest
+// divisions, and the closed-form edge within half a node spacing of the nodes where contact
+// ends (a corner and a mid-side node carry different shares of their sides: 1/6 and 2/3).
+TEST(Hertz, QuadraticTrianglesMatchTheClosedForm) {
+  json j = example_scene("hertz");
+  j["body"]["element"] = "t6";
+  const Solved s = solve_scene(j);
+  expect_every_step_sound(s);
+  ASSERT_TRUE(s.run.completed);
+  for (const StepRecord& rec : s.run.steps) {
+    const HertzReading h = read_hertz(s, rec);
+    ASSERT_TRUE(h.zone.found);
+    EXPECT_TRUE(h.set_ends_open);
+    std::printf(
+        "t6 step %d: P = %.2f N/mm; a = %.4f mm, fitted %+.3f %%; p0 = %.1f MPa, fitted %+.3f %%, peak %+.3f %%; "
+        "%d nodes touch\n",
+        rec.index, h.P, h.a, 100 * h.a_error(), h.p0, 100 * h.p0_error(), 100 * h.peak_error(), h.nodes_in_contact);
+    EXPECT_LT(std::abs(h.a_error()), 0.01);
+    EXPECT_LT(std::abs(h.p0_error()), 0.01);
+    EXPECT_TRUE(h.zone.brackets(h.a, 0.5 * h.zone.edge_element()))
+        << "a = " << h.a << ", contact ends between " << h.zone.right.inner << " and " << h.zone.right.outer;
+  }
+}
+
+// t6 under the other strategies (mid-side nodes are sites like the corners): uzawa and ssn
+// give cev's contact forces within what each run's contact error pins them to
+// (agreement_bound, force_precision.hpp).
+TEST(Hertz, QuadraticTrianglesUnderEveryStrategy) {
+  json j = hertz(0.1);
+  j["body"]["element"] = "t6";
+  const Solved cev = solve_scene(j);
+  expect_every_step_sound(cev);
+  ASSERT_TRUE(cev.run.completed);
+  for (const char* method : {"uzawa", "ssn"}) {
+    json other = j;
+    other["solver"]["contact"]["method"] = method;
+    other["solver"]["contact"]["max_iterations"] = 5000;
+    const Solved s = solve_scene(other);
+    expect_every_step_sound_within(s, 1e-3);
+    ASSERT_TRUE(s.run.completed) << method;
+    for (size_t k = 0; k < s.run.steps.size(); ++k) {
+      const double diff = force_difference(s.scene.problem, s.run.steps[k], cev.run.steps[k]);
+      const double bound = agreement_bound(s, k, cev);
+      std::printf("%s step %zu: %ld real solves; forces differ from cev's by %.6g (bound %.6g)\n", method, k + 1,
+                  s.run.counters.solves, diff, bound);
+      EXPECT_LT(diff, bound) << method << " step " << k + 1;
+    }
+  }
+}
+
 // A tangent that changes (finite kinematics) with friction: the compliance's G reused across
 // real solves and steps changes the path, not the answer (to what the contact
 // tolerance pins it), and forms G fewer times than a fresh G at every update.

@@ -11,6 +11,7 @@
 
 #include "solver/elements/continuum.hpp"
 #include "tests/support/contact_profile.hpp"
+#include "tests/support/distorted_mesh.hpp"
 #include "tests/support/force_precision.hpp"
 #include "tests/support/scenes.hpp"
 
@@ -22,26 +23,13 @@ using namespace grip::testing;
 
 constexpr double kWidth = 3.0, kHeight = 2.0, kYoung = 1000.0, kPoisson = 0.3;
 
-// An explicit mesh of 4 x 3 elements with the interior nodes moved off the grid.
-json distorted_block(QuadShape shape) {
+// An explicit mesh of 4 x 3 quadrilaterals (or 24 triangles) with the interior nodes moved off the grid.
+json distorted_block(ElementShape shape) {
   RectangleSpec spec;
   spec.size = {kWidth, kHeight};
   spec.nx = 4;
   spec.ny = 3;
-  PlaneMesh mesh = rectangle_mesh(spec, shape);
-  std::mt19937 rng(11);
-  std::uniform_real_distribution<double> shift(-0.15, 0.15);
-  auto on_boundary = [](const Vec2& x) {
-    return std::abs(x.x()) < 1e-12 || std::abs(x.x() - kWidth) < 1e-12 || std::abs(x.y()) < 1e-12 ||
-           std::abs(x.y() - kHeight) < 1e-12;
-  };
-  for (Vec2& x : mesh.nodes)
-    if (!on_boundary(x)) x += Vec2(shift(rng), shift(rng));
-  if (shape == QuadShape::q9)  // straight sides, mid-side and centre nodes in their middles
-    for (const auto& el : mesh.elements) {
-      for (int m = 0; m < 4; ++m) mesh.nodes[el[4 + m]] = 0.5 * (mesh.nodes[el[m]] + mesh.nodes[el[(m + 1) % 4]]);
-      mesh.nodes[el[8]] = 0.25 * (mesh.nodes[el[0]] + mesh.nodes[el[1]] + mesh.nodes[el[2]] + mesh.nodes[el[3]]);
-    }
+  PlaneMesh mesh = distorted_rectangle(spec, shape, 0.15, 11);
   json nodes = json::array();
   for (const Vec2& x : mesh.nodes) nodes.push_back({x.x(), x.y()});
   return {
@@ -51,7 +39,10 @@ json distorted_block(QuadShape shape) {
 }
 
 json patch_scene(const std::string& element, const std::string& kinematics, const std::string& analysis, double delta) {
-  const QuadShape shape = element == "q9" ? QuadShape::q9 : QuadShape::q4;
+  ContinuumElement kind = ContinuumElement::q4;
+  for (ContinuumElement e : {ContinuumElement::t3, ContinuumElement::t6, ContinuumElement::q8, ContinuumElement::q9})
+    if (element == element_name(e)) kind = e;
+  const ElementShape shape = element_shape(kind);
   return {
       {"body",
        {{"model", "continuum"},
@@ -97,10 +88,12 @@ TEST(ContactPatch, UniformCompressionGivesUniformPressure) {
     const char* kinematics;
     const char* analysis;
   };
-  const Case cases[] = {{"q4", "linear", "plane_strain"},      {"q4", "linear", "plane_stress"},
-                        {"q4_bbar", "linear", "plane_strain"}, {"q9", "linear", "plane_strain"},
-                        {"q4", "finite", "plane_strain"},      {"q4", "finite", "plane_stress"},
-                        {"q9", "finite", "plane_strain"},      {"q9", "finite", "plane_stress"}};
+  const Case cases[] = {
+      {"q4", "linear", "plane_strain"}, {"q4", "linear", "plane_stress"}, {"q4_bbar", "linear", "plane_strain"},
+      {"q9", "linear", "plane_strain"}, {"q4", "finite", "plane_strain"}, {"q4", "finite", "plane_stress"},
+      {"q9", "finite", "plane_strain"}, {"q9", "finite", "plane_stress"}, {"t3", "linear", "plane_strain"},
+      {"t6", "linear", "plane_stress"}, {"q8", "linear", "plane_strain"}, {"t3", "finite", "plane_strain"},
+      {"t6", "finite", "plane_strain"}, {"t6", "finite", "plane_stress"}, {"q8", "finite", "plane_strain"}};
   for (const Case& c : cases) {
     SCOPED_TRACE(std::string(c.element) + " " + c.kinematics + " " + c.analysis);
     // Finite strain at 5 % compression; the linear cases are exact at any size.

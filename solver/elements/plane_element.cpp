@@ -1,0 +1,283 @@
+#include "solver/elements/plane_element.hpp"
+
+#include <Eigen/Dense>
+#include <array>
+#include <cmath>
+
+namespace grip {
+namespace {
+
+using Vec3 = Eigen::Vector3d;
+
+// Quadratic Lagrange functions on [-1, 1] at nodes -1, 0, 1 and their derivatives.
+Vec3 lagrange2(double s) { return {0.5 * s * (s - 1), 1 - s * s, 0.5 * s * (s + 1)}; }
+Vec3 lagrange2_ds(double s) { return {s - 0.5, -2 * s, s + 0.5}; }
+
+// q9 node a -> (index along xi, index along eta) of the 1D node at -1, 0, 1 (q4 and q8 use
+// the first 4 and 8 of these positions).
+constexpr std::array<std::array<int, 2>, 9> kQ9Index{
+    {{0, 0}, {2, 0}, {2, 2}, {0, 2}, {1, 0}, {2, 1}, {1, 2}, {0, 1}, {1, 1}}};
+
+std::vector<GaussPoint> tensor_rule(const std::vector<double>& x, const std::vector<double>& w) {
+  std::vector<GaussPoint> rule;
+  for (size_t j = 0; j < x.size(); ++j)
+    for (size_t i = 0; i < x.size(); ++i) rule.push_back({x[i], x[j], w[i] * w[j]});
+  return rule;
+}
+
+// The symmetric triangle rule of degree 4 (Strang and Fix; Dunavant 1985): two orbits of three
+// points; weights sum to the reference triangle's area 1/2.
+std::vector<GaussPoint> triangle_rule6() {
+  std::vector<GaussPoint> rule;
+  const double a[2] = {0.445948490915965, 0.091576213509771}, w[2] = {0.223381589678011, 0.109951743655322};
+  for (int k = 0; k < 2; ++k)
+    for (const Vec2& p : {Vec2(a[k], a[k]), Vec2(1 - 2 * a[k], a[k]), Vec2(a[k], 1 - 2 * a[k])})
+      rule.push_back({p.x(), p.y(), 0.5 * w[k]});
+  return rule;
+}
+
+}  // namespace
+
+const char* shape_name(ElementShape shape) {
+  switch (shape) {
+    case ElementShape::t3:
+      return "t3";
+    case ElementShape::t6:
+      return "t6";
+    case ElementShape::q4:
+      return "q4";
+    case ElementShape::q8:
+      return "q8";
+    case ElementShape::q9:
+      return "q9";
+  }
+  return "?";
+}
+
+int element_node_count(ElementShape shape) {
+  constexpr int n[] = {3, 6, 4, 8, 9};
+  return n[static_cast<int>(shape)];
+}
+
+int element_corner_count(ElementShape shape) { return shape == ElementShape::t3 || shape == ElementShape::t6 ? 3 : 4; }
+
+bool is_quadratic(ElementShape shape) { return shape != ElementShape::t3 && shape != ElementShape::q4; }
+
+const std::vector<std::vector<int>>& element_sides(ElementShape shape) {
+  static const std::vector<std::vector<int>> t3{{0, 1}, {1, 2}, {2, 0}};
+  static const std::vector<std::vector<int>> t6{{0, 3, 1}, {1, 4, 2}, {2, 5, 0}};
+  static const std::vector<std::vector<int>> q4{{0, 1}, {1, 2}, {2, 3}, {3, 0}};
+  static const std::vector<std::vector<int>> q8{{0, 4, 1}, {1, 5, 2}, {2, 6, 3}, {3, 7, 0}};
+  switch (shape) {
+    case ElementShape::t3:
+      return t3;
+    case ElementShape::t6:
+      return t6;
+    case ElementShape::q4:
+      return q4;
+    default:
+      return q8;  // q8 and q9: the centre is on no side
+  }
+}
+
+Vec2 node_natural(ElementShape shape, int a) {
+  if (element_corner_count(shape) == 3) {
+    static const double xi[6] = {0, 1, 0, 0.5, 0.5, 0}, eta[6] = {0, 0, 1, 0, 0.5, 0.5};
+    return {xi[a], eta[a]};
+  }
+  return {kQ9Index[a][0] - 1.0, kQ9Index[a][1] - 1.0};
+}
+
+Vec2 centre_natural(ElementShape shape) {
+  return element_corner_count(shape) == 3 ? Vec2(1.0 / 3, 1.0 / 3) : Vec2(0, 0);
+}
+
+void shape_functions(ElementShape shape, double xi, double eta, Vector& N, ShapeGradients& dN) {
+  const int n = element_node_count(shape);
+  N.resize(n);
+  dN.resize(n, 2);
+  switch (shape) {
+    case ElementShape::t3:
+      N << 1 - xi - eta, xi, eta;
+      dN << -1, -1, 1, 0, 0, 1;
+      return;
+    case ElementShape::t6: {
+      // Area coordinates L and their constant gradients.
+      const double L[3] = {1 - xi - eta, xi, eta};
+      const Vec2 dL[3] = {{-1, -1}, {1, 0}, {0, 1}};
+      for (int a = 0; a < 3; ++a) {
+        N[a] = L[a] * (2 * L[a] - 1);
+        dN.row(a) = (4 * L[a] - 1) * dL[a].transpose();
+        const int b = (a + 1) % 3;  // mid-side node 3 + a on side a-b
+        N[3 + a] = 4 * L[a] * L[b];
+        dN.row(3 + a) = 4 * (L[a] * dL[b] + L[b] * dL[a]).transpose();
+      }
+      return;
+    }
+    case ElementShape::q4:
+      for (int a = 0; a < 4; ++a) {
+        const Vec2 p = node_natural(shape, a);
+        N[a] = 0.25 * (1 + p.x() * xi) * (1 + p.y() * eta);
+        dN(a, 0) = 0.25 * p.x() * (1 + p.y() * eta);
+        dN(a, 1) = 0.25 * p.y() * (1 + p.x() * xi);
+      }
+      return;
+    case ElementShape::q8:
+      for (int a = 0; a < 8; ++a) {
+        const double s = node_natural(shape, a).x(), t = node_natural(shape, a).y();
+        if (a < 4) {  // corners
+          N[a] = 0.25 * (1 + s * xi) * (1 + t * eta) * (s * xi + t * eta - 1);
+          dN(a, 0) = 0.25 * s * (1 + t * eta) * (2 * s * xi + t * eta);
+          dN(a, 1) = 0.25 * t * (1 + s * xi) * (s * xi + 2 * t * eta);
+        } else if (s == 0) {  // mid-sides of the sides along xi
+          N[a] = 0.5 * (1 - xi * xi) * (1 + t * eta);
+          dN(a, 0) = -xi * (1 + t * eta);
+          dN(a, 1) = 0.5 * (1 - xi * xi) * t;
+        } else {  // mid-sides of the sides along eta
+          N[a] = 0.5 * (1 + s * xi) * (1 - eta * eta);
+          dN(a, 0) = 0.5 * s * (1 - eta * eta);
+          dN(a, 1) = -eta * (1 + s * xi);
+        }
+      }
+      return;
+    case ElementShape::q9: {
+      const Vec3 lx = lagrange2(xi), ly = lagrange2(eta), dx = lagrange2_ds(xi), dy = lagrange2_ds(eta);
+      for (int a = 0; a < 9; ++a) {
+        const int i = kQ9Index[a][0], j = kQ9Index[a][1];
+        N[a] = lx[i] * ly[j];
+        dN(a, 0) = dx[i] * ly[j];
+        dN(a, 1) = lx[i] * dy[j];
+      }
+      return;
+    }
+  }
+}
+
+const std::vector<GaussPoint>& gauss_rule(ElementShape shape) {
+  static const std::vector<GaussPoint> one{{1.0 / 3, 1.0 / 3, 0.5}};
+  static const std::vector<GaussPoint> six = triangle_rule6();
+  static const std::vector<GaussPoint> two = tensor_rule({-1 / std::sqrt(3.0), 1 / std::sqrt(3.0)}, {1, 1});
+  static const std::vector<GaussPoint> three =
+      tensor_rule({-std::sqrt(0.6), 0, std::sqrt(0.6)}, {5.0 / 9, 8.0 / 9, 5.0 / 9});
+  switch (shape) {
+    case ElementShape::t3:
+      return one;
+    case ElementShape::t6:
+      return six;
+    case ElementShape::q4:
+      return two;
+    default:
+      return three;
+  }
+}
+
+ElementPoint element_point(ElementShape shape, const ShapeGradients& X, double xi, double eta,
+                           double weight_thickness) {
+  ElementPoint p;
+  ShapeGradients dN_nat;
+  shape_functions(shape, xi, eta, p.N, dN_nat);
+  const Mat2 J = X.transpose() * dN_nat;  // J(i, k) = dX_i / d xi_k
+  p.detJ = J.determinant();
+  p.dV = weight_thickness * p.detJ;
+  // dN/dX = dN/dxi * dxi/dX = dN_nat * J^-1 (J invertible only when detJ != 0).
+  p.dN = p.detJ != 0.0 ? ShapeGradients(dN_nat * J.inverse()) : ShapeGradients::Zero(X.rows(), 2);
+  return p;
+}
+
+std::vector<ElementPoint> element_points(ElementShape shape, const ShapeGradients& X, double thickness) {
+  std::vector<ElementPoint> points;
+  for (const GaussPoint& g : gauss_rule(shape))
+    points.push_back(element_point(shape, X, g.xi, g.eta, g.weight * thickness));
+  return points;
+}
+
+ShapeGradients mean_gradients(const std::vector<ElementPoint>& points) {
+  ShapeGradients mean = ShapeGradients::Zero(points.front().dN.rows(), 2);
+  double volume = 0.0;
+  for (const ElementPoint& p : points) {
+    mean += p.dV * p.dN;
+    volume += p.dV;
+  }
+  return mean / volume;
+}
+
+Matrix strain_matrix(const ElementPoint& point, const ShapeGradients* mean_dN) {
+  const int n = static_cast<int>(point.dN.rows());
+  Matrix B = Matrix::Zero(3, 2 * n);
+  for (int a = 0; a < n; ++a) {
+    const double nx = point.dN(a, 0), ny = point.dN(a, 1);
+    B(0, 2 * a) = nx;
+    B(1, 2 * a + 1) = ny;
+    B(2, 2 * a) = ny;
+    B(2, 2 * a + 1) = nx;
+    if (mean_dN) {
+      // eps11 and eps22 each gain half the difference of mean and local dilatation.
+      const double dx = 0.5 * ((*mean_dN)(a, 0) - nx), dy = 0.5 * ((*mean_dN)(a, 1) - ny);
+      B(0, 2 * a) += dx;
+      B(0, 2 * a + 1) += dy;
+      B(1, 2 * a) += dx;
+      B(1, 2 * a + 1) += dy;
+    }
+  }
+  return B;
+}
+
+Matrix small_strain_stiffness(const std::vector<ElementPoint>& points, const Eigen::Matrix3d& D,
+                              const ShapeGradients* mean_dN) {
+  const int n = 2 * static_cast<int>(points.front().dN.rows());
+  Matrix Ke = Matrix::Zero(n, n);
+  for (const ElementPoint& p : points) {
+    const Matrix B = strain_matrix(p, mean_dN);
+    Ke.noalias() += p.dV * B.transpose() * D * B;
+  }
+  return 0.5 * (Ke + Ke.transpose());
+}
+
+Mat2 deformation_gradient(const ElementPoint& point, const ShapeGradients& u) {
+  return Mat2::Identity() + u.transpose() * point.dN;  // F_ij = delta_ij + sum_a u_ai dN_a/dX_j
+}
+
+void total_lagrangian(const std::vector<ElementPoint>& points, const ShapeGradients& u, const PlaneMaterial& material,
+                      Vector& fe, Matrix* Ke) {
+  const int n = static_cast<int>(u.rows());
+  fe = Vector::Zero(2 * n);
+  if (Ke) *Ke = Matrix::Zero(2 * n, 2 * n);
+  Matrix B(3, 2 * n);
+  for (const ElementPoint& p : points) {
+    const Mat2 F = deformation_gradient(p, u);
+    const Mat2 E = 0.5 * (F.transpose() * F - Mat2::Identity());
+    const MaterialResponse r = material.response(E);
+    Mat2 S;
+    S << r.S[0], r.S[2], r.S[2], r.S[1];
+    const Mat2 P = F * S;  // first Piola-Kirchhoff stress
+    for (int a = 0; a < n; ++a) {
+      const Vec2 g = p.dN.row(a).transpose();
+      fe.segment<2>(2 * a) += p.dV * P * g;
+      // dE = B du: rows E11, E22, 2 E12; column pair of node a.
+      B(0, 2 * a) = F(0, 0) * g.x();
+      B(0, 2 * a + 1) = F(1, 0) * g.x();
+      B(1, 2 * a) = F(0, 1) * g.y();
+      B(1, 2 * a + 1) = F(1, 1) * g.y();
+      B(2, 2 * a) = F(0, 0) * g.y() + F(0, 1) * g.x();
+      B(2, 2 * a + 1) = F(1, 0) * g.y() + F(1, 1) * g.x();
+    }
+    if (!Ke) continue;
+    Ke->noalias() += p.dV * B.transpose() * r.D * B;
+    const Matrix G = p.dN * S * p.dN.transpose();  // geometric stiffness dN_a . S dN_b
+    for (int a = 0; a < n; ++a)
+      for (int b = 0; b < n; ++b) {
+        (*Ke)(2 * a, 2 * b) += p.dV * G(a, b);
+        (*Ke)(2 * a + 1, 2 * b + 1) += p.dV * G(a, b);
+      }
+  }
+}
+
+Eigen::Vector4d cauchy_stress(const Mat2& F, const MaterialResponse& r) {
+  Mat2 S;
+  S << r.S[0], r.S[2], r.S[2], r.S[1];
+  const double J = F.determinant() * std::sqrt(r.C33);
+  const Mat2 sigma = F * S * F.transpose() / J;
+  return {sigma(0, 0), sigma(1, 1), sigma(0, 1), r.C33 * r.S33 / J};
+}
+
+}  // namespace grip

@@ -1,0 +1,78 @@
+#pragma once
+// Isoparametric plane elements, as plain functions that fill a local vector and matrix (the
+// body assembles). Node orders are gmsh's:
+//   t3  corners counter-clockwise; natural coordinates (xi, eta) on the triangle (0, 0),
+//       (1, 0), (0, 1) (xi and eta are the area coordinates of corners 1 and 2);
+//   t6  t3's corners, then the mid-sides of 0-1, 1-2, 2-0 (quadratic);
+//   q4  corners counter-clockwise from (xi, eta) = (-1, -1) on the square [-1, 1]^2;
+//   q8  q4's corners, then the mid-sides of 0-1, 1-2, 2-3, 3-0 (serendipity);
+//   q9  q8's nodes and the centre (biquadratic Lagrange).
+// Local dofs are (u0x, u0y, u1x, ...). Strains and stresses in Voigt order (11, 22, 12) with
+// the engineering shear strain.
+#include <Eigen/Core>
+#include <vector>
+
+#include "solver/materials/plane_material.hpp"
+
+namespace grip {
+
+enum class ElementShape { t3, t6, q4, q8, q9 };
+
+const char* shape_name(ElementShape shape);  // "t3", ...
+int element_node_count(ElementShape shape);
+int element_corner_count(ElementShape shape);  // 3 or 4
+bool is_quadratic(ElementShape shape);         // t6, q8, q9: sides of 3 nodes
+// The local nodes of each side, counter-clockwise: 2 (t3, q4) or 3 (corner, mid-side, corner).
+const std::vector<std::vector<int>>& element_sides(ElementShape shape);
+
+using ShapeGradients = Eigen::Matrix<double, Eigen::Dynamic, 2>;  // one row per node
+
+// Natural coordinates (xi, eta) of node a, and of the centroid.
+Vec2 node_natural(ElementShape shape, int a);
+Vec2 centre_natural(ElementShape shape);
+// Shape functions N and their derivatives dN/d(xi, eta) at (xi, eta).
+void shape_functions(ElementShape shape, double xi, double eta, Vector& N, ShapeGradients& dN);
+
+struct GaussPoint {
+  double xi, eta, weight;
+};
+// t3: 1 point (constant strain: exact); t6: the 6-point rule of degree 4 (exact stiffness of
+// straight-sided t6, whose integrand has degree 2, and room for the finite-strain integrand);
+// q4: 2 x 2; q8 and q9: 3 x 3 (exact stiffness on parallelograms).
+const std::vector<GaussPoint>& gauss_rule(ElementShape shape);
+
+// The reference-configuration data of one integration point.
+struct ElementPoint {
+  Vector N;           // shape functions
+  ShapeGradients dN;  // dN/dX in the reference configuration
+  double detJ = 0.0;  // det dX/d(xi, eta); <= 0 means an inverted or degenerate element
+  double dV = 0.0;    // weight * detJ * thickness
+};
+
+// X holds the element's node coordinates, one row per node.
+ElementPoint element_point(ElementShape shape, const ShapeGradients& X, double xi, double eta, double weight_thickness);
+std::vector<ElementPoint> element_points(ElementShape shape, const ShapeGradients& X, double thickness);
+
+// The volume average of dN/dX over the element: the gradient of the mean dilatation.
+ShapeGradients mean_gradients(const std::vector<ElementPoint>& points);
+
+// Small strain: eps = B u (3 x 2n). With `mean_dN` (B-bar, plane strain), the in-plane
+// volumetric part (eps11 + eps22) / 2 of both normal strains is replaced by the element mean,
+// which removes volumetric locking as nu -> 1/2 and keeps the constant-strain patch test.
+Matrix strain_matrix(const ElementPoint& point, const ShapeGradients* mean_dN);
+// Ke = sum B^T D B dV.
+Matrix small_strain_stiffness(const std::vector<ElementPoint>& points, const Eigen::Matrix3d& D,
+                              const ShapeGradients* mean_dN);
+
+// Total Lagrangian: F = I + sum u_a (x) dN_a/dX; internal force f_a = sum F S dN_a dV and, if
+// Ke is given, its exact derivative B^T D B + (dN_a . S dN_b) I. u holds the nodal
+// displacements, one row per node.
+Mat2 deformation_gradient(const ElementPoint& point, const ShapeGradients& u);
+void total_lagrangian(const std::vector<ElementPoint>& points, const ShapeGradients& u, const PlaneMaterial& material,
+                      Vector& fe, Matrix* Ke);
+
+// The Cauchy stress (sxx, syy, sxy, szz) for a deformation gradient F (in-plane) and the
+// material response at E = (F^T F - I) / 2.
+Eigen::Vector4d cauchy_stress(const Mat2& F, const MaterialResponse& response);
+
+}  // namespace grip
