@@ -141,9 +141,10 @@ void report_mesh_issues(Reader& r, const std::vector<MeshIssue>& issues, const s
                         const std::string& kind, const FileMeshTags* tags) {
   if (kind == "gmsh") {  // name the element and node by their gmsh tags
     for (const MeshIssue& issue : issues)
-      r.error(ptr + "/gmsh", issue.element >= 0
-                                 ? "element tag " + std::to_string(tags->elements.at(issue.element)) + " " + issue.detail
-                                 : "node tag " + std::to_string(tags->nodes.at(issue.node)) + " " + issue.detail);
+      r.error(ptr + "/gmsh",
+              issue.element >= 0
+                  ? "element tag " + std::to_string(tags->elements.at(issue.element)) + " " + issue.detail
+                  : "node tag " + std::to_string(tags->nodes.at(issue.node)) + " " + issue.detail);
     return;
   }
   if (kind != "nodes") {

@@ -56,8 +56,10 @@ ProfilePiece arc_through(const Vec2& a, const Vec2& m, const Vec2& b) {
   double to = std::atan2(b.y() - c.y(), b.x() - c.x());
   // Counter-clockwise (a left turn): to above from; clockwise: below.
   const double two_pi = 2 * std::numbers::pi;
-  if (turn > 0) while (to <= from) to += two_pi;
-  else while (to >= from) to -= two_pi;
+  if (turn > 0)
+    while (to <= from) to += two_pi;
+  else
+    while (to >= from) to -= two_pi;
   return ArcPiece{c, (a - c).norm(), from, to};
 }
 
@@ -77,8 +79,8 @@ std::optional<std::vector<ProfilePiece>> read_curve_pieces(Reader& r, json& shap
   if (it == file->curves.end()) {
     std::vector<std::string> names;
     for (const auto& [n, c] : file->curves) names.push_back(n);
-    r.error(ptr + "/curve", show(shape["curve"]) + " names no physical curve of the mesh (curves: " +
-                                Reader::list(names) + ")");
+    r.error(ptr + "/curve",
+            show(shape["curve"]) + " names no physical curve of the mesh (curves: " + Reader::list(names) + ")");
     return std::nullopt;
   }
   const GmshCurve& curve = it->second;

@@ -125,7 +125,7 @@ TEST(GmshScene, ObstaclesFromPhysicalCurves) {
 
   json missing = block_from_file();
   missing["obstacles"][0]["shape"] = {{"type", "gmsh_curve"}, {"gmsh", {{"file", "tool.msh"}}}, {"curve", "punch"}};
-  expect_refused(missing, "/obstacles/0/shape/curve", "names no physical curve of the mesh (curves: arc, flat)");
+  expect_refused(missing, "/obstacles/0/shape/curve", "names no physical curve of the mesh (curves: \"arc\", \"flat\")");
 }
 
 TEST(GmshScene, RefusalsNameTheValue) {
@@ -135,11 +135,11 @@ TEST(GmshScene, RefusalsNameTheValue) {
 
   json no_set = block_from_file();
   no_set["body"]["contact_set"] = "underside";
-  expect_refused(no_set, "/body/contact_set", "names no node set (sets: bottom, top)");
+  expect_refused(no_set, "/body/contact_set", "names no node set (sets: \"bottom\", \"top\")");
 
   json no_surface = block_from_file();
   no_surface["body"]["mesh"]["gmsh"]["surfaces"] = {"hub"};
-  expect_refused(no_surface, "/body/mesh/gmsh/surfaces/0", "names no physical surface of the mesh (surfaces: block)");
+  expect_refused(no_surface, "/body/mesh/gmsh/surfaces/0", "names no physical surface of the mesh (surfaces: \"block\")");
 
   json wrong_kind = block_from_file();
   wrong_kind["body"]["element"] = "q9";
