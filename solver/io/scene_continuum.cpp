@@ -306,17 +306,35 @@ void read_continuum(Reader& r, json& body, Problem& problem, const std::string& 
   }
   const ElementShape shape = element_shape(options.element);
 
-  std::shared_ptr<const PlaneMaterial> material;
-  if (json* mat = r.object(body, ptr, "material", true)) {
-    const std::string mp = ptr + "/material";
-    const double young = r.positive(*mat, mp, "young");
-    const double poisson = r.number(*mat, mp, "poisson", 0.3);
-    if (!(poisson > -1 && poisson < 0.5)) r.error(mp + "/poisson", show((*mat)["poisson"]) + " is not in (-1, 0.5)");
-    const std::string law = r.choice(*mat, mp, "law", {"neo_hookean", "saint_venant_kirchhoff"}, "neo_hookean");
-    const PlaneAnalysis a = options.analysis;
-    if (law == "neo_hookean") material = std::make_shared<NeoHookeMaterial>(young, poisson, a);
-    else material = std::make_shared<HookeMaterial>(young, poisson, a);
+  const auto read_material = [&](json& mat, const std::string& mp) -> std::shared_ptr<const PlaneMaterial> {
+    const double young = r.positive(mat, mp, "young");
+    const double poisson = r.number(mat, mp, "poisson", 0.3);
+    if (!(poisson > -1 && poisson < 0.5)) r.error(mp + "/poisson", show(mat["poisson"]) + " is not in (-1, 0.5)");
+    const std::string law = r.choice(mat, mp, "law", {"neo_hookean", "saint_venant_kirchhoff"}, "neo_hookean");
+    if (law == "neo_hookean") return std::make_shared<NeoHookeMaterial>(young, poisson, options.analysis);
+    return std::make_shared<HookeMaterial>(young, poisson, options.analysis);
+  };
+  // `material` for every element, or `materials` by physical surface (a mesh file).
+  std::vector<std::shared_ptr<const PlaneMaterial>> materials;
+  std::map<std::string, std::shared_ptr<const PlaneMaterial>> by_surface;
+  if (body.contains("materials")) {
+    if (!file) r.error(ptr + "/materials", "name the physical surfaces of a mesh file: give \"material\" here");
+    else if (json* mats = r.object(body, ptr, "materials", true))
+      for (auto& [name, mat] : mats->items()) {
+        const std::string mp = ptr + "/materials/" + token(name);
+        if (!file->surfaces.count(name)) {
+          std::vector<std::string> names;
+          for (const auto& [n, elements] : file->surfaces) names.push_back(n);
+          r.error(mp, "\"" + name + "\" names no physical surface of the body (surfaces: " + Reader::list(names) + ")");
+        } else if (!mat.is_object()) {
+          r.error(mp, "is not an object");
+        } else {
+          by_surface[name] = read_material(mat, mp);
+        }
+      }
   }
+  if (body.contains("material") || by_surface.empty())
+    if (json* mat = r.object(body, ptr, "material", true)) materials.push_back(read_material(*mat, ptr + "/material"));
 
   std::optional<PlaneMesh> mesh;
   std::string kind, default_contact;  // kind: "nodes", "rectangle" or "half_disc"
@@ -355,9 +373,23 @@ void read_continuum(Reader& r, json& body, Problem& problem, const std::string& 
     return;
   }
   const std::vector<int> contact_set = mesh->sets.at(cs.get<std::string>());
+  if (!by_surface.empty()) {  // per element: its surface's material, else `material`
+    std::vector<std::shared_ptr<const PlaneMaterial>> per_element(mesh->elements.size(),
+                                                                  materials.empty() ? nullptr : materials[0]);
+    for (const auto& [name, material] : by_surface)
+      for (int e : file->surfaces.at(name)) per_element[e] = material;
+    for (size_t e = 0; e < per_element.size(); ++e)
+      if (!per_element[e]) {
+        r.error(ptr + "/materials", "element tag " + std::to_string(file->tags.elements[e]) +
+                                        " lies in none of these surfaces: name its surface, or give \"material\" "
+                                        "for the rest");
+        return;
+      }
+    materials = std::move(per_element);
+  }
   std::unique_ptr<ContinuumBody> continuum;
   try {
-    continuum = std::make_unique<ContinuumBody>(std::move(*mesh), contact_set, material, options);
+    continuum = std::make_unique<ContinuumBody>(std::move(*mesh), contact_set, std::move(materials), options);
   } catch (const InvalidMesh& e) {
     report_mesh_issues(r, e.issues, mp, kind, file ? &file->tags : nullptr);
     return;

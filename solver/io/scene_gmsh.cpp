@@ -130,6 +130,7 @@ std::optional<FileMesh> read_file_mesh(Reader& r, json& gmsh, const std::string&
 
   FileMesh out;
   std::vector<int> index(file->nodes.size(), -1);  // the file's node -> the body's
+  std::vector<int> element_index(file->element_count(), -1);
   int first = -1;
   for (int e = 0; e < file->element_count(); ++e) {
     if (!chosen[e]) continue;
@@ -152,6 +153,7 @@ std::optional<FileMesh> read_file_mesh(Reader& r, json& gmsh, const std::string&
       }
       element.push_back(index[n]);
     }
+    element_index[e] = static_cast<int>(out.mesh.elements.size());
     out.mesh.elements.push_back(std::move(element));
     out.tags.elements.push_back(file->element_tags[e]);
   }
@@ -161,6 +163,10 @@ std::optional<FileMesh> read_file_mesh(Reader& r, json& gmsh, const std::string&
     return std::nullopt;
   }
   out.element = element_kind_name(file->element_kinds[first]);
+
+  for (const auto& [name, surface] : file->surfaces)
+    for (int e : surface.elements)
+      if (element_index[e] >= 0) out.surfaces[name].push_back(element_index[e]);
 
   // Node sets: the curves and points that lie wholly on the body.
   const auto on_body = [&](const std::vector<int>& nodes, std::vector<int>& set) {

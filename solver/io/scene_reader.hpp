@@ -2,6 +2,7 @@
 // Internal to solver/io: reads values out of the (mutable) effective scene, writes defaults
 // in, and collects every problem with the JSON pointer of its value. Each body model's
 // reader lives in its own scene_<model>.cpp.
+#include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -242,6 +243,7 @@ struct FileMesh {
   PlaneMesh mesh;
   std::string element;
   FileMeshTags tags;
+  std::map<std::string, std::vector<int>> surfaces;  // physical surface -> the body's elements
 };
 std::optional<FileMesh> read_file_mesh(Reader& r, json& gmsh, const std::string& ptr);
 // An obstacle's shape {"type": "gmsh_curve", "gmsh": {"file" | "id"}, "curve", "reverse"}: the

@@ -144,6 +144,46 @@ void expect_refused(const json& scene, const std::string& pointer, const std::st
   }
 }
 
+// One body of two materials, one per physical surface (tests/data/gmsh/two-layers.msh: a soft
+// layer under a stiff one, 10 x 10 mm): its top pushed down by delta on a frictionless flat,
+// carries the uniaxial stress of two springs in series, sigma = delta / (h1 / E1 + h2 / E2), with
+// Poisson's ratio 0 (else each layer would spread by its own nu (1 + nu) sigma / E and the
+// interface would shear them); linear q4 reproduce it exactly.
+TEST(GmshScene, PhysicalSurfacesCarryTheirOwnMaterials) {
+  json j = example_scene("sliding-block");
+  j["body"].erase("element");
+  j["body"].erase("material");
+  j["body"]["mesh"] = {{"gmsh", {{"file", "two-layers.msh"}}}};
+  j["body"]["materials"] = {{"soft", {{"young", 1000.0}, {"poisson", 0.0}}},
+                            {"stiff", {{"young", 200000.0}, {"poisson", 0.0}}}};
+  const double delta = 0.01;
+  j["body"]["supports"] =
+      json::array({{{"set", "top"}, {"fix", {"y"}}, {"values", {{"y", -delta}}}}, {{"set", "corner"}, {"fix", {"x"}}}});
+  j["obstacles"] =
+      json::array({{{"name", "flat"}, {"shape", {{"type", "segment"}, {"from", {20.0, 0.0}}, {"to", {-10.0, 0.0}}}}}});
+  j.erase("stages");
+  j["steps"] = 1;
+  const Solved s = solve_scene(j, data_file);
+  ASSERT_TRUE(s.run.completed) << s.run.reason;
+  const double E1 = 1000.0, E2 = 200000.0;
+  const double sigma = delta / (5.0 / E1 + 5.0 / E2);
+  const Vec2 R = testing::reaction_resultant(s.scene.problem, s.run.steps.back());
+  std::printf("two layers: reaction %.9g N/mm, closed form %.9g\n", -R.y(), sigma * 10.0);
+  EXPECT_NEAR(-R.y(), sigma * 10.0, 1e-6 * sigma * 10.0);
+
+  json both = j;  // a surface left out takes `material`; one without either is refused
+  both["body"]["materials"].erase("stiff");
+  expect_refused(both, "/body/materials", "lies in none of these surfaces");
+  both["body"]["material"] = {{"young", 200000.0}, {"poisson", 0.0}};
+  const Solved same = solve_scene(both, data_file);
+  ASSERT_TRUE(same.run.completed) << same.run.reason;
+  EXPECT_NEAR(testing::reaction_resultant(same.scene.problem, same.run.steps.back()).y(), R.y(),
+              1e-9 * std::abs(R.y()));
+  json unknown = j;
+  unknown["body"]["materials"]["hub"] = {{"young", 1.0}};
+  expect_refused(unknown, "/body/materials/hub", "names no physical surface of the body");
+}
+
 // Rigid tools from a file's physical curves (tests/data/gmsh/tool.msh, curves only): the flat
 // as the example's segment gives the same run; the arc of 3-node lines is the circle through
 // its nodes (radius 2 about (0, 15)), with the solid inside (on the left of gmsh's direction).
