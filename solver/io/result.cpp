@@ -502,6 +502,8 @@ json result_json(const Scene& scene, const RunResult& run) {
             {"mesh", {{"cells", scene.problem.body->cells()}}},
             {"steps", std::move(steps)}};
   if (auto bodies = bodies_json(*scene.problem.body)) r["bodies"] = std::move(*bodies);
+  for (const FileMeshTags& tags : scene.file_meshes)
+    r["mesh"]["gmsh"].push_back({{"body", tags.body}, {"node_tags", tags.nodes}, {"element_tags", tags.elements}});
   return r;
 }
 

@@ -138,7 +138,15 @@ std::optional<PlaneMesh> read_generated_mesh(Reader& r, json& mesh, const std::s
 // The issues check_mesh found (through the body's constructor), each at its JSON pointer: an
 // explicit mesh's elements and nodes, or the generator's object (`kind`) with its first.
 void report_mesh_issues(Reader& r, const std::vector<MeshIssue>& issues, const std::string& ptr,
-                        const std::string& kind) {
+                        const std::string& kind, const FileMeshTags* tags) {
+  if (kind == "gmsh") {  // name the element and node by their gmsh tags
+    for (const MeshIssue& issue : issues)
+      r.error(ptr + "/gmsh",
+              issue.element >= 0
+                  ? "element tag " + std::to_string(tags->elements.at(issue.element)) + " " + issue.detail
+                  : "node tag " + std::to_string(tags->nodes.at(issue.node)) + " " + issue.detail);
+    return;
+  }
   if (kind != "nodes") {
     r.error(ptr + "/" + kind, "generated element " + std::to_string(issues.at(0).element) + " " + issues[0].detail +
                                   ": soften the refinement or change the divisions");
@@ -267,6 +275,17 @@ void read_continuum_loads(Reader& r, json& body, const std::string& ptr, const P
 }  // namespace
 
 void read_continuum(Reader& r, json& body, Problem& problem, const std::string& ptr) {
+  // A mesh from a file says its element kind: read it first (scene_gmsh.cpp).
+  std::optional<FileMesh> file;
+  if (body.is_object() && body.contains("mesh") && body["mesh"].is_object() && body["mesh"].contains("gmsh")) {
+    if (json* gmsh = r.object(body["mesh"], ptr + "/mesh", "gmsh", true))
+      file = read_file_mesh(r, *gmsh, ptr + "/mesh/gmsh");
+    if (!file) return;
+    if (!body.contains("element")) body["element"] = file->element;
+    else if (body["element"] != file->element)
+      r.error(ptr + "/element", show(body["element"]) + " differs from the mesh file's elements, " + file->element +
+                                    ": leave \"element\" out for a mesh from a file");
+  }
   const std::string kin = r.choice(body, ptr, "kinematics", {"finite", "linear"}, "finite");
   const std::string analysis = r.choice(body, ptr, "analysis", {"plane_strain", "plane_stress"}, "plane_strain");
   const std::string element = r.choice(body, ptr, "element", {"t3", "t6", "q4", "q4_bbar", "q8", "q9"}, "q4");
@@ -304,11 +323,14 @@ void read_continuum(Reader& r, json& body, Problem& problem, const std::string& 
   const std::string mp = ptr + "/mesh";
   if (json* m = r.object(body, ptr, "mesh", true)) {
     std::vector<std::string> kinds;
-    for (const char* k : {"nodes", "rectangle", "half_disc"})
+    for (const char* k : {"nodes", "rectangle", "half_disc", "gmsh"})
       if (m->contains(k)) kinds.push_back(k);
     if (kinds.size() != 1) {
-      r.error(mp, "needs exactly one of \"nodes\" (with \"elements\"), \"rectangle\" and \"half_disc\"");
-    } else if ((kind = kinds[0]) == "nodes") {
+      r.error(mp, "needs exactly one of \"nodes\" (with \"elements\"), \"rectangle\", \"half_disc\" and \"gmsh\"");
+    } else if ((kind = kinds[0]) == "gmsh") {
+      if (m->contains("sets")) r.error(mp + "/sets", "come from the mesh file's physical curves and points");
+      if (file) mesh = std::move(file->mesh);
+    } else if (kind == "nodes") {
       mesh = read_explicit_mesh(r, *m, mp);
     } else {
       if (m->contains("sets")) r.error(mp + "/sets", "are generated for a " + kind);
@@ -337,7 +359,7 @@ void read_continuum(Reader& r, json& body, Problem& problem, const std::string& 
   try {
     continuum = std::make_unique<ContinuumBody>(std::move(*mesh), contact_set, material, options);
   } catch (const InvalidMesh& e) {
-    report_mesh_issues(r, e.issues, mp, kind);
+    report_mesh_issues(r, e.issues, mp, kind, file ? &file->tags : nullptr);
     return;
   } catch (const std::invalid_argument& e) {
     r.error(ptr + "/contact_set", e.what());
@@ -345,6 +367,10 @@ void read_continuum(Reader& r, json& body, Problem& problem, const std::string& 
   }
   const PlaneMesh& checked = continuum->mesh();
   problem.body = std::move(continuum);
+  if (file) {
+    file->tags.body = r.body_index;
+    r.file_meshes.push_back(std::move(file->tags));
+  }
 
   read_continuum_supports(r, body, ptr, checked, problem);
   read_continuum_loads(r, body, ptr, checked, shape, problem, options.thickness);
