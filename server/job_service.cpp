@@ -167,8 +167,7 @@ namespace {
 // StoreUnavailable when a mesh could not be loaded for it.
 Scene read_with_meshes(MeshLibrary& meshes, const json& scene, MeshUse& use) {
   try {
-    (void)meshes;
-    return read_scene(scene);
+    return read_scene(scene, meshes.resolver(use));
   } catch (const SceneErrors&) {
     if (use.unavailable) std::rethrow_exception(use.unavailable);
     throw;

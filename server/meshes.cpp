@@ -1,8 +1,10 @@
 #include "server/meshes.hpp"
 
 #include <openssl/evp.h>
+#include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <chrono>
 #include <stdexcept>
 
 #include "server/compression.hpp"
@@ -130,7 +132,11 @@ std::shared_ptr<const GmshMesh> MeshLibrary::get(const std::string& id) {
       parsing.set_value(nullptr);
       return nullptr;
     }
+    const auto t0 = std::chrono::steady_clock::now();
     auto parsed = std::make_shared<const GmshMesh>(read_gmsh_mesh(stored_text(*data), "mesh " + id.substr(0, 12)));
+    spdlog::info("mesh {} read from the store in {:.3f} s: {} nodes, {} elements", id,
+                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), parsed->nodes.size(),
+                 parsed->element_count());
     std::lock_guard lock(mutex_);
     ++parses_;
     Entry& e = cache_[id];  // (an upload of the same bytes may have put it there meanwhile)

@@ -57,7 +57,8 @@ class MeshLibrary {
 
   // The parsed upload `id`; null when no mesh has that id.
   std::shared_ptr<const GmshMesh> get(const std::string& id);
-  // For read_scene: {"id"} references load uploads (recorded in `use`); {"file"} ones are refused.
+  // read_scene's MeshResolver (solver/io/scene.hpp, spelled out here: see above): {"id"}
+  // references load uploads (recorded in `use`); {"file"} ones are refused.
   std::function<std::shared_ptr<const GmshMesh>(const nlohmann::json&)> resolver(MeshUse& use);
 
   std::int64_t parses() const;  // meshes parsed from the store by this process (tests)

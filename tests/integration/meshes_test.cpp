@@ -3,8 +3,12 @@
 // reader refuses is a 422 naming its line or element tag, a file over the limit a 413.
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <thread>
+
 #include "grip_process.hpp"
 #include "server/meshes.hpp"
+#include "server/sqlite.hpp"
 
 namespace grip::testing {
 namespace {
@@ -130,6 +134,120 @@ TEST(Meshes, AnUploadOverTheLimitIs413AndOfAnotherTypeIs415) {
   EXPECT_EQ(metric(api, "grip_meshes"), 0);
   // The server is still well.
   EXPECT_EQ(upload(api, read_text(gmsh_dir() / "plate_v41_ascii.msh"))->status, 201);
+}
+
+// The sliding block (schemas/examples) on an uploaded mesh: tests/data/gmsh/block.msh, gmsh's
+// 20 x 10 quadrilaterals of the same rectangle, physical curves bottom and top.
+json sliding_block_on(const std::string& mesh_id) {
+  json scene = json::parse(read_text(examples_dir() / "sliding-block.json"));
+  scene["body"].erase("element");
+  scene["body"]["mesh"] = {{"gmsh", {{"id", mesh_id}}}};
+  return scene;
+}
+
+std::string upload_block(const Api& api) {
+  const auto r = upload(api, read_text(gmsh_dir() / "block.msh"));
+  if (!r || (r->status != 201 && r->status != 200)) throw std::runtime_error("block.msh not uploaded");
+  return json::parse(r->body)["id"];
+}
+
+TEST(Meshes, TheSlidingBlockOnAnUploadedMeshSolvesWithGmshsTagsAndKeepsItsMeshWhileStored) {
+  TempDir dir;
+  ServerProcess server(dir.path() / "grip.sqlite", {}, dir.path() / "serve.log");
+  const Api api(server.port());
+  const std::string mesh = upload_block(api);
+  const std::string job = api.submit(sliding_block_on(mesh));
+  EXPECT_EQ(api.del("/v1/meshes/" + mesh)->status, 409);  // a stored job uses it
+  api.wait_status(job, {"successful"});
+  const auto r = api.get("/v1/jobs/" + job + "/result");
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 200);
+  const json result = json::parse(r->body);
+  ASSERT_TRUE(result["mesh"].contains("gmsh")) << result["mesh"].dump().substr(0, 200);
+  ASSERT_EQ(result["mesh"]["gmsh"].size(), 1u);
+  const json& tags = result["mesh"]["gmsh"][0];
+  // 21 x 11 nodes and 20 x 10 elements, each with its own gmsh tag.
+  EXPECT_EQ(tags["body"], 0);
+  const auto nodes = tags["node_tags"].get<std::vector<long>>();
+  const auto elements = tags["element_tags"].get<std::vector<long>>();
+  EXPECT_EQ(nodes.size(), 231u);
+  EXPECT_EQ(elements.size(), 200u);
+  EXPECT_EQ(std::set<long>(nodes.begin(), nodes.end()).size(), 231u);
+  EXPECT_EQ(std::set<long>(elements.begin(), elements.end()).size(), 200u);
+  EXPECT_EQ(result["steps"].size(), 12u);
+  EXPECT_EQ(result["summary"]["completed"], true);
+  // The job removed, the mesh can go.
+  EXPECT_EQ(api.del("/v1/meshes/" + mesh)->status, 409);
+  EXPECT_EQ(api.del("/v1/jobs/" + job)->status, 200);
+  EXPECT_EQ(api.del("/v1/meshes/" + mesh)->status, 204);
+}
+
+TEST(Meshes, AHundredJobsOnOneUploadStoreItOnceAndAFreshProcessReadsItOnce) {
+  TempDir dir;
+  std::string mesh;
+  {
+    ServerProcess first(dir.path() / "grip.sqlite", {}, dir.path() / "first.log");
+    const Api api(first.port());
+    mesh = upload_block(api);
+    EXPECT_EQ(upload_block(api), mesh);  // the same bytes again
+  }
+  // A new process: its cache is empty; 100 submissions from 4 clients at once read the mesh
+  // from the store once (the others wait for that reading).
+  ServerProcess server(dir.path() / "grip.sqlite", {"--workers", "1"}, dir.path() / "serve.log");
+  const Api api(server.port());
+  std::atomic<int> accepted{0};
+  std::vector<std::thread> clients;
+  for (int c = 0; c < 4; ++c)
+    clients.emplace_back([&] {
+      for (int k = 0; k < 25; ++k)
+        if (api.post_json("/v1/jobs", sliding_block_on(mesh).dump())->status == 201) ++accepted;
+    });
+  for (auto& t : clients) t.join();
+  EXPECT_EQ(accepted, 100);
+  const std::string log = server.log();
+  size_t reads = 0;
+  for (size_t at = 0; (at = log.find("read from the store", at)) != std::string::npos; ++at) ++reads;
+  EXPECT_EQ(reads, 1u) << log;
+  server.terminate(std::chrono::seconds(30));
+  server::Database db((dir.path() / "grip.sqlite").string(), 5000);
+  auto count = [&](const char* sql) {
+    auto st = db.prepare(sql);
+    st.step();
+    return st.int64(0);
+  };
+  EXPECT_EQ(count("SELECT count(*) FROM meshes"), 1);
+  EXPECT_EQ(count("SELECT count(*) FROM job_meshes"), 100);
+  EXPECT_EQ(count("SELECT count(DISTINCT mesh_id) FROM job_meshes"), 1);
+  EXPECT_EQ(count("SELECT count(*) FROM jobs"), 100);
+}
+
+TEST(Meshes, AReferenceToNoUploadOrToAFileIsA422AtItsPointer) {
+  TempDir dir;
+  ServerProcess server(dir.path() / "grip.sqlite", {}, dir.path() / "serve.log");
+  const Api api(server.port());
+  auto refused = [&](const json& scene, const std::string& pointer, const std::string& says) {
+    const auto r = api.post_json("/v1/jobs", scene.dump());
+    ASSERT_TRUE(r);
+    ASSERT_EQ(r->status, 422) << r->body;
+    bool found = false;
+    const json problem = json::parse(r->body);
+    for (const json& e : problem["errors"])
+      if (e["pointer"] == pointer) {
+        found = true;
+        EXPECT_NE(e["detail"].get<std::string>().find(says), std::string::npos) << e.dump();
+      }
+    EXPECT_TRUE(found) << r->body;
+  };
+  refused(sliding_block_on(std::string(64, 'a')), "/body/mesh/gmsh/id", "no uploaded mesh has this id");
+  refused(sliding_block_on("not-a-hash"), "/body/mesh/gmsh/id", "no uploaded mesh has this id");
+  json by_file = sliding_block_on("x");
+  by_file["body"]["mesh"]["gmsh"] = {{"file", "block.msh"}};
+  refused(by_file, "/body/mesh/gmsh/file", "POST /v1/meshes");
+  // A tool's curve from an upload that does not exist.
+  json tool = json::parse(read_text(examples_dir() / "sliding-block.json"));
+  tool["obstacles"][0]["shape"] = {{"type", "gmsh_curve"}, {"gmsh", {{"id", std::string(64, 'b')}}}, {"curve", "top"}};
+  refused(tool, "/obstacles/0/shape/gmsh/id", "no uploaded mesh has this id");
+  EXPECT_EQ(json::parse(api.get("/v1/jobs")->body)["jobs"].size(), 0u);
 }
 
 }  // namespace
