@@ -19,15 +19,6 @@ httplib::Result upload(const Api& api, const std::string& bytes, const std::stri
   return api.client().Post("/v1/meshes", bytes, type.c_str());
 }
 
-// The value of an unlabelled sample in /v1/metrics.
-double metric(const Api& api, const std::string& name) {
-  const auto r = api.get("/v1/metrics");
-  if (!r) throw std::runtime_error("no /v1/metrics");
-  const size_t at = r->body.find("\n" + name + " ");
-  if (at == std::string::npos) throw std::runtime_error("no " + name + " in /v1/metrics");
-  return std::stod(r->body.substr(at + name.size() + 2));
-}
-
 TEST(Meshes, Sha256IsFips180sDigest) {
   // FIPS 180-2, appendix B.1 and the empty message.
   EXPECT_EQ(server::sha256_hex("abc"), "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
