@@ -24,7 +24,7 @@ RUN cmake -S . -B /build -G Ninja -DCMAKE_BUILD_TYPE=Release \
 FROM debian:12-slim
 RUN apt-get update -qq \
  && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
-      libcpp-httplib0.11 libspdlog1.10 libfmt9 libsqlite3-0 libpq5 libmetis5 liblapack3 libgomp1 libzstd1 \
+      libcpp-httplib0.11 libspdlog1.10 libfmt9 libsqlite3-0 libpq5 libmetis5 liblapack3 libgomp1 libzstd1 libssl3 \
  && rm -rf /var/lib/apt/lists/* \
  && groupadd --system --gid 10001 grip \
  && useradd --system --uid 10001 --gid 10001 --home-dir /var/lib/grip --create-home grip

@@ -10,6 +10,7 @@ service=(
   libpq-dev  # the shared job store (grip serve --db postgresql://...)
   zlib1g-dev  # results stored gzip-compressed by earlier versions (read still)
   libzstd-dev  # results stored zstd-compressed
+  libssl-dev  # SHA-256 (libcrypto): uploaded meshes' content-addressed ids
   libsuitesparse-dev  # CHOLMOD: sparse Cholesky of symmetric tangents; UMFPACK: LU of large contact zones' saddle-point systems
 )
 extras=(

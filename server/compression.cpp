@@ -53,9 +53,9 @@ std::string gunzip(std::string_view data) {
 
 }  // namespace
 
-std::string zstd(std::string_view text) {
+std::string zstd(std::string_view text, int level) {
   std::string out(ZSTD_compressBound(text.size()), '\0');
-  const int level = text.size() >= kLargeResult ? kZstdLargeLevel : kZstdLevel;
+  if (level == 0) level = text.size() >= kLargeResult ? kZstdLargeLevel : kZstdLevel;
   // One context per thread, kept: a new one per result allocated its tables (hundreds of KB)
   // every time.
   thread_local const std::unique_ptr<ZSTD_CCtx, decltype(&ZSTD_freeCCtx)> context(ZSTD_createCCtx(), ZSTD_freeCCtx);

@@ -23,6 +23,7 @@
 #include "server/util.hpp"
 #include "solver/io/export_csv.hpp"
 #include "solver/io/export_vtk.hpp"
+#include "solver/io/gmsh_mesh.hpp"
 #include "solver/io/json_depth.hpp"
 #include "solver/io/scene.hpp"
 
@@ -139,6 +140,8 @@ std::string allowed_methods(const std::string& path) {
       {std::regex(R"(/(v1/)?processes/contact2d/execution)"), "POST"},
       {std::regex(R"(/|/conformance|/(v1/)?processes(/contact2d)?|/v1/(health|ready|metrics))"), "GET"},
       {std::regex(R"(/v1/(schemas|examples)(/[^/]+)?)"), "GET"},
+      {std::regex(R"(/v1/meshes)"), "POST"},
+      {std::regex(R"(/v1/meshes/[^/]+)"), "GET, DELETE"},
   };
   for (const auto& [pattern, methods] : routes)
     if (std::regex_match(path, pattern)) return methods;
@@ -192,6 +195,14 @@ json job_document(const JobView& v) {
   return doc;
 }
 
+// An uploaded mesh as the API answers it: id, sizes, when, and what the reader found.
+json mesh_document(const MeshRecord& r, json summary) {
+  json doc = {{"id", r.id}, {"bytes", r.bytes}, {"stored_bytes", r.stored}, {"created", r.created}};
+  doc.update(summary);
+  doc["links"] = json::array({{{"href", "/v1/meshes/" + r.id}, {"rel", "self"}, {"type", kJson}}});
+  return doc;
+}
+
 }  // namespace
 
 struct HttpServer::Impl {
@@ -219,6 +230,12 @@ struct HttpServer::Impl {
 
   // ---- handlers
   void submit(const Request& req, Response& res, const httplib::ContentReader& reader, bool ogc);
+  // Reads the body, up to `limit` bytes, into `text`; false after answering 413, 408 or 400.
+  bool read_body(const Request& req, Response& res, const httplib::ContentReader& reader, std::size_t limit,
+                 std::string& text);
+  void upload_mesh(const Request& req, Response& res, const httplib::ContentReader& reader);
+  void get_mesh(const Request& req, Response& res);
+  void remove_mesh(const Request& req, Response& res);
   void list_jobs(const Request& req, Response& res);
   void get_job(const Request& req, Response& res);
   void dismiss(const Request& req, Response& res);
@@ -238,7 +255,8 @@ struct HttpServer::Impl {
 
 void HttpServer::Impl::hooks() {
   // Threads, deadlines and limits per connection: HttpFront (server/http_front.hpp).
-  svr.set_payload_max_length(options.max_body_bytes);
+  // The larger of the two: each route holds its own limit (read_body).
+  svr.set_payload_max_length(std::max(options.max_body_bytes, options.max_mesh_bytes));
   svr.set_tcp_nodelay(true);  // events are small writes: no Nagle delay
   // Instead of the default options: SO_REUSEADDR only (the default's SO_REUSEPORT would let a
   // second server bind the same port unnoticed), and the socket kept so that bind() can
@@ -458,6 +476,13 @@ void HttpServer::Impl::routes() {
   get({R"(/v1/jobs/([^/]+)/result)", R"(/jobs/([^/]+)/results?)"},
       [this](const Request& req, Response& res) { result(req, res); });
 
+  // ---- uploaded meshes
+  svr.Post("/v1/meshes", [this](const Request& req, Response& res, const httplib::ContentReader& reader) {
+    upload_mesh(req, res, reader);
+  });
+  svr.Get(R"(/v1/meshes/([^/]+))", [this](const Request& req, Response& res) { get_mesh(req, res); });
+  svr.Delete(R"(/v1/meshes/([^/]+))", [this](const Request& req, Response& res) { remove_mesh(req, res); });
+
   // ---- schemas and examples
   const fs::path schemas = options.schemas_dir;
   svr.Get("/v1/schemas", [this, schemas](const Request& req, Response& res) {
@@ -484,32 +509,8 @@ void HttpServer::Impl::submit(const Request& req, Response& res, const httplib::
                    "this server is reading as many scenes as its memory budget allows; nothing was accepted; "
                    "retry after 5 s");  // after 2 minutes of waiting
   }
-  if (ConnectionNote* note = HttpFront::note(); note && note->restart_body_deadline) note->restart_body_deadline();
-  // The body is read here: httplib 0.11.4 holds a body to the payload limit only when it has
-  // a Content-Length (a chunked one of 100 MB was buffered whole). Past the limit the rest is
-  // read and dropped, as httplib does with a long Content-Length, so the client gets its 413.
   std::string text;
-  bool too_large = false;
-  const bool complete = reader([&](const char* data, size_t n) {
-    if (!too_large && text.size() + n > options.max_body_bytes) {
-      too_large = true;
-      std::string().swap(text);
-    }
-    if (!too_large) text.append(data, n);
-    return true;
-  });
-  if (too_large || res.status == 413)
-    return problem(
-        res, req, 413, "payload-too-large", "Payload too large",
-        "the request body is over this server's limit of " + std::to_string(options.max_body_bytes) + " bytes");
-  if (!complete) {
-    if (const ConnectionNote* note = HttpFront::note(); note && note->deadline_missed) {
-      res.set_header("Connection", "close");
-      return problem(res, req, 408, "request-timeout", "Request timeout",
-                     "the request body did not arrive within " + std::to_string(options.front.body.count()) + " ms");
-    }
-    return problem(res, req, 400, "unreadable-body", "Unreadable body", "the request body could not be read");
-  }
+  if (!read_body(req, res, reader, options.max_body_bytes, text)) return;
   const std::string type = lower(req.get_header_value("Content-Type"));
   const std::string media = type.substr(0, type.find(';'));
   auto trimmed = media;
@@ -585,6 +586,93 @@ void HttpServer::Impl::submit(const Request& req, Response& res, const httplib::
     problem(res, req, 503, "shutting-down", "Shutting down", "the server is shutting down; nothing was accepted");
   } catch (const IdempotencyConflict& e) {
     problem(res, req, 422, "idempotency-key-reused", "Idempotency-Key reused", e.what());
+  }
+}
+
+bool HttpServer::Impl::read_body(const Request& req, Response& res, const httplib::ContentReader& reader,
+                                 std::size_t limit, std::string& text) {
+  if (ConnectionNote* note = HttpFront::note(); note && note->restart_body_deadline) note->restart_body_deadline();
+  // The body is read here: httplib 0.11.4 holds a body to the payload limit only when it has
+  // a Content-Length (a chunked one of 100 MB was buffered whole). Past the limit the rest is
+  // read and dropped, as httplib does with a long Content-Length, so the client gets its 413.
+  bool too_large = false;
+  const bool complete = reader([&](const char* data, size_t n) {
+    if (!too_large && text.size() + n > limit) {
+      too_large = true;
+      std::string().swap(text);
+    }
+    if (!too_large) text.append(data, n);
+    return true;
+  });
+  if (too_large || res.status == 413) {
+    problem(res, req, 413, "payload-too-large", "Payload too large",
+            "the request body is over this server's limit of " + std::to_string(limit) + " bytes");
+    return false;
+  }
+  if (!complete) {
+    if (const ConnectionNote* note = HttpFront::note(); note && note->deadline_missed) {
+      res.set_header("Connection", "close");
+      problem(res, req, 408, "request-timeout", "Request timeout",
+              "the request body did not arrive within " + std::to_string(options.front.body.count()) + " ms");
+      return false;
+    }
+    problem(res, req, 400, "unreadable-body", "Unreadable body", "the request body could not be read");
+    return false;
+  }
+  return true;
+}
+
+void HttpServer::Impl::upload_mesh(const Request& req, Response& res, const httplib::ContentReader& reader) {
+  const std::string type = lower(req.get_header_value("Content-Type"));
+  std::string media = type.substr(0, type.find(';'));
+  media.erase(std::remove_if(media.begin(), media.end(), ::isspace), media.end());
+  const auto declared = parse_count(req.get_header_value("Content-Length"));
+  if (media != "application/octet-stream" && media != "text/plain") {
+    reader([](const char*, size_t) { return true; });  // drained unkept: the connection stays in step
+    res.set_header("Accept-Post", "application/octet-stream, text/plain");
+    return problem(res, req, 415, "unsupported-media-type", "Unsupported media type",
+                   "a mesh is uploaded as the .msh file's bytes, application/octet-stream or text/plain, not '" +
+                       (media.empty() ? std::string("(none)") : media) + "'");
+  }
+  // Reading a mesh takes some 3 times its file (the file, the reader's arrays, the compressed copy).
+  auto hold = budget.take(std::min<std::size_t>(declared.value_or(options.max_mesh_bytes), options.max_mesh_bytes),
+                          std::chrono::seconds(120));
+  if (!hold) {
+    res.set_header("Retry-After", "5");
+    return problem(res, req, 503, "busy", "Busy",
+                   "this server is reading as many bodies as its memory budget allows; nothing was stored; "
+                   "retry after 5 s");
+  }
+  std::string bytes;
+  if (!read_body(req, res, reader, options.max_mesh_bytes, bytes)) return;
+  MeshLibrary::Upload up;
+  try {
+    up = service.meshes().upload(bytes);
+  } catch (const GmshError& e) {
+    return problem(res, req, 422, "invalid-mesh", "Invalid mesh", e.what(), error_list(e.what(), ""));
+  }
+  json doc = mesh_document(up.record, std::move(up.summary));
+  res.set_header("Location", "/v1/meshes/" + up.record.id);
+  send_json(res, up.created ? 201 : 200, doc);
+}
+
+void HttpServer::Impl::get_mesh(const Request& req, Response& res) {
+  const std::string id = req.matches[1];
+  const auto rec = service.meshes().find(id);
+  if (!rec) return problem(res, req, 404, "mesh-not-found", "Mesh not found", "no uploaded mesh has id '" + id + "'");
+  send_json(res, 200, mesh_document(*rec, json::parse(rec->summary)));
+}
+
+void HttpServer::Impl::remove_mesh(const Request& req, Response& res) {
+  const std::string id = req.matches[1];
+  switch (service.meshes().remove(id)) {
+    case MeshRemoval::not_found:
+      return problem(res, req, 404, "mesh-not-found", "Mesh not found", "no uploaded mesh has id '" + id + "'");
+    case MeshRemoval::in_use:
+      return problem(res, req, 409, "mesh-in-use", "Mesh in use",
+                     "a stored job uses mesh '" + id + "'; remove its jobs first (DELETE /v1/jobs/{id})");
+    case MeshRemoval::removed:
+      res.status = 204;
   }
 }
 
@@ -858,6 +946,11 @@ void HttpServer::Impl::metrics(const Request&, Response& res) {
      << "# HELP grip_store_disk_bytes The job database on disk (SQLite: the file; PostgreSQL: grip's tables).\n"
      << "# TYPE grip_store_disk_bytes gauge\n"
      << "grip_store_disk_bytes " << s.disk_bytes << "\n"
+     << "# HELP grip_meshes Uploaded meshes stored (POST /v1/meshes).\n# TYPE grip_meshes gauge\n"
+     << "grip_meshes " << s.meshes << "\n"
+     << "# HELP grip_mesh_stored_bytes Stored (compressed) bytes of the uploaded meshes.\n"
+     << "# TYPE grip_mesh_stored_bytes gauge\n"
+     << "grip_mesh_stored_bytes " << s.mesh_bytes << "\n"
      << "# HELP grip_retention_max_jobs Finished jobs kept (0: no bound).\n# TYPE grip_retention_max_jobs gauge\n"
      << "grip_retention_max_jobs " << s.retention.max_jobs << "\n"
      << "# HELP grip_retention_max_age_seconds Age of finished jobs kept (0: no bound).\n"

@@ -35,8 +35,9 @@ struct HttpOptions {
   FrontLimits front;
   int max_streams = 32;  // open event streams
   std::size_t max_body_bytes = 8u << 20;
-  std::size_t parse_budget_bytes = 0;  // bodies read and checked at once; 0: max_body_bytes
-  std::optional<std::string> token;    // bearer token required on every route but health
+  std::size_t max_mesh_bytes = 64u << 20;  // an uploaded mesh file (POST /v1/meshes)
+  std::size_t parse_budget_bytes = 0;      // bodies read and checked at once; 0: max_body_bytes
+  std::optional<std::string> token;        // bearer token required on every route but health
   std::chrono::milliseconds heartbeat{15000};
   std::string schemas_dir;  // schemas/*.schema.json and schemas/examples/*.json
 };

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <tuple>
 
 #include "server/compression.hpp"
 #include "server/util.hpp"
@@ -84,7 +85,8 @@ std::optional<std::int64_t> least_generated_nodes(const json& scene) {
 
 }  // namespace
 
-JobService::JobService(Store& store, ServiceOptions options) : store_(store), options_(std::move(options)) {
+JobService::JobService(Store& store, ServiceOptions options)
+    : store_(store), options_(std::move(options)), meshes_(store) {
   if (options_.workers <= 0) options_.workers = std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
   options_.queue_capacity = std::max(1, options_.queue_capacity);
   options_.event_buffer = std::max<std::size_t>(16, options_.event_buffer);
@@ -159,6 +161,21 @@ bool JobService::ready() {
   return store_.ping();
 }
 
+namespace {
+
+// read_scene with the uploaded meshes; `use` gets the ids it named. Throws SceneErrors, or
+// StoreUnavailable when a mesh could not be loaded for it.
+Scene read_with_meshes(MeshLibrary& meshes, const json& scene, MeshUse& use) {
+  try {
+    return read_scene(scene, meshes.resolver(use));
+  } catch (const SceneErrors&) {
+    if (use.unavailable) std::rethrow_exception(use.unavailable);
+    throw;
+  }
+}
+
+}  // namespace
+
 std::optional<SubmitResult> JobService::replay(const std::optional<std::string>& key, const std::string& scene) {
   if (!key) return std::nullopt;
   auto existing = store_.job_by_idempotency_key(*key);
@@ -182,8 +199,9 @@ SubmitResult JobService::submit(const json& scene_json, const std::optional<std:
   struct {
     int nodes, steps;
   } size;
+  MeshUse meshes;
   {
-    const Scene scene = read_scene(scene_json);  // throws SceneErrors
+    const Scene scene = read_with_meshes(meshes_, scene_json, meshes);  // throws SceneErrors
     size = {scene.problem.body->node_count(), static_cast<int>(scene.steps.size())};
   }
   std::vector<SceneIssue> issues;
@@ -219,6 +237,7 @@ SubmitResult JobService::submit(const json& scene_json, const std::optional<std:
   rec.nodes = size.nodes;
   rec.idempotency_key = idempotency_key;
   rec.request_id = request_id;
+  rec.meshes = std::move(meshes.ids);
   try {
     store_.insert_job(rec);
   } catch (const StoreUnavailable&) {
@@ -352,6 +371,7 @@ ServiceStats JobService::stats() {
   s.retention = options_.retention;
   s.pruned = pruner_ ? pruner_->pruned() : 0;
   s.disk_bytes = store_.disk_bytes();
+  std::tie(s.meshes, s.mesh_bytes) = store_.mesh_totals();
   {
     std::lock_guard lock(mutex_);
     std::int64_t below = 0;
@@ -668,7 +688,18 @@ void JobService::run_job(const std::shared_ptr<ActiveJob>& job, const JobRecord&
   JobOutcome outcome;
   std::optional<Scene> scene;
   try {
-    scene.emplace(read_scene(json::parse(rec.scene)));
+    const json stored = json::parse(rec.scene);
+    // Uploaded meshes come from the store: wait for it rather than fail the job.
+    for (int failures = 0; !scene; ++failures) {
+      try {
+        MeshUse use;
+        scene.emplace(read_with_meshes(meshes_, stored, use));
+      } catch (const StoreUnavailable& e) {
+        if (abort_runs_ || job->lost) throw;
+        if (failures % 20 == 0) spdlog::warn("job {}: store unavailable, retrying: {}", id, e.what());
+        std::this_thread::sleep_for(std::chrono::milliseconds(std::min(2000, 50 * (failures + 1))));
+      }
+    }
   } catch (const SceneErrors& e) {
     failed(outcome, FailureKind::invalid_scene, std::string("invalid scene: ") + e.what());
   } catch (const std::exception& e) {

@@ -39,6 +39,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "server/meshes.hpp"
 #include "server/observability.hpp"
 #include "server/pruner.hpp"
 #include "server/store.hpp"
@@ -124,8 +125,9 @@ struct ServiceStats {
   std::optional<std::pair<std::int64_t, std::int64_t>> db_traffic;
   std::map<JobStatus, std::int64_t> jobs;  // by status, from the store
   Retention retention;
-  std::int64_t pruned = 0;      // finished jobs removed by retention, this process
-  std::int64_t disk_bytes = 0;  // the database on disk
+  std::int64_t pruned = 0;                  // finished jobs removed by retention, this process
+  std::int64_t disk_bytes = 0;              // the database on disk
+  std::int64_t meshes = 0, mesh_bytes = 0;  // uploaded meshes stored, their stored bytes
   // Stored bytes of the jobs this process finished: {upper bound, count} and their sum.
   std::vector<std::pair<double, std::int64_t>> stored_bytes_buckets;
   std::int64_t stored_bytes_sum = 0, stored_bytes_count = 0;
@@ -168,6 +170,8 @@ class JobService {
   bool ready();
   const std::string& replica() const { return options_.replica; }
   const ServiceOptions& options() const { return options_; }
+  // Uploaded meshes (POST /v1/meshes), and the parsed ones shared by submissions and workers.
+  MeshLibrary& meshes() { return meshes_; }
 
   // Refuses new submissions and releases every event reader at once.
   void begin_drain();
@@ -197,6 +201,7 @@ class JobService {
 
   Store& store_;
   ServiceOptions options_;
+  MeshLibrary meshes_;
   std::unique_ptr<Pruner> pruner_;                 // with a retention, while started
   std::vector<std::int64_t> stored_bytes_counts_;  // per kStoredBytesBuckets (mutex_)
   std::int64_t stored_bytes_sum_ = 0, stored_bytes_count_ = 0;

@@ -70,6 +70,8 @@ std::string route_template(const std::string& path) {
       {std::regex(R"(/v1/(schemas|examples))"), ""},
       {std::regex(R"(/v1/(schemas|examples)/[^/]+)"), "/v1/{folder}/{name}"},
       {std::regex(R"(/ui(/[^/]+)?)"), "/ui"},
+      {std::regex(R"(/v1/meshes)"), ""},
+      {std::regex(R"(/v1/meshes/[^/]+)"), "/v1/meshes/{id}"},
   };
   for (const auto& [pattern, name] : routes)
     if (std::regex_match(path, pattern)) return name.empty() ? path : name;

@@ -59,6 +59,20 @@ ALTER TABLE grip_results ADD COLUMN IF NOT EXISTS bytes BYTEA;
 ALTER TABLE grip_results ALTER COLUMN data DROP NOT NULL;
 ALTER TABLE grip_jobs ADD COLUMN IF NOT EXISTS stored_bytes BIGINT NOT NULL DEFAULT 0;
 ALTER TABLE grip_jobs ADD COLUMN IF NOT EXISTS request_id TEXT NOT NULL DEFAULT '';
+CREATE TABLE IF NOT EXISTS grip_meshes (
+  id TEXT PRIMARY KEY,
+  bytes BIGINT NOT NULL,
+  data BYTEA NOT NULL,
+  summary TEXT NOT NULL,
+  created TEXT NOT NULL,
+  used TEXT NOT NULL
+);
+CREATE TABLE IF NOT EXISTS grip_job_meshes (
+  job_id TEXT NOT NULL,
+  mesh_id TEXT NOT NULL,
+  PRIMARY KEY (job_id, mesh_id)
+);
+CREATE INDEX IF NOT EXISTS grip_job_meshes_by_mesh ON grip_job_meshes (mesh_id);
 )sql";
 
 // Columns read by read_job, in this order.
@@ -436,12 +450,17 @@ bool PostgresStore::ping() {
 
 void PostgresStore::insert_job(JobRecord& job) {
   Session s(*pool_);
+  // One statement: the job, the meshes it uses (their last use), the announcement.
+  nlohmann::json meshes = job.meshes;
   const Result r = s.query(
       "WITH ins AS (INSERT INTO grip_jobs (id, status, scene, created, updated, message, steps, "
-      "nodes, idempotency_key, request_id) VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10) RETURNING ord, id) "
+      "nodes, idempotency_key, request_id) VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10) RETURNING ord, id), "
+      "uses AS (INSERT INTO grip_job_meshes (job_id, mesh_id) SELECT ins.id, m FROM ins, "
+      "jsonb_array_elements_text($11::jsonb) m ON CONFLICT DO NOTHING), "
+      "touch AS (UPDATE grip_meshes SET used = $4 WHERE id IN (SELECT jsonb_array_elements_text($11::jsonb))) "
       "SELECT ord, pg_notify('grip', 'j' || id) FROM ins",
       {job.id, std::string(to_string(job.status)), job.scene, job.created, job.updated, job.message,
-       num(std::int64_t{job.steps}), num(std::int64_t{job.nodes}), job.idempotency_key, job.request_id});
+       num(std::int64_t{job.steps}), num(std::int64_t{job.nodes}), job.idempotency_key, job.request_id, meshes.dump()});
   job.ord = r.int64(0, 0);
 }
 
@@ -646,6 +665,7 @@ std::pair<DismissOutcome, std::optional<JobRecord>> PostgresStore::dismiss_job(c
   } else {
     s.query("DELETE FROM grip_events WHERE job_id = $1", {id});
     s.query("DELETE FROM grip_results WHERE job_id = $1", {id});
+    s.query("DELETE FROM grip_job_meshes WHERE job_id = $1", {id});
     s.query("DELETE FROM grip_jobs WHERE id = $1", {id});
     s.query("SELECT pg_notify('grip', 'j' || $1::text)", {id});
     outcome = DismissOutcome::removed;
@@ -687,7 +707,8 @@ std::int64_t PostgresStore::prune(const Retention& retention, const std::string&
   std::vector<FinishedJob> finished;
   for (int i = 0; i < r.rows(); ++i)
     finished.push_back({r.text(i, 0), r.text(i, 1) == "dismissed", r.text(i, 2), r.int64(i, 3)});
-  const std::vector<std::string> gone = beyond_retention(finished, retention, retention_cutoff(retention, now));
+  const std::string cutoff = retention_cutoff(retention, now);
+  const std::vector<std::string> gone = beyond_retention(finished, retention, cutoff);
   // In batches, each one transaction; ids are UUIDs (no quoting needed in the array literal).
   for (size_t from = 0; from < gone.size(); from += 500) {
     std::string ids = "{";
@@ -696,18 +717,69 @@ std::int64_t PostgresStore::prune(const Retention& retention, const std::string&
     s.begin();
     s.query("DELETE FROM grip_events WHERE job_id = ANY($1::text[])", {ids});
     s.query("DELETE FROM grip_results WHERE job_id = ANY($1::text[])", {ids});
+    s.query("DELETE FROM grip_job_meshes WHERE job_id = ANY($1::text[])", {ids});
     s.query("DELETE FROM grip_jobs WHERE id = ANY($1::text[]) AND finished IS NOT NULL", {ids});
     s.query("SELECT pg_notify('grip', 'j')");
     s.commit();
   }
+  // Meshes no stored job uses, named by no job since the cutoff.
+  if (!cutoff.empty())
+    s.query(
+        "DELETE FROM grip_meshes m WHERE used < $1 AND NOT EXISTS (SELECT 1 FROM grip_job_meshes u WHERE u.mesh_id = "
+        "m.id)",
+        {cutoff});
   return static_cast<std::int64_t>(gone.size());
+}
+
+bool PostgresStore::put_mesh(const MeshRecord& mesh, const std::string& data) {
+  Session s(*pool_);
+  const Result r = s.query(
+      "INSERT INTO grip_meshes (id, bytes, data, summary, created, used) VALUES ($1, $2, $3::bytea, $4, $5, $5) "
+      "ON CONFLICT (id) DO NOTHING RETURNING id",
+      {mesh.id, num(mesh.bytes), bytea(data), mesh.summary, mesh.created});
+  return r.rows() == 1;
+}
+
+std::optional<MeshRecord> PostgresStore::mesh(const std::string& id) {
+  Session s(*pool_);
+  const Result r =
+      s.query("SELECT id, bytes, octet_length(data), summary, created FROM grip_meshes WHERE id = $1", {id});
+  if (r.rows() == 0) return std::nullopt;
+  return MeshRecord{r.text(0, 0), r.int64(0, 1), r.int64(0, 2), r.text(0, 3), r.text(0, 4)};
+}
+
+std::optional<std::string> PostgresStore::mesh_data(const std::string& id) {
+  Session s(*pool_);
+  const Result r = s.query("SELECT data FROM grip_meshes WHERE id = $1", {id});
+  if (r.rows() == 0) return std::nullopt;
+  return from_bytea(r.text(0, 0));
+}
+
+MeshRemoval PostgresStore::remove_mesh(const std::string& id) {
+  Session s(*pool_);
+  // One statement: a job inserted meanwhile either sees the mesh gone (its submission was
+  // checked before) or keeps it.
+  const Result r = s.query(
+      "WITH found AS (SELECT id FROM grip_meshes WHERE id = $1 FOR UPDATE), "
+      "used AS (SELECT count(*) AS n FROM grip_job_meshes WHERE mesh_id = $1), "
+      "del AS (DELETE FROM grip_meshes m USING found, used WHERE m.id = found.id AND used.n = 0 RETURNING m.id) "
+      "SELECT (SELECT count(*) FROM found), (SELECT n FROM used), (SELECT count(*) FROM del)",
+      {id});
+  if (r.int64(0, 0) == 0) return MeshRemoval::not_found;
+  return r.int64(0, 2) == 1 ? MeshRemoval::removed : MeshRemoval::in_use;
+}
+
+std::pair<std::int64_t, std::int64_t> PostgresStore::mesh_totals() {
+  Session s(*pool_);
+  const Result r = s.query("SELECT count(*), coalesce(sum(octet_length(data)), 0) FROM grip_meshes");
+  return {r.int64(0, 0), r.int64(0, 1)};
 }
 
 std::int64_t PostgresStore::disk_bytes() {
   Session s(*pool_);
   const Result r = s.query(
       "SELECT coalesce(pg_total_relation_size('grip_jobs'), 0) + coalesce(pg_total_relation_size('grip_events'), 0) + "
-      "coalesce(pg_total_relation_size('grip_results'), 0)");
+      "coalesce(pg_total_relation_size('grip_results'), 0) + coalesce(pg_total_relation_size('grip_meshes'), 0)");
   return r.int64(0, 0);
 }
 

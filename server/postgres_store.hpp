@@ -47,6 +47,11 @@ class PostgresStore final : public Store {
   std::vector<StoredEvent> events_after(const std::string& id, std::int64_t after, int limit,
                                         std::string_view type) override;
   std::optional<std::string> result(const std::string& id) override;
+  bool put_mesh(const MeshRecord& mesh, const std::string& data) override;
+  std::optional<MeshRecord> mesh(const std::string& id) override;
+  std::optional<std::string> mesh_data(const std::string& id) override;
+  MeshRemoval remove_mesh(const std::string& id) override;
+  std::pair<std::int64_t, std::int64_t> mesh_totals() override;
   std::int64_t prune(const Retention& retention, const std::string& now) override;
   std::int64_t disk_bytes() override;
   bool ping() override;

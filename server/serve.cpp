@@ -101,6 +101,10 @@ const std::vector<Flag>& flags() {
        [](ServeConfig& c, const std::string& v) {
          c.http.max_body_bytes = static_cast<size_t>(integer(v, "--max-body", 1024, 1LL << 34));
        }},
+      {"max-mesh", "GRIP_MAX_MESH", "BYTES", "largest uploaded mesh file, POST /v1/meshes (default 67108864)",
+       [](ServeConfig& c, const std::string& v) {
+         c.http.max_mesh_bytes = static_cast<size_t>(integer(v, "--max-mesh", 1024, 1LL << 34));
+       }},
       {"parse-budget", "GRIP_PARSE_BUDGET", "BYTES",
        "submitted bodies read and checked at once; more wait (default: max-body)",
        [](ServeConfig& c, const std::string& v) {
@@ -246,9 +250,9 @@ int serve(const ServeConfig& config) {
                c.service.queue_capacity, c.http.max_streams, f.max_connections);
   spdlog::info("connections: {} per client, {} kept idle, head within {} s, body within {} s", f.per_client, f.max_idle,
                f.head.count() / 1000.0, f.body.count() / 1000.0);
-  spdlog::info("limits: body {} bytes, {} nodes, {} steps, {} contact iterations, {} s per job", c.http.max_body_bytes,
-               c.service.limits.max_nodes, c.service.limits.max_steps, c.service.limits.max_iterations,
-               c.service.limits.max_seconds);
+  spdlog::info("limits: body {} bytes, mesh {} bytes, {} nodes, {} steps, {} contact iterations, {} s per job",
+               c.http.max_body_bytes, c.http.max_mesh_bytes, c.service.limits.max_nodes, c.service.limits.max_steps,
+               c.service.limits.max_iterations, c.service.limits.max_seconds);
   const Retention& keep = c.service.retention;
   spdlog::info("retention: {} finished jobs, {} s, {} bytes (0: no bound), every {} s; parse budget {} bytes",
                keep.max_jobs, keep.max_age_seconds, keep.max_bytes, c.service.prune_interval.count() / 1000.0,

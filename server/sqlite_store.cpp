@@ -49,6 +49,20 @@ CREATE TABLE IF NOT EXISTS results (
   job_id TEXT PRIMARY KEY,
   data TEXT NOT NULL
 );
+CREATE TABLE IF NOT EXISTS meshes (
+  id TEXT PRIMARY KEY,
+  bytes INTEGER NOT NULL,
+  data BLOB NOT NULL,
+  summary TEXT NOT NULL,
+  created TEXT NOT NULL,
+  used TEXT NOT NULL
+);
+CREATE TABLE IF NOT EXISTS job_meshes (
+  job_id TEXT NOT NULL,
+  mesh_id TEXT NOT NULL,
+  PRIMARY KEY (job_id, mesh_id)
+) WITHOUT ROWID;
+CREATE INDEX IF NOT EXISTS job_meshes_by_mesh ON job_meshes (mesh_id);
 )sql";
 
 // Schema 1 (before leases) to 2.
@@ -173,14 +187,25 @@ void SqliteStore::announce(StoreChange::Kind kind, const std::string& job_id) {
 void SqliteStore::insert_job(JobRecord& job) {
   {
     std::lock_guard lock(write_mutex_);
-    auto st = writer_->prepare(
-        "INSERT INTO jobs (id, status, scene, created, updated, message, steps, nodes, "
-        "idempotency_key, request_id) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
-    st.bind(1, job.id).bind(2, to_string(job.status)).bind(3, job.scene).bind(4, job.created);
-    st.bind(5, job.updated).bind(6, job.message).bind(7, job.steps).bind(8, job.nodes);
-    st.bind(9, job.idempotency_key).bind(10, job.request_id);
-    st.run();
-    job.ord = sqlite3_last_insert_rowid(writer_->handle());
+    Transaction tx(*writer_);
+    {
+      auto st = writer_->prepare(
+          "INSERT INTO jobs (id, status, scene, created, updated, message, steps, nodes, "
+          "idempotency_key, request_id) VALUES (?, ?, ?, ?, ?, ?, ?, ?, ?, ?)");
+      st.bind(1, job.id).bind(2, to_string(job.status)).bind(3, job.scene).bind(4, job.created);
+      st.bind(5, job.updated).bind(6, job.message).bind(7, job.steps).bind(8, job.nodes);
+      st.bind(9, job.idempotency_key).bind(10, job.request_id);
+      st.run();
+      job.ord = sqlite3_last_insert_rowid(writer_->handle());
+    }
+    for (const std::string& mesh : job.meshes) {
+      writer_->prepare("INSERT OR IGNORE INTO job_meshes (job_id, mesh_id) VALUES (?, ?)")
+          .bind(1, job.id)
+          .bind(2, mesh)
+          .run();
+      writer_->prepare("UPDATE meshes SET used = ? WHERE id = ?").bind(1, job.created).bind(2, mesh).run();
+    }
+    tx.commit();
   }
   announce(StoreChange::job, job.id);
 }
@@ -496,6 +521,7 @@ std::pair<DismissOutcome, std::optional<JobRecord>> SqliteStore::dismiss_job(con
     } else {
       writer_->prepare("DELETE FROM events WHERE job_id = ?").bind(1, id).run();
       writer_->prepare("DELETE FROM results WHERE job_id = ?").bind(1, id).run();
+      writer_->prepare("DELETE FROM job_meshes WHERE job_id = ?").bind(1, id).run();
       writer_->prepare("DELETE FROM jobs WHERE id = ?").bind(1, id).run();
       out = {DismissOutcome::removed, rec};
     }
@@ -545,8 +571,12 @@ std::int64_t SqliteStore::prune(const Retention& retention, const std::string& n
         "status IN ('successful', 'failed', 'dismissed') ORDER BY status = 'dismissed', ord DESC");
     while (st.step()) finished.push_back({st.text(0), st.text(1) == "dismissed", st.text(2), st.int64(3)});
   }
-  const std::vector<std::string> gone = beyond_retention(finished, retention, retention_cutoff(retention, now));
-  if (gone.empty()) return 0;
+  const std::string cutoff = retention_cutoff(retention, now);
+  const std::vector<std::string> gone = beyond_retention(finished, retention, cutoff);
+  if (gone.empty()) {
+    prune_meshes(cutoff);
+    return 0;
+  }
   // In batches, each its own transaction and vacuum, with a pause between them: the one
   // writer is everyone's (submissions, events, finishes), and a pass that removed 2,800 jobs
   // in one transaction held it 1.9 s, which the jobs finishing meanwhile waited out.
@@ -556,17 +586,85 @@ std::int64_t SqliteStore::prune(const Retention& retention, const std::string& n
     Transaction tx(*writer_);
     auto events = writer_->prepare("DELETE FROM events WHERE job_id = ?");
     auto results = writer_->prepare("DELETE FROM results WHERE job_id = ?");
+    auto uses = writer_->prepare("DELETE FROM job_meshes WHERE job_id = ?");
     auto jobs = writer_->prepare("DELETE FROM jobs WHERE id = ? AND finished IS NOT NULL");
     for (size_t i = from; i < std::min(gone.size(), from + kPruneBatch); ++i)
-      for (Statement* st : {&events, &results, &jobs}) {
+      for (Statement* st : {&events, &results, &uses, &jobs}) {
         st->reset();
         st->bind(1, gone[i]).run();
       }
     tx.commit();
     writer_->exec("PRAGMA incremental_vacuum");
   }
+  prune_meshes(cutoff);
   announce(StoreChange::job, "");
   return static_cast<std::int64_t>(gone.size());
+}
+
+void SqliteStore::prune_meshes(const std::string& cutoff) {
+  if (cutoff.empty()) return;
+  std::lock_guard lock(write_mutex_);
+  writer_
+      ->prepare(
+          "DELETE FROM meshes WHERE used < ? AND NOT EXISTS (SELECT 1 FROM job_meshes u WHERE u.mesh_id = meshes.id)")
+      .bind(1, cutoff)
+      .run();
+  if (writer_->changes() > 0) writer_->exec("PRAGMA incremental_vacuum");
+}
+
+bool SqliteStore::put_mesh(const MeshRecord& mesh, const std::string& data) {
+  std::lock_guard lock(write_mutex_);
+  writer_
+      ->prepare(
+          "INSERT INTO meshes (id, bytes, data, summary, created, used) VALUES (?1, ?2, ?3, ?4, ?5, ?5) "
+          "ON CONFLICT (id) DO NOTHING")
+      .bind(1, mesh.id)
+      .bind(2, mesh.bytes)
+      .bind_blob(3, data)
+      .bind(4, mesh.summary)
+      .bind(5, mesh.created)
+      .run();
+  return writer_->changes() == 1;
+}
+
+std::optional<MeshRecord> SqliteStore::mesh(const std::string& id) {
+  std::lock_guard lock(read_mutex_);
+  auto st = reader_->prepare("SELECT id, bytes, length(data), summary, created FROM meshes WHERE id = ?");
+  st.bind(1, id);
+  if (!st.step()) return std::nullopt;
+  return MeshRecord{st.text(0), st.int64(1), st.int64(2), st.text(3), st.text(4)};
+}
+
+std::optional<std::string> SqliteStore::mesh_data(const std::string& id) {
+  std::lock_guard lock(read_mutex_);
+  auto st = reader_->prepare("SELECT data FROM meshes WHERE id = ?");
+  st.bind(1, id);
+  if (!st.step()) return std::nullopt;
+  return st.blob(0);
+}
+
+MeshRemoval SqliteStore::remove_mesh(const std::string& id) {
+  std::lock_guard lock(write_mutex_);
+  Transaction tx(*writer_);
+  {
+    auto st = writer_->prepare(
+        "SELECT (SELECT count(*) FROM meshes WHERE id = ?1), "
+        "(SELECT count(*) FROM job_meshes WHERE mesh_id = ?1)");
+    st.bind(1, id);
+    st.step();
+    if (st.int64(0) == 0) return MeshRemoval::not_found;
+    if (st.int64(1) > 0) return MeshRemoval::in_use;
+  }
+  writer_->prepare("DELETE FROM meshes WHERE id = ?").bind(1, id).run();
+  tx.commit();
+  return MeshRemoval::removed;
+}
+
+std::pair<std::int64_t, std::int64_t> SqliteStore::mesh_totals() {
+  std::lock_guard lock(read_mutex_);
+  auto st = reader_->prepare("SELECT count(*), coalesce(sum(length(data)), 0) FROM meshes");
+  st.step();
+  return {st.int64(0), st.int64(1)};
 }
 
 std::int64_t SqliteStore::disk_bytes() {

@@ -39,6 +39,11 @@ class SqliteStore final : public Store {
   std::vector<StoredEvent> events_after(const std::string& id, std::int64_t after, int limit,
                                         std::string_view type) override;
   std::optional<std::string> result(const std::string& id) override;
+  bool put_mesh(const MeshRecord& mesh, const std::string& data) override;
+  std::optional<MeshRecord> mesh(const std::string& id) override;
+  std::optional<std::string> mesh_data(const std::string& id) override;
+  MeshRemoval remove_mesh(const std::string& id) override;
+  std::pair<std::int64_t, std::int64_t> mesh_totals() override;
   std::int64_t prune(const Retention& retention, const std::string& now) override;
   std::int64_t disk_bytes() override;
   bool ping() override { return true; }
@@ -46,6 +51,8 @@ class SqliteStore final : public Store {
 
  private:
   void announce(StoreChange::Kind kind, const std::string& job_id);
+  // Meshes no stored job uses, named by no job since `cutoff` (empty: none go).
+  void prune_meshes(const std::string& cutoff);
   std::optional<JobRecord> job_locked(Database& db, const std::string& id, bool with_scene);
 
   std::mutex write_mutex_;

@@ -68,9 +68,21 @@ struct JobRecord {
   std::string failure_kind;
   int failure_step = 0;
   int steps_completed = 0;
-  std::int64_t stored_bytes = 0;  // of its scene, events and result, once finished
-  std::string request_id;         // of the request that submitted it (X-Request-Id)
+  std::int64_t stored_bytes = 0;    // of its scene, events and result, once finished
+  std::string request_id;           // of the request that submitted it (X-Request-Id)
+  std::vector<std::string> meshes;  // ids of the uploaded meshes its scene uses (written by insert_job)
 };
+
+// An uploaded mesh (POST /v1/meshes): content-addressed by the SHA-256 of its bytes.
+struct MeshRecord {
+  std::string id;           // hex SHA-256 of the file's bytes
+  std::int64_t bytes = 0;   // the file's size
+  std::int64_t stored = 0;  // its size as stored (zstd)
+  std::string summary;      // gmsh_mesh_summary as compact JSON
+  std::string created;      // ISO 8601 UTC
+};
+
+enum class MeshRemoval { not_found, in_use, removed };
 
 // Which finished jobs the store keeps; 0: no bound of that kind. Beyond a bound the
 // dismissed jobs go first, then the oldest.
@@ -196,8 +208,19 @@ class Store {
   // The result as stored: bytes (zstd; gzip or JSON text if stored by an earlier version).
   virtual std::optional<std::string> result(const std::string& id) = 0;
 
+  // Meshes. put_mesh stores `data` (the file zstd-compressed) under mesh.id unless a mesh with
+  // that id is stored; true when this call stored it. The same bytes are stored once.
+  virtual bool put_mesh(const MeshRecord& mesh, const std::string& data) = 0;
+  virtual std::optional<MeshRecord> mesh(const std::string& id) = 0;
+  virtual std::optional<std::string> mesh_data(const std::string& id) = 0;
+  // Removes a mesh unless a stored job uses it (insert_job's JobRecord::meshes).
+  virtual MeshRemoval remove_mesh(const std::string& id) = 0;
+  // Meshes stored and their stored bytes.
+  virtual std::pair<std::int64_t, std::int64_t> mesh_totals() = 0;
+
   // Removes the finished jobs beyond `retention` at `now` (ISO 8601), with their events and
-  // results, and hands their space back (SQLite: incremental vacuum). Returns how many.
+  // results, and hands their space back (SQLite: incremental vacuum). Returns how many. With an
+  // age bound, meshes that no stored job uses and that no job named for that long go too.
   virtual std::int64_t prune(const Retention& retention, const std::string& now) = 0;
   // Bytes the database takes on disk (SQLite: the file; PostgreSQL: grip's tables).
   virtual std::int64_t disk_bytes() = 0;

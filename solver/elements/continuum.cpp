@@ -26,9 +26,11 @@ const char* element_name(ContinuumElement element) {
 }
 
 ContinuumBody::ContinuumBody(PlaneMesh mesh, const std::vector<int>& contact_set,
-                             std::shared_ptr<const PlaneMaterial> material, ContinuumOptions options)
+                             std::vector<std::shared_ptr<const PlaneMaterial>> materials, ContinuumOptions options)
     : mesh_(std::move(mesh)), options_(options), shape_(element_shape(options.element)),
-      material_(std::move(material)) {
+      materials_(std::move(materials)) {
+  if (materials_.empty() || (materials_.size() != 1 && materials_.size() != mesh_.elements.size()))
+    throw std::invalid_argument("a continuum body needs one material, or one per element");
   if (options_.element == ContinuumElement::q4_bbar && options_.kinematics == ContinuumKinematics::finite)
     throw std::invalid_argument("q4_bbar is implemented for linear kinematics (use q9 for finite strain)");
   if (!(options_.thickness > 0)) throw std::invalid_argument("thickness must be positive");
@@ -56,8 +58,8 @@ const ContinuumBody::Integration& ContinuumBody::integration() const {
       if (options_.element == ContinuumElement::q4_bbar) in->mean_dN.push_back(mean_gradients(in->points.back()));
     }
     if (options_.kinematics == ContinuumKinematics::linear) {
-      const Eigen::Matrix3d D = material_->small_strain().D;
       for (int e = 0; e < element_count(); ++e) {
+        const Eigen::Matrix3d D = material(e).small_strain().D;
         const Matrix Ke = small_strain_stiffness(in->points[e], D, in->mean_dN.empty() ? nullptr : &in->mean_dN[e]);
         const auto& el = mesh_.elements[e];
         for (int i = 0; i < 2 * n; ++i)
@@ -95,7 +97,7 @@ void ContinuumBody::internal_force(const Vector& q, Vector& force, Triplets* tan
   Vector fe;
   Matrix Ke;
   for (int e = 0; e < element_count(); ++e) {
-    total_lagrangian(in.points[e], element_displacements(q, e), *material_, fe, tangent ? &Ke : nullptr);
+    total_lagrangian(in.points[e], element_displacements(q, e), material(e), fe, tangent ? &Ke : nullptr);
     const auto& el = mesh_.elements[e];
     const int m = static_cast<int>(fe.size());
     for (int i = 0; i < m; ++i) {
@@ -204,7 +206,7 @@ Eigen::Vector4d ContinuumBody::centroid_stress(const Vector& q, int e) const {
   const ShapeGradients u = element_displacements(q, e);
   const ElementPoint& c = integration().centroids[e];
   if (options_.kinematics == ContinuumKinematics::linear) {
-    const MaterialResponse r = material_->small_strain();
+    const MaterialResponse r = material(e).small_strain();
     Vector ue(2 * u.rows());
     for (int a = 0; a < u.rows(); ++a) ue.segment<2>(2 * a) = u.row(a).transpose();
     const Eigen::Vector3d eps = strain_matrix(c, mean_gradient(e)) * ue;
@@ -212,7 +214,7 @@ Eigen::Vector4d ContinuumBody::centroid_stress(const Vector& q, int e) const {
     return {s[0], s[1], s[2], r.dS33 * eps};
   }
   const Mat2 F = deformation_gradient(c, u);
-  return cauchy_stress(F, material_->response(0.5 * (F.transpose() * F - Mat2::Identity())));
+  return cauchy_stress(F, material(e).response(0.5 * (F.transpose() * F - Mat2::Identity())));
 }
 
 FieldTable ContinuumBody::element_fields(const Vector& q) const {

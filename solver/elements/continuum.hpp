@@ -42,8 +42,10 @@ class ContinuumBody final : public Body {
   // The mesh must pass check_mesh (InvalidMesh otherwise); contact_set is a node set on the
   // boundary (boundary_part). Throws std::invalid_argument otherwise, or for q4_bbar with
   // finite kinematics.
-  ContinuumBody(PlaneMesh mesh, const std::vector<int>& contact_set, std::shared_ptr<const PlaneMaterial> material,
-                ContinuumOptions options);
+  // `materials`: one for every element, or one per element (a body of several materials: the
+  // physical surfaces of a mesh file).
+  ContinuumBody(PlaneMesh mesh, const std::vector<int>& contact_set,
+                std::vector<std::shared_ptr<const PlaneMaterial>> materials, ContinuumOptions options);
 
   int dof_count() const override { return 2 * node_count(); }
   Vector dof_length_scales() const override { return Vector::Ones(dof_count()); }
@@ -102,7 +104,8 @@ class ContinuumBody final : public Body {
   PlaneMesh mesh_;
   ContinuumOptions options_;
   ElementShape shape_;
-  std::shared_ptr<const PlaneMaterial> material_;
+  const PlaneMaterial& material(int e) const { return *materials_[materials_.size() == 1 ? 0 : e]; }
+  std::vector<std::shared_ptr<const PlaneMaterial>> materials_;
   BoundaryPart contact_;
   double length_ = 0.0;
   mutable std::once_flag integration_once_;

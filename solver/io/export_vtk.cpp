@@ -123,6 +123,26 @@ Grid grid_of(const json& result, size_t k) {
       g.pieces.push_back({entry.value("first_node", size_t{0}), entry.value("nodes", size_t{0}),
                           entry.value("first_element", size_t{0}), entry.value("elements", size_t{0})});
   }
+  // gmsh's tags of the bodies meshed from files (result mesh.gmsh), -1 elsewhere: a user finds
+  // their node and element by the tag gmsh gave it.
+  if (result.contains("mesh") && result["mesh"].contains("gmsh")) {
+    Array node_tag{"gmsh_tag", std::vector<double>(g.points.size(), -1.0)};
+    Array cell_tag{"gmsh_tag", std::vector<double>(g.cells.size(), -1.0)};
+    for (const json& tags : result["mesh"]["gmsh"]) {
+      const size_t b = tags.value("body", size_t{0});
+      const bool several = result.contains("bodies") && b < result["bodies"].size();
+      const size_t first_node = several ? result["bodies"][b].value("first_node", size_t{0}) : 0;
+      const size_t first_cell = several ? result["bodies"][b].value("first_element", size_t{0}) : 0;
+      const json& nodes = tags["node_tags"];
+      const json& cells = tags["element_tags"];
+      for (size_t i = 0; i < nodes.size() && first_node + i < g.points.size(); ++i)
+        node_tag.values[first_node + i] = nodes[i].get<double>();
+      for (size_t i = 0; i < cells.size() && first_cell + i < g.cells.size(); ++i)
+        cell_tag.values[first_cell + i] = cells[i].get<double>();
+    }
+    g.point_data.push_back(std::move(node_tag));
+    g.cell_data.push_back(std::move(cell_tag));
+  }
   // A piece must hold its rows and its cells' points.
   bool whole = true;
   for (const auto& [first_point, points, first_cell, cells] : g.pieces) {

@@ -8,7 +8,8 @@
 // 0 open, 1 stick, 2 slip) are point arrays at their node (named `<obstacle>.<field>` when
 // the scene has several obstacles). Several bodies: the .vtu holds one <Piece> per body (its
 // points, cells and array rows; result.bodies[] gives the rows), and both formats carry a cell
-// array `body` (the index in bodies[]); the legacy .vtk is one grid. Steps without node fields
+// array `body` (the index in bodies[]); the legacy .vtk is one grid. Bodies meshed from gmsh
+// files carry point and cell arrays `gmsh_tag` (result mesh.gmsh; -1 elsewhere). Steps without node fields
 // (a failed step) are skipped.
 #include <nlohmann/json.hpp>
 #include <string>

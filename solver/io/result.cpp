@@ -487,8 +487,8 @@ std::vector<ResultPart> object_parts(const json& small, Streamed streamed) {
   return parts;
 }
 
-// mesh.cells, one cell a line.
-void write_cells(JsonWriter& w, const std::vector<std::vector<int>>& cells) {
+// mesh: cells, one a line, and the gmsh tags of bodies from files (as result_json's mesh.gmsh).
+void write_mesh(JsonWriter& w, const std::vector<std::vector<int>>& cells, const std::vector<FileMeshTags>& files) {
   w.raw("{\"cells\":[");
   for (size_t e = 0; e < cells.size(); ++e) {
     w.raw(e ? ",\n[" : "\n[");
@@ -498,7 +498,15 @@ void write_cells(JsonWriter& w, const std::vector<std::vector<int>>& cells) {
     }
     w.put(']');
   }
-  w.raw("]}");
+  w.put(']');
+  if (!files.empty()) {
+    json gmsh = json::array();
+    for (const FileMeshTags& tags : files)
+      gmsh.push_back({{"body", tags.body}, {"node_tags", tags.nodes}, {"element_tags", tags.elements}});
+    w.raw(",\"gmsh\":");
+    w.value(gmsh);
+  }
+  w.put('}');
 }
 
 }  // namespace
@@ -512,6 +520,8 @@ json result_json(const Scene& scene, const RunResult& run) {
             {"mesh", {{"cells", scene.problem.body->cells()}}},
             {"steps", std::move(steps)}};
   if (auto bodies = bodies_json(*scene.problem.body)) r["bodies"] = std::move(*bodies);
+  for (const FileMeshTags& tags : scene.file_meshes)
+    r["mesh"]["gmsh"].push_back({{"body", tags.body}, {"node_tags", tags.nodes}, {"element_tags", tags.elements}});
   return r;
 }
 
@@ -554,7 +564,7 @@ std::vector<ResultPart> result_head_parts(const Scene& scene) {
       w.put(',');
     }
     w.raw("\"mesh\":");
-    write_cells(w, scene.problem.body->cells());
+    write_mesh(w, scene.problem.body->cells(), scene.file_meshes);
     w.raw(",\"scene\":");
     w.value(scene.effective);
     w.raw(",\"steps\":[");

@@ -4,13 +4,16 @@
 #include <Eigen/QR>
 #include <Eigen/SVD>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
+#include <map>
 #include <numbers>
 #include <optional>
 #include <sstream>
 #include <unordered_map>
 #include <unordered_set>
 
+#include "solver/io/gmsh_mesh.hpp"
 #include "solver/io/json_depth.hpp"
 #include "solver/io/scene_reader.hpp"
 #include "solver/io/schema_validation.hpp"
@@ -43,9 +46,15 @@ ProfilePiece read_piece(Reader& r, json& j, const std::string& ptr) {
 }
 
 std::unique_ptr<Obstacle> read_shape(Reader& r, json& j, const std::string& ptr) {
-  const std::string type = r.choice(j, ptr, "type", {"circle", "segment", "arc", "profile"}, std::nullopt);
+  const std::string type =
+      r.choice(j, ptr, "type", {"circle", "segment", "arc", "profile", "gmsh_curve"}, std::nullopt);
   const size_t before = r.issues.size();
   std::vector<ProfilePiece> pieces;
+  if (type == "gmsh_curve") {
+    auto curve = scene_io::read_curve_pieces(r, j, ptr);
+    if (!curve) return nullptr;
+    pieces = std::move(*curve);
+  }
   if (type == "circle") {
     const Vec2 c = r.vec2(j, ptr, "centre");
     const double radius = r.positive(j, ptr, "radius");
@@ -64,7 +73,7 @@ std::unique_ptr<Obstacle> read_shape(Reader& r, json& j, const std::string& ptr)
         }
         pieces.push_back(read_piece(r, (*arr)[i], pp));
       }
-  } else {
+  } else if (type != "gmsh_curve") {
     pieces.push_back(read_piece(r, j, ptr));
   }
   if (r.issues.size() > before) return nullptr;
@@ -551,12 +560,12 @@ std::vector<LoadStep> read_load_path(Reader& r, json& scene, std::vector<Obstacl
 
 }  // namespace
 
-Scene read_checked_scene(const nlohmann::json& input);
+Scene read_checked_scene(const nlohmann::json& input, const MeshResolver& meshes);
 
 SceneErrors::SceneErrors(std::vector<SceneIssue> issues, bool more)
     : std::runtime_error(join(issues)), issues_(std::move(issues)), more_(more) {}
 
-Scene read_scene(const nlohmann::json& input) {
+Scene read_scene(const nlohmann::json& input, const MeshResolver& meshes) {
   // Stage 1: the schema (types, ranges, unknown keys); stage 2: the readers' own checks
   // (references, meshes, rigid motions). Both run, so every error is reported at once; a
   // reader error under a value the schema already rejected is left out. The readers run
@@ -566,7 +575,7 @@ Scene read_scene(const nlohmann::json& input) {
   std::vector<SceneIssue> reader_issues;
   bool more = false;
   try {
-    scene.emplace(read_checked_scene(input));
+    scene.emplace(read_checked_scene(input, meshes));
   } catch (const SceneErrors& e) {
     reader_issues = e.issues();
     more = e.more();
@@ -619,8 +628,9 @@ void refuse_huge_numbers(Reader& r, const json& v, const std::string& pointer) {
 
 }  // namespace
 
-Scene read_checked_scene(const nlohmann::json& input) {
+Scene read_checked_scene(const nlohmann::json& input, const MeshResolver& meshes) {
   Reader r;
+  if (meshes) r.meshes = &meshes;
   Scene scene;
   scene.effective = input;
   json& e = scene.effective;
@@ -681,6 +691,7 @@ Scene read_checked_scene(const nlohmann::json& input) {
   add_candidates(scene.problem, scene.steps, reach);
   hold_rigid_modes(r, scene.problem);
   if (!r.issues.empty()) throw SceneErrors(std::move(r.issues));
+  scene.file_meshes = std::move(r.file_meshes);
   return scene;
 }
 
@@ -698,7 +709,18 @@ Scene read_scene_file(const std::string& path) {
   } catch (const json::exception& e) {  // parse_error, or out_of_range.406 for a number like 1e400
     throw SceneErrors(std::vector<SceneIssue>{{"/", std::string("malformed JSON: ") + e.what()}});
   }
-  return read_scene(j);
+  // body.mesh.gmsh.file: relative to the scene's folder, read once per file.
+  const std::filesystem::path folder = std::filesystem::path(path).parent_path();
+  std::map<std::string, std::shared_ptr<const GmshMesh>> read;
+  const MeshResolver files = [&](const json& ref) -> std::shared_ptr<const GmshMesh> {
+    if (!ref.contains("file") || !ref["file"].is_string())
+      throw std::invalid_argument("an uploaded mesh (\"id\") is read by the service; grip solve reads \"file\"");
+    const std::string file = (folder / ref["file"].get<std::string>()).string();
+    auto& mesh = read[file];
+    if (!mesh) mesh = std::make_shared<const GmshMesh>(read_gmsh_file(file));
+    return mesh;
+  };
+  return read_scene(j, files);
 }
 
 }  // namespace grip

@@ -4,6 +4,8 @@
 // up to kMaxSceneIssues.
 #include <algorithm>
 #include <cstddef>
+#include <functional>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string>
@@ -43,6 +45,20 @@ struct OutputOptions {
   bool wants(const std::string& field) const { return std::find(fields.begin(), fields.end(), field) != fields.end(); }
 };
 
+struct GmshMesh;
+
+// A mesh that a scene names by reference, body.mesh.gmsh {"file": ...} or {"id": ...}: the
+// caller resolves it (grip solve reads a file relative to the scene, the service an upload by
+// its id). Throws std::invalid_argument with a sentence that names the file or the id.
+using MeshResolver = std::function<std::shared_ptr<const GmshMesh>(const nlohmann::json& ref)>;
+
+// The gmsh tags of a body whose mesh came from a file: per node and per element of the body,
+// so that a user finds their node and element (result mesh.gmsh, the VTK arrays gmsh_tag).
+struct FileMeshTags {
+  int body = 0;  // index in the scene's bodies (0 for `body`)
+  std::vector<std::size_t> nodes, elements;
+};
+
 struct Scene {
   nlohmann::json effective;  // the scene with every default filled in
   Problem problem;
@@ -50,10 +66,13 @@ struct Scene {
   std::vector<LoadStep> steps;
   SteppingParams params;  // params.record_fields: the steps whose fields are kept
   OutputOptions output;
+  std::vector<FileMeshTags> file_meshes;
 };
 
-// Throws SceneErrors listing the problems found (at most kMaxSceneIssues).
-Scene read_scene(const nlohmann::json& scene);
+// Throws SceneErrors listing the problems found (at most kMaxSceneIssues). Without `meshes` a
+// scene that names a mesh file is refused (body.mesh.gmsh names the pointer).
+Scene read_scene(const nlohmann::json& scene, const MeshResolver& meshes = {});
+// Mesh files are read relative to the scene file's folder.
 Scene read_scene_file(const std::string& path);
 
 }  // namespace grip

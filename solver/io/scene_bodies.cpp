@@ -58,6 +58,7 @@ void read_bodies(Reader& r, json& bodies, Problem& problem) {
               "body's compliance, which gives no starting force, so a membrane is for one-body scenes (body)");
     if (!r.issues.empty()) continue;
     Problem part;
+    r.body_index = static_cast<int>(b);
     read_body(r, body, part, bp);
     if (!r.issues.empty() || !part.body) continue;
     names.push_back(name.get<std::string>());

@@ -138,7 +138,15 @@ std::optional<PlaneMesh> read_generated_mesh(Reader& r, json& mesh, const std::s
 // The issues check_mesh found (through the body's constructor), each at its JSON pointer: an
 // explicit mesh's elements and nodes, or the generator's object (`kind`) with its first.
 void report_mesh_issues(Reader& r, const std::vector<MeshIssue>& issues, const std::string& ptr,
-                        const std::string& kind) {
+                        const std::string& kind, const FileMeshTags* tags) {
+  if (kind == "gmsh") {  // name the element and node by their gmsh tags
+    for (const MeshIssue& issue : issues)
+      r.error(ptr + "/gmsh",
+              issue.element >= 0
+                  ? "element tag " + std::to_string(tags->elements.at(issue.element)) + " " + issue.detail
+                  : "node tag " + std::to_string(tags->nodes.at(issue.node)) + " " + issue.detail);
+    return;
+  }
   if (kind != "nodes") {
     r.error(ptr + "/" + kind, "generated element " + std::to_string(issues.at(0).element) + " " + issues[0].detail +
                                   ": soften the refinement or change the divisions");
@@ -267,6 +275,17 @@ void read_continuum_loads(Reader& r, json& body, const std::string& ptr, const P
 }  // namespace
 
 void read_continuum(Reader& r, json& body, Problem& problem, const std::string& ptr) {
+  // A mesh from a file says its element kind: read it first (scene_gmsh.cpp).
+  std::optional<FileMesh> file;
+  if (body.is_object() && body.contains("mesh") && body["mesh"].is_object() && body["mesh"].contains("gmsh")) {
+    if (json* gmsh = r.object(body["mesh"], ptr + "/mesh", "gmsh", true))
+      file = read_file_mesh(r, *gmsh, ptr + "/mesh/gmsh");
+    if (!file) return;
+    if (!body.contains("element")) body["element"] = file->element;
+    else if (body["element"] != file->element)
+      r.error(ptr + "/element", show(body["element"]) + " differs from the mesh file's elements, " + file->element +
+                                    ": leave \"element\" out for a mesh from a file");
+  }
   const std::string kin = r.choice(body, ptr, "kinematics", {"finite", "linear"}, "finite");
   const std::string analysis = r.choice(body, ptr, "analysis", {"plane_strain", "plane_stress"}, "plane_strain");
   const std::string element = r.choice(body, ptr, "element", {"t3", "t6", "q4", "q4_bbar", "q8", "q9"}, "q4");
@@ -287,28 +306,49 @@ void read_continuum(Reader& r, json& body, Problem& problem, const std::string& 
   }
   const ElementShape shape = element_shape(options.element);
 
-  std::shared_ptr<const PlaneMaterial> material;
-  if (json* mat = r.object(body, ptr, "material", true)) {
-    const std::string mp = ptr + "/material";
-    const double young = r.positive(*mat, mp, "young");
-    const double poisson = r.number(*mat, mp, "poisson", 0.3);
-    if (!(poisson > -1 && poisson < 0.5)) r.error(mp + "/poisson", show((*mat)["poisson"]) + " is not in (-1, 0.5)");
-    const std::string law = r.choice(*mat, mp, "law", {"neo_hookean", "saint_venant_kirchhoff"}, "neo_hookean");
-    const PlaneAnalysis a = options.analysis;
-    if (law == "neo_hookean") material = std::make_shared<NeoHookeMaterial>(young, poisson, a);
-    else material = std::make_shared<HookeMaterial>(young, poisson, a);
+  const auto read_material = [&](json& mat, const std::string& mp) -> std::shared_ptr<const PlaneMaterial> {
+    const double young = r.positive(mat, mp, "young");
+    const double poisson = r.number(mat, mp, "poisson", 0.3);
+    if (!(poisson > -1 && poisson < 0.5)) r.error(mp + "/poisson", show(mat["poisson"]) + " is not in (-1, 0.5)");
+    const std::string law = r.choice(mat, mp, "law", {"neo_hookean", "saint_venant_kirchhoff"}, "neo_hookean");
+    if (law == "neo_hookean") return std::make_shared<NeoHookeMaterial>(young, poisson, options.analysis);
+    return std::make_shared<HookeMaterial>(young, poisson, options.analysis);
+  };
+  // `material` for every element, or `materials` by physical surface (a mesh file).
+  std::vector<std::shared_ptr<const PlaneMaterial>> materials;
+  std::map<std::string, std::shared_ptr<const PlaneMaterial>> by_surface;
+  if (body.contains("materials")) {
+    if (!file) r.error(ptr + "/materials", "name the physical surfaces of a mesh file: give \"material\" here");
+    else if (json* mats = r.object(body, ptr, "materials", true))
+      for (auto& [name, mat] : mats->items()) {
+        const std::string mp = ptr + "/materials/" + token(name);
+        if (!file->surfaces.count(name)) {
+          std::vector<std::string> names;
+          for (const auto& [n, elements] : file->surfaces) names.push_back(n);
+          r.error(mp, "\"" + name + "\" names no physical surface of the body (surfaces: " + Reader::list(names) + ")");
+        } else if (!mat.is_object()) {
+          r.error(mp, "is not an object");
+        } else {
+          by_surface[name] = read_material(mat, mp);
+        }
+      }
   }
+  if (body.contains("material") || by_surface.empty())
+    if (json* mat = r.object(body, ptr, "material", true)) materials.push_back(read_material(*mat, ptr + "/material"));
 
   std::optional<PlaneMesh> mesh;
   std::string kind, default_contact;  // kind: "nodes", "rectangle" or "half_disc"
   const std::string mp = ptr + "/mesh";
   if (json* m = r.object(body, ptr, "mesh", true)) {
     std::vector<std::string> kinds;
-    for (const char* k : {"nodes", "rectangle", "half_disc"})
+    for (const char* k : {"nodes", "rectangle", "half_disc", "gmsh"})
       if (m->contains(k)) kinds.push_back(k);
     if (kinds.size() != 1) {
-      r.error(mp, "needs exactly one of \"nodes\" (with \"elements\"), \"rectangle\" and \"half_disc\"");
-    } else if ((kind = kinds[0]) == "nodes") {
+      r.error(mp, "needs exactly one of \"nodes\" (with \"elements\"), \"rectangle\", \"half_disc\" and \"gmsh\"");
+    } else if ((kind = kinds[0]) == "gmsh") {
+      if (m->contains("sets")) r.error(mp + "/sets", "come from the mesh file's physical curves and points");
+      if (file) mesh = std::move(file->mesh);
+    } else if (kind == "nodes") {
       mesh = read_explicit_mesh(r, *m, mp);
     } else {
       if (m->contains("sets")) r.error(mp + "/sets", "are generated for a " + kind);
@@ -333,11 +373,25 @@ void read_continuum(Reader& r, json& body, Problem& problem, const std::string& 
     return;
   }
   const std::vector<int> contact_set = mesh->sets.at(cs.get<std::string>());
+  if (!by_surface.empty()) {  // per element: its surface's material, else `material`
+    std::vector<std::shared_ptr<const PlaneMaterial>> per_element(mesh->elements.size(),
+                                                                  materials.empty() ? nullptr : materials[0]);
+    for (const auto& [name, material] : by_surface)
+      for (int e : file->surfaces.at(name)) per_element[e] = material;
+    for (size_t e = 0; e < per_element.size(); ++e)
+      if (!per_element[e]) {
+        r.error(ptr + "/materials", "element tag " + std::to_string(file->tags.elements[e]) +
+                                        " lies in none of these surfaces: name its surface, or give \"material\" "
+                                        "for the rest");
+        return;
+      }
+    materials = std::move(per_element);
+  }
   std::unique_ptr<ContinuumBody> continuum;
   try {
-    continuum = std::make_unique<ContinuumBody>(std::move(*mesh), contact_set, material, options);
+    continuum = std::make_unique<ContinuumBody>(std::move(*mesh), contact_set, std::move(materials), options);
   } catch (const InvalidMesh& e) {
-    report_mesh_issues(r, e.issues, mp, kind);
+    report_mesh_issues(r, e.issues, mp, kind, file ? &file->tags : nullptr);
     return;
   } catch (const std::invalid_argument& e) {
     r.error(ptr + "/contact_set", e.what());
@@ -345,6 +399,10 @@ void read_continuum(Reader& r, json& body, Problem& problem, const std::string& 
   }
   const PlaneMesh& checked = continuum->mesh();
   problem.body = std::move(continuum);
+  if (file) {
+    file->tags.body = r.body_index;
+    r.file_meshes.push_back(std::move(file->tags));
+  }
 
   read_continuum_supports(r, body, ptr, checked, problem);
   read_continuum_loads(r, body, ptr, checked, shape, problem, options.thickness);

@@ -2,13 +2,16 @@
 // Internal to solver/io: reads values out of the (mutable) effective scene, writes defaults
 // in, and collects every problem with the JSON pointer of its value. Each body model's
 // reader lives in its own scene_<model>.cpp.
+#include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <unordered_map>
 #include <vector>
 
+#include "solver/elements/plane_mesh.hpp"
 #include "solver/io/scene.hpp"
+#include "solver/obstacles/obstacle.hpp"
 #include "solver/problem/problem.hpp"
 
 namespace grip::scene_io {
@@ -176,6 +179,12 @@ class Reader {
     return out;
   }
 
+  // Resolves body.mesh.gmsh references (read_scene's caller; null: none can be read).
+  const MeshResolver* meshes = nullptr;
+  // The gmsh tags of the bodies read from files, and the index of the body being read.
+  std::vector<FileMeshTags> file_meshes;
+  int body_index = 0;
+
   // Load cases by name, in order of first mention; "main" unless a value names another.
   std::vector<std::string> cases{"main"};
 
@@ -228,6 +237,20 @@ void read_supports(Reader& r, json& body, const std::string& ptr, int nodes, con
 // (scene["body"], or an entry of scene["bodies"]).
 void read_timoshenko_beam(Reader& r, json& body, Problem& problem, const std::string& ptr = "/body");
 void read_rigid_plastic_membrane(Reader& r, json& body, Problem& problem, const std::string& ptr = "/body");
+// A continuum body's mesh from a gmsh file (scene_gmsh.cpp): the mesh, its element kind ("q4",
+// "t6", ...) and the gmsh tags of its nodes and elements; nullopt after an error.
+struct FileMesh {
+  PlaneMesh mesh;
+  std::string element;
+  FileMeshTags tags;
+  std::map<std::string, std::vector<int>> surfaces;  // physical surface -> the body's elements
+};
+std::optional<FileMesh> read_file_mesh(Reader& r, json& gmsh, const std::string& ptr);
+// An obstacle's shape {"type": "gmsh_curve", "gmsh": {"file" | "id"}, "curve", "reverse"}: the
+// physical curve's lines in order along it (2-node lines as segments, 3-node lines as arcs
+// through their mid node), the solid on the left of gmsh's direction (or of the reverse).
+std::optional<std::vector<ProfilePiece>> read_curve_pieces(Reader& r, json& shape, const std::string& ptr);
+
 void read_continuum(Reader& r, json& body, Problem& problem, const std::string& ptr = "/body");
 // One body at `ptr` by its model's reader.
 void read_body(Reader& r, json& body, Problem& problem, const std::string& ptr);

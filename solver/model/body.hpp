@@ -110,8 +110,8 @@ class Body {
   // Shape of the elements of a plane mesh (none for line models).
   virtual std::optional<ElementQuality> element_quality() const { return std::nullopt; }
 
-  // Sites of each cell, for plots and VTK: pairs for lines, four corners (counter-clockwise)
-  // for quadrilaterals.
+  // Sites of each cell, for plots and VTK: pairs for lines, the corners (counter-clockwise) of
+  // triangles (3) and quadrilaterals (4).
   virtual std::vector<std::vector<int>> cells() const = 0;
 
   // Output: deformed position and displacements per site; stresses or section forces per element.

@@ -186,6 +186,15 @@ class Api {
   std::optional<std::string> token_;
 };
 
+// The value of an unlabelled sample in /v1/metrics.
+inline double metric(const Api& api, const std::string& name) {
+  const auto r = api.get("/v1/metrics");
+  if (!r) throw std::runtime_error("no /v1/metrics");
+  const size_t at = r->body.find("\n" + name + " ");
+  if (at == std::string::npos) throw std::runtime_error("no " + name + " in /v1/metrics");
+  return std::stod(r->body.substr(at + name.size() + 2));
+}
+
 // Polls /v1/metrics until the server counts `n` open event streams (a stream the client
 // dropped counts until the server's next write to it fails).
 inline bool wait_open_streams(const Api& api, int n) {

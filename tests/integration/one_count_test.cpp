@@ -30,14 +30,6 @@ void expect_valid(const std::string& schema, const json& doc) {
   }
 }
 
-std::int64_t metric(const Api& api, const std::string& name) {
-  const auto r = api.get("/v1/metrics");
-  const std::regex line("(^|\n)" + name + " ([0-9]+)\n");
-  std::smatch m;
-  if (!r || !std::regex_search(r->body, m, line)) throw std::runtime_error("no metric " + name);
-  return std::stoll(m[2]);
-}
-
 // What every surface says about one finished job.
 struct Story {
   json doc;
@@ -56,7 +48,7 @@ Story read_story(const Server& server, const std::string& id, std::int64_t metri
   const json conv = json::parse(api.get("/v1/jobs/" + id + "/convergence")->body);
   for (const json& row : conv["iterations"]) s.convergence_trials += row["trials"].get<std::int64_t>();
   if (const auto r = api.get("/v1/jobs/" + id + "/result"); r && r->status == 200) s.result = json::parse(r->body);
-  s.metrics_iterations = metric(api, "grip_contact_iterations_total") - metric_before;
+  s.metrics_iterations = static_cast<std::int64_t>(metric(api, "grip_contact_iterations_total")) - metric_before;
   // "job ID STATUS in T s: N contact iterations; MESSAGE", written as the job's outcome is stored.
   const std::regex outcome("[^\n]* job " + id + " (successful|failed|dismissed) in [0-9.]+ s: [^\n]*");
   for (int tries = 0; tries < 200 && s.log_line.empty(); ++tries) {
@@ -157,7 +149,7 @@ int cuts(const json& result) {
 
 Story run(const Server& server, const json& scene) {
   const Api api = server.api();
-  const std::int64_t before = metric(api, "grip_contact_iterations_total");
+  const auto before = static_cast<std::int64_t>(metric(api, "grip_contact_iterations_total"));
   return read_story(server, api.submit(scene), before);
 }
 
@@ -206,7 +198,7 @@ TEST(OneCount, EverySurfaceAgreesAtTheNodeAndStepLimitsOfARestartedServer) {
   server.process->kill9();
   server.start({"--workers", "1", "--max-nodes", "10", "--max-steps", "2"});
   const Api again = server.api();
-  const std::int64_t before = metric(again, "grip_contact_iterations_total");
+  const auto before = static_cast<std::int64_t>(metric(again, "grip_contact_iterations_total"));
   const Story a = read_story(server, first, before);
   const Story b = read_story(server, queued, before);
   for (const Story* s : {&a, &b}) {

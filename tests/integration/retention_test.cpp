@@ -32,15 +32,6 @@ std::string inflate_gzip(const std::string& data) {
   return out;
 }
 
-// The value of an unlabelled sample in /v1/metrics.
-double metric(const Api& api, const std::string& name) {
-  const auto r = api.get("/v1/metrics");
-  if (!r) throw std::runtime_error("no /v1/metrics");
-  const size_t at = r->body.find("\n" + name + " ");
-  if (at == std::string::npos) throw std::runtime_error("no " + name + " in /v1/metrics");
-  return std::stod(r->body.substr(at + name.size() + 2));
-}
-
 TEST(Retention, TheSlidingBlocksResultIsStoredCompressedAndServedAsStoredOrAsText) {
   TempDir dir;
   ServerProcess server(dir.path() / "grip.sqlite", {}, dir.path() / "serve.log");

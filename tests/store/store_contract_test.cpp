@@ -352,8 +352,10 @@ TEST_P(StoreContract, AReopenedStoreKeepsEverythingAndFreesWhatTheDeadProcessHel
 // Runs job `id` to its end: claimed, `events` events, finished as `status` at `finished` with
 // `result` (dismissed: dismissed first while running).
 void run_to_end(Store& store, const std::string& id, JobStatus status, const std::string& finished,
-                std::optional<std::string> result, int events = 2) {
+                std::optional<std::string> result, int events = 2, std::vector<std::string> meshes = {}) {
   JobRecord r = new_job(id);
+  r.meshes = std::move(meshes);
+  if (!r.meshes.empty()) r.created = r.updated = finished;
   store.insert_job(r);
   const auto run = store.claim_job("me", finished, 30);
   ASSERT_TRUE(run);
@@ -416,6 +418,64 @@ TEST_P(StoreContract, RetentionRemovesTheFinishedJobsBeyondItsBoundsDismissedFir
   EXPECT_EQ(store->prune(Retention{0, 0, one + 10}, "2025-01-01T00:00:08.000Z"), 1);
   EXPECT_EQ(ids(), (std::set<std::string>{"a5", "waiting"}));
   EXPECT_EQ(store->count_accepted(), 1);  // unfinished jobs are never removed
+}
+
+MeshRecord mesh_record(const std::string& id, const std::string& created) {
+  return {id, 1000, 0, R"({"nodes":4})", created};
+}
+
+TEST_P(StoreContract, MeshesAreStoredOnceAndKeptWhileAStoredJobUsesThem) {
+  auto store = open();
+  auto other = open();                    // another replica
+  std::string data = "\x28\xb5\x2f\xfd";  // any byte, 0 included
+  for (int i = 0; i < 256; ++i) data += static_cast<char>(i);
+  EXPECT_TRUE(store->put_mesh(mesh_record("m-a", "2025-01-01T00:00:00.000Z"), data));
+  EXPECT_FALSE(other->put_mesh(mesh_record("m-a", "2025-01-01T00:00:09.000Z"), "other bytes"));  // stored once
+  const auto a = other->mesh("m-a");
+  ASSERT_TRUE(a);
+  EXPECT_EQ(a->bytes, 1000);
+  EXPECT_EQ(a->stored, static_cast<std::int64_t>(data.size()));
+  EXPECT_EQ(a->summary, R"({"nodes":4})");
+  EXPECT_EQ(a->created, "2025-01-01T00:00:00.000Z");  // the first upload's
+  EXPECT_EQ(other->mesh_data("m-a"), data);
+  EXPECT_EQ(store->mesh_totals(), (std::pair<std::int64_t, std::int64_t>{1, static_cast<std::int64_t>(data.size())}));
+  EXPECT_FALSE(store->mesh("nope"));
+  EXPECT_FALSE(store->mesh_data("nope"));
+  EXPECT_EQ(store->remove_mesh("nope"), MeshRemoval::not_found);
+
+  // A job that uses it keeps it, also once finished, until the job is removed.
+  run_to_end(*store, "job-a", JobStatus::successful, "2025-01-01T00:00:01.000Z", "r", 2, {"m-a"});
+  EXPECT_EQ(other->remove_mesh("m-a"), MeshRemoval::in_use);
+  EXPECT_EQ(store->dismiss_job("job-a", "2025-01-01T00:00:02.000Z").first, DismissOutcome::removed);
+  EXPECT_EQ(other->remove_mesh("m-a"), MeshRemoval::removed);
+  EXPECT_FALSE(store->mesh("m-a"));
+  EXPECT_EQ(store->mesh_totals().first, 0);
+}
+
+TEST_P(StoreContract, RetentionRemovesMeshesNoStoredJobUsesOnceTheyAreOlderThanItsAgeBound) {
+  auto store = open();
+  // b: uploaded at 00:00, named by job-b at 00:05; c: uploaded at 00:00, never named; d: at 00:06.
+  for (const auto& [id, created] :
+       std::vector<std::pair<std::string, std::string>>{{"m-b", "2025-01-01T00:00:00.000Z"},
+                                                        {"m-c", "2025-01-01T00:00:00.000Z"},
+                                                        {"m-d", "2025-01-01T00:00:06.000Z"}})
+    ASSERT_TRUE(store->put_mesh(mesh_record(id, created), "bytes of " + id));
+  run_to_end(*store, "job-b", JobStatus::successful, "2025-01-01T00:00:05.000Z", "r", 2, {"m-b"});
+  auto meshes = [&] {
+    std::set<std::string> out;
+    for (const char* id : {"m-b", "m-c", "m-d"})
+      if (store->mesh(id)) out.insert(id);
+    return out;
+  };
+  // Without an age bound no mesh goes.
+  EXPECT_EQ(store->prune(Retention{0, 100, 0}, "2025-01-01T01:00:00.000Z"), 0);
+  EXPECT_EQ(meshes(), (std::set<std::string>{"m-b", "m-c", "m-d"}));
+  // Kept 2 s, at 00:07: job-b (finished 00:05) stays and keeps m-b; m-c goes; m-d is recent.
+  EXPECT_EQ(store->prune(Retention{2, 0, 0}, "2025-01-01T00:00:07.000Z"), 0);
+  EXPECT_EQ(meshes(), (std::set<std::string>{"m-b", "m-d"}));
+  // At 00:20: job-b goes, and with it the last use of m-b; m-d too.
+  EXPECT_EQ(store->prune(Retention{2, 0, 0}, "2025-01-01T00:00:20.000Z"), 1);
+  EXPECT_EQ(meshes(), (std::set<std::string>{}));
 }
 
 TEST_P(StoreContract, PruningHandsTheSpaceBackToTheFileSystem) {

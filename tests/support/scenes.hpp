@@ -108,8 +108,8 @@ inline nlohmann::json beam_lying_on_a_flat(const std::string& kinematics) {
 }
 
 // Solved, with the step checks of every converged step held to their limits (issue 33.1).
-inline Solved solve_scene(const nlohmann::json& j) {
-  Solved s{read_scene(j), {}};
+inline Solved solve_scene(const nlohmann::json& j, const MeshResolver& meshes = {}) {
+  Solved s{read_scene(j, meshes), {}};
   s.run = run_load_steps(s.scene.problem, s.scene.steps, s.scene.params);
   const ContactParams& c = s.scene.params.contact;
   const bool moving_bound =

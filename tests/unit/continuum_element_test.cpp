@@ -43,7 +43,7 @@ std::shared_ptr<const PlaneMaterial> material(PlaneAnalysis analysis, double nu 
 ContinuumBody body_of(const Variant& v, double nu = 0.3) {
   const PlaneMesh mesh = distorted_patch(element_shape(v.element));
   ContinuumOptions options{v.element, v.kinematics, v.analysis, 0.5};
-  return ContinuumBody(mesh, mesh.sets.at("bottom"), material(v.analysis, nu), options);
+  return ContinuumBody(mesh, mesh.sets.at("bottom"), {material(v.analysis, nu)}, options);
 }
 
 Vector force(const Body& body, const Vector& q) {
@@ -313,7 +313,7 @@ TEST(ContinuumLocking, MeanDilatationAndNineNodesDoNotLock) {
     spec.ny = ny;
     const PlaneMesh mesh = rectangle_mesh(spec, element_shape(element));
     ContinuumOptions options{element, ContinuumKinematics::linear, PlaneAnalysis::plane_strain, 1.0};
-    const ContinuumBody body(mesh, mesh.sets.at("bottom"), material(PlaneAnalysis::plane_strain, nu), options);
+    const ContinuumBody body(mesh, mesh.sets.at("bottom"), {material(PlaneAnalysis::plane_strain, nu)}, options);
     const Matrix K = tangent(body, Vector::Zero(body.dof_count()));
     // Clamp the left end; shear the right end by a parabolic traction (consistent loads).
     std::vector<char> fixed(body.dof_count(), 0);
@@ -358,7 +358,7 @@ TEST(ContinuumBodyMesh, RejectsAFaultyMeshWithAllItsIssues) {
   const std::vector<MeshIssue> expected = check_mesh(mesh, ElementShape::q4);
   ASSERT_EQ(expected.size(), 3u);
   try {
-    ContinuumBody(mesh, bottom, material(PlaneAnalysis::plane_strain), ContinuumOptions{});
+    ContinuumBody(mesh, bottom, {material(PlaneAnalysis::plane_strain)}, ContinuumOptions{});
     FAIL() << "a faulty mesh was accepted";
   } catch (const InvalidMesh& e) {
     ASSERT_EQ(e.issues.size(), expected.size());

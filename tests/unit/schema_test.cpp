@@ -55,9 +55,10 @@ json example_or_continuum(const std::string& name) {
 
 // The reader's issues with a scene; when it reads it, none, and (for a valid scene) the
 // effective scene it writes, every default filled in, must validate too.
-std::vector<SceneIssue> reader_issues(const json& scene, bool valid = true) {
+// `file`: read as grip solve reads it (mesh files relative to it), else the JSON alone.
+std::vector<SceneIssue> reader_issues(const json& scene, bool valid = true, const fs::path& file = {}) {
   try {
-    const Scene read = read_scene(scene);
+    const Scene read = file.empty() ? read_scene(scene) : read_scene_file(file.string());
     const auto effective = validate_against(read.effective, SchemaName::scene);
     if (valid) EXPECT_TRUE(effective.empty()) << "effective scene:" << listed(effective);
     return {};
@@ -83,7 +84,7 @@ TEST(SchemaScene, EveryExampleValidatesAndReads) {
     const json scene = read_json(entry.path());
     const auto issues = validate_against(scene, SchemaName::scene);
     EXPECT_TRUE(issues.empty()) << listed(issues);
-    const auto read = reader_issues(scene);
+    const auto read = reader_issues(scene, true, entry.path());
     EXPECT_TRUE(read.empty()) << "the reader says" << listed(read);
     ++count;
   }
@@ -406,7 +407,8 @@ const InvalidScene kInvalidScenes[] = {
      "needs exactly one of \"set\" (a node set's name) and \"node\" (a node id)", Reader::same_pointer},
     {"a continuum mesh with a rectangle and a half-disc", "continuum",
      R"([{"op": "add", "path": "/body/mesh/half_disc", "value": {"radius": 1, "divisions": [4, 2]}}])", "/body/mesh",
-     "needs exactly one of \"nodes\" (with \"elements\"), \"rectangle\" and \"half_disc\"", Reader::same_pointer},
+     "needs exactly one of \"nodes\" (with \"elements\"), \"rectangle\", \"half_disc\" and \"gmsh\"",
+     Reader::same_pointer},
     {"a t6 element of four nodes", "continuum",
      R"([{"op": "replace", "path": "/body/mesh", "value": {"nodes": [[0, 0], [1, 0], [1, 1], [0, 1]], "elements": [[0, 1, 2, 3]],
            "sets": {"bottom": [0, 1], "top": [2, 3]}}},

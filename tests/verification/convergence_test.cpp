@@ -66,7 +66,7 @@ Solution solve(ContinuumElement element, int n) {
   Solution s{mapped_square(shape, n), {}, 0.0};
   const PlaneMesh& mesh = s.mesh;
   const ContinuumBody body(mesh, mesh.sets.at("bottom"),
-                           std::make_shared<HookeMaterial>(kYoung, kPoisson, PlaneAnalysis::plane_strain),
+                           {std::make_shared<HookeMaterial>(kYoung, kPoisson, PlaneAnalysis::plane_strain)},
                            {element, ContinuumKinematics::linear, PlaneAnalysis::plane_strain, 1.0});
   const int dofs = body.dof_count();
   Vector f = Vector::Zero(dofs);
