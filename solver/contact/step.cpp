@@ -356,9 +356,10 @@ bool StepSolver::budget_left() {
     return fail(FailureKind::contact_budget, "the friction bound did not settle in " +
                                                  std::to_string(params_.max_iterations) + " contact iterations (" +
                                                  std::to_string(pass_) + " tau passes; ||v|| within the tolerance)");
-  return fail(FailureKind::contact_budget, "contact error " + number_text(error_.norm2) + " above tolerance " +
-                                               number_text(tol_) + " after " + std::to_string(params_.max_iterations) +
-                                               " contact iterations");
+  std::string why = "contact error " + number_text(error_.norm2) + " above its bound " + number_text(tol_) + " after " +
+                    std::to_string(params_.max_iterations) + " contact iterations";
+  if (out_.budget_spent) why += " (uzawa converges linearly: raise solver.contact.max_iterations or use method cev)";
+  return fail(FailureKind::contact_budget, why);
 }
 
 bool StepSolver::line_search(const Vector& pl, const Vector& du, int& trials) {
