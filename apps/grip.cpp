@@ -3,9 +3,13 @@
 //   grip serve [options]        the HTTP/JSON service (grip serve --help)
 //   grip healthcheck [--host H] [--port P]
 //   grip mesh-info MESH.msh     what a gmsh mesh holds, as JSON (the service's answer to an upload)
+//   grip mesh PART.geo [-o PART.msh] [--order 2]   meshes a geometry with the gmsh executable
 // serve and healthcheck run grip-server (apps/grip_server.cpp) from grip's own directory, so
 // that solving does not load the service's libraries.
 // Exit codes of solve: 0 solved, 1 a step failed, 2 usage or scene error.
+#include <spawn.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -40,7 +44,8 @@ int usage() {
                "usage: grip solve SCENE.json [--out RESULT.json] [--events EVENTS.ndjson] [--threads N]\n"
                "       grip serve [options]   (grip serve --help)\n"
                "       grip healthcheck [--host H] [--port P]\n"
-               "       grip mesh-info MESH.msh\n");
+               "       grip mesh-info MESH.msh\n"
+               "       grip mesh PART.geo [-o PART.msh] [--order 2]\n");
   return 2;
 }
 
@@ -160,6 +165,81 @@ int mesh_info(int argc, char** argv) {
   }
 }
 
+// The gmsh executable on PATH, or "" (this command only: the service never runs gmsh, since a
+// .geo can call the shell).
+std::string find_gmsh() {
+  const char* path = std::getenv("PATH");
+  std::string dirs = path ? path : "";
+  for (size_t start = 0; start <= dirs.size();) {
+    const size_t end = std::min(dirs.find(':', start), dirs.size());
+    const std::string candidate = (end > start ? dirs.substr(start, end - start) : ".") + "/gmsh";
+    struct stat st {};
+    if (stat(candidate.c_str(), &st) == 0 && S_ISREG(st.st_mode) && access(candidate.c_str(), X_OK) == 0)
+      return candidate;
+    start = end + 1;
+  }
+  return "";
+}
+
+// mesh: `gmsh PART.geo -2 -format msh41 [-order N] -o PART.msh` (gmsh's messages on stderr),
+// then the file read back as the service would read it: its summary on stdout.
+int mesh(int argc, char** argv) {
+  std::string geo, out, order;
+  for (int i = 2; i < argc; ++i) {
+    const std::string a = argv[i];
+    if ((a == "-o" || a == "--out") && i + 1 < argc) out = argv[++i];
+    else if (a == "--order" && i + 1 < argc) order = argv[++i];
+    else if (geo.empty() && !a.empty() && a[0] != '-') geo = a;
+    else return usage();
+  }
+  if (geo.empty() || (!order.empty() && order != "1" && order != "2")) return usage();
+  if (out.empty()) out = geo.substr(0, geo.size() - (geo.ends_with(".geo") ? 4 : 0)) + ".msh";
+  if (access(geo.c_str(), R_OK) != 0) {
+    std::fprintf(stderr, "grip mesh: cannot read %s: %s\n", geo.c_str(), std::strerror(errno));
+    return 2;
+  }
+  const std::string gmsh = find_gmsh();
+  if (gmsh.empty()) {
+    std::fprintf(stderr,
+                 "grip mesh: the gmsh executable is not on PATH; install Debian's gmsh (apt-get install gmsh), or "
+                 "mesh %s with gmsh elsewhere and give grip the .msh file\n",
+                 geo.c_str());
+    return 2;
+  }
+  std::vector<std::string> args = {gmsh, geo, "-2", "-format", "msh41", "-o", out};
+  if (!order.empty()) args.insert(args.end(), {"-order", order});
+  std::vector<char*> cargv;
+  for (std::string& a : args) cargv.push_back(a.data());
+  cargv.push_back(nullptr);
+  std::remove(out.c_str());  // a file left from before is not this run's mesh
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_adddup2(&actions, STDERR_FILENO, STDOUT_FILENO);  // stdout: the summary only
+  pid_t pid = 0;
+  const int spawned = posix_spawn(&pid, gmsh.c_str(), &actions, nullptr, cargv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (spawned != 0) {
+    std::fprintf(stderr, "grip mesh: cannot run %s: %s\n", gmsh.c_str(), std::strerror(spawned));
+    return 2;
+  }
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0 || access(out.c_str(), R_OK) != 0) {
+    std::fprintf(stderr, "grip mesh: gmsh did not mesh %s (%s; its messages are above)\n", geo.c_str(),
+                 WIFEXITED(status) ? ("exit code " + std::to_string(WEXITSTATUS(status))).c_str() : "killed");
+    return 2;
+  }
+  try {
+    std::cout << grip::gmsh_mesh_summary(grip::read_gmsh_file(out)).dump(2) << '\n';
+    std::fprintf(stderr, "grip mesh: wrote %s\n", out.c_str());
+    return 0;
+  } catch (const grip::GmshError& e) {
+    std::fprintf(stderr, "grip mesh: gmsh wrote a mesh grip cannot solve: %s\n", e.what());
+    return 2;
+  }
+}
+
 // serve and healthcheck: grip-server next to this executable, with the same arguments.
 int run_server(char** argv) {
   char self[PATH_MAX];
@@ -184,5 +264,6 @@ int main(int argc, char** argv) {
   }
   if (command == "serve" || command == "healthcheck") return run_server(argv);
   if (command == "mesh-info") return mesh_info(argc, argv);
+  if (command == "mesh") return mesh(argc, argv);
   return usage();
 }

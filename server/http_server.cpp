@@ -493,6 +493,9 @@ void HttpServer::Impl::routes() {
   svr.Get("/v1/examples", [this, schemas](const Request& req, Response& res) {
     file_list(req, res, schemas / "examples", ".json", "/v1/examples/");
   });
+  // An example's mesh file (body.mesh.gmsh {"file"}): what the page and the client upload for it.
+  svr.Get(R"(/v1/examples/([^/]+\.msh))",
+          [this, schemas](const Request& req, Response& res) { file(req, res, schemas / "examples", ".msh"); });
   svr.Get(R"(/v1/examples/([^/]+))",
           [this, schemas](const Request& req, Response& res) { file(req, res, schemas / "examples", ".json"); });
 }
@@ -1038,7 +1041,9 @@ void HttpServer::Impl::file(const Request& req, Response& res, const fs::path& d
     name.resize(name.size() - suffix.size());
   const auto content = safe_name(name) ? read_file(dir / (name + suffix)) : std::nullopt;
   if (!content) return problem(res, req, 404, "not-found", "Not found", "no document named '" + name + "'");
-  res.set_content(*content, suffix == ".schema.json" ? "application/schema+json" : kJson);
+  res.set_content(*content, suffix == ".schema.json" ? "application/schema+json"
+                            : suffix == ".msh"       ? "application/octet-stream"
+                                                     : kJson);
 }
 
 HttpServer::HttpServer(JobService& service, HttpOptions options)

@@ -146,21 +146,44 @@ std::optional<std::string> Statement::optional_text(int column) const {
 
 bool Statement::is_null(int column) const { return sqlite3_column_type(stmt_, column) == SQLITE_NULL; }
 
-Transaction::Transaction(Database& db) : db_(db) { db_.exec("BEGIN IMMEDIATE"); }
+// The few fixed texts run as kept statements: sqlite3_exec parsed them again at every use.
+Transaction::Transaction(Database& db, Sync sync) : db_(db), sync_(sync) {
+  if (sync_ == Sync::relaxed) db_.prepare("PRAGMA synchronous=NORMAL").run();
+  try {
+    db_.prepare("BEGIN IMMEDIATE").run();
+  } catch (...) {
+    if (sync_ == Sync::relaxed) db_.prepare("PRAGMA synchronous=FULL").run();
+    throw;
+  }
+}
 
 Transaction::~Transaction() {
-  if (!done_) {
-    try {
-      db_.exec("ROLLBACK");
-    } catch (...) {
-      // Nothing more to do: SQLite rolls back on its own when a statement failed hard.
-    }
+  if (done_) return;
+  try {
+    end("ROLLBACK");
+  } catch (...) {
+    // Nothing more to do: SQLite rolls back on its own when a statement failed hard.
   }
 }
 
 void Transaction::commit() {
-  db_.exec("COMMIT");
+  end("COMMIT");
   done_ = true;
+}
+
+void Transaction::end(const char* sql) {
+  struct Restore {
+    Database& db;
+    bool relaxed;
+    ~Restore() {
+      if (!relaxed) return;
+      try {
+        db.prepare("PRAGMA synchronous=FULL").run();
+      } catch (...) {
+      }
+    }
+  } restore{db_, sync_ == Sync::relaxed};
+  db_.prepare(sql).run();
 }
 
 }  // namespace grip::server

@@ -87,16 +87,22 @@ class Statement {
 };
 
 // BEGIN IMMEDIATE on construction; ROLLBACK on destruction unless commit() was called.
+// A relaxed transaction commits with synchronous=NORMAL (no fsync: the WAL reaches the disk at
+// the connection's next FULL commit or checkpoint), for writes that a crash may lose because
+// recovery redoes them anyway (docs/running.md#the-service); the connection is FULL again after.
 class Transaction {
  public:
-  explicit Transaction(Database& db);
+  enum class Sync { full, relaxed };
+  explicit Transaction(Database& db, Sync sync = Sync::full);
   ~Transaction();
   Transaction(const Transaction&) = delete;
   Transaction& operator=(const Transaction&) = delete;
   void commit();
 
  private:
+  void end(const char* sql);
   Database& db_;
+  Sync sync_;
   bool done_ = false;
 };
 

@@ -29,12 +29,12 @@ export class ApiError extends Error {
   }
 }
 
-async function send(method, path, body) {
+async function send(method, path, body, type = "application/json") {
   let res;
   try {
     res = await fetch(path, {
       method,
-      headers: headers(body === undefined ? {} : { "Content-Type": "application/json" }),
+      headers: headers(body === undefined ? {} : { "Content-Type": type }),
       body,
       cache: "no-store",
     });
@@ -56,6 +56,16 @@ export const getJson = (path) => send("GET", path);
 export const dismissJob = (id) => send("DELETE", `/v1/jobs/${encodeURIComponent(id)}`);
 // `text` is sent as it is: the server's own parser names the problems.
 export const submitScene = (text) => send("POST", "/v1/jobs", text);
+// A gmsh .msh file (a File or Blob) as its bytes: answered with its id and what was read.
+export const uploadMesh = (blob) => send("POST", "/v1/meshes", blob, "application/octet-stream");
+
+// A file the server serves (an example's mesh), as a Blob; null when it has none by that name.
+export async function getBlob(path) {
+  const res = await fetch(path, { headers: headers({ Accept: "*/*" }), cache: "no-store" });
+  if (res.status === 404) return null;
+  if (!res.ok) throw new ApiError(res.status, { detail: `${path}: ${res.status}` });
+  return res.blob();
+}
 
 // A download with the token: fetched, then saved from a blob URL.
 export async function download(path, filename) {

@@ -1,6 +1,6 @@
 // The page: the job list, the submit form, and one job watched live (its contact error per
 // iteration, its step table) and then shown (deformed body, contact stresses, downloads).
-import { ApiError, dismissJob, download, followEvents, getJson, setToken, submitScene, token } from "./api.js";
+import { ApiError, dismissJob, download, followEvents, getBlob, getJson, setToken, submitScene, token, uploadMesh } from "./api.js";
 import { STATE_COLOURS, bodyBounds, drawBody, drawConvergence, drawStress } from "./charts.js";
 
 const $ = (id) => document.getElementById(id);
@@ -134,9 +134,58 @@ function absoluteTolerance(scene, result) {
   return tol * Math.max(Math.max(...xs) - Math.min(...xs), Math.max(...ys) - Math.min(...ys));
 }
 
+// The scene's gmsh mesh references that name a file (body.mesh.gmsh, bodies[].mesh.gmsh,
+// obstacles[].shape.gmsh): [{pointer, ref}].
+function gmshReferences(node, pointer = "", out = []) {
+  if (Array.isArray(node)) node.forEach((v, k) => gmshReferences(v, `${pointer}/${k}`, out));
+  else if (node && typeof node === "object") {
+    for (const [key, value] of Object.entries(node)) {
+      const here = `${pointer}/${key.replace(/~/g, "~0").replace(/\//g, "~1")}`;
+      if (key === "gmsh" && value && typeof value.file === "string") out.push({ pointer: here, ref: value });
+      else gmshReferences(value, here, out);
+    }
+  }
+  return out;
+}
+
+// The example the editor holds (its mesh files are the server's), or null once another scene is loaded.
+let loadedExample = null;
+
+// Uploads the .msh files the scene names (the chosen ones by name; an example's from the
+// server) and puts their ids in place of the names. Throws {errors} at the references' pointers.
+async function attachMeshes(scene) {
+  const chosen = new Map([...$("mesh-files").files].map((f) => [f.name, f]));
+  const ids = new Map();
+  const errors = [];
+  for (const { pointer, ref } of gmshReferences(scene)) {
+    const name = ref.file.split("/").pop();
+    if (!ids.has(name)) {
+      let file = chosen.get(name) || null;
+      if (!file && loadedExample) file = await getBlob(`/v1/examples/${encodeURIComponent(name)}`);
+      if (!file) {
+        errors.push({ pointer: pointer + "/file", detail: `choose ${name} under "Its gmsh meshes (.msh)"` });
+        continue;
+      }
+      $("submit-status").textContent = `uploading ${name}`;
+      try {
+        const doc = await uploadMesh(file);
+        ids.set(name, doc.id);
+      } catch (e) {
+        if (!(e instanceof ApiError) || e.status !== 422) throw e;
+        errors.push(...e.errors.map((x) => ({ pointer: pointer + "/file", detail: `${name}: ${x.detail}` })));
+        continue;
+      }
+    }
+    delete ref.file;
+    ref.id = ids.get(name);
+  }
+  if (errors.length) throw Object.assign(new Error("mesh files"), { errors, problem: { title: "mesh files missing or refused" } });
+  return ids.size;
+}
+
 async function submit(event) {
   event.preventDefault();
-  const text = $("scene").value;
+  let text = $("scene").value;
   $("submit-status").textContent = "";
   let scene;
   try {
@@ -147,6 +196,7 @@ async function submit(event) {
   }
   $("submit").disabled = true;
   try {
+    if (await attachMeshes(scene)) text = JSON.stringify(scene);
     const job = await submitScene(text);
     showErrors([]);
     $("submit-status").textContent = `queued as ${job.jobID.slice(0, 8)}`;
@@ -154,7 +204,7 @@ async function submit(event) {
     location.hash = "job=" + job.jobID;
     refreshJobs();
   } catch (e) {
-    $("submit-status").textContent = e instanceof ApiError ? `not queued: ${e.problem.title || e.message}` : String(e);
+    $("submit-status").textContent = e.problem ? `not queued: ${e.problem.title || e.message}` : String(e);
     showErrors(e.errors?.length ? e.errors : [{ pointer: "", detail: e.message }]);
   } finally {
     $("submit").disabled = false;
@@ -348,6 +398,7 @@ function init() {
     if (!href) return;
     try {
       $("scene").value = JSON.stringify(await getJson(href), null, 2);
+      loadedExample = href;
       showErrors([]);
     } catch (e) {
       showConnection(e);
@@ -355,7 +406,10 @@ function init() {
   });
   $("scene-file").addEventListener("change", async () => {
     const file = $("scene-file").files[0];
-    if (file) $("scene").value = await file.text();
+    if (file) {
+      $("scene").value = await file.text();
+      loadedExample = null;
+    }
   });
   $("submit-form").addEventListener("submit", submit);
   $("step-slider").addEventListener("input", showStep);

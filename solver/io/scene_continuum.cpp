@@ -9,7 +9,7 @@
 //                    "refine": {"size", "extent"}}}
 //   "contact_set": a node set on the boundary (default "bottom" for a rectangle, "arc" for a
 //     half-disc); its nodes are the contact candidates
-//   "supports": [{"set" | "node", "fix": ["x", "y"], "values": {"x", "y"}, "case"}]
+//   "supports": [{"set" | "node", "fix": ["x", "y"], "values": {"x", "y"} | "rotation": {"about", "angle"}, "case"}]
 //   "loads": [{"set" | "node", "force": [fx, fy] (on each node) | "traction": [tx, ty] (per
 //     unit area of the set's boundary sides), "case"}]
 #include <stdexcept>
@@ -203,6 +203,38 @@ void read_continuum_supports(Reader& r, json& body, const std::string& ptr, cons
   for_each_object(r, body, ptr, "supports", [&](json& s, const std::string& sp) {
     const auto nodes = read_target(r, s, sp, mesh);
     const int load_case = r.load_case(s, sp);
+    if (s.contains("fix") == s.contains("rotation")) {
+      r.error(sp, "needs exactly one of \"fix\" (components, with values) and \"rotation\" (a rigid rotation)");
+      return;
+    }
+    const auto hold = [&](int dof, double value, const std::string& at, const std::string& what) {
+      if (fixed_by[dof] >= 0) {
+        // The same zero support twice (a corner in two sets) is harmless; two prescribed
+        // values of one dof are ambiguous.
+        if (value != 0.0 || fixed_value[dof] != 0.0)
+          r.error(at, "prescribes " + what + ", which " + pointers[fixed_by[dof]] +
+                          " fixes already: give each dof one support");
+        return;
+      }
+      fixed_by[dof] = static_cast<int>(pointers.size()) - 1;
+      fixed_value[dof] = value;
+      problem.constraints.push_back({dof, value, load_case});
+    };
+    if (json* rotation = s.contains("rotation") ? r.object(s, sp, "rotation", true) : nullptr) {
+      // A small rigid rotation: u = angle (-(y - yc), x - xc).
+      const std::string rp = sp + "/rotation";
+      const Vec2 about = r.vec2(*rotation, rp, "about");
+      const double angle = r.number(*rotation, rp, "angle");
+      if (s.contains("values")) r.error(sp + "/values", "goes with \"fix\"; a rotation sets both components");
+      if (!nodes) return;
+      pointers.push_back(sp);
+      for (int node : *nodes) {
+        const Vec2 d = mesh.nodes[node] - about;
+        hold(ContinuumBody::node_dof(node, 0), -angle * d.y(), rp, "x and y of node " + std::to_string(node));
+        hold(ContinuumBody::node_dof(node, 1), angle * d.x(), rp, "x and y of node " + std::to_string(node));
+      }
+      return;
+    }
     json* fix = r.array(s, sp, "fix", true);
     json* values = r.object(s, sp, "values", false);
     if (!fix || !nodes) return;
@@ -216,21 +248,9 @@ void read_continuum_supports(Reader& r, json& body, const std::string& ptr, cons
       }
       const std::string name = comp.get<std::string>();
       const double value = values && values->contains(name) ? r.number(*values, sp + "/values", name.c_str()) : 0.0;
-      for (int node : *nodes) {
-        const int dof = ContinuumBody::node_dof(node, name == "x" ? 0 : 1);
-        if (fixed_by[dof] >= 0) {
-          // The same zero support twice (a corner in two sets) is harmless; two prescribed
-          // values of one dof are ambiguous.
-          if (value != 0.0 || fixed_value[dof] != 0.0)
-            r.error(sp + "/fix/" + std::to_string(c), "prescribes " + name + " of node " + std::to_string(node) +
-                                                          ", which " + pointers[fixed_by[dof]] +
-                                                          " fixes already: give each dof one support");
-          continue;
-        }
-        fixed_by[dof] = static_cast<int>(pointers.size()) - 1;
-        fixed_value[dof] = value;
-        problem.constraints.push_back({dof, value, load_case});
-      }
+      for (int node : *nodes)
+        hold(ContinuumBody::node_dof(node, name == "x" ? 0 : 1), value, sp + "/fix/" + std::to_string(c),
+             name + " of node " + std::to_string(node));
     }
     if (values)
       for (const auto& [name, v] : values->items()) {

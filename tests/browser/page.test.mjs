@@ -1,14 +1,15 @@
 // The page of `grip serve` in a real browser: Debian's headless Chromium driven by
 // puppeteer-core (tests/browser/package-lock.json, installed by scripts/setup.sh with npm ci).
 // Against a live `grip serve` on a free loopback port: a running job watched live and across a
-// server restart, the beam example submitted and shown, a bad scene's pointer errors.
-// Screenshots go to $GRIP_ARTIFACTS (default build/browser-artifacts), never committed.
+// server restart, the beam example submitted and shown, a bad scene's pointer errors, gmsh
+// meshes uploaded beside a scene. Screenshots go to $GRIP_ARTIFACTS (default build/browser-artifacts), never committed.
 //   GRIP_BINARY=build/apps/grip node --test tests/browser/page.test.mjs
 import { test, before, after } from "node:test";
 import assert from "node:assert/strict";
 import { spawn } from "node:child_process";
 import { createServer, connect } from "node:net";
-import { mkdtempSync, mkdirSync, readFileSync, rmSync, openSync } from "node:fs";
+import { mkdtempSync, mkdirSync, readFileSync, rmSync, openSync, writeFileSync } from "node:fs";
+import { createHash } from "node:crypto";
 import { tmpdir } from "node:os";
 import { dirname, join, resolve } from "node:path";
 import { fileURLToPath } from "node:url";
@@ -337,6 +338,56 @@ test("a bad scene: errors next to the pointers the server names, nothing queued"
   await page.click("#submit");
   await page.waitForFunction(() => /not JSON/.test(document.getElementById("submit-errors").textContent));
   assert.equal((await server.api("/v1/jobs?limit=1000")).body.jobs.length, before);
+});
+
+test("gmsh meshes: an example's mesh and a chosen .msh are uploaded and named by their ids", async () => {
+  await page.bringToFront();
+  await page.goto(server.url + "/ui");
+  const sha256 = (path) => createHash("sha256").update(readFileSync(path)).digest("hex");
+  const until = (state) => page.waitForFunction((s) => document.getElementById("job-panel").dataset.state === s, { timeout: 60000 }, state);
+
+  // hertz-t6 names its mesh as a file: the page uploads the server's copy and submits its id.
+  await page.waitForFunction(() => document.querySelectorAll("#example option").length > 1);
+  await page.select("#example", "/v1/examples/hertz-t6");
+  await page.waitForFunction(() => document.getElementById("scene").value.includes("hertz-t6.msh"));
+  await page.click("#submit");
+  await until("result");
+  let id = await text("#job-id");
+  let result = (await server.api(`/v1/jobs/${id}/result`)).body;
+  const hertzId = sha256(join(REPO, "schemas/examples/hertz-t6.msh"));
+  assert.deepEqual(result.scene.body.mesh.gmsh, { id: hertzId, surfaces: [] });
+  assert.equal(result.summary.completed, true);
+  assert.equal((await server.api(`/v1/meshes/${hertzId}`)).body.elements.t6 > 0, true);
+  // Its 6-node triangles drawn by their corners, one path per cell.
+  assert.equal(await count("#body-view path.cell"), result.mesh.cells.length);
+  await page.screenshot({ path: join(ARTIFACTS, "gmsh-example.png"), fullPage: true });
+
+  // A scene of one's own naming block.msh: refused at its pointer until the file is chosen.
+  const block = example("sliding-block");
+  delete block.body.element;
+  block.body.mesh = { gmsh: { file: "block.msh" } };
+  const input = await page.$("#scene-file");
+  const sceneFile = join(server.dir, "block-scene.json");
+  writeFileSync(sceneFile, JSON.stringify(block));
+  await input.uploadFile(sceneFile);  // another scene: the example's files no longer apply
+  await page.waitForFunction(() => document.getElementById("scene").value.includes("block.msh"));
+  const jobsBefore = (await server.api("/v1/jobs?limit=1000")).body.jobs.length;
+  await page.click("#submit");
+  await page.waitForSelector("#submit-errors li[data-pointer='/body/mesh/gmsh/file']");
+  assert.match(await text("#submit-errors"), /choose block\.msh/);
+  assert.equal((await server.api("/v1/jobs?limit=1000")).body.jobs.length, jobsBefore);
+
+  const blockMsh = join(REPO, "tests/data/gmsh/block.msh");
+  await (await page.$("#mesh-files")).uploadFile(blockMsh);
+  await page.click("#submit");
+  await page.waitForFunction((old) => document.getElementById("job-id").textContent !== old, { timeout: 30000 }, id);
+  await until("result");
+  id = await text("#job-id");
+  result = (await server.api(`/v1/jobs/${id}/result`)).body;
+  assert.equal(result.scene.body.mesh.gmsh.id, sha256(blockMsh));
+  assert.equal(result.mesh.cells.length, 200);  // gmsh's 20 x 10 quadrilaterals
+  assert.equal((await server.api("/v1/jobs?limit=1000")).body.jobs.length, jobsBefore + 1);
+  assert.equal(await page.$$eval("#submit-errors li", (lis) => lis.length), 0);
 });
 
 // The page cannot resume what it never read: when the browser surfaces nothing of the cut

@@ -1,7 +1,7 @@
 // Memory against hostile scenes (issue 34.2): 8 clients submit 6 MB scenes at once (under the
 // 8 MiB body limit), each built to make the reader or the validator find problems in every
 // entry. The real `grip serve` must keep its peak resident memory (VmHWM) under 500 MB and
-// come back near its idle size (VmRSS) afterwards (within 10 MB; see below). The measured numbers are printed
+// come back within 20 % of its idle size (VmRSS) afterwards. The measured numbers are printed
 // for bench/results/hostile-clients.md.
 #include <gtest/gtest.h>
 
@@ -116,10 +116,11 @@ TEST(HostileMemory, EightLargeAdversarialScenesAtOnceStayUnder500MbAndMemoryCome
       "peak (VmHWM) %.1f MB, after %.1f MB\n",
       attacks[0].second.size(), attacks[1].second.size(), attacks[2].second.size(), seconds, idle, peak, after);
   EXPECT_LT(peak, 500.0);
-  // Issue 34 asks for 20 % of the idle size; what stays is some 6 MB in glibc's second malloc
-  // arena that malloc_trim cannot return (pages shared with live allocations): 26 MB against
-  // 18-20 MB idle (bench/results/hostile-clients.md). Before: 823 MB after one such request.
-  EXPECT_LE(after, idle + 10.0);
+  // Issue 34: back within 20 % of the idle size. glibc's per-thread caches of freed blocks
+  // held pages of the parses' memory that malloc_trim cannot return (26.8 MB against 21.6 MB
+  // idle); grip serve runs without them (apps/grip_server.cpp). Before: 823 MB after one such
+  // request.
+  EXPECT_LE(after, 1.2 * idle);
   // Still serving.
   auto health = api.get("/v1/health");
   ASSERT_TRUE(health);

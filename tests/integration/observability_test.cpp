@@ -30,13 +30,22 @@ TEST(Observability, RequestsAreCountedByMethodRouteAndStatusWithLatencyAndJobHis
   ASSERT_EQ(api.get("/v1/jobs/no-such-job")->status, 404);
   ASSERT_EQ(api.post_json("/v1/jobs", R"({"body": {}})")->status, 422);
   ASSERT_EQ(api.get("/no/such/route")->status, 404);
-  // A request is counted by httplib's logger, which runs once its answer has gone out: the
-  // client may ask for the metrics first (a parallel test run did). Read until the last one
-  // is in.
+  // A request is counted by httplib's logger, which runs once its answer has gone out, on the
+  // thread of its connection (each request here has its own): the client may ask for the
+  // metrics before an earlier request is counted. A job's run is observed just after its end
+  // is stored, so wait_status may see it finished first. Read until every series asserted
+  // below is in (the counts only grow).
   std::string m;
-  for (int tries = 0; tries < 100; ++tries) {
+  const auto all_in = [&] {
+    return sample(m, R"(grip_http_requests_total{method="GET",route="other",status="404"})") >= 1 &&
+           sample(m, R"(grip_http_requests_total{method="GET",route="/v1/jobs/{id}",status="404"})") >= 1 &&
+           sample(m, R"(grip_http_requests_total{method="GET",route="/v1/jobs/{id}",status="200"})") >= 4 &&
+           sample(m, R"(grip_http_request_duration_seconds_count{route="/v1/jobs"})") >= 2 &&
+           sample(m, R"(grip_job_run_seconds_count{outcome="successful"})") >= 1;
+  };
+  for (int tries = 0; tries < 250; ++tries) {
     m = api.get("/v1/metrics")->body;
-    if (sample(m, R"(grip_http_requests_total{method="GET",route="other",status="404"})") >= 0) break;
+    if (all_in()) break;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
 

@@ -17,7 +17,7 @@ import sys
 import tarfile
 from typing import Any, Dict, List, Optional, Sequence, TextIO
 
-from .client import Client, GripError, Job
+from .client import Client, GripError, Job, gmsh_references
 
 EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
 
@@ -199,6 +199,43 @@ def load_scene(client: Client, spec: str) -> dict:
         raise UsageError(f"{spec} is not JSON: {e}") from None
 
 
+def scene_meshes(client: Client, spec: str, scene: dict, given: Sequence[str]) -> Dict[str, Any]:
+    """The .msh files for a scene's gmsh references {"file": NAME}, by NAME: each --mesh PATH
+    under its base name; a name without one is read as grip solve reads it, beside the scene
+    file (example:NAME: the server's example file)."""
+    meshes: Dict[str, Any] = {}
+    for path in given:
+        if not os.path.isfile(path):
+            raise UsageError(f"--mesh {path}: no such file")
+        meshes[os.path.basename(path)] = path
+    used = set()
+    for pointer, ref in gmsh_references(scene):
+        name = ref["file"]
+        if name in meshes or os.path.basename(name) in meshes:
+            used.add(name if name in meshes else os.path.basename(name))
+            continue
+        if spec.startswith("example:"):
+            meshes[name] = client.example_mesh(name)
+        else:
+            beside = os.path.join(os.path.dirname(os.path.abspath(spec)), name)
+            if not os.path.isfile(beside):
+                raise UsageError(f"{spec}: {pointer}/file names '{name}': give it with --mesh "
+                                 f"(not found beside the scene either)")
+            meshes[name] = beside
+    unused = sorted(set(os.path.basename(p) for p in given) - used)
+    if unused:
+        raise UsageError(f"--mesh {', '.join(unused)}: the scene names no such file (its gmsh "
+                         f"references: {', '.join(r['file'] for _, r in gmsh_references(scene)) or 'none'})")
+    return meshes
+
+
+def load_scene_with_meshes(client: Client, spec: str, given: Sequence[str]) -> dict:
+    """The scene with its gmsh mesh files uploaded (POST /v1/meshes) and named by their ids."""
+    scene = load_scene(client, spec)
+    meshes = scene_meshes(client, spec, scene, given)
+    return client.with_meshes(scene, meshes) if meshes else scene
+
+
 # ---- watching
 
 
@@ -271,7 +308,7 @@ def watch_job(job: Job, out: TextIO, raw: bool = False, live: Optional[bool] = N
 
 
 def cmd_submit(client: Client, args, out: TextIO) -> int:
-    scene = load_scene(client, args.scene)
+    scene = load_scene_with_meshes(client, args.scene, args.mesh)
     job = client.submit(scene, idempotency_key=args.key)
     if args.json:
         out.write(json.dumps(job.doc, indent=2) + "\n")
@@ -453,7 +490,7 @@ def plot_paper(client: Client, args, out: TextIO, plots) -> int:
 
 
 def cmd_sweep(client: Client, args, out: TextIO) -> int:
-    base = load_scene(client, args.scene)
+    base = load_scene_with_meshes(client, args.scene, args.mesh)  # each mesh uploaded once
     sets = [parse_set(s) for s in args.set]
     outputs = args.output or ["summary.contact_iterations", "summary.newton_iterations"]
     variants = []
@@ -520,6 +557,10 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--watch", action="store_true", help="then follow it as `watch` does")
     s.add_argument("--key", help="Idempotency-Key: resubmitting with it returns the same job")
     s.add_argument("--json", action="store_true", help="print the job document")
+    s.add_argument("--mesh", action="append", default=[], metavar="PART.msh",
+                   help="a gmsh mesh the scene names as {\"file\": \"PART.msh\"}: uploaded (POST "
+                        "/v1/meshes) and named by its id (repeatable; default: the files beside "
+                        "the scene)")
     s.set_defaults(func=cmd_submit)
 
     s = sub.add_parser("watch", parents=[common],
@@ -568,6 +609,8 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--output", action="append", metavar="PATH",
                    help="result path to tabulate, e.g. steps.-1.nodes.-1.w (repeatable; default "
                         "summary.contact_iterations and summary.newton_iterations)")
+    s.add_argument("--mesh", action="append", default=[], metavar="PART.msh",
+                   help="a gmsh mesh the scene names, uploaded once for every variant (as submit)")
     s.add_argument("--csv", help="also write the table as CSV")
     s.add_argument("--json", action="store_true", help="print the table as JSON")
     s.set_defaults(func=cmd_sweep)

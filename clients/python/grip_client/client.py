@@ -8,6 +8,7 @@
     doc = job.wait()                      # the final job document (OGC status info)
     result = job.result()                 # the result JSON as a dict
     job.dismiss()
+    job = c.submit(scene, meshes={"part.msh": "part.msh"})   # gmsh meshes uploaded first
 
 Every HTTP error raises GripError, which carries the RFC 9457 problem document and its
 `errors[]` of {pointer, detail}.
@@ -25,7 +26,8 @@ import urllib.parse
 import urllib.request
 from typing import Any, Dict, Iterator, List, Optional, Union
 
-__all__ = ["Client", "Job", "Event", "GripError", "TERMINAL_EVENTS", "FINISHED_STATUSES"]
+__all__ = ["Client", "Job", "Event", "GripError", "TERMINAL_EVENTS", "FINISHED_STATUSES",
+           "gmsh_references"]
 
 TERMINAL_EVENTS = ("job_finished", "job_failed")
 FINISHED_STATUSES = ("successful", "failed", "dismissed")
@@ -200,14 +202,65 @@ class Client:
         """A JSON Schema by name: scene, result, event or job."""
         return self.get("/v1/schemas/" + urllib.parse.quote(name))
 
+    # ---- meshes
+
+    def upload_mesh(self, mesh: Union[bytes, str, os.PathLike]) -> dict:
+        """Uploads a gmsh .msh file (its bytes, or a path) with POST /v1/meshes and returns what
+        the server read: {"id", "nodes", "elements": {kind: count}, "physical_groups", ...}.
+        The id is the SHA-256 of the bytes: the same file uploaded again is stored once."""
+        if not isinstance(mesh, (bytes, bytearray)):
+            with open(mesh, "rb") as f:
+                mesh = f.read()
+        return self.request("POST", "/v1/meshes", bytes(mesh),
+                            {"Content-Type": "application/octet-stream"})
+
+    def example_mesh(self, name: str) -> bytes:
+        """The mesh file a built-in example names (e.g. hertz-t6.msh), as bytes."""
+        return self.get("/v1/examples/" + urllib.parse.quote(name), raw=True)
+
+    def with_meshes(self, scene: dict,
+                    meshes: Dict[str, Union[bytes, str, os.PathLike]]) -> dict:
+        """A copy of `scene` in which every gmsh mesh reference {"file": NAME} (body.mesh.gmsh,
+        bodies[].mesh.gmsh, obstacles[].shape.gmsh) is {"id": ...} of the upload of
+        meshes[NAME] (bytes or a path; NAME as the scene writes it, or its base name). Each
+        file is uploaded once. A reference without a mesh raises ValueError naming its
+        pointer."""
+        out = json.loads(json.dumps(scene))
+        ids: Dict[str, str] = {}
+        missing = []
+        for pointer, ref in gmsh_references(out):
+            name = ref["file"]
+            key = name if name in meshes else os.path.basename(name)
+            if key not in meshes:
+                missing.append(f"{pointer}/file: no mesh given for '{name}'")
+                continue
+            if key not in ids:
+                ids[key] = self.upload_mesh(meshes[key])["id"]
+            del ref["file"]
+            ref["id"] = ids[key]
+        if missing:
+            raise ValueError("; ".join(missing))
+        return out
+
     # ---- jobs
 
     def submit(self, scene: Union[dict, str, os.PathLike, bytes],
-               idempotency_key: Optional[str] = None) -> "Job":
+               idempotency_key: Optional[str] = None,
+               meshes: Optional[Dict[str, Union[bytes, str, os.PathLike]]] = None) -> "Job":
         """Submits a scene (a dict, a path to a JSON file, or raw bytes) and returns its Job.
+        `meshes`: the .msh files its gmsh references name, by name (see with_meshes), uploaded
+        first.
 
         A 503 (queue full: nothing was accepted) is retried up to `submit_retries` times after
         its Retry-After."""
+        if meshes:
+            if not isinstance(scene, dict):
+                if isinstance(scene, (bytes, bytearray)):
+                    scene = json.loads(bytes(scene).decode("utf-8"))
+                else:
+                    with open(scene, "rb") as f:
+                        scene = json.load(f)
+            scene = self.with_meshes(scene, meshes)
         if isinstance(scene, (bytes, bytearray)):
             body = bytes(scene)
         elif isinstance(scene, dict):
@@ -428,6 +481,22 @@ class Job:
             time.sleep(0.05)
             self.doc = self.client.request("DELETE", self.path)
         return self.doc
+
+
+def gmsh_references(scene: Any, pointer: str = "") -> Iterator[tuple]:
+    """(JSON pointer, object) of every gmsh mesh reference of a scene that names a file: the
+    objects under a "gmsh" key with a string "file" (body.mesh.gmsh, bodies[].mesh.gmsh,
+    obstacles[].shape.gmsh)."""
+    if isinstance(scene, dict):
+        for key, value in scene.items():
+            here = pointer + "/" + key.replace("~", "~0").replace("/", "~1")
+            if key == "gmsh" and isinstance(value, dict) and isinstance(value.get("file"), str):
+                yield here, value
+            else:
+                yield from gmsh_references(value, here)
+    elif isinstance(scene, list):
+        for k, value in enumerate(scene):
+            yield from gmsh_references(value, f"{pointer}/{k}")
 
 
 def _parse_sse(resp) -> Iterator[tuple]:

@@ -1,6 +1,7 @@
 """`python3 -m grip_client` against a live server: output, files and exit codes
 (0 success, 1 job failed, 2 usage or HTTP error with the problem's pointers)."""
 
+import hashlib
 import json
 import os
 import re
@@ -174,6 +175,64 @@ class Cli(unittest.TestCase):
         self.assertEqual([r["status"] for r in rows], ["successful", "failed"])
         self.assertEqual(rows[0]["summary.steps"], 4)
         self.assertIsNone(rows[1]["summary.steps"])
+
+
+class Meshes(unittest.TestCase):
+    """submit --mesh: the scene's gmsh files uploaded (POST /v1/meshes), named by their ids."""
+
+    @classmethod
+    def setUpClass(cls):
+        cls.tmp = tempfile.TemporaryDirectory()
+        cls.client = support.client()
+        cls.msh = os.path.join(support.EXAMPLES, "hertz-t6.msh")
+        with open(cls.msh, "rb") as f:
+            cls.sha = hashlib.sha256(f.read()).hexdigest()
+        # The example alone in a folder of its own: its .msh is not beside it.
+        cls.alone = write_json(cls.tmp.name, "hertz.json", support.example("hertz-t6"))
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.tmp.cleanup()
+
+    def solved_with_the_upload(self, p):
+        self.assertEqual(p.returncode, 0, p.stdout + p.stderr)
+        job = self.client.job(p.stdout.splitlines()[0].strip())
+        self.assertEqual(job.wait()["status"], "successful")
+        result = job.result()
+        self.assertEqual(result["scene"]["body"]["mesh"]["gmsh"], {"id": self.sha, "surfaces": []})
+        self.assertTrue(result["summary"]["completed"])
+        return result
+
+    def test_submit_with_mesh_uploads_it_and_the_job_solves(self):
+        self.solved_with_the_upload(support.cli("submit", self.alone, "--mesh", self.msh, "--watch"))
+        # Without --mesh: the file beside the scene, as grip solve reads it; example:NAME: the
+        # server's example file. The same bytes each time: one stored mesh.
+        beside = self.solved_with_the_upload(
+            support.cli("submit", os.path.join(support.EXAMPLES, "hertz-t6.json")))
+        example = self.solved_with_the_upload(support.cli("submit", "example:hertz-t6"))
+        self.assertEqual(beside["steps"][-1]["nodes"], example["steps"][-1]["nodes"])
+        self.assertEqual(self.client.get("/v1/meshes/" + self.sha)["id"], self.sha)
+
+    def test_a_missing_or_unused_mesh_is_a_usage_error(self):
+        p = support.cli("submit", self.alone)
+        self.assertEqual(p.returncode, 2)
+        self.assertIn("/body/mesh/gmsh/file names 'hertz-t6.msh': give it with --mesh", p.stderr)
+        other = os.path.join(support.REPO, "tests", "data", "gmsh", "block.msh")
+        p = support.cli("submit", self.alone, "--mesh", self.msh, "--mesh", other)
+        self.assertEqual(p.returncode, 2)
+        self.assertIn("--mesh block.msh: the scene names no such file", p.stderr)
+        p = support.cli("submit", self.alone, "--mesh", os.path.join(self.tmp.name, "none.msh"))
+        self.assertEqual(p.returncode, 2)
+        self.assertIn("none.msh: no such file", p.stderr)
+        # A file the reader refuses: the server's 422 with the line.
+        bad = os.path.join(self.tmp.name, "hertz-t6.msh")
+        with open(bad, "w", encoding="utf-8") as f:
+            f.write("$MeshFormat\n5.0 0 8\n$EndMeshFormat\n")
+        p = support.cli("submit", self.alone, "--mesh", bad)
+        self.assertEqual(p.returncode, 2)
+        self.assertIn("422 Invalid mesh", p.stderr)
+        self.assertIn("upload:2:", p.stderr)
+        os.remove(bad)
 
 
 if __name__ == "__main__":

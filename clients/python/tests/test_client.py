@@ -2,8 +2,10 @@
 errors with pointers, paging."""
 
 import csv
+import hashlib
 import io
 import json
+import os
 import tarfile
 import unittest
 import uuid
@@ -272,6 +274,73 @@ class Paging(unittest.TestCase):
             client.submit(support.small_beam(steps=2), idempotency_key=key)
         self.assertEqual(ctx.exception.status, 422)
         first.wait()
+
+
+class Meshes(unittest.TestCase):
+    """gmsh meshes: uploaded once (POST /v1/meshes), named in the scene by their id."""
+
+    BLOCK = os.path.join(support.REPO, "tests", "data", "gmsh", "block.msh")
+
+    @classmethod
+    def setUpClass(cls):
+        cls.client = support.client()
+
+    def block_scene(self):
+        # The sliding block on gmsh's 20 x 10 quadrilaterals of the same rectangle (block.geo).
+        scene = support.example("sliding-block")
+        del scene["body"]["element"]
+        scene["body"]["mesh"] = {"gmsh": {"file": "block.msh"}}
+        return scene
+
+    def test_a_mesh_is_uploaded_and_the_scene_names_it_by_id(self):
+        with open(self.BLOCK, "rb") as f:
+            data = f.read()
+        sha = hashlib.sha256(data).hexdigest()
+        job = self.client.submit(self.block_scene(), meshes={"block.msh": self.BLOCK})
+        self.assertEqual(job.wait()["status"], "successful")
+        result = job.result()
+        self.assertEqual(result["scene"]["body"]["mesh"]["gmsh"]["id"], sha)
+        self.assertNotIn("file", result["scene"]["body"]["mesh"]["gmsh"])
+        upload = self.client.upload_mesh(data)  # the same bytes again: the same id
+        self.assertEqual(upload["id"], sha)
+        self.assertEqual(upload["elements"], {"q4": 200})
+        self.assertEqual(upload["nodes"], 231)
+
+        # It solves as the generated rectangle: the same displacement at each place.
+        generated = self.client.submit(support.example("sliding-block"))
+        self.assertEqual(generated.wait()["status"], "successful")
+        reference = generated.result()
+        for mine, theirs in zip(result["steps"], reference["steps"]):
+            def by_place(nodes):
+                return {(round(n["x"] - n["ux"], 4), round(n["y"] - n["uy"], 4)): (n["ux"], n["uy"])
+                        for n in nodes}
+            a, b = by_place(mine["nodes"]), by_place(theirs["nodes"])
+            self.assertEqual(a.keys(), b.keys())
+            largest = max(abs(v) for uv in b.values() for v in uv)
+            for place, uv in b.items():
+                for u, v in zip(a[place], uv):
+                    self.assertAlmostEqual(u, v, delta=1e-6 * largest, msg=f"node at {place}")
+
+    def test_a_reference_without_a_mesh_names_its_pointer(self):
+        scene = self.block_scene()
+        scene["obstacles"][0]["shape"] = {"type": "gmsh_curve", "gmsh": {"file": "tools/tool.msh"},
+                                          "curve": "flat"}
+        with self.assertRaises(ValueError) as e:
+            self.client.with_meshes(scene, {"block.msh": self.BLOCK})
+        self.assertIn("/obstacles/0/shape/gmsh/file: no mesh given for 'tools/tool.msh'",
+                      str(e.exception))
+        self.assertNotIn("/body/mesh", str(e.exception))
+        # A name with a folder takes the file of its base name; each file is uploaded once.
+        tool = os.path.join(support.REPO, "tests", "data", "gmsh", "tool.msh")
+        out = self.client.with_meshes(scene, {"block.msh": self.BLOCK, "tool.msh": tool})
+        self.assertEqual(set(out["obstacles"][0]["shape"]["gmsh"]), {"id"})
+        self.assertEqual(scene["obstacles"][0]["shape"]["gmsh"]["file"], "tools/tool.msh")  # a copy
+
+    def test_a_file_the_reader_refuses_is_a_422_naming_its_line(self):
+        with self.assertRaises(GripError) as e:
+            self.client.upload_mesh(b"$MeshFormat\n5.0 0 8\n$EndMeshFormat\n")
+        self.assertEqual(e.exception.status, 422)
+        self.assertIn("upload:2:", e.exception.describe())
 
 
 if __name__ == "__main__":
