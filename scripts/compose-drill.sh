@@ -15,25 +15,39 @@ trap '"${compose[@]}" down -v >/dev/null 2>&1 || true' EXIT
 api=http://127.0.0.1:8080
 for _ in $(seq 1 120); do curl -sf "$api/v1/ready" >/dev/null && break; sleep 1; done
 
-python3 scripts/compose_drill.py "$api" tests/load/small-job.json 2 50 &
+# The client submits one job every 0.3 s per client (some 15 s of submissions), so that
+# submissions and polls meet both faults: a replica killed at 3 s, PostgreSQL stopped from
+# 5 s to 13 s.
+t0=$(date +%s.%N)
+since() { printf '%.1f' "$(echo "$(date +%s.%N) - $t0" | bc)"; }
+python3 scripts/compose_drill.py "$api" tests/load/small-job.json 2 50 0.3 &
 client=$!
 sleep 3
-"${compose[@]}" kill -s KILL grip2
+echo "$(since) s: kill -9 grip2"
+"${compose[@]}" kill -s KILL grip2 >/dev/null 2>&1
 sleep 2
-"${compose[@]}" stop -t 0 postgres
+echo "$(since) s: PostgreSQL stopped"
+"${compose[@]}" stop -t 0 postgres >/dev/null 2>&1
 sleep 8
-"${compose[@]}" start postgres
-"${compose[@]}" start grip2
+echo "$(since) s: PostgreSQL started, grip2 started"
+"${compose[@]}" start postgres >/dev/null 2>&1
+"${compose[@]}" start grip2 >/dev/null 2>&1
 status=0
 wait "$client" || status=$?
+echo "$(since) s: the client ended (exit status $status)"
 
-# Stopping: HAProxy on SIGTERM at once; the replicas within their grace.
+# Stopping: HAProxy on SIGTERM at once; the replicas within their grace. Timed from `docker
+# stop` to the container's own end (its FinishedAt), without compose's own start-up.
 for service in haproxy grip1 grip3; do
-  start=$(date +%s.%N)
-  "${compose[@]}" stop "$service" >/dev/null 2>&1
-  code=$(docker inspect -f '{{.State.ExitCode}}' "$("${compose[@]}" ps -q "$service")")
-  echo "$service stopped in $(echo "$(date +%s.%N) - $start" | bc) s, exit status $code"
+  id=$("${compose[@]}" ps -q "$service")
+  start=$(date -u +%s.%N)
+  docker stop "$id" >/dev/null
+  finished=$(date -u -d "$(docker inspect -f '{{.State.FinishedAt}}' "$id")" +%s.%N)
+  code=$(docker inspect -f '{{.State.ExitCode}}' "$id")
+  echo "$service stopped $(printf '%.2f' "$(echo "$finished - $start" | bc)") s after SIGTERM, exit status $code"
   [ "$code" != 137 ] || status=1
+  if [ "$service" = haproxy ] && [ "$(echo "$finished - $start > 1" | bc)" = 1 ]; then status=1; fi
 done
+"${compose[@]}" logs grip1 grip2 grip3 | grep -c 'lease lost' | sed 's/^/replicas logged "lease lost": /' || true
 "${compose[@]}" logs haproxy | grep -c '"POST /v1/jobs' | sed 's/^/haproxy logged POSTs: /'
 exit "$status"

@@ -1,8 +1,10 @@
 #pragma once
-// The embedded job store: one SQLite file in WAL mode, used by one process. Job changes
-// commit with synchronous=FULL (they survive kill -9 and power loss); event batches with
-// NORMAL (they survive kill -9, and the job's FULL finish makes them durable before it is
-// reported). One connection writes and one reads (WAL lets reads run beside a write), each
+// The embedded job store: one SQLite file in WAL mode, used by one process. A job's end
+// commits with synchronous=FULL (it survives kill -9 and power loss); a submission commits
+// with NORMAL and is then fsynced (the WAL file) outside the writer's lock, before
+// insert_job returns, so that concurrent submissions do not queue behind each other's fsync;
+// claims, lease renewals and event batches commit with NORMAL (they survive kill -9; what a
+// power cut takes of them, recovery redoes; the next fsync makes them durable). One connection writes and one reads (WAL lets reads run beside a write), each
 // under its own mutex. Since no other process shares the file, opening it releases every
 // lease: the runs of the previous process are requeued at once by requeue_expired. Changes
 // are announced to the listener right after they commit.
@@ -20,6 +22,7 @@ class SqliteStore final : public Store {
  public:
   // Creates the file (and its folder) and the schema when missing; upgrades an older schema.
   explicit SqliteStore(const std::string& path, int busy_timeout_ms = 5000);
+  ~SqliteStore() override;
 
   void insert_job(JobRecord& job) override;
   std::optional<JobRecord> job(const std::string& id, bool with_scene) override;
@@ -57,6 +60,9 @@ class SqliteStore final : public Store {
 
   std::mutex write_mutex_;
   std::unique_ptr<Database> writer_;
+  // The WAL file, opened once more to fsync a submission's commit after the writer is free
+  // (insert_job); -1: submissions commit with synchronous=FULL instead.
+  int wal_fd_ = -1;
   std::mutex read_mutex_;
   std::unique_ptr<Database> reader_;
   std::mutex listener_mutex_;

@@ -1,6 +1,9 @@
 // Slow, idle and hostile clients against one `grip serve` (issue 34): raw loopback sockets,
 // bounded in count and time. The asserts are about the service answering; the latencies are
-// printed ([ info ] lines) and recorded in bench/results/hostile-clients.md.
+// printed ([ info ] lines) and recorded in bench/results/hostile-clients.md. The issue's 100 ms
+// for /v1/health is not asserted: nine in ten answer within 5 ms, but on 2 shared cores about
+// one request in 70 waits 0.4-0.7 s, of which the client's own loopback connect takes up to
+// 170 ms (the measuring process was not running), so a bound would fail on the machine's load.
 //
 // The attackers connect from other loopback addresses (127.0.1.x, 127.0.2.x: Linux routes
 // all of 127/8 to lo) than the well-behaved client (127.0.0.1), as they would from other
