@@ -32,7 +32,7 @@ namespace {
 // The arrays' bytes, roughly: what the cache is bounded by.
 std::size_t mesh_bytes(const GmshMesh& m) {
   std::size_t n = m.nodes.size() * sizeof(Vec2) + m.node_tags.size() * sizeof(std::size_t) +
-                  m.element_tags.size() * (sizeof(std::size_t) + sizeof(GmshElementKind) + sizeof(int)) +
+                  m.element_tags.size() * (sizeof(std::size_t) + sizeof(ElementShape) + sizeof(int)) +
                   m.element_nodes.size() * sizeof(int);
   for (const auto& [name, s] : m.surfaces) n += s.elements.size() * sizeof(int);
   for (const auto& [name, c] : m.curves) n += (c.nodes.size() + 3 * c.edges.size()) * sizeof(int);

@@ -18,29 +18,13 @@
 
 namespace grip {
 
-const char* element_kind_name(GmshElementKind kind) {
-  switch (kind) {
-    case GmshElementKind::t3:
-      return "t3";
-    case GmshElementKind::t6:
-      return "t6";
-    case GmshElementKind::q4:
-      return "q4";
-    case GmshElementKind::q8:
-      return "q8";
-    case GmshElementKind::q9:
-      return "q9";
-  }
-  return "?";
-}
-
 namespace {
 
 // What grip does with each gmsh element type it reads.
 struct TypeInfo {
   int dimension = -1;  // -1: not read
   int nodes = 0;
-  GmshElementKind kind = GmshElementKind::t3;  // for dimension 2
+  ElementShape kind = ElementShape::t3;  // for dimension 2
   int corners = 0;
 };
 
@@ -53,15 +37,15 @@ TypeInfo type_info(std::int64_t type) {
     case 8:
       return {1, 3};
     case 2:
-      return {2, 3, GmshElementKind::t3, 3};
+      return {2, 3, ElementShape::t3, 3};
     case 9:
-      return {2, 6, GmshElementKind::t6, 3};
+      return {2, 6, ElementShape::t6, 3};
     case 3:
-      return {2, 4, GmshElementKind::q4, 4};
+      return {2, 4, ElementShape::q4, 4};
     case 16:
-      return {2, 8, GmshElementKind::q8, 4};
+      return {2, 8, ElementShape::q8, 4};
     case 10:
-      return {2, 9, GmshElementKind::q9, 4};
+      return {2, 9, ElementShape::q9, 4};
     default:
       return {};
   }
@@ -654,10 +638,10 @@ std::pair<double, double> corner_area(const std::vector<Vec2>& xy, std::span<con
 }
 
 // The same element counter-clockwise: corners reversed from corner 0, mid-sides after them.
-void reorient(GmshElementKind kind, std::span<int> n) {
+void reorient(ElementShape kind, std::span<int> n) {
   static constexpr std::array<int, 9> t6 = {0, 2, 1, 5, 4, 3};
   static constexpr std::array<int, 9> q9 = {0, 3, 2, 1, 7, 6, 5, 4, 8};
-  const auto& order = (kind == GmshElementKind::t3 || kind == GmshElementKind::t6) ? t6 : q9;
+  const auto& order = element_corner_count(kind) == 3 ? t6 : q9;
   std::array<int, 9> copy{};
   std::copy(n.begin(), n.end(), copy.begin());
   for (std::size_t k = 0; k < n.size(); ++k) n[k] = copy[order[k]];
@@ -674,7 +658,7 @@ void check_elements(const Cursor& c, Reading& r) {
           c.fail("element " + std::to_string(m.element_tags[e]) + " uses node " + std::to_string(r.tags[nodes[a]]) +
                  " twice");
     const auto kind = m.element_kinds[e];
-    const int corners = (kind == GmshElementKind::t3 || kind == GmshElementKind::t6) ? 3 : 4;
+    const int corners = element_corner_count(kind);
     const auto [area, longest] = corner_area(r.xy, nodes, corners);
     if (!(std::abs(area) > 1e-12 * longest))
       c.fail("element " + std::to_string(m.element_tags[e]) + " has zero area (its corners lie on one line)");
@@ -907,7 +891,7 @@ nlohmann::json gmsh_mesh_summary(const GmshMesh& mesh) {
   for (auto kind : mesh.element_kinds) ++per_kind[static_cast<int>(kind)];
   nlohmann::json elements = nlohmann::json::object();
   for (int k = 0; k < 5; ++k)
-    if (per_kind[k] > 0) elements[element_kind_name(static_cast<GmshElementKind>(k))] = per_kind[k];
+    if (per_kind[k] > 0) elements[shape_name(static_cast<ElementShape>(k))] = per_kind[k];
   nlohmann::json groups = nlohmann::json::array();
   std::vector<int> in_group(mesh.nodes.size(), -1);  // the last surface that counted each node
   int group = 0;

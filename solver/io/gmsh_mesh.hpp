@@ -19,6 +19,7 @@
 #include <string_view>
 #include <vector>
 
+#include "solver/elements/plane_element.hpp"
 #include "solver/model/types.hpp"
 
 namespace grip {
@@ -29,9 +30,6 @@ namespace grip {
 struct GmshError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
-
-enum class GmshElementKind { t3, t6, q4, q8, q9 };
-const char* element_kind_name(GmshElementKind kind);  // "t3", "t6", ...
 
 // A physical surface: an element set (indices into GmshMesh's elements).
 struct GmshSurface {
@@ -72,7 +70,7 @@ struct GmshMesh {
   int body_nodes = 0;
 
   std::vector<std::size_t> element_tags;
-  std::vector<GmshElementKind> element_kinds;
+  std::vector<ElementShape> element_kinds;
   std::vector<int> element_offsets{0};  // element e's nodes: element_nodes[offsets[e], offsets[e + 1])
   std::vector<int> element_nodes;
   int reoriented = 0;

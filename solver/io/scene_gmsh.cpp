@@ -136,10 +136,9 @@ std::optional<FileMesh> read_file_mesh(Reader& r, json& gmsh, const std::string&
     if (!chosen[e]) continue;
     if (first < 0) first = e;
     if (file->element_kinds[e] != file->element_kinds[first]) {
-      r.error(ptr, std::string("mixes ") + element_kind_name(file->element_kinds[first]) + " (element tag " +
-                       std::to_string(file->element_tags[first]) + ") and " +
-                       element_kind_name(file->element_kinds[e]) + " (element tag " +
-                       std::to_string(file->element_tags[e]) +
+      r.error(ptr, std::string("mixes ") + shape_name(file->element_kinds[first]) + " (element tag " +
+                       std::to_string(file->element_tags[first]) + ") and " + shape_name(file->element_kinds[e]) +
+                       " (element tag " + std::to_string(file->element_tags[e]) +
                        ") elements: one body takes one element kind (mesh the part with one, or name its surfaces "
                        "as bodies)");
       return std::nullopt;
@@ -162,7 +161,7 @@ std::optional<FileMesh> read_file_mesh(Reader& r, json& gmsh, const std::string&
                      ": a body needs triangles or quadrilaterals");
     return std::nullopt;
   }
-  out.element = element_kind_name(file->element_kinds[first]);
+  out.element = shape_name(file->element_kinds[first]);
 
   for (const auto& [name, surface] : file->surfaces)
     for (int e : surface.elements)

@@ -34,7 +34,7 @@ TEST(GripMesh, MeshesTheHertzGeometryIntoT6WithItsPhysicalGroups) {
   const GmshMesh mesh = read_gmsh_file(msh.string());
   EXPECT_EQ(summary, gmsh_mesh_summary(mesh));
   ASSERT_GT(mesh.element_count(), 100);
-  for (int e = 0; e < mesh.element_count(); ++e) ASSERT_EQ(mesh.element_kinds[e], GmshElementKind::t6) << e;
+  for (int e = 0; e < mesh.element_count(); ++e) ASSERT_EQ(mesh.element_kinds[e], ElementShape::t6) << e;
   EXPECT_EQ(mesh.reoriented, 0);
   ASSERT_EQ(mesh.surfaces.count("disc"), 1u);
   EXPECT_EQ(mesh.surfaces.at("disc").elements.size(), static_cast<size_t>(mesh.element_count()));

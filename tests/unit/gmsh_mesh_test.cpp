@@ -55,8 +55,7 @@ void expect_plate(const GmshMesh& m) {
   EXPECT_EQ(m.nodes[7], Vec2(2, 1.5));
   ASSERT_EQ(m.element_count(), 3);
   EXPECT_EQ(m.element_tags, (std::vector<std::size_t>{1, 2, 3}));
-  EXPECT_EQ(m.element_kinds,
-            (std::vector<GmshElementKind>{GmshElementKind::q4, GmshElementKind::t3, GmshElementKind::t3}));
+  EXPECT_EQ(m.element_kinds, (std::vector<ElementShape>{ElementShape::q4, ElementShape::t3, ElementShape::t3}));
   EXPECT_EQ(nodes_of(m, 0), (std::vector<int>{0, 1, 4, 5}));
   EXPECT_EQ(nodes_of(m, 1), (std::vector<int>{1, 2, 3}));
   EXPECT_EQ(nodes_of(m, 2), (std::vector<int>{1, 3, 4}));  // written 20 50 40: clockwise
@@ -109,8 +108,8 @@ TEST(GmshMesh, QuadraticElementsKeepGmshNodeOrderCounterClockwise) {
     for (std::size_t i = 0; i < m.nodes.size(); ++i)
       EXPECT_EQ(m.node_tags[i], 1 + std::lround(2 * m.nodes[i].x()) + 7 * std::lround(2 * m.nodes[i].y()));
     ASSERT_EQ(m.element_count(), 4);
-    EXPECT_EQ(m.element_kinds, (std::vector<GmshElementKind>{GmshElementKind::q9, GmshElementKind::q8,
-                                                             GmshElementKind::t6, GmshElementKind::t6}));
+    EXPECT_EQ(m.element_kinds,
+              (std::vector<ElementShape>{ElementShape::q9, ElementShape::q8, ElementShape::t6, ElementShape::t6}));
     EXPECT_EQ(m.reoriented, 1);
     // Every element: corners counter-clockwise; each mid-side node halfway between the
     // corners the documented order gives; a q9's centre at the mean of its corners.

@@ -20,17 +20,17 @@ namespace {
 
 using Tags = std::vector<std::size_t>;
 
-int gmsh_type(GmshElementKind kind) {
+int gmsh_type(ElementShape kind) {
   switch (kind) {
-    case GmshElementKind::t3:
+    case ElementShape::t3:
       return 2;
-    case GmshElementKind::t6:
+    case ElementShape::t6:
       return 9;
-    case GmshElementKind::q4:
+    case ElementShape::q4:
       return 3;
-    case GmshElementKind::q8:
+    case ElementShape::q8:
       return 16;
-    case GmshElementKind::q9:
+    case ElementShape::q9:
       return 10;
   }
   return 0;
