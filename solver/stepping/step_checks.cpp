@@ -19,13 +19,9 @@ std::string num(double x) {
   return s.str();
 }
 
-// The rigid motions of each body (translations along x and y, the rotation where the model has
-// one), each on that body's dofs only, with the body's characteristic length.
-struct BodyModes {
-  std::vector<Vector> modes;  // x, y, and the rotation if any
-  double length;
-};
-std::vector<BodyModes> body_modes(const Body& body) {
+}  // namespace
+
+std::vector<StepChecker::BodyModes> StepChecker::body_modes(const Body& body) {
   std::vector<BodyModes> out;
   auto add = [&](const Body& part, int offset) {
     BodyModes b{{}, part.characteristic_length()};
@@ -44,8 +40,6 @@ std::vector<BodyModes> body_modes(const Body& body) {
   for (int b = 0; b < std::max(1, body.part_count()); ++b) add(body.part(b), body.dof_offset(b));
   return out;
 }
-
-}  // namespace
 
 void StepChecks::worst_of(const StepChecks& o) {
   balance = std::max(balance, o.balance);
@@ -101,6 +95,7 @@ StepChecker::StepChecker(const Problem& problem, const ContactParams& contact, d
     }
   }
   nodes_without_site_ = body.nodes_without_site();
+  body_modes_ = body_modes(body);
   // The element size: the largest spacing of a site to its nearer neighbour in site order.
   for (int site = 0; site < sites; ++site) {
     double d = std::numeric_limits<double>::infinity();
@@ -162,7 +157,7 @@ std::string StepChecker::state(const Equilibrium& eq, const EquilibriumState& s,
   const double floor = 1e-8 * std::max(internal, force_level_);
   // Each resultant over what the body carries: along an axis that carries nothing (a vertical
   // load), over what the other axis carries; a moment over that times the body's length.
-  for (const BodyModes& b : body_modes(body)) {
+  for (const BodyModes& b : body_modes_) {
     std::vector<double> scales;
     for (const Vector& m : b.modes) scales.push_back(m.cwiseAbs().dot(carried));
     const double translations = std::max(scales[0], scales[1]);

@@ -84,6 +84,12 @@ class StepChecker {
     int side;
     int obstacle;
   };
+  // The rigid motions of each body (translations along x and y, the rotation where the model
+  // has one), each on that body's dofs only, with the body's characteristic length.
+  struct BodyModes {
+    std::vector<Vector> modes;
+    double length;
+  };
   const Problem& problem_;
   bool penalty_;
   double reach_;
@@ -91,6 +97,8 @@ class StepChecker {
   std::vector<Pairing> outside_sites_;   // (site, rigid obstacle) not among the candidates
   std::vector<int> nodes_without_site_;  // held against every rigid obstacle
   double element_size_ = 0.0;            // the largest spacing of neighbouring sites
+  std::vector<BodyModes> body_modes_;    // of the reference configuration, formed once
+  static std::vector<BodyModes> body_modes(const Body& body);
   // The largest force a checked state carried in this run: the scale of round-off where a
   // state carries almost nothing (a punch lifted off).
   mutable double force_level_ = 0.0;
