@@ -5,6 +5,19 @@
 #include <stdexcept>
 
 namespace grip {
+namespace {
+
+// The 4 x 4 small-strain law of (rr, zz, rz, tt) from the plane-strain block and the hoop row.
+Eigen::Matrix4d axisymmetric_D(const MaterialResponse& r) {
+  Eigen::Matrix4d D = Eigen::Matrix4d::Zero();
+  D.topLeftCorner<3, 3>() = r.D;
+  D.block<1, 3>(3, 0) = r.dS33;
+  D.block<3, 1>(0, 3) = r.dS33.transpose();
+  D(3, 3) = r.dS33_dE33;
+  return D;
+}
+
+}  // namespace
 
 ElementShape element_shape(ContinuumElement element) {
   switch (element) {
@@ -25,6 +38,27 @@ const char* element_name(ContinuumElement element) {
   return element == ContinuumElement::q4_bbar ? "q4_bbar" : shape_name(element_shape(element));
 }
 
+std::vector<int> nodes_off_half_plane(const PlaneMesh& mesh) {
+  std::vector<int> off;
+  for (int k = 0; k < static_cast<int>(mesh.nodes.size()); ++k)
+    if (!(mesh.nodes[k].x() >= 0)) off.push_back(k);
+  return off;
+}
+
+std::vector<int> axis_nodes(const PlaneMesh& mesh) {
+  std::vector<int> on;
+  for (int k = 0; k < static_cast<int>(mesh.nodes.size()); ++k)
+    if (mesh.nodes[k].x() == 0) on.push_back(k);
+  return on;
+}
+
+std::string id_list(const std::vector<int>& ids) {
+  std::string s;
+  for (size_t k = 0; k < ids.size() && k < 20; ++k) s += (k ? ", " : "") + std::to_string(ids[k]);
+  if (ids.size() > 20) s += " and " + std::to_string(ids.size() - 20) + " more";
+  return s;
+}
+
 ContinuumBody::ContinuumBody(PlaneMesh mesh, const std::vector<int>& contact_set,
                              std::vector<std::shared_ptr<const PlaneMaterial>> materials, ContinuumOptions options)
     : mesh_(std::move(mesh)), options_(options), shape_(element_shape(options.element)),
@@ -34,6 +68,12 @@ ContinuumBody::ContinuumBody(PlaneMesh mesh, const std::vector<int>& contact_set
   if (options_.element == ContinuumElement::q4_bbar && options_.kinematics == ContinuumKinematics::finite)
     throw std::invalid_argument("q4_bbar is implemented for linear kinematics (use q9 for finite strain)");
   if (!(options_.thickness > 0)) throw std::invalid_argument("thickness must be positive");
+  if (options_.analysis == PlaneAnalysis::axisymmetric) {
+    if (options_.kinematics == ContinuumKinematics::finite || options_.element == ContinuumElement::q4_bbar)
+      throw std::invalid_argument("axisymmetric is implemented for linear kinematics and t3, t6, q4, q8, q9");
+    if (const std::vector<int> off = nodes_off_half_plane(mesh_); !off.empty())
+      throw std::invalid_argument("axisymmetric: nodes at r = x < 0: " + id_list(off));
+  }
   // The only check of the mesh: the scene reader reads the issues off the exception.
   if (std::vector<MeshIssue> issues = check_mesh(mesh_, shape_); !issues.empty()) throw InvalidMesh(std::move(issues));
   contact_ = boundary_part(mesh_, shape_, contact_set);
@@ -49,18 +89,25 @@ const ContinuumBody::Integration& ContinuumBody::integration() const {
   std::call_once(integration_once_, [this] {
     auto in = std::make_unique<Integration>();
     const int n = element_node_count(shape_);
+    const bool axisymmetric = options_.analysis == PlaneAnalysis::axisymmetric;
     for (const auto& el : mesh_.elements) {
       ShapeGradients X(n, 2);
       for (int a = 0; a < n; ++a) X.row(a) = mesh_.nodes[el[a]].transpose();
-      in->points.push_back(element_points(shape_, X, options_.thickness));
+      in->points.push_back(element_points(shape_, X, axisymmetric ? 1.0 : options_.thickness));
       const Vec2 c = centre_natural(shape_);
       in->centroids.push_back(element_point(shape_, X, c.x(), c.y(), 0.0));
+      if (axisymmetric) {
+        for (ElementPoint& p : in->points.back()) make_axisymmetric(p, X);
+        make_axisymmetric(in->centroids.back(), X);
+      }
       if (options_.element == ContinuumElement::q4_bbar) in->mean_dN.push_back(mean_gradients(in->points.back()));
     }
     if (options_.kinematics == ContinuumKinematics::linear) {
       for (int e = 0; e < element_count(); ++e) {
-        const Eigen::Matrix3d D = material(e).small_strain().D;
-        const Matrix Ke = small_strain_stiffness(in->points[e], D, in->mean_dN.empty() ? nullptr : &in->mean_dN[e]);
+        const Matrix Ke = axisymmetric
+                              ? axisymmetric_stiffness(in->points[e], axisymmetric_D(material(e).small_strain()))
+                              : small_strain_stiffness(in->points[e], material(e).small_strain().D,
+                                                       in->mean_dN.empty() ? nullptr : &in->mean_dN[e]);
         const auto& el = mesh_.elements[e];
         for (int i = 0; i < 2 * n; ++i)
           for (int j = 0; j < 2 * n; ++j)
@@ -209,6 +256,8 @@ Eigen::Vector4d ContinuumBody::centroid_stress(const Vector& q, int e) const {
     const MaterialResponse r = material(e).small_strain();
     Vector ue(2 * u.rows());
     for (int a = 0; a < u.rows(); ++a) ue.segment<2>(2 * a) = u.row(a).transpose();
+    if (options_.analysis == PlaneAnalysis::axisymmetric)
+      return axisymmetric_D(r) * (axisymmetric_strain_matrix(c) * ue);
     const Eigen::Vector3d eps = strain_matrix(c, mean_gradient(e)) * ue;
     const Eigen::Vector3d s = r.D * eps;
     return {s[0], s[1], s[2], r.dS33 * eps};

@@ -1,6 +1,8 @@
 #pragma once
 // A plane continuum body: isoparametric triangles and quadrilaterals (plane_element.hpp) in
-// plane strain or plane stress, with an elastic law (plane_material.hpp).
+// plane strain, plane stress or axisymmetry (linear kinematics; x = r, y = z, every point
+// weighted by 2 pi r so that forces are totals over the full circle, `thickness` unused), with
+// an elastic law (plane_material.hpp).
 //   linear: small strain, sigma = D eps; K is constant, assembled once and reused (traits()
 //   says so, and the equilibrium oracle then factorizes it once).
 //   finite: total Lagrangian, S(E) of the law, exact tangent.
@@ -17,6 +19,7 @@
 // two contact segments, corner - mid-side - corner: its mid-side node is a site like the corners.
 #include <memory>
 #include <mutex>
+#include <string>
 #include <vector>
 
 #include "solver/elements/plane_mesh.hpp"
@@ -35,6 +38,11 @@ struct ContinuumOptions {
 };
 
 ElementShape element_shape(ContinuumElement element);
+// Axisymmetric (docs/algorithm.md#axisymmetric): the nodes at r = x < 0 (refused), and those on
+// the axis r = 0 (their u_r is held at zero by the scene reader).
+std::vector<int> nodes_off_half_plane(const PlaneMesh& mesh);
+std::vector<int> axis_nodes(const PlaneMesh& mesh);
+std::string id_list(const std::vector<int>& ids);    // "3, 7, 12" (the first 20 and a count)
 const char* element_name(ContinuumElement element);  // as the scene names it: "q4_bbar", ...
 
 class ContinuumBody final : public Body {
@@ -68,11 +76,13 @@ class ContinuumBody final : public Body {
   Vector rigid_translation(const Vec2& d) const override;
   Vector rigid_rotation() const override;
   Traits traits() const override;
+  bool axisymmetric() const override { return options_.analysis == PlaneAnalysis::axisymmetric; }
   std::optional<ElementQuality> element_quality() const override { return grip::element_quality(mesh_); }
   std::vector<std::vector<int>> cells() const override;  // element corners (node ids): 3 or 4
   // Per node: x, y (deformed), ux, uy.
   FieldTable site_fields(const Vector& q) const override;
-  // Per element, at its centroid: Cauchy stress sxx, syy, sxy, szz.
+  // Per element, at its centroid: Cauchy stress sxx, syy, sxy, szz (axisymmetric: srr, szz,
+  // srz under the names sxx, syy, sxy, and the hoop stress under szz).
   FieldTable element_fields(const Vector& q) const override;
 
   static int node_dof(int node, int component) { return 2 * node + component; }

@@ -3,6 +3,8 @@
 #include <Eigen/Dense>
 #include <array>
 #include <cmath>
+#include <numbers>
+#include <stdexcept>
 
 namespace grip {
 namespace {
@@ -228,6 +230,30 @@ Matrix small_strain_stiffness(const std::vector<ElementPoint>& points, const Eig
   Matrix Ke = Matrix::Zero(n, n);
   for (const ElementPoint& p : points) {
     const Matrix B = strain_matrix(p, mean_dN);
+    Ke.noalias() += p.dV * B.transpose() * D * B;
+  }
+  return 0.5 * (Ke + Ke.transpose());
+}
+
+void make_axisymmetric(ElementPoint& point, const ShapeGradients& X) {
+  point.radius = point.N.dot(X.col(0));
+  if (!(point.radius > 0)) throw std::logic_error("axisymmetric element: a Gauss point at r <= 0");
+  point.dV *= 2 * std::numbers::pi * point.radius;
+}
+
+Matrix axisymmetric_strain_matrix(const ElementPoint& point) {
+  const int n = static_cast<int>(point.dN.rows());
+  Matrix B = Matrix::Zero(4, 2 * n);
+  B.topRows(3) = strain_matrix(point, nullptr);
+  for (int a = 0; a < n; ++a) B(3, 2 * a) = point.N[a] / point.radius;
+  return B;
+}
+
+Matrix axisymmetric_stiffness(const std::vector<ElementPoint>& points, const Eigen::Matrix4d& D) {
+  const int n = 2 * static_cast<int>(points.front().dN.rows());
+  Matrix Ke = Matrix::Zero(n, n);
+  for (const ElementPoint& p : points) {
+    const Matrix B = axisymmetric_strain_matrix(p);
     Ke.noalias() += p.dV * B.transpose() * D * B;
   }
   return 0.5 * (Ke + Ke.transpose());

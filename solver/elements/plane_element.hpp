@@ -43,10 +43,11 @@ const std::vector<GaussPoint>& gauss_rule(ElementShape shape);
 
 // The reference-configuration data of one integration point.
 struct ElementPoint {
-  Vector N;           // shape functions
-  ShapeGradients dN;  // dN/dX in the reference configuration
-  double detJ = 0.0;  // det dX/d(xi, eta); <= 0 means an inverted or degenerate element
-  double dV = 0.0;    // weight * detJ * thickness
+  Vector N;             // shape functions
+  ShapeGradients dN;    // dN/dX in the reference configuration
+  double detJ = 0.0;    // det dX/d(xi, eta); <= 0 means an inverted or degenerate element
+  double dV = 0.0;      // weight * detJ * thickness (axisymmetric: weight * detJ * 2 pi r)
+  double radius = 0.0;  // axisymmetric: r = sum N_a X_a (> 0 at every Gauss point); else 0
 };
 
 // X holds the element's node coordinates, one row per node.
@@ -60,6 +61,14 @@ ShapeGradients mean_gradients(const std::vector<ElementPoint>& points);
 // volumetric part (eps11 + eps22) / 2 of both normal strains is replaced by the element mean,
 // which removes volumetric locking as nu -> 1/2 and keeps the constant-strain patch test.
 Matrix strain_matrix(const ElementPoint& point, const ShapeGradients* mean_dN);
+// Axisymmetric (x = r, y = z): the point weighted by the full circle, dV = weight detJ 2 pi r,
+// and its radius kept. Throws std::logic_error if r <= 0 there (no Gauss point of these
+// elements lies on an edge, so only an element crossing the axis can get there).
+void make_axisymmetric(ElementPoint& point, const ShapeGradients& X);
+// Small strain in axisymmetry: (e_rr, e_zz, g_rz, e_tt) = B u (4 x 2n), e_tt = u_r / r.
+Matrix axisymmetric_strain_matrix(const ElementPoint& point);
+// Ke = sum B^T D B dV with the 4 x 4 D of (rr, zz, rz, tt).
+Matrix axisymmetric_stiffness(const std::vector<ElementPoint>& points, const Eigen::Matrix4d& D);
 // Ke = sum B^T D B dV.
 Matrix small_strain_stiffness(const std::vector<ElementPoint>& points, const Eigen::Matrix3d& D,
                               const ShapeGradients* mean_dN);

@@ -325,6 +325,14 @@ json effects_json(const Scene& scene) {
               "forces, the whole body's equilibrium their rows; no regularization"
             : "the contact forces: the rigid amplitudes are contact unknowns and the whole body's equilibrium "
               "their condition; no regularization";
+  // Axisymmetric bodies: the conventions, and the axis nodes held by the reader.
+  for (const AxisHold& hold : scene.axis_holds)
+    effects["axisymmetric"].push_back(
+        {{"body", hold.body},
+         {"axis_nodes_held", hold.nodes},
+         {"conventions",
+          "x = r, y = z (the axis); loads, reactions and contact forces are totals over the full circle, tractions "
+          "per unit area; szz is the hoop stress; u_r = 0 imposed on the nodes on the axis listed here"}});
   if (const auto* all = body_set_of(*problem.body)) {
     // Per body what it simulates, and per contact pair its candidates.
     json bodies = json::array(), pairs = json::array();

@@ -167,9 +167,12 @@ std::string motion_name(const Vector& coefficients, double L) {
 // The rigid motions the supports leave free, as coefficients of body_modes() (columns).
 Matrix scene_io::free_motions(const Body& body, const std::vector<int>& fixed) {
   const std::vector<Vector> modes = body_modes(body);
-  Matrix R = Matrix::Zero(std::max<size_t>(fixed.size(), 1), modes.size());
+  // Axisymmetric: the translation along x and the rotation are no motions of the body at all.
+  const size_t extra = body.axisymmetric() ? modes.size() - 1 : 0;
+  Matrix R = Matrix::Zero(std::max<size_t>(fixed.size() + extra, 1), modes.size());
   for (size_t i = 0; i < fixed.size(); ++i)
     for (size_t m = 0; m < modes.size(); ++m) R(i, m) = modes[m][fixed[i]];
+  for (size_t e = 0; e < extra; ++e) R(fixed.size() + e, e == 0 ? 0 : 2) = 1.0;
   Eigen::FullPivLU<Matrix> lu(R);
   lu.setThreshold(1e-9);
   if (lu.rank() == static_cast<Eigen::Index>(modes.size())) return Matrix(modes.size(), 0);
@@ -692,6 +695,7 @@ Scene read_checked_scene(const nlohmann::json& input, const MeshResolver& meshes
   hold_rigid_modes(r, scene.problem);
   if (!r.issues.empty()) throw SceneErrors(std::move(r.issues));
   scene.file_meshes = std::move(r.file_meshes);
+  scene.axis_holds = std::move(r.axis_holds);
   return scene;
 }
 

@@ -59,6 +59,13 @@ struct FileMeshTags {
   std::vector<std::size_t> nodes, elements;
 };
 
+// An axisymmetric body (docs/algorithm.md#axisymmetric): the nodes on the axis whose u_r = 0 the
+// reader imposed (those the scene's supports did not hold already).
+struct AxisHold {
+  int body = 0;  // index in the scene's bodies (0 for `body`)
+  std::vector<int> nodes;
+};
+
 struct Scene {
   nlohmann::json effective;  // the scene with every default filled in
   Problem problem;
@@ -67,6 +74,7 @@ struct Scene {
   SteppingParams params;  // params.record_fields: the steps whose fields are kept
   OutputOptions output;
   std::vector<FileMeshTags> file_meshes;
+  std::vector<AxisHold> axis_holds;  // one per axisymmetric body
 };
 
 // Throws SceneErrors listing the problems found (at most kMaxSceneIssues). Without `meshes` a

@@ -1,5 +1,5 @@
 // body.model "continuum": plane triangles and quadrilaterals (solver/elements/continuum.hpp).
-//   "kinematics": "finite" (default) | "linear";  "analysis": "plane_strain" | "plane_stress"
+//   "kinematics": "finite" (default) | "linear";  "analysis": "plane_strain" | "plane_stress" | "axisymmetric"
 //   "element": "t3" | "t6" | "q4" | "q4_bbar" | "q8" | "q9";  "thickness" (default 1)
 //   "material": {"young", "poisson", "law": "neo_hookean" | "saint_venant_kirchhoff"}
 //   "mesh": one of
@@ -12,6 +12,8 @@
 //   "supports": [{"set" | "node", "fix": ["x", "y"], "values": {"x", "y"} | "rotation": {"about", "angle"}, "case"}]
 //   "loads": [{"set" | "node", "force": [fx, fy] (on each node) | "traction": [tx, ty] (per
 //     unit area of the set's boundary sides), "case"}]
+#include <cmath>
+#include <numbers>
 #include <stdexcept>
 
 #include "solver/elements/continuum.hpp"
@@ -261,8 +263,48 @@ void read_continuum_supports(Reader& r, json& body, const std::string& ptr, cons
   });
 }
 
+// Axisymmetric: u_r = 0 on the axis (a node there lies on every meridian plane), imposed on the
+// nodes whose x is not held already, and listed for the result's effects.
+void hold_axis(const PlaneMesh& mesh, Reader& r, Problem& problem) {
+  std::vector<char> fixed(2 * mesh.nodes.size(), 0);
+  for (const Constraint& c : problem.constraints) fixed[c.dof] = 1;
+  AxisHold hold{r.body_index, {}};
+  for (int node : axis_nodes(mesh))
+    if (!fixed[ContinuumBody::node_dof(node, 0)]) {
+      problem.constraints.push_back({ContinuumBody::node_dof(node, 0), 0.0, 0});
+      hold.nodes.push_back(node);
+    }
+  r.axis_holds.push_back(std::move(hold));
+}
+
+// A traction per unit area on the revolved sides: f integrated with N_a 2 pi r ds along each
+// side (2 or 3 nodes), by 3-point Gauss (exact on straight sides, where r is linear in s).
+void add_revolved_traction(const PlaneMesh& mesh, const BoundaryPart& part, const Vec2& f, Vector& load) {
+  const double g = std::sqrt(0.6), points[3] = {-g, 0.0, g}, weights[3] = {5.0 / 9, 8.0 / 9, 5.0 / 9};
+  for (const auto& side : part.sides)
+    for (int i = 0; i < 3; ++i) {
+      const double s = points[i];
+      // 1D shape functions on [-1, 1]: linear (ends) or quadratic (end, middle, end).
+      std::vector<double> N, dN;
+      if (side.size() == 2) {
+        N = {(1 - s) / 2, (1 + s) / 2};
+        dN = {-0.5, 0.5};
+      } else {
+        N = {s * (s - 1) / 2, 1 - s * s, s * (s + 1) / 2};
+        dN = {s - 0.5, -2 * s, s + 0.5};
+      }
+      Vec2 x = Vec2::Zero(), dx = Vec2::Zero();
+      for (size_t a = 0; a < side.size(); ++a) {
+        x += N[a] * mesh.nodes[side[a]];
+        dx += dN[a] * mesh.nodes[side[a]];
+      }
+      const double w = weights[i] * dx.norm() * 2 * std::numbers::pi * x.x();
+      for (size_t a = 0; a < side.size(); ++a) load.segment<2>(2 * side[a]) += N[a] * w * f;
+    }
+}
+
 void read_continuum_loads(Reader& r, json& body, const std::string& ptr, const PlaneMesh& mesh, ElementShape shape,
-                          Problem& problem, double thickness) {
+                          Problem& problem, double thickness, bool axisymmetric) {
   for_each_object(r, body, ptr, "loads", [&](json& l, const std::string& lp) {
     const auto nodes = read_target(r, l, lp, mesh);
     const int load_case = r.load_case(l, lp);
@@ -284,6 +326,10 @@ void read_continuum_loads(Reader& r, json& body, const std::string& ptr, const P
     }
     try {
       const BoundaryPart part = boundary_part(mesh, shape, *nodes);
+      if (axisymmetric) {
+        add_revolved_traction(mesh, part, f, load);
+        return;
+      }
       for (size_t k = 0; k < part.nodes.size(); ++k)
         load.segment<2>(2 * part.nodes[k]) += part.lengths[k] * thickness * f;
     } catch (const std::invalid_argument& e) {
@@ -307,11 +353,14 @@ void read_continuum(Reader& r, json& body, Problem& problem, const std::string& 
                                     ": leave \"element\" out for a mesh from a file");
   }
   const std::string kin = r.choice(body, ptr, "kinematics", {"finite", "linear"}, "finite");
-  const std::string analysis = r.choice(body, ptr, "analysis", {"plane_strain", "plane_stress"}, "plane_strain");
+  const std::string analysis =
+      r.choice(body, ptr, "analysis", {"plane_strain", "plane_stress", "axisymmetric"}, "plane_strain");
   const std::string element = r.choice(body, ptr, "element", {"t3", "t6", "q4", "q4_bbar", "q8", "q9"}, "q4");
   ContinuumOptions options;
   options.kinematics = kin == "linear" ? ContinuumKinematics::linear : ContinuumKinematics::finite;
-  options.analysis = analysis == "plane_stress" ? PlaneAnalysis::plane_stress : PlaneAnalysis::plane_strain;
+  options.analysis = analysis == "plane_stress"   ? PlaneAnalysis::plane_stress
+                     : analysis == "axisymmetric" ? PlaneAnalysis::axisymmetric
+                                                  : PlaneAnalysis::plane_strain;
   for (ContinuumElement e : {ContinuumElement::t3, ContinuumElement::t6, ContinuumElement::q4,
                              ContinuumElement::q4_bbar, ContinuumElement::q8, ContinuumElement::q9})
     if (element == element_name(e)) options.element = e;
@@ -323,6 +372,14 @@ void read_continuum(Reader& r, json& body, Problem& problem, const std::string& 
               "for finite strain near incompressibility use \"q9\"");
     if (options.analysis == PlaneAnalysis::plane_stress)
       r.error(ptr + "/element", "\"q4_bbar\" is for plane strain: plane stress does not lock, use \"q4\"");
+    if (options.analysis == PlaneAnalysis::axisymmetric)
+      r.error(ptr + "/element", "\"q4_bbar\" is for plane strain: in axisymmetry use t3, t6, q4, q8 or q9");
+  }
+  if (options.analysis == PlaneAnalysis::axisymmetric) {
+    if (options.kinematics == ContinuumKinematics::finite)
+      r.error(ptr + "/kinematics", "\"axisymmetric\" is implemented for linear kinematics: give \"linear\"");
+    if (body.contains("thickness"))
+      r.error(ptr + "/thickness", "has no meaning in axisymmetry (the section is revolved by 2 pi): leave it out");
   }
   const ElementShape shape = element_shape(options.element);
 
@@ -377,6 +434,11 @@ void read_continuum(Reader& r, json& body, Problem& problem, const std::string& 
     }
   }
   if (!mesh || !r.issues.empty()) return;
+  if (options.analysis == PlaneAnalysis::axisymmetric)
+    if (const std::vector<int> off = nodes_off_half_plane(*mesh); !off.empty()) {
+      r.error(mp, "axisymmetric: the section lies in the half-plane r = x >= 0; nodes at x < 0: " + id_list(off));
+      return;
+    }
 
   if (!body.contains("contact_set")) {
     if (default_contact.empty()) {
@@ -425,8 +487,10 @@ void read_continuum(Reader& r, json& body, Problem& problem, const std::string& 
   }
 
   read_continuum_supports(r, body, ptr, checked, problem);
-  read_continuum_loads(r, body, ptr, checked, shape, problem, options.thickness);
+  read_continuum_loads(r, body, ptr, checked, shape, problem, options.thickness,
+                       options.analysis == PlaneAnalysis::axisymmetric);
   if (!r.issues.empty()) return;
+  if (options.analysis == PlaneAnalysis::axisymmetric) hold_axis(checked, r, problem);
   // docs/algorithm.md#bodies-held-only-by-contact: contact holds the free rigid motions of one
   // connected body (scene.cpp); a mesh of several parts must have each part held by its supports.
   std::vector<char> fixed(problem.body->dof_count(), 0);

@@ -184,6 +184,7 @@ class Reader {
   // The gmsh tags of the bodies read from files, and the index of the body being read.
   std::vector<FileMeshTags> file_meshes;
   int body_index = 0;
+  std::vector<AxisHold> axis_holds;  // the axisymmetric bodies' axis nodes (scene.hpp)
 
   // Load cases by name, in order of first mention; "main" unless a value names another.
   std::vector<std::string> cases{"main"};

@@ -38,9 +38,10 @@ MaterialResponse HookeMaterial::response(const Mat2& E) const {
   r.D = D_;
   r.S = D_ * e;
   const double l = lame_.lambda, m = lame_.mu;
-  if (analysis_ == PlaneAnalysis::plane_strain) {
+  if (analysis_ != PlaneAnalysis::plane_stress) {
     r.dS33 << l, l, 0;
     r.S33 = r.dS33 * e;
+    r.dS33_dE33 = l + 2 * m;
   } else {
     r.C33 = 1 - 2 * l / (l + 2 * m) * (e[0] + e[1]);  // 1 + 2 E33, E33 from S33 = 0
   }
@@ -75,9 +76,10 @@ MaterialResponse NeoHookeMaterial::response(const Mat2& E) const {
   r.S = voigt(m * (Mat2::Identity() - Ci) + l * lnJ * Ci);
   r.D = voigt_tangent(Ci, l, b);
   const Vec3 ci = voigt(Ci);
-  if (analysis_ == PlaneAnalysis::plane_strain) {
+  if (analysis_ != PlaneAnalysis::plane_stress) {
     r.S33 = l * lnJ;
     r.dS33 = l * ci.transpose();
+    r.dS33_dE33 = l + 2 * b;  // at C33 = 1
   } else {
     // Condense E33 out: dS33 = 0 = l/C33 ci . dE + (l + 2 b)/C33^2 dE33.
     r.D -= l * l / (l + 2 * b) * ci * ci.transpose();

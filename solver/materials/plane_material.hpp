@@ -4,7 +4,10 @@
 // linear strain and S the Cauchy stress. Voigt order (11, 22, 12); strain vectors carry the
 // engineering shear 2 E12, so that S . dE is the work per unit reference volume.
 // Plane strain: E33 = 0, S33 follows. Plane stress: S33 = 0, E33 follows (condensed out of
-// the tangent). Units are the scene's: young in force / length^2.
+// the tangent). Axisymmetric: the section in the r-z half-plane (x = r, y = z), direction 3 the
+// hoop direction; the laws answer as in plane strain at E33 = 0 (S33 the hoop stress there) and
+// give the hoop stiffness dS33/dE33, which the axisymmetric element (small strain) needs.
+// Units are the scene's: young in force / length^2.
 #include <Eigen/Core>
 #include <memory>
 
@@ -12,7 +15,7 @@
 
 namespace grip {
 
-enum class PlaneAnalysis { plane_strain, plane_stress };
+enum class PlaneAnalysis { plane_strain, plane_stress, axisymmetric };
 
 // Response of a law at one material point.
 struct MaterialResponse {
@@ -21,6 +24,7 @@ struct MaterialResponse {
   double S33 = 0.0;                                      // out-of-plane normal stress (zero in plane stress)
   Eigen::RowVector3d dS33 = Eigen::RowVector3d::Zero();  // dS33/dE (zero in plane stress)
   double C33 = 1.0;                                      // out-of-plane stretch squared (one in plane strain)
+  double dS33_dE33 = 0.0;                                // hoop stiffness at E33 = 0 (zero in plane stress)
 };
 
 class PlaneMaterial {

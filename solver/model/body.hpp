@@ -107,6 +107,9 @@ class Body {
     bool constant_tangent = false;
   };
   virtual Traits traits() const { return {}; }
+  // A section of a body of revolution (x = r, y = z: the axis): of its rigid motions only the
+  // translation along y is one (u_r = const strains the hoops, and the section does not rotate).
+  virtual bool axisymmetric() const { return false; }
   // Shape of the elements of a plane mesh (none for line models).
   virtual std::optional<ElementQuality> element_quality() const { return std::nullopt; }
 
