@@ -378,8 +378,6 @@ void read_continuum(Reader& r, json& body, Problem& problem, const std::string& 
   if (options.analysis == PlaneAnalysis::axisymmetric) {
     if (options.kinematics == ContinuumKinematics::finite)
       r.error(ptr + "/kinematics", "\"axisymmetric\" is implemented for linear kinematics: give \"linear\"");
-    if (body.contains("thickness"))
-      r.error(ptr + "/thickness", "has no meaning in axisymmetry (the section is revolved by 2 pi): leave it out");
   }
   const ElementShape shape = element_shape(options.element);
 

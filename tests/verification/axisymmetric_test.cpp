@@ -10,6 +10,9 @@
 // totalled over the circle (sphere), within 0.5 % of the closed form at every node.
 #include <gtest/gtest.h>
 
+#include <Eigen/Dense>
+#include <Eigen/SparseCore>
+
 #include <cmath>
 #include <map>
 #include <numbers>
@@ -187,7 +190,8 @@ TEST(Axisymmetric, ThickSphereUnderInternalPressure) {
         const double N[3] = {s * (s - 1) / 2, 1 - s * s, s * (s + 1) / 2};
         const Vec2 eR(std::sin(phi), std::cos(phi));
         const double ds = a * std::abs(phi2 - phi0) / 2 * w[q];
-        for (int m = 0; m < 3; ++m) force[side[m]] += N[m] * p * eR * 2 * pi * a * std::sin(phi) * ds;
+        for (int m = 0; m < 3; ++m)
+          force.try_emplace(side[m], Vec2::Zero()).first->second += N[m] * p * eR * 2 * pi * a * std::sin(phi) * ds;
       }
     }
     json loads = json::array();
