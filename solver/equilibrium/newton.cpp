@@ -162,7 +162,7 @@ EquilibriumState Equilibrium::newton(const Vector& q_guess, const Vector& p) {
   EquilibriumState state;
   state.q = q_guess;
   for (const Constraint& c : problem_.constraints)
-    state.q[c.dof] = c.load_case < static_cast<int>(factors_.size()) ? factors_[c.load_case] * c.value : 0.0;
+    state.q[c.dof] = c.load_case < static_cast<int>(factors_.size()) ? c.at(factors_[c.load_case]) : 0.0;
   for (const Constraint& c : extra_) state.q[c.dof] = c.value;
   const RigidModes& rigid = problem_.rigid;
   if (!pins_free_)

@@ -197,7 +197,8 @@ void for_each_object(Reader& r, json& body, const std::string& ptr, const char* 
   }
 }
 
-void read_continuum_supports(Reader& r, json& body, const std::string& ptr, const PlaneMesh& mesh, Problem& problem) {
+void read_continuum_supports(Reader& r, json& body, const std::string& ptr, const PlaneMesh& mesh, bool finite,
+                             Problem& problem) {
   // Per dof: the support that fixes it (an index of `pointers`, -1 for none) and its value.
   std::vector<int> fixed_by(2 * mesh.nodes.size(), -1);
   std::vector<double> fixed_value(fixed_by.size(), 0.0);
@@ -209,7 +210,9 @@ void read_continuum_supports(Reader& r, json& body, const std::string& ptr, cons
       r.error(sp, "needs exactly one of \"fix\" (components, with values) and \"rotation\" (a rigid rotation)");
       return;
     }
-    const auto hold = [&](int dof, double value, const std::string& at, const std::string& what) {
+    // axis >= 0: a finite rotation of the node at `arm` (Constraint::at), value its angle.
+    const auto hold = [&](int dof, double value, const std::string& at, const std::string& what, int axis = -1,
+                          const Vec2& arm = Vec2::Zero()) {
       if (fixed_by[dof] >= 0) {
         // The same zero support twice (a corner in two sets) is harmless; two prescribed
         // values of one dof are ambiguous.
@@ -220,10 +223,11 @@ void read_continuum_supports(Reader& r, json& body, const std::string& ptr, cons
       }
       fixed_by[dof] = static_cast<int>(pointers.size()) - 1;
       fixed_value[dof] = value;
-      problem.constraints.push_back({dof, value, load_case});
+      problem.constraints.push_back({dof, value, load_case, axis, arm});
     };
     if (json* rotation = s.contains("rotation") ? r.object(s, sp, "rotation", true) : nullptr) {
-      // A small rigid rotation: u = angle (-(y - yc), x - xc).
+      // A rigid rotation: with finite kinematics the exact one, u = (R(t angle) - I)(X - c) at
+      // factor t; with linear kinematics the small one, u = t angle (-(y - yc), x - xc).
       const std::string rp = sp + "/rotation";
       const Vec2 about = r.vec2(*rotation, rp, "about");
       const double angle = r.number(*rotation, rp, "angle");
@@ -232,8 +236,15 @@ void read_continuum_supports(Reader& r, json& body, const std::string& ptr, cons
       pointers.push_back(sp);
       for (int node : *nodes) {
         const Vec2 d = mesh.nodes[node] - about;
-        hold(ContinuumBody::node_dof(node, 0), -angle * d.y(), rp, "x and y of node " + std::to_string(node));
-        hold(ContinuumBody::node_dof(node, 1), angle * d.x(), rp, "x and y of node " + std::to_string(node));
+        const std::string what = "x and y of node " + std::to_string(node);
+        if (finite) {
+          const double a = d.isZero() ? 0.0 : angle;  // the centre stays put
+          hold(ContinuumBody::node_dof(node, 0), a, rp, what, 0, d);
+          hold(ContinuumBody::node_dof(node, 1), a, rp, what, 1, d);
+        } else {
+          hold(ContinuumBody::node_dof(node, 0), -angle * d.y(), rp, what);
+          hold(ContinuumBody::node_dof(node, 1), angle * d.x(), rp, what);
+        }
       }
       return;
     }
@@ -484,7 +495,7 @@ void read_continuum(Reader& r, json& body, Problem& problem, const std::string& 
     r.file_meshes.push_back(std::move(file->tags));
   }
 
-  read_continuum_supports(r, body, ptr, checked, problem);
+  read_continuum_supports(r, body, ptr, checked, options.kinematics == ContinuumKinematics::finite, problem);
   read_continuum_loads(r, body, ptr, checked, shape, problem, options.thickness,
                        options.analysis == PlaneAnalysis::axisymmetric);
   if (!r.issues.empty()) return;

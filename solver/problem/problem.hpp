@@ -1,6 +1,7 @@
 #pragma once
 // A contact problem in typed form: one deformable body, rigid obstacles, supports, loads, and
 // the contact candidates. Built from a scene by solver/io; solved by solver/stepping.
+#include <cmath>
 #include <memory>
 #include <optional>
 #include <string>
@@ -42,6 +43,18 @@ struct Constraint {
   int dof;
   double value = 0.0;
   int load_case = 0;
+  // A finite rigid rotation (a `rotation` support of a body with finite kinematics): the dof is
+  // component `axis` (0: x, 1: y) of a node at `arm` from the centre, `value` the angle at factor
+  // 1; at factor t the node sits at R(t value) arm, on its circle, not on the chord.
+  int axis = -1;
+  Vec2 arm = Vec2::Zero();
+  // The prescribed value at the factor t of its load case.
+  double at(double t) const {
+    if (axis < 0) return t * value;
+    const double c = std::cos(t * value), s = std::sin(t * value);
+    const Vec2 turned(c * arm.x() - s * arm.y(), s * arm.x() + c * arm.y());
+    return (turned - arm)[axis];
+  }
 };
 
 // One load step's target: a factor per load case and the friction per obstacle.

@@ -145,7 +145,7 @@ Vector amplitudes_following_supports(const Problem& problem, const LoadFactors& 
     for (const Constraint& c : problem.constraints)
       if (c.dof >= offset && c.dof < offset + m) {
         rows.push_back(c.dof);
-        values.push_back(c.value * (factor(to, c.load_case) - factor(from, c.load_case)));
+        values.push_back(c.at(factor(to, c.load_case)) - c.at(factor(from, c.load_case)));
       }
     Matrix Bc(rows.size(), modes.size());
     Vector d(rows.size());

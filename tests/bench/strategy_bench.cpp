@@ -52,6 +52,7 @@ namespace {
 
 using json = nlohmann::json;
 using Clock = std::chrono::steady_clock;
+using testing::contact_resultant;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
@@ -94,18 +95,6 @@ std::vector<double> column(const FieldTable& t, const std::string& name) {
   std::vector<double> out;
   for (const auto& row : t.rows) out.push_back(row.at(c));
   return out;
-}
-
-// The resultant of the contact forces on the body at the last step (all obstacles, or one).
-Vec2 contact_resultant(const Problem& problem, const StepRecord& rec, const std::string& obstacle = {}) {
-  Vec2 f = Vec2::Zero();
-  for (size_t i = 0; i < problem.candidates.size(); ++i) {
-    const Candidate& c = problem.candidates[i];
-    if (!obstacle.empty() && problem.obstacles[c.obstacle].name != obstacle) continue;
-    const PairedPoint& pp = rec.state.points[i];
-    f += rec.p[c.eta] * pp.eta + (c.xi >= 0 ? rec.p[c.xi] : 0.0) * pp.xi;
-  }
-  return f;
 }
 
 // The largest normal contact stress |p_n| / tributary area.
@@ -313,7 +302,10 @@ std::vector<SceneCase> scene_cases() {
     s.measure = [](const Scene& sc, const RunResult& run) {
       const StepRecord& last = run.steps.back();
       Quantities q;
-      q.force = -contact_resultant(sc.problem, last, "punch").y();  // the punch force
+      const auto named = std::find_if(sc.problem.obstacles.begin(), sc.problem.obstacles.end(),
+                                      [](const ObstacleInstance& o) { return o.name == "punch"; });
+      const int punch = static_cast<int>(named - sc.problem.obstacles.begin());
+      q.force = -contact_resultant(sc.problem, last, punch).y();  // the punch force
       const auto strain = column(last.element_fields, "major_strain");
       q.peak = *std::max_element(strain.begin(), strain.end());
       q.point = -column(last.site_fields, "uy").front();  // the pole's displacement

@@ -168,7 +168,7 @@ void expect_turned_near_the_limit(const Strategy& strategy) {
   expect_disc_balanced(s);
   double ratio = 0.0;
   for (const StepRecord& rec : s.run.steps) {
-    const Vec2 lower = flat_resultant(s.scene.problem, rec, 0), upper = flat_resultant(s.scene.problem, rec, 1);
+    const Vec2 lower = contact_resultant(s.scene.problem, rec, 0), upper = contact_resultant(s.scene.problem, rec, 1);
     const json step = step_json(s.scene.problem, rec, s.scene.output);
     ratio = std::abs(lower.x()) / (0.3 * lower.y());
     std::printf(

@@ -11,6 +11,7 @@
 #include <limits>
 #include <string>
 
+#include "tests/support/contact_profile.hpp"
 #include "tests/support/result_checks.hpp"
 #include "tests/support/scenes.hpp"
 
@@ -20,17 +21,6 @@ namespace {
 nlohmann::json robustness_scene(const std::string& name) {
   std::ifstream in(std::string(GRIP_SOURCE_DIR) + "/tests/robustness/scenes/" + name + ".json");
   return nlohmann::json::parse(in);
-}
-
-// The resultant of the contact forces on the body at a step.
-Vec2 contact_resultant(const Problem& problem, const StepRecord& rec) {
-  Vec2 f = Vec2::Zero();
-  for (size_t i = 0; i < problem.candidates.size(); ++i) {
-    const Candidate& c = problem.candidates[i];
-    const PairedPoint& pp = rec.state.points[i];
-    f += rec.p[c.eta] * pp.eta + (c.xi >= 0 ? rec.p[c.xi] : 0.0) * pp.xi;
-  }
-  return f;
 }
 
 // The row of the node whose reference position is nearest to x (site_fields: x, y, ux, uy).

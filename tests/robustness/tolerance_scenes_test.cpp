@@ -7,6 +7,7 @@
 #include <fstream>
 
 #include "tests/robustness/mutations.hpp"
+#include "tests/support/contact_profile.hpp"
 
 namespace grip::testing {
 namespace {
@@ -25,17 +26,6 @@ Vec2 reaction_sum(const Problem& problem, const StepRecord& rec) {
     sum += Vec2(tx[c.dof], ty[c.dof]) * rec.reactions[c.dof];
   }
   return sum;
-}
-
-// The contact forces' resultant on the body (Coulomb's forces on the obstacles' frames).
-Vec2 contact_resultant(const Problem& problem, const StepRecord& rec) {
-  Vec2 total = Vec2::Zero();
-  for (size_t i = 0; i < problem.candidates.size(); ++i) {
-    const Candidate& c = problem.candidates[i];
-    const PairedPoint& pp = rec.state.points[i];
-    total += rec.p[c.eta] * pp.eta + (c.xi >= 0 ? rec.p[c.xi] : 0.0) * pp.xi;
-  }
-  return total;
 }
 
 // The applied load's resultant at a step's factors.

@@ -89,6 +89,18 @@ inline std::vector<ContactNode> contact_profile(const Problem& problem, const St
   return nodes;
 }
 
+// The resultant of the contact forces on the body: of one obstacle's points, or of all (-1).
+inline Vec2 contact_resultant(const Problem& problem, const StepRecord& rec, int obstacle = -1) {
+  Vec2 total = Vec2::Zero();
+  for (size_t i = 0; i < problem.candidates.size(); ++i) {
+    const Candidate& c = problem.candidates[i];
+    if (obstacle >= 0 && c.obstacle != obstacle) continue;
+    const PairedPoint& pp = rec.state.points[i];
+    total += rec.p[c.eta] * pp.eta + (c.xi >= 0 ? rec.p[c.xi] : 0.0) * pp.xi;
+  }
+  return total;
+}
+
 // The resultant of the support reactions on the body.
 inline Vec2 reaction_resultant(const Problem& problem, const StepRecord& rec) {
   return {problem.body->rigid_translation(Vec2::UnitX()).dot(rec.reactions),

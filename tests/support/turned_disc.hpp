@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "solver/elements/continuum.hpp"
+#include "tests/support/contact_profile.hpp"
 #include "tests/support/force_precision.hpp"
 #include "tests/support/held.hpp"
 #include "tests/support/result_checks.hpp"
@@ -80,17 +81,6 @@ inline DiscBalance balance_about(const Problem& problem, const StepRecord& rec, 
     b.moment += x.x() * fn.y() - x.y() * fn.x();
   }
   return b;
-}
-
-// Each flat's resultant on the disc.
-inline Vec2 flat_resultant(const Problem& problem, const StepRecord& rec, int obstacle) {
-  Vec2 total = Vec2::Zero();
-  for (size_t i = 0; i < problem.candidates.size(); ++i) {
-    const Candidate& c = problem.candidates[i];
-    if (c.obstacle == obstacle)
-      total += rec.p[c.eta] * rec.state.points[i].eta + (c.xi >= 0 ? rec.p[c.xi] : 0.0) * rec.state.points[i].xi;
-  }
-  return total;
 }
 
 // Every converged step: held and sound (expect_held: the balance on the motions about the
@@ -188,8 +178,8 @@ inline double limit_ratio(const Solved& s) {
 // lines without `geometry`, over the two levers 2R), and the couple's arm by its loaded nodes'
 // displacements (against `ref`'s, or against none, over the arm 2R).
 inline double limit_drift(const Problem& problem, const StepRecord& now, const StepRecord& ref, bool geometry) {
-  const Vec2 lower = flat_resultant(problem, now, 0), upper = flat_resultant(problem, now, 1);
-  const Vec2 lower_ref = flat_resultant(problem, ref, 0), upper_ref = flat_resultant(problem, ref, 1);
+  const Vec2 lower = contact_resultant(problem, now, 0), upper = contact_resultant(problem, now, 1);
+  const Vec2 lower_ref = contact_resultant(problem, ref, 0), upper_ref = contact_resultant(problem, ref, 1);
   const double P_now = lower.y() - upper.y(), P_ref = lower_ref.y() - upper_ref.y();
   double drift = std::abs(P_now / P_ref - 1) + std::abs(lower.y() + upper.y()) / P_now +
                  std::abs(lower_ref.y() + upper_ref.y()) / P_ref;
@@ -230,14 +220,16 @@ inline double expect_turned_beyond_the_limit(const Solved& s) {
   if (ratio == 0.0) return 0.0;
   // The closed form from the previous step's normal forces.
   const StepRecord& before = s.run.steps[1];
-  const double P = flat_resultant(s.scene.problem, before, 0).y() - flat_resultant(s.scene.problem, before, 1).y();
+  const double P =
+      contact_resultant(s.scene.problem, before, 0).y() - contact_resultant(s.scene.problem, before, 1).y();
   const double F = 1369.0 * 1.05, mu = 0.3, h = kDiscRadius - 0.1 / 2;
   const double closed = 2 * kDiscRadius * F / (mu * P * h);
   // The diagnosis reads the normal forces where the attempt stopped, not the previous step's:
   // they differ by the change of P over the step (the couple lowers the squeeze force), the
   // unbalance of the two flats, and the levers by the displacements (|u| / R at the loaded
   // nodes, the contact points' distance from the flats' lines); all read from that state.
-  const double P_now = flat_resultant(s.scene.problem, failed, 0).y() - flat_resultant(s.scene.problem, failed, 1).y();
+  const double P_now =
+      contact_resultant(s.scene.problem, failed, 0).y() - contact_resultant(s.scene.problem, failed, 1).y();
   const double drift = limit_drift(s.scene.problem, failed, before, false);
   EXPECT_GT(ratio, 1.0);
   EXPECT_NEAR(ratio, closed, drift * closed + 1e-6);

@@ -2,6 +2,7 @@
 // both parse exactly), as a floating-point number, with the same shortest significant digits
 // std::to_chars finds (so nothing longer than needed is written).
 #include "solver/io/json_writer.hpp"
+#include "solver/io/result.hpp"
 
 #include <gtest/gtest.h>
 
@@ -100,6 +101,69 @@ TEST(JsonWriter, SmallValuesReadBackAsTheDocument) {
   }
   EXPECT_EQ(nlohmann::json::parse(out.str()), doc);
   EXPECT_EQ(out.str().substr(0, 5), "{\"a\":");  // keys in nlohmann's order
+}
+
+// field_value takes a path without text where that is exact: it must give the double that
+// rounding v's decimal to kFieldDigits digits and reading it back gives (the text way), bit for bit.
+double field_value_by_text(double v) {
+  if (!std::isfinite(v) || v == 0) return v;
+  char text[32];
+  const char* end = std::to_chars(text, text + sizeof text, v, std::chars_format::scientific, kFieldDigits - 1).ptr;
+  double rounded = v;
+  std::from_chars(text, end, rounded);
+  return rounded;
+}
+
+TEST(FieldValue, EqualsTheDecimalRoundedAndReadBack) {
+  std::mt19937_64 random(34);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::uniform_int_distribution<int> exponent(-40, 40);
+  std::uniform_int_distribution<std::uint64_t> bits;
+  for (int i = 0; i < 2000000; ++i) {
+    const double scaled = unit(random) * std::pow(10.0, exponent(random));
+    ASSERT_EQ(std::bit_cast<std::uint64_t>(field_value(scaled)),
+              std::bit_cast<std::uint64_t>(field_value_by_text(scaled)))
+        << scaled;
+    const double any = std::bit_cast<double>(bits(random));  // every binade, subnormals, NaN
+    if (std::isnan(any)) continue;
+    ASSERT_EQ(std::bit_cast<std::uint64_t>(field_value(any)), std::bit_cast<std::uint64_t>(field_value_by_text(any)))
+        << any;
+  }
+  // Halves of the 7th digit (ties) and near-ties, powers of ten and their neighbours.
+  for (double v : {1.0000005, 1.00000050000001, 2.5e-7, 9999999.5, 0.99999995, 999999.95, 1e22, 1e23, 1e-22, 1e-23,
+                   123456.75, 5e-324, 1.7976931348623157e308}) {
+    for (double w : {v, std::nextafter(v, 0.0), std::nextafter(v, 2 * v), -v})
+      EXPECT_EQ(std::bit_cast<std::uint64_t>(field_value(w)), std::bit_cast<std::uint64_t>(field_value_by_text(w)))
+          << w;
+  }
+}
+
+// A step's contact points are written without a JSON document: the same text as the document
+// contact_points_json builds, written by value(), for one body and for several (body, master).
+TEST(ContactPoints, WrittenAsTheirDocument) {
+  ContactPointRow one{
+      3,      "floor",     "slip",          {},     {}, Vec2(0.1, -2.5e-9), Vec2(1.0 / 3, 100), Vec2(0, -1), 12.5,
+      -1e300, 1234567.891, -0.000123456789, -3e-12, 0.0};
+  ContactPointRow two = one;
+  two.node = 41;
+  two.obstacle = "quote \" pair";
+  two.state = "stick";
+  two.body = "upper";
+  two.master = "lower\\block";
+  two.several_bodies = true;
+  for (const std::vector<ContactPointRow>& rows :
+       {std::vector<ContactPointRow>{}, std::vector<ContactPointRow>{one}, std::vector<ContactPointRow>{one, two}}) {
+    StepOutput step;
+    step.summary = nlohmann::json::object();
+    step.contact_points = rows;
+    std::ostringstream streamed, document;
+    write_step(streamed, step);
+    {
+      JsonWriter w(document);
+      w.value(nlohmann::json{{"contact_points", contact_points_json(rows)}});
+    }
+    EXPECT_EQ(streamed.str(), document.str());
+  }
 }
 
 }  // namespace

@@ -43,7 +43,7 @@ TEST(HeldByContactFinite, TurnedDiscBalancesAboutItsDeformedShape) {
   EXPECT_EQ(s.scene.problem.rigid.count(), 3);
   expect_disc_balanced(s);
   for (const StepRecord& rec : s.run.steps) {
-    const Vec2 lower = flat_resultant(s.scene.problem, rec, 0), upper = flat_resultant(s.scene.problem, rec, 1);
+    const Vec2 lower = contact_resultant(s.scene.problem, rec, 0), upper = contact_resultant(s.scene.problem, rec, 1);
     const json step = step_json(s.scene.problem, rec, s.scene.output);
     std::printf(
         "finite disc, step %d: P = %.4f, Q lower %.6f upper %.6f N/mm, rotation %.3e; %d real solves, %d Newton\n",
@@ -82,7 +82,7 @@ TEST(HeldByContactFinite, SmallLoadAgreesWithSmallStrain) {
   ASSERT_TRUE(l.run.completed) << l.run.reason;
   expect_disc_balanced(f);
   const StepRecord &fr = f.run.steps.back(), &lr = l.run.steps.back();
-  const Vec2 pf = flat_resultant(f.scene.problem, fr, 0), pl = flat_resultant(l.scene.problem, lr, 0);
+  const Vec2 pf = contact_resultant(f.scene.problem, fr, 0), pl = contact_resultant(l.scene.problem, lr, 0);
   const double gradient = largest_gradient(l.scene.problem, lr.state.q);
   std::printf(
       "small load: P finite %.6f, linear %.6f (%+.3e), Q finite %.6f, linear %.6f (%+.3e); largest "
@@ -117,7 +117,7 @@ TEST(HeldByContactFinite, TurnedDiscByForceMatchesDisplacementControl) {
   }
   const double q_diff = (q - dr.state.q).lpNorm<Eigen::Infinity>(), q_max = q.lpNorm<Eigen::Infinity>();
   const Vec2 reaction = reaction_resultant(d.scene.problem, dr);
-  const double P = flat_resultant(f.scene.problem, fr, 0).y();
+  const double P = contact_resultant(f.scene.problem, fr, 0).y();
   std::printf(
       "by force: %d real solves, %d Newton; by displacement: %d real solves, %d Newton; forces differ by "
       "%.2e, displacements by %.2e (relative), support reaction %.2e of P\n",

@@ -20,17 +20,6 @@ namespace {
 using nlohmann::json;
 using namespace grip::testing;
 
-Vec2 contact_resultant(const Problem& problem, const StepRecord& rec, int obstacle) {
-  Vec2 total = Vec2::Zero();
-  for (size_t i = 0; i < problem.candidates.size(); ++i) {
-    const Candidate& c = problem.candidates[i];
-    if (c.obstacle != obstacle) continue;
-    const PairedPoint& pp = rec.state.points[i];
-    total += rec.p[c.eta] * pp.eta + (c.xi >= 0 ? rec.p[c.xi] : 0.0) * pp.xi;
-  }
-  return total;
-}
-
 // The node of a continuum scene's mesh at `x`.
 int node_at(const json& scene, const Vec2& x) {
   const Scene s = read_scene(scene);
