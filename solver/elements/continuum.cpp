@@ -222,11 +222,18 @@ std::vector<int> ContinuumBody::add_sites(const std::vector<int>& nodes) {
   if (static_cast<int>(set.size()) == before) return {};
   BoundaryPart grown = boundary_part(mesh_, shape_, set);
   // The existing sites keep their indices; the new ones follow. Tributary lengths from the grown part.
-  std::vector<double> length_of(node_count(), 0.0);
-  for (size_t k = 0; k < grown.nodes.size(); ++k) length_of[grown.nodes[k]] = grown.lengths[k];
+  std::vector<double> length_of(node_count(), 0.0), revolved_of(node_count(), 0.0);
+  for (size_t k = 0; k < grown.nodes.size(); ++k) {
+    length_of[grown.nodes[k]] = grown.lengths[k];
+    revolved_of[grown.nodes[k]] = grown.revolved_areas[k];
+  }
   grown.nodes = set;
   grown.lengths.clear();
-  for (int node : set) grown.lengths.push_back(length_of[node]);
+  grown.revolved_areas.clear();
+  for (int node : set) {
+    grown.lengths.push_back(length_of[node]);
+    grown.revolved_areas.push_back(revolved_of[node]);
+  }
   contact_ = std::move(grown);
   std::vector<int> added;
   for (int s = before; s < site_count(); ++s) added.push_back(s);

@@ -15,7 +15,7 @@
 // them), so a site's row in site_fields is site_node(site). A site's surface point is the
 // node itself (no offset; `side` is ignored) and its contact force acts on the node's two
 // dofs. Tributary area = integral of the node's shape function over the contact sides x
-// thickness (half the adjacent side lengths for t3 and q4). A quadratic side (t6, q8, q9) is
+// thickness (half the adjacent side lengths for t3 and q4); axisymmetric: x 2 pi r instead. A quadratic side (t6, q8, q9) is
 // two contact segments, corner - mid-side - corner: its mid-side node is a site like the corners.
 #include <memory>
 #include <mutex>
@@ -70,7 +70,10 @@ class ContinuumBody final : public Body {
     return mesh_.nodes[node] + Vec2(q[node_dof(node, 0)], q[node_dof(node, 1)]);
   }
   std::vector<int> add_sites(const std::vector<int>& nodes) override;
-  double tributary_area(int site) const override { return contact_.lengths[site] * options_.thickness; }
+  // Plane: length x thickness; axisymmetric: the revolved area (integral of N 2 pi r ds).
+  double tributary_area(int site) const override {
+    return axisymmetric() ? contact_.revolved_areas[site] : contact_.lengths[site] * options_.thickness;
+  }
   double characteristic_length() const override { return length_; }
 
   Vector rigid_translation(const Vec2& d) const override;

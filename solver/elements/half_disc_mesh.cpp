@@ -229,11 +229,50 @@ constexpr double kAngleSlack = 60.0;
 
 bool well_shaped(const PlaneMesh& mesh) { return corner_angles_within(mesh, 90 - kAngleSlack, 90 + kAngleSlack); }
 
+// The half at x >= the centre's: the blocks are symmetric about the line through the pole and
+// the centre (an even number of columns on each side of it), so no element crosses it. Its
+// nodes are put exactly on it, the others dropped and the sets renumbered; "axis" is added.
+PlaneMesh right_half(PlaneMesh whole, const Vec2& centre, double radius) {
+  const double x0 = centre.x(), slack = 1e-9 * radius;
+  for (Vec2& x : whole.nodes)
+    if (std::abs(x.x() - x0) <= slack) x.x() = x0;
+  PlaneMesh half;
+  std::vector<int> id(whole.nodes.size(), -1);
+  for (const auto& el : whole.elements) {
+    const bool right = std::all_of(el.begin(), el.end(), [&](int n) { return whole.nodes[n].x() >= x0; });
+    if (!right) {
+      if (std::any_of(el.begin(), el.end(), [&](int n) { return whole.nodes[n].x() > x0; }))
+        throw std::logic_error("half_disc: an element crosses the line through the pole and the centre");
+      continue;
+    }
+    std::vector<int> kept;
+    for (int n : el) {
+      if (id[n] < 0) {
+        id[n] = static_cast<int>(half.nodes.size());
+        half.nodes.push_back(whole.nodes[n]);
+      }
+      kept.push_back(id[n]);
+    }
+    half.elements.push_back(std::move(kept));
+  }
+  for (const auto& [name, set] : whole.sets) {
+    std::vector<int>& renumbered = half.sets[name];
+    for (int n : set)
+      if (id[n] >= 0) renumbered.push_back(id[n]);
+  }
+  std::vector<int>& axis = half.sets["axis"];
+  for (size_t n = 0; n < half.nodes.size(); ++n)
+    if (half.nodes[n].x() == x0) axis.push_back(static_cast<int>(n));
+  std::sort(axis.begin(), axis.end(), [&](int a, int b) { return half.nodes[a].y() < half.nodes[b].y(); });
+  return half;
+}
+
 }  // namespace
 
 PlaneMesh half_disc_mesh(const HalfDiscSpec& spec, ElementShape shape) {
   PlaneMesh mesh = build_half_disc(spec, grid_shape(shape));
-  if (well_shaped(mesh)) return quads_as(std::move(mesh), shape);
+  if (well_shaped(mesh))
+    return quads_as(spec.right_half ? right_half(std::move(mesh), spec.centre, spec.radius) : std::move(mesh), shape);
   // Name the fewest arc divisions that shape the elements well (more arc divisions, more ring
   // rows, fewer pole block rows).
   std::string hint = "give fewer divisions from the pole to the centre";

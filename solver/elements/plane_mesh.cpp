@@ -26,19 +26,33 @@ std::string point_text(const Vec2& p) {
 }
 
 // Integral of each node's shape function along a side (2 or 3 nodes), by 3-point Gauss.
-std::array<double, 3> side_weights(const PlaneMesh& mesh, const std::vector<int>& side) {
+// Per node of a side: the integral of its shape function along the side, and the same weighted
+// by 2 pi r (r = x: the area it sweeps revolved about the axis x = 0). 3-point Gauss: exact on
+// straight sides, where r is linear along the side.
+std::array<std::array<double, 3>, 2> side_weights(const PlaneMesh& mesh, const std::vector<int>& side) {
   static const double g[3] = {-std::sqrt(0.6), 0.0, std::sqrt(0.6)}, w[3] = {5.0 / 9, 8.0 / 9, 5.0 / 9};
   const bool quadratic = side.size() == 3;
-  std::array<double, 3> out{0.0, 0.0, 0.0};
+  std::array<std::array<double, 3>, 2> out{};
   for (int k = 0; k < 3; ++k) {
     const double s = g[k];
     const double N[3] = {quadratic ? 0.5 * s * (s - 1) : 0.5 * (1 - s), quadratic ? 1 - s * s : 0.5 * (1 + s),
                          quadratic ? 0.5 * s * (s + 1) : 0.0};
     const double dN[3] = {quadratic ? s - 0.5 : -0.5, quadratic ? -2 * s : 0.5, quadratic ? s + 0.5 : 0.0};
-    Vec2 dx = Vec2::Zero();
-    for (size_t a = 0; a < side.size(); ++a) dx += dN[a] * mesh.nodes[side[a]];
-    for (size_t a = 0; a < side.size(); ++a) out[a] += w[k] * N[a] * dx.norm();
+    Vec2 x = Vec2::Zero(), dx = Vec2::Zero();
+    for (size_t a = 0; a < side.size(); ++a) {
+      x += N[a] * mesh.nodes[side[a]];
+      dx += dN[a] * mesh.nodes[side[a]];
+    }
+    for (size_t a = 0; a < side.size(); ++a) {
+      out[0][a] += w[k] * N[a] * dx.norm();
+      out[1][a] += w[k] * N[a] * dx.norm() * 2 * std::numbers::pi * x.x();
+    }
   }
+  // A quadratic side's corner on the axis: 2 pi r N_a integrates to 0 on a straight side, and on
+  // a curved one to a sliver set by the side's curvature, not by what the node carries: no share.
+  if (quadratic)
+    for (int a : {0, 2})
+      if (mesh.nodes[side[a]].x() == 0.0) out[1][a] = 0.0;
   return out;
 }
 
@@ -372,13 +386,14 @@ BoundaryPart boundary_part(const PlaneMesh& mesh, ElementShape shape, const std:
   // whether a side holds it, and its tributary length.
   std::vector<int> next(nodes, -1);
   std::vector<char> has_previous(nodes, 0), on_side(nodes, 0);
-  std::vector<double> length(nodes, 0.0);
+  std::vector<double> length(nodes, 0.0), revolved(nodes, 0.0);
   for (auto& side : boundary_sides_within(mesh, shape, &in)) {
     if (!std::all_of(side.begin(), side.end(), [&](int a) { return in[a] != 0; }))
       continue;  // a quadratic side's middle
-    const std::array<double, 3> w = side_weights(mesh, side);
+    const auto w = side_weights(mesh, side);
     for (size_t a = 0; a < side.size(); ++a) {
-      length[side[a]] += w[a];
+      length[side[a]] += w[0][a];
+      revolved[side[a]] += w[1][a];
       on_side[side[a]] = 1;
     }
     for (size_t a = 0; a + 1 < side.size(); ++a) {
@@ -403,6 +418,7 @@ BoundaryPart boundary_part(const PlaneMesh& mesh, ElementShape shape, const std:
       visited[i] = 1;
       part.nodes.push_back(i);
       part.lengths.push_back(length[i]);
+      part.revolved_areas.push_back(revolved[i]);
       if (next[i] < 0) break;
     }
   return part;

@@ -45,11 +45,13 @@ std::vector<std::vector<int>> boundary_sides(const PlaneMesh& mesh, ElementShape
 // to the set, the set's nodes in order along them (counter-clockwise round the body; several
 // runs one after another), and per node the integral of its shape function over those sides
 // (half the adjacent side lengths for t3 and q4; 1/6, 2/3, 1/6 of a straight side for t6, q8
-// and q9).
+// and q9), and that integral weighted by 2 pi r (r = x: the area the node's share sweeps
+// revolved about the axis, for axisymmetry).
 struct BoundaryPart {
   std::vector<std::vector<int>> sides;
   std::vector<int> nodes;
-  std::vector<double> lengths;  // per entry of `nodes`
+  std::vector<double> lengths;         // per entry of `nodes`
+  std::vector<double> revolved_areas;  // per entry of `nodes`
 };
 // Throws if a node of the set lies on no such side.
 BoundaryPart boundary_part(const PlaneMesh& mesh, ElementShape shape, const std::vector<int>& set);
@@ -92,12 +94,15 @@ PlaneMesh rectangle_mesh(const RectangleSpec& spec, ElementShape shape);
 // nt divisions from the pole to the centre: the ring's rows (ns less the pole block's, halved)
 // and the pole block's below them. Sets: "arc" (counter-clockwise), "diameter", "pole" (one
 // node), "centre" (the middle of the diameter, one node), and with a refinement "arc_refined"
-// (the arc nodes within its extent of the pole, along the arc).
+// (the arc nodes within its extent of the pole, along the arc). `right_half`: only the half
+// at x >= the centre's (the section of a hemisphere about the axis through the pole and the
+// centre, for axisymmetry), with the set "axis" (its nodes on that line, upward).
 struct HalfDiscSpec {
   Vec2 centre = Vec2::Zero();
   double radius = 1.0;
   int ns = 4, nt = 2;
   bool facing_up = false;
+  bool right_half = false;
   std::optional<Refinement> refine;
 };
 PlaneMesh half_disc_mesh(const HalfDiscSpec& spec, ElementShape shape);

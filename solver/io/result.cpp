@@ -7,6 +7,7 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <map>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -122,6 +123,37 @@ json table_json(const FieldTable& t, const char* index_name) {
 
 }  // namespace
 
+namespace {
+
+// Axisymmetric, a quadratic side's corner on the axis: 2 pi r N vanishes there, so the node
+// carries no share of the area (nor of a pressure's force) and force / area says nothing. Its
+// contact stress is read at the adjacent site along the surface (h / 2 away: the pressure's
+// change over that distance is of order h^2 on a smooth profile).
+void share_axis_stresses(const Problem& problem, std::vector<ContactPointRow>& rows) {
+  const Body& body = *problem.body;
+  std::map<std::pair<int, int>, size_t> row_of;  // (obstacle, site) -> row
+  for (size_t i = 0; i < problem.candidates.size(); ++i)
+    row_of[{problem.candidates[i].obstacle, problem.candidates[i].site}] = i;
+  for (size_t i = 0; i < problem.candidates.size(); ++i) {
+    const Candidate& c = problem.candidates[i];
+    if (body.tributary_area(c.site) > 0) continue;
+    const Vec2 at = body.site_reference(c.site);
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const int s : {c.site - 1, c.site + 1}) {
+      const auto it = row_of.find({c.obstacle, s});
+      if (it == row_of.end() || !(body.tributary_area(s) > 0)) continue;
+      const double d = (body.site_reference(s) - at).norm();
+      if (d >= nearest) continue;
+      nearest = d;
+      rows[i].sigma_n = rows[it->second].sigma_n;
+      rows[i].sigma_t = rows[it->second].sigma_t;
+    }
+    if (!std::isfinite(nearest)) rows[i].sigma_n = rows[i].sigma_t = 0.0;  // no neighbour: none to read
+  }
+}
+
+}  // namespace
+
 // The contact points' numbers, read from the problem and the record.
 std::vector<ContactPointRow> contact_point_rows(const Problem& problem, const StepRecord& rec) {
   const Body& body = *problem.body;
@@ -155,6 +187,7 @@ std::vector<ContactPointRow> contact_point_rows(const Problem& problem, const St
     }
     rows.push_back(std::move(r));
   }
+  share_axis_stresses(problem, rows);
   return rows;
 }
 

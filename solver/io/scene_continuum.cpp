@@ -6,7 +6,7 @@
 //     {"nodes": [[x, y], ...], "elements": [[n0, n1, n2(, ...9)], ...], "sets": {name: [ids]}}
 //     {"rectangle": {"origin", "size", "divisions": [nx, ny], "refine": {"towards", "size", "extent"}}}
 //     {"half_disc": {"centre", "radius", "divisions": [ns (arc), nt (pole to centre)], "facing": "down" | "up",
-//                    "refine": {"size", "extent"}}}
+//                    "part": "whole" | "right" (x >= centre's: a ball's section), "refine": {"size", "extent"}}}
 //   "contact_set": a node set on the boundary (default "bottom" for a rectangle, "arc" for a
 //     half-disc); its nodes are the contact candidates
 //   "supports": [{"set" | "node", "fix": ["x", "y"], "values": {"x", "y"} | "rotation": {"about", "angle"}, "case"}]
@@ -124,6 +124,7 @@ std::optional<PlaneMesh> read_generated_mesh(Reader& r, json& mesh, const std::s
                 "must be an even integer from 4: a node sits at the pole, and the arc has a block at each end");
       if (div && div->second < 2) r.error(gp + "/divisions/1", "must be at least 2: a pole block and a ring round it");
       spec.facing_up = r.choice(*gen, gp, "facing", {"down", "up"}, "down") == "up";
+      spec.right_half = r.choice(*gen, gp, "part", {"whole", "right"}, "whole") == "right";
       spec.refine = read_refinement(r, *gen, gp, nullptr);
       if (r.issues.size() > before || !div) return std::nullopt;
       spec.ns = div->first;
@@ -288,32 +289,6 @@ void hold_axis(const PlaneMesh& mesh, Reader& r, Problem& problem) {
   r.axis_holds.push_back(std::move(hold));
 }
 
-// A traction per unit area on the revolved sides: f integrated with N_a 2 pi r ds along each
-// side (2 or 3 nodes), by 3-point Gauss (exact on straight sides, where r is linear in s).
-void add_revolved_traction(const PlaneMesh& mesh, const BoundaryPart& part, const Vec2& f, Vector& load) {
-  const double g = std::sqrt(0.6), points[3] = {-g, 0.0, g}, weights[3] = {5.0 / 9, 8.0 / 9, 5.0 / 9};
-  for (const auto& side : part.sides)
-    for (int i = 0; i < 3; ++i) {
-      const double s = points[i];
-      // 1D shape functions on [-1, 1]: linear (ends) or quadratic (end, middle, end).
-      std::vector<double> N, dN;
-      if (side.size() == 2) {
-        N = {(1 - s) / 2, (1 + s) / 2};
-        dN = {-0.5, 0.5};
-      } else {
-        N = {s * (s - 1) / 2, 1 - s * s, s * (s + 1) / 2};
-        dN = {s - 0.5, -2 * s, s + 0.5};
-      }
-      Vec2 x = Vec2::Zero(), dx = Vec2::Zero();
-      for (size_t a = 0; a < side.size(); ++a) {
-        x += N[a] * mesh.nodes[side[a]];
-        dx += dN[a] * mesh.nodes[side[a]];
-      }
-      const double w = weights[i] * dx.norm() * 2 * std::numbers::pi * x.x();
-      for (size_t a = 0; a < side.size(); ++a) load.segment<2>(2 * side[a]) += N[a] * w * f;
-    }
-}
-
 void read_continuum_loads(Reader& r, json& body, const std::string& ptr, const PlaneMesh& mesh, ElementShape shape,
                           Problem& problem, double thickness, bool axisymmetric) {
   for_each_object(r, body, ptr, "loads", [&](json& l, const std::string& lp) {
@@ -337,12 +312,11 @@ void read_continuum_loads(Reader& r, json& body, const std::string& ptr, const P
     }
     try {
       const BoundaryPart part = boundary_part(mesh, shape, *nodes);
-      if (axisymmetric) {
-        add_revolved_traction(mesh, part, f, load);
-        return;
-      }
+      // A traction is per unit area: each node takes f times its share of the side's area
+      // (axisymmetric: the revolved area, so that the force is the total over the circle).
       for (size_t k = 0; k < part.nodes.size(); ++k)
-        load.segment<2>(2 * part.nodes[k]) += part.lengths[k] * thickness * f;
+        load.segment<2>(2 * part.nodes[k]) +=
+            (axisymmetric ? part.revolved_areas[k] : part.lengths[k] * thickness) * f;
     } catch (const std::invalid_argument& e) {
       r.error(lp + "/set", e.what());
     }

@@ -15,6 +15,7 @@
 
 #include "solver/contact/contact_error.hpp"
 #include "solver/elements/plane_mesh.hpp"
+#include "solver/io/result.hpp"
 #include "solver/stepping/load_stepping.hpp"
 #include "tests/support/scenes.hpp"
 
@@ -69,8 +70,9 @@ struct ContactNode {
   ContactState state = ContactState::open;
 };
 
-// The candidates on `obstacle`, by increasing reference x.
+// The candidates on `obstacle`, by increasing reference x; the stresses as the result gives them.
 inline std::vector<ContactNode> contact_profile(const Problem& problem, const StepRecord& rec, int obstacle = 0) {
+  const std::vector<ContactPointRow> rows = contact_point_rows(problem, rec);
   std::vector<ContactNode> nodes;
   for (size_t i = 0; i < problem.candidates.size(); ++i) {
     const Candidate& c = problem.candidates[i];
@@ -79,9 +81,8 @@ inline std::vector<ContactNode> contact_profile(const Problem& problem, const St
     n.x = problem.body->site_reference(c.site).x();
     n.p_n = rec.p[c.eta];
     n.p_t = c.xi >= 0 ? rec.p[c.xi] : 0.0;
-    const double area = problem.body->tributary_area(c.site);
-    n.sigma_n = n.p_n / area;
-    n.sigma_t = n.p_t / area;
+    n.sigma_n = rows[i].sigma_n;
+    n.sigma_t = rows[i].sigma_t;
     n.state = contact_state(problem, i, rec.p, rec.tau);
     nodes.push_back(n);
   }
@@ -162,13 +163,8 @@ Zone zone_of(const std::vector<ContactNode>& nodes, InZone in_zone, Vanishing f)
 struct EllipseFit {
   double a = 0.0, p0 = 0.0;
 };
-inline EllipseFit fit_semi_ellipse(const std::vector<ContactNode>& nodes) {
-  double force = 0, moment = 0;
-  for (const auto& c : nodes) {
-    force += c.p_n;
-    moment += c.p_n * c.x;
-  }
-  const double xc = force != 0 ? moment / force : 0.0;
+// About a given centre (axisymmetric: the axis, x = r = 0).
+inline EllipseFit fit_semi_ellipse_about(const std::vector<ContactNode>& nodes, double xc) {
   double n = 0, sx = 0, sy = 0, sxx = 0, sxy = 0;
   for (const auto& c : nodes) {
     if (c.p_n >= 0) continue;
@@ -183,6 +179,14 @@ inline EllipseFit fit_semi_ellipse(const std::vector<ContactNode>& nodes) {
   const double slope = (n * sxy - sx * sy) / (n * sxx - sx * sx), intercept = (sy - slope * sx) / n;
   if (!(slope < 0 && intercept > 0)) return {};
   return {std::sqrt(-intercept / slope), std::sqrt(intercept)};
+}
+inline EllipseFit fit_semi_ellipse(const std::vector<ContactNode>& nodes) {
+  double force = 0, moment = 0;
+  for (const auto& c : nodes) {
+    force += c.p_n;
+    moment += c.p_n * c.x;
+  }
+  return fit_semi_ellipse_about(nodes, force != 0 ? moment / force : 0.0);
 }
 
 // The contact zone: nodes that press; the pressure vanishes like sqrt(a - |x|) at its edges.

@@ -108,8 +108,8 @@ inline nlohmann::json beam_lying_on_a_flat(const std::string& kinematics) {
 }
 
 // Solved, with the step checks of every converged step held to their limits (issue 33.1).
-inline Solved solve_scene(const nlohmann::json& j, const MeshResolver& meshes = {}) {
-  Solved s{read_scene(j, meshes), {}};
+inline Solved solve_read_scene(Scene scene) {
+  Solved s{std::move(scene), {}};
   s.run = run_load_steps(s.scene.problem, s.scene.steps, s.scene.params);
   const ContactParams& c = s.scene.params.contact;
   const bool moving_bound =
@@ -121,6 +121,13 @@ inline Solved solve_scene(const nlohmann::json& j, const MeshResolver& meshes = 
                                             c.tolerance * s.scene.problem.body->characteristic_length(),
                                             moving_bound ? 1e-9 : c.tau_tolerance));
   return s;
+}
+inline Solved solve_scene(const nlohmann::json& j, const MeshResolver& meshes = {}) {
+  return solve_read_scene(read_scene(j, meshes));
+}
+// A shipped example as a user runs it: its mesh files read beside it.
+inline Solved solve_example(const std::string& name) {
+  return solve_read_scene(read_scene_file(std::string(GRIP_SOURCE_DIR) + "/schemas/examples/" + name + ".json"));
 }
 
 }  // namespace grip::testing

@@ -37,8 +37,7 @@ double moment(const Problem& problem, int b, const Vector& q, const Vector& forc
 }
 
 TEST(GearPair, TheContactRunsUpTheFlankAndTheHubsCarryItsMoment) {
-  Solved s{read_scene_file(std::string(GRIP_SOURCE_DIR) + "/schemas/examples/gear-pair.json"), {}};
-  s.run = run_load_steps(s.scene.problem, s.scene.steps, s.scene.params);
+  const Solved s = testing::solve_example("gear-pair");
   ASSERT_TRUE(s.run.completed) << s.run.reason;
   ASSERT_EQ(s.run.steps.size(), 10u);
   const Problem& problem = s.scene.problem;

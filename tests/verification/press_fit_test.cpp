@@ -36,8 +36,7 @@ double body_moment(const Problem& problem, int b, const Vector& force) {
 }
 
 TEST(PressFit, LamePressureThenTorsionThenTheSlipTorque) {
-  Solved s{read_scene_file(std::string(GRIP_SOURCE_DIR) + "/schemas/examples/press-fit.json"), {}};
-  s.run = run_load_steps(s.scene.problem, s.scene.steps, s.scene.params);
+  const Solved s = testing::solve_example("press-fit");
   ASSERT_TRUE(s.run.completed) << s.run.reason;
   ASSERT_EQ(s.run.steps.size(), 7u);
   const Problem& problem = s.scene.problem;
