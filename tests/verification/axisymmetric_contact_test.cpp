@@ -109,23 +109,39 @@ TEST(AxisymmetricContact, HertzSphereHeldOnlyByContact) {
   EXPECT_NEAR(fit.p0, 3 * P / (2 * pi * a * a), 0.01 * 3 * P / (2 * pi * a * a));
 }
 
-// Every strategy on the sphere. uzawa converges linearly: at a tolerance of 1e-5 (about 1e-4
-// of the approach) it needs some hundred iterations where cev at 1e-8 needs 4.
+// Every strategy on the sphere: ssn at the shipped tolerance; penalty at 1e-6 (at 1e-8 it
+// says, honestly, that k_n would have to be 4.8 times larger). uzawa converges linearly (3267
+// iterations at 1e-5 on elements of 0.1 mm, where cev needs 4): on that mesh, against cev.
 TEST(AxisymmetricContact, EveryStrategyOnTheSphere) {
-  for (const char* method : {"uzawa", "ssn", "penalty"}) {
+  for (const char* method : {"ssn", "penalty"}) {
     json m = example_scene("hertz-sphere");
     m["solver"]["contact"]["method"] = method;
-    if (std::string(method) == "uzawa") {
-      m["solver"]["contact"]["tolerance"] = 1e-5;
-      m["solver"]["contact"]["max_iterations"] = 5000;
-    }
+    if (std::string(method) == "penalty") m["solver"]["contact"]["tolerance"] = 1e-6;
     const Solved s = solve_scene(m);
     ASSERT_TRUE(s.run.completed) << method << ": " << s.run.reason;
+    for (const StepRecord& rec : s.run.steps)  // ||v|| is not what ssn and penalty lower
+      EXPECT_TRUE(step_invariants(s.scene.problem, rec, tolerances_of(s.scene))) << method;
     std::printf("%s: %ld real solves\n", method, s.run.counters.solves);
     const SphereReading h = read_sphere(s, s.run.steps.back());
     EXPECT_NEAR(h.fit.a, h.a, 0.01 * h.a) << method;
     EXPECT_NEAR(h.fit.p0, h.p0, 0.01 * h.p0) << method;
   }
+  json coarse = example_scene("hertz-sphere");
+  coarse["body"]["mesh"]["half_disc"]["divisions"] = {48, 24};
+  coarse["body"]["mesh"]["half_disc"]["refine"]["size"] = 0.1;
+  const Solved cev = solve_scene(coarse);
+  coarse["solver"]["contact"]["method"] = "uzawa";
+  coarse["solver"]["contact"]["tolerance"] = 1e-5;
+  coarse["solver"]["contact"]["max_iterations"] = 5000;
+  const Solved uzawa = solve_scene(coarse);
+  expect_every_step_sound(cev);
+  expect_every_step_sound(uzawa);
+  ASSERT_TRUE(cev.run.completed && uzawa.run.completed) << uzawa.run.reason;
+  const SphereReading c = read_sphere(cev, cev.run.steps.back()), u = read_sphere(uzawa, uzawa.run.steps.back());
+  std::printf("uzawa: %ld real solves, cev %ld\n", uzawa.run.counters.solves, cev.run.counters.solves);
+  EXPECT_NEAR(u.P, c.P, 1e-3 * c.P);
+  EXPECT_NEAR(u.fit.a, c.fit.a, 2e-3 * c.fit.a);
+  EXPECT_NEAR(u.fit.p0, c.fit.p0, 2e-3 * c.fit.p0);
 }
 
 TEST(AxisymmetricContact, FlatPunchMatchesBoussinesq) {
