@@ -315,8 +315,7 @@ void read_continuum_loads(Reader& r, json& body, const std::string& ptr, const P
       // A traction is per unit area: each node takes f times its share of the side's area
       // (axisymmetric: the revolved area, so that the force is the total over the circle).
       for (size_t k = 0; k < part.nodes.size(); ++k)
-        load.segment<2>(2 * part.nodes[k]) +=
-            (axisymmetric ? part.revolved_areas[k] : part.lengths[k] * thickness) * f;
+        load.segment<2>(2 * part.nodes[k]) += (axisymmetric ? part.revolved_areas[k] : part.lengths[k] * thickness) * f;
     } catch (const std::invalid_argument& e) {
       r.error(lp + "/set", e.what());
     }

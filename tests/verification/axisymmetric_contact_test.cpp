@@ -23,9 +23,9 @@ using std::numbers::pi;
 using namespace grip::testing;
 
 struct SphereReading {
-  double P = 0, a = 0, p0 = 0;  // the closed form at the computed load
-  EllipseFit fit;               // fitted about the axis to the computed contact stresses
-  double worst_inside = 0;      // largest |sigma - closed form| / p0 at the nodes inside 0.9 a
+  double P = 0, a = 0, p0 = 0;        // the closed form at the computed load
+  EllipseFit fit;                     // fitted about the axis to the computed contact stresses
+  double worst_inside = 0;            // largest |sigma - closed form| / p0 at the nodes inside 0.9 a
   double last_in = 0, first_out = 0;  // the contact's end: the last node that presses, the next
   double contact = 0;                 // the contact forces' resultant (pressing: > 0)
 };
@@ -50,10 +50,11 @@ SphereReading read_sphere(const Solved& s, const StepRecord& rec) {
   h.first_out = h.last_in;
   for (const auto& n : nodes)
     if (n.x > h.last_in && (h.first_out == h.last_in || n.x < h.first_out)) h.first_out = n.x;
-  std::printf("step %d: P = %.1f N; a = %.4f mm, fitted %+.3f %%; p0 = %.1f MPa, fitted %+.3f %%; "
-              "worst inside 0.9 a %.3f %% of p0; contact ends between %.4f and %.4f\n",
-              rec.index, h.P, h.a, 100 * (h.fit.a / h.a - 1), h.p0, 100 * (h.fit.p0 / h.p0 - 1),
-              100 * h.worst_inside, h.last_in, h.first_out);
+  std::printf(
+      "step %d: P = %.1f N; a = %.4f mm, fitted %+.3f %%; p0 = %.1f MPa, fitted %+.3f %%; "
+      "worst inside 0.9 a %.3f %% of p0; contact ends between %.4f and %.4f\n",
+      rec.index, h.P, h.a, 100 * (h.fit.a / h.a - 1), h.p0, 100 * (h.fit.p0 / h.p0 - 1), 100 * h.worst_inside,
+      h.last_in, h.first_out);
   return h;
 }
 
@@ -72,7 +73,9 @@ void expect_hertz_sphere(const Solved& s) {
 }
 
 // The shipped scene: q8, a / h about 29 (nodes h / 2 apart along the arc).
-TEST(AxisymmetricContact, HertzSphereMatchesTheClosedForm) { expect_hertz_sphere(solve_scene(example_scene("hertz-sphere"))); }
+TEST(AxisymmetricContact, HertzSphereMatchesTheClosedForm) {
+  expect_hertz_sphere(solve_scene(example_scene("hertz-sphere")));
+}
 
 // Linear quadrilaterals and quadratic triangles on the same section; the axis corner of a
 // quadratic side has no share of the swept area, and reads its stress at the next node.
