@@ -2,7 +2,8 @@
 // study of Lame's thick cylinder (axisymmetric, q4, internal pressure: u_r closed form) runs
 // as three jobs, and its table gives an observed order near q4's 2 and a Richardson value
 // closer to the closed form than the finest level's; bad plans are refused before any job is
-// stored, with the pointer of the field at fault; deleting the study dismisses its jobs.
+// stored, with the pointer of the field at fault; deleting the study dismisses its jobs. A sweep
+// runs a job per variant and tabulates each as that job gives it.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -136,7 +137,8 @@ TEST(Studies, BadPlansAreRefusedWithThePointerBeforeAnyJobIsStored) {
       {{{"scene", cylinder()}, {"refine", {{"levels", 3}}}, {"outputs", {"u_middle"}}},
        "/outputs/0",
        "names no output"},
-      {{{"scene", cylinder()}, {"refine", {{"levels", 3}}}, {"sweep", json::array()}}, "/sweep", "not a member"},
+      {{{"scene", cylinder()}, {"refine", {{"levels", 3}}}, {"accuracy", 0.01}}, "/accuracy", "not a member"},
+      {{{"scene", cylinder()}, {"refine", {{"levels", 3}}}, {"sweep", json::array()}}, "/sweep", "goes without refine"},
       {{{"scene", large}, {"refine", {{"levels", 3}}}}, "/scene/body/mesh", "level 3 of 3"},
   };
   for (const Case& c : cases) {
@@ -150,6 +152,82 @@ TEST(Studies, BadPlansAreRefusedWithThePointerBeforeAnyJobIsStored) {
   const auto jobs = api.get("/v1/jobs");
   ASSERT_TRUE(jobs);
   EXPECT_TRUE(json::parse(jobs->body)["jobs"].empty()) << jobs->body;
+}
+
+// A sweep of the pressure and the modulus (a grid of 3 x 2 variants of the 8 x 4 cylinder):
+// linear elasticity makes u_r proportional to p / E, and each variant's row is its job's
+// result, bit for bit, as is a job submitted on its own with the same scene.
+TEST(Studies, ASweepTabulatesEveryVariantAsItsOwnJobWouldGiveIt) {
+  TempDir dir;
+  ServerProcess server(dir.path() / "grip.sqlite", {"--workers", "2"}, dir.path() / "serve.log");
+  const Api api(server.port());
+  json scene = cylinder();
+  scene["body"]["mesh"]["rectangle"]["divisions"] = {8, 4};
+  const json request = {
+      {"scene", scene},
+      {"sweep",
+       {{{"pointer", "/body/loads/0/traction/0"}, {"values", {5, 10, 20}}},
+        {{"pointer", "/body/material/young"}, {"range", {{"from", 1000}, {"to", 2000}, {"count", 2}}}}}}};
+  const json accepted = post_study(api, request, 201);
+  ASSERT_EQ(accepted["levels"].size(), 6u);
+  json study;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  do {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    study = json::parse(api.get("/v1/studies/" + accepted["id"].get<std::string>())->body);
+  } while (study["status"] != "successful" && std::chrono::steady_clock::now() < deadline);
+  ASSERT_EQ(study["status"], "successful") << study.dump(2);
+  EXPECT_EQ(study["pointers"], json({"/body/loads/0/traction/0", "/body/material/young"}));
+  const double reference = study["levels"][0]["outputs"]["u_inner"].get<double>() * 1000 / 5;
+  for (size_t k = 0; k < 6; ++k) {
+    const json& level = study["levels"][k];
+    const double p = level["parameters"][0], E = level["parameters"][1];
+    EXPECT_EQ(p, (std::vector<double>{5, 10, 20})[k / 2]);  // the last pointer fastest
+    EXPECT_EQ(E, k % 2 ? 2000 : 1000);
+    EXPECT_NEAR(level["outputs"]["u_inner"].get<double>() * E / p, reference, 1e-9 * reference);
+    EXPECT_EQ(study["quantities"][0]["values"][k], level["outputs"]["u_inner"]);
+    const auto result = api.get("/v1/jobs/" + level["job"].get<std::string>() + "/result");
+    EXPECT_EQ(json::parse(result->body)["steps"].back()["outputs"], level["outputs"]);
+  }
+  // The variant (10, 2000) submitted as a job of its own gives the same numbers.
+  json own = scene;
+  own["body"]["loads"][0]["traction"][0] = 10;
+  own["body"]["material"]["young"] = 2000.0;
+  const std::string id = api.submit(own);
+  api.wait_status(id, {"successful"});
+  EXPECT_EQ(json::parse(api.get("/v1/jobs/" + id + "/result")->body)["steps"].back()["outputs"],
+            study["levels"][3]["outputs"]);
+
+  // Bad sweeps, refused before any job is stored.
+  const size_t jobs_before = json::parse(api.get("/v1/jobs?limit=1000")->body)["jobs"].size();
+  struct Case {
+    json sweep;
+    std::string mode, pointer, says;
+  };
+  const Case cases[] = {
+      {{{{"pointer", "/obstacles/0/friction"}, {"values", {0.1, 0.2}}}}, "grid", "/sweep/0/pointer", "names no value"},
+      {{{{"pointer", "/body/material/young"}, {"values", {1000, -1}}}},
+       "grid",
+       "/scene/body/material/young",
+       "variant 2 of 2 ([-1])"},
+      {{{{"pointer", "/body/material/young"}, {"values", {1000, 2000}}},
+        {{"pointer", "/body/material/poisson"}, {"values", {0.2, 0.3, 0.4}}}},
+       "zip",
+       "/sweep/1",
+       "zipped"},
+      {{{{"pointer", "/body/material/young"}, {"range", {{"from", 1}, {"to", 2}, {"count", 100}}}},
+        {{"pointer", "/body/material/poisson"}, {"values", {0.2, 0.3}}}},
+       "grid",
+       "/sweep",
+       "makes 200 jobs"},
+  };
+  for (const Case& c : cases) {
+    const json p = post_study(api, {{"scene", scene}, {"sweep", c.sweep}, {"mode", c.mode}}, 422);
+    ASSERT_TRUE(p.contains("errors")) << p.dump();
+    EXPECT_EQ(p["errors"][0]["pointer"], c.pointer) << p.dump();
+    EXPECT_NE(p["errors"][0]["detail"].get<std::string>().find(c.says), std::string::npos) << p.dump();
+  }
+  EXPECT_EQ(json::parse(api.get("/v1/jobs?limit=1000")->body)["jobs"].size(), jobs_before);
 }
 
 }  // namespace
