@@ -729,6 +729,14 @@ void HttpServer::Impl::get_study(const Request& req, Response& res) {
   const std::string id = req.matches[1];
   const auto doc = studies.study(id);
   if (!doc) return problem(res, req, 404, "study-not-found", "Study not found", "no study has id '" + id + "'");
+  const std::string format = req.has_param("format") ? req.get_param_value("format") : "json";
+  if (format == "csv") {
+    res.set_header("Content-Disposition", "attachment; filename=\"study-" + id + ".csv\"");
+    res.set_content(objects_csv(study_rows(*doc)), "text/csv; charset=utf-8");
+    return;
+  }
+  if (format != "json")
+    return problem(res, req, 400, "bad-parameter", "Bad query parameter", "format must be json or csv");
   send_json(res, 200, *doc);
 }
 

@@ -425,6 +425,25 @@ std::optional<json> Studies::study(const std::string& id) {
   return doc;
 }
 
+std::vector<json> study_rows(const json& study) {
+  std::vector<json> rows;
+  for (size_t k = 0; k < study["levels"].size(); ++k) {
+    const json& level = study["levels"][k];
+    json row = {
+        {"level", level["level"]}, {"job", level["job"]}, {"status", level["status"]}, {"nodes", level["nodes"]}};
+    row["seconds"] = level.value("seconds", json(nullptr));
+    for (const char* key : {"h", "parameters"})
+      if (level.contains(key)) row[key] = level[key];
+    for (const json& q : study["quantities"]) {
+      const std::string name = q["name"];
+      row["outputs"][name] = q["values"][k];
+      if (q.contains("estimated_error")) row["estimated_error"][name] = q["estimated_error"][k];
+    }
+    rows.push_back(std::move(row));
+  }
+  return rows;
+}
+
 bool Studies::remove(const std::string& id) {
   const auto rec = jobs_.store().study(id);
   if (!rec) return false;

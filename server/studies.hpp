@@ -50,6 +50,10 @@ StudyPlan plan_study(const nlohmann::json& request);
 // The thresholds of "the cheapest level whose estimated error is below": 10 %, 1 %, 0.1 %.
 inline const std::vector<double> kStudyThresholds = {0.1, 0.01, 0.001};
 
+// A study's table as rows, one per level (or variant), for CSV (objects_csv): level, job,
+// status, nodes, seconds, h or parameters, outputs.NAME, estimated_error.NAME.
+std::vector<nlohmann::json> study_rows(const nlohmann::json& study);
+
 class Studies {
  public:
   explicit Studies(JobService& jobs) : jobs_(jobs) {}

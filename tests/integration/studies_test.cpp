@@ -6,6 +6,7 @@
 // runs a job per variant and tabulates each as that job gives it.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -101,6 +102,15 @@ TEST(Studies, ThreeLevelsOfLamesCylinderGiveQ4sOrderAndABetterExtrapolation) {
     for (const json& c : q["cheapest"])
       if (!c["level"].is_null()) EXPECT_LT(c["level"]["estimated_error"].get<double>(), c["below"].get<double>());
   }
+  // The table as CSV: a header and a row per level, the values as in the JSON.
+  const auto csv = api.get("/v1/studies/" + id + "?format=csv");
+  ASSERT_TRUE(csv && csv->status == 200);
+  const std::string text = csv->body;
+  EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 4);
+  const std::string header = text.substr(0, text.find('\n'));
+  for (const char* column : {"level", "job", "nodes", "seconds", "h", "outputs.u_inner", "estimated_error.u_outer"})
+    EXPECT_NE(header.find(column), std::string::npos) << header;
+  EXPECT_NE(text.find(study["levels"][2]["job"].get<std::string>()), std::string::npos);
   // Deleting the study dismisses its jobs (finished ones are removed).
   const auto removed = api.del("/v1/studies/" + id);
   ASSERT_TRUE(removed);
