@@ -240,5 +240,39 @@ TEST(Studies, ASweepTabulatesEveryVariantAsItsOwnJobWouldGiveIt) {
   EXPECT_EQ(json::parse(api.get("/v1/jobs?limit=1000")->body)["jobs"].size(), jobs_before);
 }
 
+// A sweep of the friction coefficient over the sliding block (schemas/examples/sliding-block.json,
+// the flat moved 0.01 mm under the pressed block): once every contact node slips, the
+// tangential force the top's supports carry is mu times the normal one, for every mu of 0, 0.1,
+// ..., 0.5 (to what the contact tolerance pins the forces).
+TEST(Studies, AFrictionSweepOfTheSlidingBlockSlipsAtMuN) {
+  TempDir dir;
+  ServerProcess server(dir.path() / "grip.sqlite", {"--workers", "2"}, dir.path() / "serve.log");
+  const Api api(server.port());
+  json scene = json::parse(read_text(examples_dir() / "sliding-block.json"));
+  scene["outputs"] = {{{"name", "Q"}, {"kind", "reaction"}, {"set", "top"}, {"component", "x"}},
+                      {{"name", "N"}, {"kind", "reaction"}, {"set", "top"}, {"component", "y"}},
+                      {{"name", "contact_x"}, {"kind", "resultant"}, {"component", "x"}}};
+  const json accepted = post_study(
+      api,
+      {{"scene", scene},
+       {"sweep", {{{"pointer", "/obstacles/0/friction"}, {"range", {{"from", 0}, {"to", 0.5}, {"count", 6}}}}}}},
+      201);
+  json study;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  do {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    study = json::parse(api.get("/v1/studies/" + accepted["id"].get<std::string>())->body);
+  } while (study["status"] != "successful" && std::chrono::steady_clock::now() < deadline);
+  ASSERT_EQ(study["status"], "successful") << study.dump(2);
+  for (const json& level : study["levels"]) {
+    const double mu = level["parameters"][0], Q = level["outputs"]["Q"], N = level["outputs"]["N"];
+    std::printf("mu %.1f: N %.3f N/mm, Q %.6f N/mm, Q / N %.8f\n", mu, N, Q, std::abs(Q / N));
+    EXPECT_GT(std::abs(N), 0.0);
+    EXPECT_NEAR(std::abs(Q), mu * std::abs(N), 1e-6 * std::abs(N)) << "mu " << mu;
+    // The supports carry what the contact carries.
+    EXPECT_NEAR(level["outputs"]["contact_x"].get<double>(), -Q, 1e-8 * std::abs(N));
+  }
+}
+
 }  // namespace
 }  // namespace grip::testing
