@@ -58,15 +58,27 @@ TEST(Studies, ThreeLevelsOfLamesCylinderGiveQ4sOrderAndABetterExtrapolation) {
   const json accepted = post_study(api, {{"scene", cylinder()}, {"refine", {{"levels", 3}}}}, 201);
   const std::string id = accepted["id"];
   ASSERT_EQ(accepted["levels"].size(), 3u);
-  json study;
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
-  do {
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    const auto r = api.get("/v1/studies/" + id);
-    ASSERT_TRUE(r && r->status == 200);
-    study = json::parse(r->body);
-  } while (study["status"] != "successful" && std::chrono::steady_clock::now() < deadline);
+  // The study's stream: its table each time it changes, study_finished last (then it ends).
+  std::string stream;
+  const auto streamed = api.client(120).Get("/v1/studies/" + id + "/events", [&](const char* data, size_t n) {
+    stream.append(data, n);
+    return true;
+  });
+  ASSERT_TRUE(streamed);
+  EXPECT_EQ(streamed->get_header_value("Content-Type"), "text/event-stream");
+  std::vector<std::pair<std::string, json>> events;  // type, table
+  for (size_t at = stream.find("event: "); at != std::string::npos; at = stream.find("event: ", at + 1)) {
+    const size_t data = stream.find("data: ", at), end = stream.find("\n", data);
+    events.emplace_back(stream.substr(at + 7, stream.find('\n', at) - at - 7),
+                        json::parse(stream.substr(data + 6, end - data - 6)));
+  }
+  ASSERT_FALSE(events.empty()) << stream;
+  for (size_t k = 0; k + 1 < events.size(); ++k) EXPECT_EQ(events[k].first, "study");
+  EXPECT_EQ(events.back().first, "study_finished");
+  const json study = json::parse(api.get("/v1/studies/" + id)->body);
   ASSERT_EQ(study["status"], "successful") << study.dump(2);
+  EXPECT_EQ(events.back().second, study);
+  std::printf("%zu study events\n", events.size());
   // Each level is a job of its own; its table row holds the job's last step's outputs.
   for (int j = 0; j < 3; ++j) {
     const json& level = study["levels"][j];
