@@ -69,7 +69,8 @@ ContinuumBody::ContinuumBody(PlaneMesh mesh, const std::vector<int>& contact_set
   if (!(options_.thickness > 0)) throw std::invalid_argument("thickness must be positive");
   for (const auto& m : materials_) has_history_ |= m->has_history();
   if (has_history_ && options_.kinematics == ContinuumKinematics::finite)
-    throw std::invalid_argument("a law with history (j2_plasticity) is implemented for small strain: linear kinematics");
+    throw std::invalid_argument(
+        "a law with history (j2_plasticity) is implemented for small strain: linear kinematics");
   if (options_.analysis == PlaneAnalysis::axisymmetric) {
     if (options_.kinematics == ContinuumKinematics::finite || options_.element == ContinuumElement::q4_bbar)
       throw std::invalid_argument("axisymmetric is implemented for linear kinematics and t3, t6, q4, q8, q9");
@@ -107,10 +108,9 @@ const ContinuumBody::Integration& ContinuumBody::integration() const {
     }
     if (options_.kinematics == ContinuumKinematics::linear && !has_history_) {
       for (int e = 0; e < element_count(); ++e) {
-        const Matrix Ke = axisymmetric
-                              ? axisymmetric_stiffness(in->points[e], material(e).small_strain_D4())
-                              : small_strain_stiffness(in->points[e], material(e).small_strain().D,
-                                                       in->mean_dN.empty() ? nullptr : &in->mean_dN[e]);
+        const Matrix Ke = axisymmetric ? axisymmetric_stiffness(in->points[e], material(e).small_strain_D4())
+                                       : small_strain_stiffness(in->points[e], material(e).small_strain().D,
+                                                                in->mean_dN.empty() ? nullptr : &in->mean_dN[e]);
         const auto& el = mesh_.elements[e];
         for (int i = 0; i < 2 * n; ++i)
           for (int j = 0; j < 2 * n; ++j)
@@ -175,7 +175,8 @@ void ContinuumBody::internal_force(const Vector& q, Vector& force, Triplets* tan
         const int gi = node_dof(el[i / 2], i % 2);
         force[gi] += fe[i];
         if (tangent)
-          for (int j = 0; j < m; ++j) tangent->emplace_back(gi, node_dof(el[j / 2], j % 2), 0.5 * (Ke(i, j) + Ke(j, i)));
+          for (int j = 0; j < m; ++j)
+            tangent->emplace_back(gi, node_dof(el[j / 2], j % 2), 0.5 * (Ke(i, j) + Ke(j, i)));
       }
     }
     return;

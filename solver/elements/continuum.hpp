@@ -130,8 +130,8 @@ class ContinuumBody final : public Body {
   std::vector<std::shared_ptr<const PlaneMaterial>> materials_;
   BoundaryPart contact_;
   double length_ = 0.0;
-  bool has_history_ = false;               // some element's law keeps history
-  std::vector<PointHistory> history_;      // committed, per element and point (element e from e x points)
+  bool has_history_ = false;           // some element's law keeps history
+  std::vector<PointHistory> history_;  // committed, per element and point (element e from e x points)
   mutable std::once_flag integration_once_;
   mutable std::unique_ptr<const Integration> integration_;
 };

@@ -67,7 +67,8 @@ J2Material::J2Material(double young, double poisson, double yield_stress, Isotro
       yield_stress_(yield_stress), hardening_(std::move(hardening)), kinematic_(kinematic_modulus) {
   if (const std::string why = j2_data_issue(yield_stress_, hardening_, kinematic_); !why.empty())
     throw std::invalid_argument("j2_plasticity: " + why);
-  if (hardening_.kind == IsotropicHardening::Kind::power) alpha0_ = std::pow(yield_stress_ / hardening_.K, 1 / hardening_.n);
+  if (hardening_.kind == IsotropicHardening::Kind::power)
+    alpha0_ = std::pow(yield_stress_ / hardening_.K, 1 / hardening_.n);
 }
 
 MaterialResponse J2Material::response(const Mat2& E) const { return elastic_.response(E); }
@@ -82,7 +83,8 @@ double J2Material::yield_stress(double alpha) const {
       const auto& t = hardening_.table;
       for (size_t k = 1; k < t.size(); ++k)
         if (alpha < t[k].first)
-          return t[k - 1].second + (t[k].second - t[k - 1].second) * (alpha - t[k - 1].first) / (t[k].first - t[k - 1].first);
+          return t[k - 1].second +
+                 (t[k].second - t[k - 1].second) * (alpha - t[k - 1].first) / (t[k].first - t[k - 1].first);
       return t.back().second;
     }
   }

@@ -35,8 +35,8 @@ std::string j2_data_issue(double yield_stress, const IsotropicHardening& hardeni
 class J2Material final : public PlaneMaterial {
  public:
   // Throws std::invalid_argument where j2_data_issue finds an issue.
-  J2Material(double young, double poisson, double yield_stress, IsotropicHardening hardening,
-             double kinematic_modulus, PlaneAnalysis analysis);
+  J2Material(double young, double poisson, double yield_stress, IsotropicHardening hardening, double kinematic_modulus,
+             PlaneAnalysis analysis);
   // The elastic law (Hooke's), what the material is until it yields.
   MaterialResponse response(const Mat2& E) const override;
   bool has_history() const override { return true; }

@@ -28,7 +28,8 @@ json pressed_and_released(bool plastic, const std::string& method) {
   json j = example_scene("hertz");
   j["body"]["element"] = "q4_bbar";  // plastic flow keeps the volume: q4 would lock
   if (plastic)
-    j["body"]["material"].update({{"law", "j2_plasticity"}, {"yield_stress", 2000.0}, {"hardening", {{"linear", 20000.0}}}});
+    j["body"]["material"].update(
+        {{"law", "j2_plasticity"}, {"yield_stress", 2000.0}, {"hardening", {{"linear", 20000.0}}}});
   j.erase("steps");
   j["stages"] = json::array({{{"steps", 4}, {"factors", {{"main", 1}}}}, {{"steps", 4}, {"factors", {{"main", 0}}}}});
   j["solver"]["contact"]["method"] = method;
@@ -111,10 +112,11 @@ TEST(J2Contact, PlasticCylinderKeepsAFlatAfterRelease) {
     SCOPED_TRACE(method);
     const Reading elastic = run(pressed_and_released(false, method), false);
     const Reading plastic = run(pressed_and_released(true, method), true);
-    std::printf("%s: residual pole displacement elastic %.3e mm, plastic %.3e mm (approach 0.05 mm); real solves "
-                "(Newton iterations) elastic %d (%d), plastic %d (%d): %.2fx\n",
-                method.c_str(), elastic.pole_uy, plastic.pole_uy, elastic.solves, elastic.newton, plastic.solves,
-                plastic.newton, double(plastic.solves) / elastic.solves);
+    std::printf(
+        "%s: residual pole displacement elastic %.3e mm, plastic %.3e mm (approach 0.05 mm); real solves "
+        "(Newton iterations) elastic %d (%d), plastic %d (%d): %.2fx\n",
+        method.c_str(), elastic.pole_uy, plastic.pole_uy, elastic.solves, elastic.newton, plastic.solves,
+        plastic.newton, double(plastic.solves) / elastic.solves);
     // The elastic body with a changing tangent (finite strain, q4), for the solve counts only.
     json finite = pressed_and_released(false, method);
     finite["body"]["kinematics"] = "finite";

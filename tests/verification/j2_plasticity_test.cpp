@@ -68,7 +68,8 @@ struct Driver {
   Vector q;
   std::vector<double> residuals;
 
-  Driver(ContinuumBody& b, std::vector<char> held) : body(b), prescribed(std::move(held)), q(Vector::Zero(b.dof_count())) {}
+  Driver(ContinuumBody& b, std::vector<char> held)
+      : body(b), prescribed(std::move(held)), q(Vector::Zero(b.dof_count())) {}
 
   Vector force(Triplets* t) const {
     Vector f = Vector::Zero(body.dof_count());
@@ -179,7 +180,11 @@ TEST(J2Plasticity, UniaxialStressFollowsTheClosedFormOfEachLaw) {
       Driver d(body, held);
       double worst = 0.0;
       for (const Point& p : uniaxial_path(law, *m, kYoung)) {
-        d.solve([&](Vector& q) { for (int n : pulled) q[2 * n + axial] = p.eps; }, 1e-9 * kYield);
+        d.solve(
+            [&](Vector& q) {
+              for (int n : pulled) q[2 * n + axial] = p.eps;
+            },
+            1e-9 * kYield);
         const std::vector<double> row = d.element_row(0);
         const double s = row[axial], lateral = row[1 - axial];
         worst = std::max(worst, std::abs(s - p.expected) / kYield);
@@ -197,7 +202,8 @@ TEST(J2Plasticity, SimpleShearFollowsTheClosedFormOfEachLaw) {
   const double G = kYoung / (2 * (1 + kPoisson));
   for (PlaneAnalysis analysis : {PlaneAnalysis::plane_strain, PlaneAnalysis::plane_stress}) {
     for (const Law& law : laws()) {
-      SCOPED_TRACE(std::string(law.name) + (analysis == PlaneAnalysis::plane_strain ? " plane strain" : " plane stress"));
+      SCOPED_TRACE(std::string(law.name) +
+                   (analysis == PlaneAnalysis::plane_strain ? " plane strain" : " plane stress"));
       const auto m = material(law, analysis);
       ContinuumBody body(square(0.0), {0, 1}, {m}, {ContinuumElement::q4, ContinuumKinematics::linear, analysis, 1.0});
       Driver d(body, std::vector<char>(8, 1));  // u = gamma y, v = 0 at every node: simple shear
@@ -237,7 +243,8 @@ Bent bent_block(const Law& law, PlaneAnalysis analysis, ContinuumElement element
   Bent b;
   b.tip = mesh.sets.at("right");
   const std::vector<int> left = mesh.sets.at("left");
-  b.body = std::make_unique<ContinuumBody>(mesh, mesh.sets.at("bottom"), std::vector<std::shared_ptr<const PlaneMaterial>>{material(law, analysis)},
+  b.body = std::make_unique<ContinuumBody>(mesh, mesh.sets.at("bottom"),
+                                           std::vector<std::shared_ptr<const PlaneMaterial>>{material(law, analysis)},
                                            ContinuumOptions{element, ContinuumKinematics::linear, analysis, 1.0});
   b.held.assign(b.body->dof_count(), 0);
   for (int n : left) b.held[2 * n] = b.held[2 * n + 1] = 1;
@@ -254,7 +261,11 @@ TEST(J2Plasticity, ConsistentTangentMatchesDifferencesOfTheForce) {
         Bent b = bent_block(law, analysis, element);
         Driver d(*b.body, b.held);
         for (double tip : {0.01, 0.03})  // a committed plastic history
-          d.solve([&](Vector& q) { for (int n : b.tip) q[2 * n + 1] = tip; }, 1e-9 * kYield);
+          d.solve(
+              [&](Vector& q) {
+                for (int n : b.tip) q[2 * n + 1] = tip;
+              },
+              1e-9 * kYield);
         // A state beyond it, off equilibrium: every dof moved.
         Vector q = d.q;
         for (int i = 0; i < q.size(); ++i) q[i] += 0.004 * std::sin(1.0 + 3.7 * i);
@@ -288,8 +299,16 @@ TEST(J2Plasticity, NewtonConvergesQuadraticallyOnAPlasticStep) {
     SCOPED_TRACE(law.name);
     Bent b = bent_block(law, PlaneAnalysis::plane_strain, ContinuumElement::q8);
     Driver d(*b.body, b.held);
-    d.solve([&](Vector& q) { for (int n : b.tip) q[2 * n + 1] = 0.01; }, 1e-10 * kYield);
-    d.solve([&](Vector& q) { for (int n : b.tip) q[2 * n + 1] = 0.03; }, 1e-10 * kYield);
+    d.solve(
+        [&](Vector& q) {
+          for (int n : b.tip) q[2 * n + 1] = 0.01;
+        },
+        1e-10 * kYield);
+    d.solve(
+        [&](Vector& q) {
+          for (int n : b.tip) q[2 * n + 1] = 0.03;
+        },
+        1e-10 * kYield);
     const std::vector<double>& r = d.residuals;
     std::string line;
     char buffer[32];
@@ -317,7 +336,11 @@ TEST(J2Plasticity, OnlyCommitMovesTheHistory) {
   const Law law = laws()[0];
   Bent b = bent_block(law, PlaneAnalysis::plane_strain, ContinuumElement::q4);
   Driver d(*b.body, b.held);
-  d.solve([&](Vector& q) { for (int n : b.tip) q[2 * n + 1] = 0.01; }, 1e-9 * kYield);
+  d.solve(
+      [&](Vector& q) {
+        for (int n : b.tip) q[2 * n + 1] = 0.01;
+      },
+      1e-9 * kYield);
   const Vector at_first = d.force(nullptr);
   // An attempt further on (a cut or refused increment evaluates such states) leaves it unchanged.
   Vector further = d.q;
