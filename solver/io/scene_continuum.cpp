@@ -544,6 +544,7 @@ void read_continuum(Reader& r, json& body, Problem& problem, const std::string& 
   }
   const PlaneMesh& checked = continuum->mesh();
   problem.body = std::move(continuum);
+  r.node_sets[r.body_index] = checked.sets;
   if (file) {
     file->tags.body = r.body_index;
     r.file_meshes.push_back(std::move(file->tags));
