@@ -14,6 +14,7 @@
 #include <limits>
 #include <regex>
 #include <sstream>
+#include <thread>
 
 #include "server/body_budget.hpp"
 #include "server/compression.hpp"
@@ -144,6 +145,7 @@ std::string allowed_methods(const std::string& path) {
       {std::regex(R"(/v1/meshes)"), "POST"},
       {std::regex(R"(/v1/studies)"), "POST"},
       {std::regex(R"(/v1/studies/[^/]+)"), "GET, DELETE"},
+      {std::regex(R"(/v1/studies/[^/]+/events)"), "GET"},
       {std::regex(R"(/v1/meshes/[^/]+)"), "GET, DELETE"},
   };
   for (const auto& [pattern, methods] : routes)
@@ -245,6 +247,8 @@ struct HttpServer::Impl {
                const std::string& what);
   void submit_study(const Request& req, Response& res, const httplib::ContentReader& reader);
   void get_study(const Request& req, Response& res);
+  // The study's table as Server-Sent Events: `study` each time it changes, `study_finished` last.
+  void study_events(const Request& req, Response& res);
   void remove_study(const Request& req, Response& res);
   void upload_mesh(const Request& req, Response& res, const httplib::ContentReader& reader);
   void get_mesh(const Request& req, Response& res);
@@ -494,6 +498,7 @@ void HttpServer::Impl::routes() {
     submit_study(req, res, reader);
   });
   svr.Get(R"(/v1/studies/([^/]+))", [this](const Request& req, Response& res) { get_study(req, res); });
+  svr.Get(R"(/v1/studies/([^/]+)/events)", [this](const Request& req, Response& res) { study_events(req, res); });
   svr.Delete(R"(/v1/studies/([^/]+))", [this](const Request& req, Response& res) { remove_study(req, res); });
 
   // ---- uploaded meshes
@@ -729,7 +734,76 @@ void HttpServer::Impl::get_study(const Request& req, Response& res) {
   const std::string id = req.matches[1];
   const auto doc = studies.study(id);
   if (!doc) return problem(res, req, 404, "study-not-found", "Study not found", "no study has id '" + id + "'");
+  const std::string format = req.has_param("format") ? req.get_param_value("format") : "json";
+  if (format == "csv") {
+    res.set_header("Content-Disposition", "attachment; filename=\"study-" + id + ".csv\"");
+    res.set_content(objects_csv(study_rows(*doc)), "text/csv; charset=utf-8");
+    return;
+  }
+  if (format != "json")
+    return problem(res, req, 400, "bad-parameter", "Bad query parameter", "format must be json or csv");
   send_json(res, 200, *doc);
+}
+
+void HttpServer::Impl::study_events(const Request& req, Response& res) {
+  const std::string id = req.matches[1];
+  if (!studies.study(id))
+    return problem(res, req, 404, "study-not-found", "Study not found", "no study has id '" + id + "'");
+  if (service.draining()) {
+    res.set_header("Retry-After", "10");
+    return problem(res, req, 503, "shutting-down", "Shutting down", "the server is shutting down");
+  }
+  if (open_streams.fetch_add(1) >= options.max_streams) {  // counted with the jobs' streams
+    --open_streams;
+    res.set_header("Retry-After", "5");
+    return problem(res, req, 503, "too-many-streams", "Too many event streams",
+                   "this server has " + std::to_string(options.max_streams) +
+                       " event streams open; retry later or poll the study");
+  }
+  struct State {
+    std::string last;  // the table last sent
+    std::int64_t seq = 0;
+    std::chrono::steady_clock::time_point last_write;
+  };
+  auto state = std::make_shared<State>();
+  state->last_write = std::chrono::steady_clock::now();
+  res.set_header("Cache-Control", "no-cache");
+  res.set_header("X-Accel-Buffering", "no");
+  const auto heartbeat = options.heartbeat;
+  res.set_chunked_content_provider(
+      "text/event-stream",
+      [this, id, state, heartbeat](size_t, httplib::DataSink& sink) {
+        if (stopping || service.draining()) {
+          sink.done();
+          return true;
+        }
+        if (!sink.is_writable()) return false;
+        // The table is read from the jobs (server/studies.hpp); a look every 500 ms at most.
+        if (state->seq > 0) std::this_thread::sleep_for(std::chrono::milliseconds(500));
+        const auto doc = studies.study(id);
+        if (!doc) {  // removed meanwhile
+          sink.done();
+          return true;
+        }
+        const std::string text = doc->dump();
+        const std::string status = (*doc)["status"];
+        const bool ended = status != "accepted" && status != "running";
+        std::string out;
+        if (text != state->last) {
+          out = "id: " + std::to_string(++state->seq) + "\nevent: " + (ended ? "study_finished" : "study") +
+                "\ndata: " + text + "\n\n";
+          state->last = text;
+        }
+        const auto now = std::chrono::steady_clock::now();
+        if (out.empty() && now - state->last_write >= heartbeat) out = ": ping\n\n";
+        if (!out.empty()) {
+          if (!sink.write(out.data(), out.size())) return false;
+          state->last_write = now;
+        }
+        if (ended) sink.done();
+        return true;
+      },
+      [this](bool) { --open_streams; });
 }
 
 void HttpServer::Impl::remove_study(const Request& req, Response& res) {

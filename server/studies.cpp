@@ -9,6 +9,7 @@
 #include "server/richardson.hpp"
 #include "server/util.hpp"
 #include "solver/io/scene.hpp"
+#include "solver/model/number_text.hpp"
 
 namespace grip::server {
 namespace {
@@ -73,25 +74,126 @@ std::optional<json> last_outputs(JobService& jobs, const std::string& id) {
 
 json number_or_null(const std::optional<double>& v) { return v && std::isfinite(*v) ? json(*v) : json(nullptr); }
 
+// The variants of a sweep: [{pointer, values | range: {from, to, count}}], as a grid (every
+// combination, the last pointer fastest) or zipped (mode "zip": the k-th value of each).
+void plan_sweep(const json& request, StudyPlan& plan, std::vector<SceneIssue>& issues) {
+  const json& scene = request["scene"];
+  const json& sweep = request["sweep"];
+  plan.kind = "sweep";
+  if (!sweep.is_array() || sweep.empty()) {
+    issues.push_back({"/sweep", "is a non-empty list of {\"pointer\", \"values\" | \"range\"}"});
+    return;
+  }
+  std::string mode = "grid";
+  if (request.contains("mode")) {
+    if (request["mode"] != "grid" && request["mode"] != "zip")
+      issues.push_back({"/mode", show(request["mode"]) + " is not \"grid\" or \"zip\""});
+    else mode = request["mode"];
+  }
+  std::vector<json::json_pointer> pointers;
+  std::vector<std::vector<json>> lists;
+  for (size_t i = 0; i < sweep.size(); ++i) {
+    const std::string sp = "/sweep/" + std::to_string(i);
+    const json& item = sweep[i];
+    if (!item.is_object()) {
+      issues.push_back({sp, "is not an object {\"pointer\", \"values\" | \"range\"}"});
+      continue;
+    }
+    for (const auto& [key, value] : item.items())
+      if (key != "pointer" && key != "values" && key != "range")
+        issues.push_back({sp + "/" + key, "is not a member of a sweep (pointer, values, range)"});
+    std::optional<json::json_pointer> pointer;
+    if (!item.contains("pointer") || !item["pointer"].is_string()) {
+      issues.push_back({sp + "/pointer", "is required: the JSON pointer of the scene's value to sweep"});
+    } else {
+      try {
+        pointer = json::json_pointer(item["pointer"].get<std::string>());
+      } catch (const json::exception&) {
+        issues.push_back({sp + "/pointer", show(item["pointer"]) + " is not a JSON pointer (RFC 6901)"});
+      }
+      if (pointer && (pointer->empty() || !scene.contains(*pointer))) {
+        issues.push_back({sp + "/pointer", show(item["pointer"]) + " names no value of the scene"});
+        pointer.reset();
+      }
+    }
+    std::vector<json> values;
+    if (item.contains("values") == item.contains("range")) {
+      issues.push_back({sp, "needs exactly one of \"values\" (a list) and \"range\" ({from, to, count})"});
+    } else if (item.contains("values")) {
+      if (!item["values"].is_array() || item["values"].empty())
+        issues.push_back({sp + "/values", "is a non-empty list of the values to give it"});
+      else values = item["values"].get<std::vector<json>>();
+    } else {
+      const json& r = item["range"];
+      const bool ok = r.is_object() && r.contains("from") && r["from"].is_number() && r.contains("to") &&
+                      r["to"].is_number() && r.contains("count") && r["count"].is_number_integer() &&
+                      r["count"].get<long long>() >= 2 && r["count"].get<long long>() <= kMaxStudyJobs;
+      if (!ok) {
+        issues.push_back({sp + "/range", "is {\"from\", \"to\", \"count\"}: numbers and an integer count in [2, " +
+                                             std::to_string(kMaxStudyJobs) + "]"});
+      } else {
+        const double from = r["from"], to = r["to"];
+        const int count = r["count"];
+        for (int k = 0; k < count; ++k) values.push_back(k + 1 == count ? to : from + (to - from) * k / (count - 1));
+      }
+    }
+    if (pointer) pointers.push_back(*pointer);
+    lists.push_back(std::move(values));
+  }
+  if (!issues.empty()) return;
+  // The number of jobs, checked before any is made.
+  double jobs = mode == "zip" ? static_cast<double>(lists[0].size()) : 1.0;
+  for (size_t i = 0; i < lists.size(); ++i) {
+    if (mode == "zip" && lists[i].size() != lists[0].size())
+      issues.push_back({"/sweep/" + std::to_string(i), "has " + std::to_string(lists[i].size()) +
+                                                           " values; zipped with /sweep/0 it needs " +
+                                                           std::to_string(lists[0].size())});
+    if (mode == "grid") jobs *= static_cast<double>(lists[i].size());
+  }
+  if (jobs > kMaxStudyJobs)
+    issues.push_back({"/sweep", "makes " + number_text(jobs) + " jobs; this service runs at most " +
+                                    std::to_string(kMaxStudyJobs) + " per study"});
+  if (!issues.empty()) return;
+  for (const auto& p : pointers) plan.pointers.push_back(p.to_string());
+  std::vector<size_t> at(lists.size(), 0);
+  for (size_t n = 0; n < static_cast<size_t>(jobs); ++n) {
+    StudyLevel level{scene, 1.0, json::array()};
+    for (size_t i = 0; i < lists.size(); ++i) {
+      const json& value = lists[i][mode == "zip" ? n : at[i]];
+      level.scene[pointers[i]] = value;
+      level.parameters.push_back(value);
+    }
+    plan.levels.push_back(std::move(level));
+    for (size_t i = lists.size(); mode == "grid" && i-- > 0;) {  // the odometer: the last pointer fastest
+      if (++at[i] < lists[i].size()) break;
+      at[i] = 0;
+    }
+  }
+}
+
 }  // namespace
 
 StudyPlan plan_study(const json& request) {
   std::vector<SceneIssue> issues;
   auto fail = [&]() { throw SceneErrors(std::move(issues)); };
   if (!request.is_object()) {
-    issues.push_back({"/", "a study is a JSON object: {\"scene\", \"refine\", \"outputs\"}"});
+    issues.push_back({"/", "a study is a JSON object: {\"scene\", \"refine\" | \"sweep\", \"outputs\"}"});
     fail();
   }
   for (const auto& [key, value] : request.items())
-    if (key != "scene" && key != "refine" && key != "outputs" && key != "description")
-      issues.push_back({"/" + key, "is not a member of a study (scene, refine, outputs, description)"});
+    if (key != "scene" && key != "refine" && key != "sweep" && key != "mode" && key != "outputs" &&
+        key != "description")
+      issues.push_back({"/" + key, "is not a member of a study (scene, refine, sweep, mode, outputs, description)"});
   if (!request.contains("scene") || !request["scene"].is_object())
     issues.push_back({"/scene", "is required: the scene to study (an object, as POST /v1/jobs takes it)"});
-  if (!request.contains("refine") || !request["refine"].is_object())
-    issues.push_back({"/refine", "is required: {\"levels\": k} (generated meshes) or {\"meshes\": [...]} (gmsh)"});
+  const bool sweeping = request.contains("sweep");
+  if (sweeping && request.contains("refine"))
+    issues.push_back({"/sweep", "goes without refine: a study either refines the mesh or sweeps parameters"});
+  else if (!sweeping && (!request.contains("refine") || !request["refine"].is_object()))
+    issues.push_back(
+        {"/refine", "is required (or sweep): {\"levels\": k} (generated meshes) or {\"meshes\": [...]} (gmsh)"});
   if (!issues.empty()) fail();
   const json& scene = request["scene"];
-  const json& refine = request["refine"];
 
   // The outputs: the scene's, each named where it stays the same point as the mesh changes.
   std::vector<std::string> names;
@@ -105,7 +207,7 @@ StudyPlan plan_study(const json& request) {
       if (!q.is_object()) continue;  // the reader says what is wrong
       if (q.contains("name") && q["name"].is_string()) names.push_back(q["name"]);
       for (const char* key : {"node", "element"})
-        if (q.contains(key))
+        if (q.contains(key) && !sweeping)
           issues.push_back({"/scene/outputs/" + std::to_string(i) + "/" + key,
                             std::string("an index changes with the mesh: name the point with \"at\" (a study compares "
                                         "the same quantity on every level)")});
@@ -124,7 +226,14 @@ StudyPlan plan_study(const json& request) {
   } else {
     plan.outputs = names;
   }
+  if (sweeping) {
+    if (!issues.empty()) fail();
+    plan_sweep(request, plan, issues);
+    if (!issues.empty()) fail();
+    return plan;
+  }
 
+  const json& refine = request["refine"];
   const bool by_levels = refine.contains("levels"), by_meshes = refine.contains("meshes");
   for (const auto& [key, value] : refine.items())
     if (key != "levels" && key != "meshes")
@@ -144,7 +253,7 @@ StudyPlan plan_study(const json& request) {
     }
     const int k = levels.get<int>();
     for (int j = 0; j < k; ++j) {
-      StudyLevel level{scene, std::ldexp(1.0, -j)};
+      StudyLevel level{scene, std::ldexp(1.0, -j), nullptr};
       bool refined = true;
       for (auto& [ptr, body] : bodies_of(level.scene)) refined &= refine_generated(*body, ptr, j, issues);
       if (!refined || !issues.empty()) fail();
@@ -161,7 +270,7 @@ StudyPlan plan_study(const json& request) {
     if (!issues.empty()) fail();
     plan.h_from_nodes = true;
     for (const json& ref : meshes) {
-      StudyLevel level{scene, 1.0};
+      StudyLevel level{scene, 1.0, nullptr};
       level.scene["body"]["mesh"]["gmsh"] = ref;
       plan.levels.push_back(std::move(level));
     }
@@ -181,9 +290,11 @@ json Studies::submit(const json& request, const std::string& request_id) {
       nodes.push_back(jobs_.check(plan.levels[j].scene));
     } catch (const SceneErrors& e) {
       for (const SceneIssue& issue : e.issues())
-        issues.push_back(
-            {"/scene" + (issue.pointer == "/" ? "" : issue.pointer),
-             "level " + std::to_string(j + 1) + " of " + std::to_string(plan.levels.size()) + ": " + issue.detail});
+        issues.push_back({"/scene" + (issue.pointer == "/" ? "" : issue.pointer),
+                          (plan.kind == "sweep" ? "variant " : "level ") + std::to_string(j + 1) + " of " +
+                              std::to_string(plan.levels.size()) +
+                              (plan.kind == "sweep" ? " (" + plan.levels[j].parameters.dump() + ")" : std::string()) +
+                              ": " + issue.detail});
     }
     if (!issues.empty()) throw SceneErrors(std::move(issues));
   }
@@ -200,9 +311,14 @@ json Studies::submit(const json& request, const std::string& request_id) {
   }
   StudyRecord rec{new_job_id(), now_iso8601(), {}};
   json levels = json::array();
-  for (size_t j = 0; j < ids.size(); ++j)
-    levels.push_back({{"job", ids[j]}, {"h", plan.levels[j].h}, {"nodes", nodes[j]}});
-  rec.document = json{{"kind", "refinement"}, {"outputs", plan.outputs}, {"levels", levels}}.dump();
+  for (size_t j = 0; j < ids.size(); ++j) {
+    levels.push_back({{"job", ids[j]}, {"nodes", nodes[j]}});
+    if (plan.kind == "sweep") levels.back()["parameters"] = plan.levels[j].parameters;
+    else levels.back()["h"] = plan.levels[j].h;
+  }
+  json document = {{"kind", plan.kind}, {"outputs", plan.outputs}, {"levels", levels}};
+  if (plan.kind == "sweep") document["pointers"] = plan.pointers;
+  rec.document = document.dump();
   try {
     jobs_.store().insert_study(rec);
   } catch (...) {
@@ -224,7 +340,9 @@ std::optional<json> Studies::study(const std::string& id) {
   for (size_t j = 0; j < plan["levels"].size(); ++j) {
     const json& l = plan["levels"][j];
     const std::string job = l["job"];
-    json level = {{"level", j + 1}, {"job", job}, {"h", l["h"]}, {"nodes", l["nodes"]}};
+    json level = {{"level", j + 1}, {"job", job}, {"nodes", l["nodes"]}};
+    for (const char* key : {"h", "parameters"})  // a refinement's level, a sweep's variant
+      if (l.contains(key)) level[key] = l[key];
     const auto view = jobs_.job(job);
     std::optional<json> values;
     std::optional<double> time;
@@ -245,7 +363,8 @@ std::optional<json> Studies::study(const std::string& id) {
     outputs.push_back(values);
     seconds.push_back(time);
   }
-  // Each output over the levels that have it: Richardson on their sizes.
+  // Each output over the levels that have it: Richardson on their sizes (a sweep: its values).
+  const bool sweep = plan["kind"] == "sweep";
   json quantities = json::array();
   for (const json& name : plan["outputs"]) {
     std::vector<double> v, h;
@@ -256,8 +375,12 @@ std::optional<json> Studies::study(const std::string& id) {
       values.push_back(has ? (*outputs[j])[name] : json(nullptr));
       if (!has) continue;
       v.push_back((*outputs[j])[name].get<double>());
-      h.push_back(plan["levels"][j]["h"].get<double>());
+      h.push_back(plan["levels"][j].value("h", 1.0));
       at.push_back(j);
+    }
+    if (sweep) {
+      quantities.push_back({{"name", name}, {"values", values}});
+      continue;
     }
     const Richardson r = richardson(v, h);
     json orders = json::array(), errors = json(std::vector<json>(outputs.size(), nullptr));
@@ -295,8 +418,30 @@ std::optional<json> Studies::study(const std::string& id) {
   for (const json& l : levels)
     links.push_back(
         {{"href", "/v1/jobs/" + l["job"].get<std::string>()}, {"rel", "item"}, {"type", "application/json"}});
-  return json{{"id", rec->id},    {"created", rec->created},  {"kind", plan["kind"]},           {"status", status},
-              {"levels", levels}, {"quantities", quantities}, {"thresholds", kStudyThresholds}, {"links", links}};
+  json doc = {{"id", rec->id},    {"created", rec->created},  {"kind", plan["kind"]}, {"status", status},
+              {"levels", levels}, {"quantities", quantities}, {"links", links}};
+  if (sweep) doc["pointers"] = plan["pointers"];
+  else doc["thresholds"] = kStudyThresholds;
+  return doc;
+}
+
+std::vector<json> study_rows(const json& study) {
+  std::vector<json> rows;
+  for (size_t k = 0; k < study["levels"].size(); ++k) {
+    const json& level = study["levels"][k];
+    json row = {
+        {"level", level["level"]}, {"job", level["job"]}, {"status", level["status"]}, {"nodes", level["nodes"]}};
+    row["seconds"] = level.value("seconds", json(nullptr));
+    for (const char* key : {"h", "parameters"})
+      if (level.contains(key)) row[key] = level[key];
+    for (const json& q : study["quantities"]) {
+      const std::string name = q["name"];
+      row["outputs"][name] = q["values"][k];
+      if (q.contains("estimated_error")) row["estimated_error"][name] = q["estimated_error"][k];
+    }
+    rows.push_back(std::move(row));
+  }
+  return rows;
 }
 
 bool Studies::remove(const std::string& id) {

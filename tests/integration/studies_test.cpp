@@ -2,9 +2,11 @@
 // study of Lame's thick cylinder (axisymmetric, q4, internal pressure: u_r closed form) runs
 // as three jobs, and its table gives an observed order near q4's 2 and a Richardson value
 // closer to the closed form than the finest level's; bad plans are refused before any job is
-// stored, with the pointer of the field at fault; deleting the study dismisses its jobs.
+// stored, with the pointer of the field at fault; deleting the study dismisses its jobs. A sweep
+// runs a job per variant and tabulates each as that job gives it.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -56,15 +58,27 @@ TEST(Studies, ThreeLevelsOfLamesCylinderGiveQ4sOrderAndABetterExtrapolation) {
   const json accepted = post_study(api, {{"scene", cylinder()}, {"refine", {{"levels", 3}}}}, 201);
   const std::string id = accepted["id"];
   ASSERT_EQ(accepted["levels"].size(), 3u);
-  json study;
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
-  do {
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    const auto r = api.get("/v1/studies/" + id);
-    ASSERT_TRUE(r && r->status == 200);
-    study = json::parse(r->body);
-  } while (study["status"] != "successful" && std::chrono::steady_clock::now() < deadline);
+  // The study's stream: its table each time it changes, study_finished last (then it ends).
+  std::string stream;
+  const auto streamed = api.client(120).Get("/v1/studies/" + id + "/events", [&](const char* data, size_t n) {
+    stream.append(data, n);
+    return true;
+  });
+  ASSERT_TRUE(streamed);
+  EXPECT_EQ(streamed->get_header_value("Content-Type"), "text/event-stream");
+  std::vector<std::pair<std::string, json>> events;  // type, table
+  for (size_t at = stream.find("event: "); at != std::string::npos; at = stream.find("event: ", at + 1)) {
+    const size_t data = stream.find("data: ", at), end = stream.find("\n", data);
+    events.emplace_back(stream.substr(at + 7, stream.find('\n', at) - at - 7),
+                        json::parse(stream.substr(data + 6, end - data - 6)));
+  }
+  ASSERT_FALSE(events.empty()) << stream;
+  for (size_t k = 0; k + 1 < events.size(); ++k) EXPECT_EQ(events[k].first, "study");
+  EXPECT_EQ(events.back().first, "study_finished");
+  const json study = json::parse(api.get("/v1/studies/" + id)->body);
   ASSERT_EQ(study["status"], "successful") << study.dump(2);
+  EXPECT_EQ(events.back().second, study);
+  std::printf("%zu study events\n", events.size());
   // Each level is a job of its own; its table row holds the job's last step's outputs.
   for (int j = 0; j < 3; ++j) {
     const json& level = study["levels"][j];
@@ -100,6 +114,15 @@ TEST(Studies, ThreeLevelsOfLamesCylinderGiveQ4sOrderAndABetterExtrapolation) {
     for (const json& c : q["cheapest"])
       if (!c["level"].is_null()) EXPECT_LT(c["level"]["estimated_error"].get<double>(), c["below"].get<double>());
   }
+  // The table as CSV: a header and a row per level, the values as in the JSON.
+  const auto csv = api.get("/v1/studies/" + id + "?format=csv");
+  ASSERT_TRUE(csv && csv->status == 200);
+  const std::string text = csv->body;
+  EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 4);
+  const std::string header = text.substr(0, text.find('\n'));
+  for (const char* column : {"level", "job", "nodes", "seconds", "h", "outputs.u_inner", "estimated_error.u_outer"})
+    EXPECT_NE(header.find(column), std::string::npos) << header;
+  EXPECT_NE(text.find(study["levels"][2]["job"].get<std::string>()), std::string::npos);
   // Deleting the study dismisses its jobs (finished ones are removed).
   const auto removed = api.del("/v1/studies/" + id);
   ASSERT_TRUE(removed);
@@ -136,7 +159,8 @@ TEST(Studies, BadPlansAreRefusedWithThePointerBeforeAnyJobIsStored) {
       {{{"scene", cylinder()}, {"refine", {{"levels", 3}}}, {"outputs", {"u_middle"}}},
        "/outputs/0",
        "names no output"},
-      {{{"scene", cylinder()}, {"refine", {{"levels", 3}}}, {"sweep", json::array()}}, "/sweep", "not a member"},
+      {{{"scene", cylinder()}, {"refine", {{"levels", 3}}}, {"accuracy", 0.01}}, "/accuracy", "not a member"},
+      {{{"scene", cylinder()}, {"refine", {{"levels", 3}}}, {"sweep", json::array()}}, "/sweep", "goes without refine"},
       {{{"scene", large}, {"refine", {{"levels", 3}}}}, "/scene/body/mesh", "level 3 of 3"},
   };
   for (const Case& c : cases) {
@@ -150,6 +174,116 @@ TEST(Studies, BadPlansAreRefusedWithThePointerBeforeAnyJobIsStored) {
   const auto jobs = api.get("/v1/jobs");
   ASSERT_TRUE(jobs);
   EXPECT_TRUE(json::parse(jobs->body)["jobs"].empty()) << jobs->body;
+}
+
+// A sweep of the pressure and the modulus (a grid of 3 x 2 variants of the 8 x 4 cylinder):
+// linear elasticity makes u_r proportional to p / E, and each variant's row is its job's
+// result, bit for bit, as is a job submitted on its own with the same scene.
+TEST(Studies, ASweepTabulatesEveryVariantAsItsOwnJobWouldGiveIt) {
+  TempDir dir;
+  ServerProcess server(dir.path() / "grip.sqlite", {"--workers", "2"}, dir.path() / "serve.log");
+  const Api api(server.port());
+  json scene = cylinder();
+  scene["body"]["mesh"]["rectangle"]["divisions"] = {8, 4};
+  const json request = {
+      {"scene", scene},
+      {"sweep",
+       {{{"pointer", "/body/loads/0/traction/0"}, {"values", {5, 10, 20}}},
+        {{"pointer", "/body/material/young"}, {"range", {{"from", 1000}, {"to", 2000}, {"count", 2}}}}}}};
+  const json accepted = post_study(api, request, 201);
+  ASSERT_EQ(accepted["levels"].size(), 6u);
+  json study;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  do {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    study = json::parse(api.get("/v1/studies/" + accepted["id"].get<std::string>())->body);
+  } while (study["status"] != "successful" && std::chrono::steady_clock::now() < deadline);
+  ASSERT_EQ(study["status"], "successful") << study.dump(2);
+  EXPECT_EQ(study["pointers"], json({"/body/loads/0/traction/0", "/body/material/young"}));
+  const double reference = study["levels"][0]["outputs"]["u_inner"].get<double>() * 1000 / 5;
+  for (size_t k = 0; k < 6; ++k) {
+    const json& level = study["levels"][k];
+    const double p = level["parameters"][0], E = level["parameters"][1];
+    EXPECT_EQ(p, (std::vector<double>{5, 10, 20})[k / 2]);  // the last pointer fastest
+    EXPECT_EQ(E, k % 2 ? 2000 : 1000);
+    EXPECT_NEAR(level["outputs"]["u_inner"].get<double>() * E / p, reference, 1e-9 * reference);
+    EXPECT_EQ(study["quantities"][0]["values"][k], level["outputs"]["u_inner"]);
+    const auto result = api.get("/v1/jobs/" + level["job"].get<std::string>() + "/result");
+    EXPECT_EQ(json::parse(result->body)["steps"].back()["outputs"], level["outputs"]);
+  }
+  // The variant (10, 2000) submitted as a job of its own gives the same numbers.
+  json own = scene;
+  own["body"]["loads"][0]["traction"][0] = 10;
+  own["body"]["material"]["young"] = 2000.0;
+  const std::string id = api.submit(own);
+  api.wait_status(id, {"successful"});
+  EXPECT_EQ(json::parse(api.get("/v1/jobs/" + id + "/result")->body)["steps"].back()["outputs"],
+            study["levels"][3]["outputs"]);
+
+  // Bad sweeps, refused before any job is stored.
+  const size_t jobs_before = json::parse(api.get("/v1/jobs?limit=1000")->body)["jobs"].size();
+  struct Case {
+    json sweep;
+    std::string mode, pointer, says;
+  };
+  const Case cases[] = {
+      {{{{"pointer", "/obstacles/0/friction"}, {"values", {0.1, 0.2}}}}, "grid", "/sweep/0/pointer", "names no value"},
+      {{{{"pointer", "/body/material/young"}, {"values", {1000, -1}}}},
+       "grid",
+       "/scene/body/material/young",
+       "variant 2 of 2 ([-1])"},
+      {{{{"pointer", "/body/material/young"}, {"values", {1000, 2000}}},
+        {{"pointer", "/body/material/poisson"}, {"values", {0.2, 0.3, 0.4}}}},
+       "zip",
+       "/sweep/1",
+       "zipped"},
+      {{{{"pointer", "/body/material/young"}, {"range", {{"from", 1}, {"to", 2}, {"count", 100}}}},
+        {{"pointer", "/body/material/poisson"}, {"values", {0.2, 0.3}}}},
+       "grid",
+       "/sweep",
+       "makes 200 jobs"},
+  };
+  for (const Case& c : cases) {
+    const json p = post_study(api, {{"scene", scene}, {"sweep", c.sweep}, {"mode", c.mode}}, 422);
+    ASSERT_TRUE(p.contains("errors")) << p.dump();
+    EXPECT_EQ(p["errors"][0]["pointer"], c.pointer) << p.dump();
+    EXPECT_NE(p["errors"][0]["detail"].get<std::string>().find(c.says), std::string::npos) << p.dump();
+  }
+  EXPECT_EQ(json::parse(api.get("/v1/jobs?limit=1000")->body)["jobs"].size(), jobs_before);
+}
+
+// A sweep of the friction coefficient over the sliding block (schemas/examples/sliding-block.json,
+// the flat moved 0.01 mm under the pressed block): once every contact node slips, the
+// tangential force the top's supports carry is mu times the normal one, for every mu of 0, 0.1,
+// ..., 0.5 (to what the contact tolerance pins the forces).
+TEST(Studies, AFrictionSweepOfTheSlidingBlockSlipsAtMuN) {
+  TempDir dir;
+  ServerProcess server(dir.path() / "grip.sqlite", {"--workers", "2"}, dir.path() / "serve.log");
+  const Api api(server.port());
+  json scene = json::parse(read_text(examples_dir() / "sliding-block.json"));
+  scene["outputs"] = {{{"name", "Q"}, {"kind", "reaction"}, {"set", "top"}, {"component", "x"}},
+                      {{"name", "N"}, {"kind", "reaction"}, {"set", "top"}, {"component", "y"}},
+                      {{"name", "contact_x"}, {"kind", "resultant"}, {"component", "x"}}};
+  const json accepted = post_study(
+      api,
+      {{"scene", scene},
+       {"sweep", {{{"pointer", "/obstacles/0/friction"}, {"range", {{"from", 0}, {"to", 0.5}, {"count", 6}}}}}}},
+      201);
+  json study;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  do {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    study = json::parse(api.get("/v1/studies/" + accepted["id"].get<std::string>())->body);
+  } while (study["status"] != "successful" && std::chrono::steady_clock::now() < deadline);
+  ASSERT_EQ(study["status"], "successful") << study.dump(2);
+  for (const json& level : study["levels"]) {
+    const double mu = level["parameters"][0], Q = level["outputs"]["Q"], N = level["outputs"]["N"];
+    std::printf("mu %.1f: N %.3f N/mm, Q %.6f N/mm, Q / N %.8f\n", mu, N, Q, std::abs(Q / N));
+    EXPECT_GT(std::abs(N), 0.0);
+    EXPECT_NEAR(std::abs(Q), mu * std::abs(N), 1e-6 * std::abs(N)) << "mu " << mu;
+    // The supports carry what the contact carries.
+    EXPECT_NEAR(level["outputs"]["contact_x"].get<double>(), -Q, 1e-8 * std::abs(N));
+  }
 }
 
 }  // namespace
