@@ -115,7 +115,7 @@ int solve(int argc, char** argv) {
   observer.step_started = [&](int step, double lf) { emit(grip::step_started_event(step, lf)); };
   observer.iteration = [&](const grip::IterationEvent& ev) { emit(grip::iteration_event(ev)); };
   observer.step_finished = [&](const grip::StepRecord& rec) {
-    emit(grip::step_finished_event(rec));
+    emit(grip::step_finished_event(scene.problem, rec, scene.output));
     if (writer) writer->add_step(rec);
     const auto& last = rec.history.empty() ? grip::IterationEvent{} : rec.history.back();
     std::printf("%5d %12.6g %6d %6d %6d %12.3e %7d %6d %6d %9.2f  %s\n", rec.index, rec.load_factor, rec.solves,

@@ -14,10 +14,12 @@
 #include <limits>
 #include <regex>
 #include <sstream>
+#include <thread>
 
 #include "server/body_budget.hpp"
 #include "server/compression.hpp"
 #include "server/observability.hpp"
+#include "server/studies.hpp"
 #include "server/tar.hpp"
 #include "server/ui.hpp"
 #include "server/util.hpp"
@@ -141,6 +143,9 @@ std::string allowed_methods(const std::string& path) {
       {std::regex(R"(/|/conformance|/(v1/)?processes(/contact2d)?|/v1/(health|ready|metrics))"), "GET"},
       {std::regex(R"(/v1/(schemas|examples)(/[^/]+)?)"), "GET"},
       {std::regex(R"(/v1/meshes)"), "POST"},
+      {std::regex(R"(/v1/studies)"), "POST"},
+      {std::regex(R"(/v1/studies/[^/]+)"), "GET, DELETE"},
+      {std::regex(R"(/v1/studies/[^/]+/events)"), "GET"},
       {std::regex(R"(/v1/meshes/[^/]+)"), "GET, DELETE"},
   };
   for (const auto& [pattern, methods] : routes)
@@ -207,10 +212,11 @@ json mesh_document(const MeshRecord& r, json summary) {
 
 struct HttpServer::Impl {
   Impl(JobService& s, HttpOptions o, std::atomic<int>& streams)
-      : service(s), options(std::move(o)), open_streams(streams), svr(options.front),
+      : service(s), studies(s), options(std::move(o)), open_streams(streams), svr(options.front),
         budget(options.parse_budget_bytes ? options.parse_budget_bytes : options.max_body_bytes) {}
 
   JobService& service;
+  Studies studies;
   HttpOptions options;
   std::atomic<int>& open_streams;
   HttpFront svr;
@@ -233,6 +239,17 @@ struct HttpServer::Impl {
   // Reads the body, up to `limit` bytes, into `text`; false after answering 413, 408 or 400.
   bool read_body(const Request& req, Response& res, const httplib::ContentReader& reader, std::size_t limit,
                  std::string& text);
+  // read_body, then the body as JSON (`what` names it in a 415); false after answering 4xx.
+  bool read_json_body(const Request& req, Response& res, const httplib::ContentReader& reader, const char* what,
+                      json& body);
+  // 422 with every issue's pointer (under `prefix`): an invalid `what` (scene, study).
+  void invalid(const Request& req, Response& res, const SceneErrors& e, const std::string& prefix,
+               const std::string& what);
+  void submit_study(const Request& req, Response& res, const httplib::ContentReader& reader);
+  void get_study(const Request& req, Response& res);
+  // The study's table as Server-Sent Events: `study` each time it changes, `study_finished` last.
+  void study_events(const Request& req, Response& res);
+  void remove_study(const Request& req, Response& res);
   void upload_mesh(const Request& req, Response& res, const httplib::ContentReader& reader);
   void get_mesh(const Request& req, Response& res);
   void remove_mesh(const Request& req, Response& res);
@@ -476,6 +493,14 @@ void HttpServer::Impl::routes() {
   get({R"(/v1/jobs/([^/]+)/result)", R"(/jobs/([^/]+)/results?)"},
       [this](const Request& req, Response& res) { result(req, res); });
 
+  // ---- studies
+  svr.Post("/v1/studies", [this](const Request& req, Response& res, const httplib::ContentReader& reader) {
+    submit_study(req, res, reader);
+  });
+  svr.Get(R"(/v1/studies/([^/]+))", [this](const Request& req, Response& res) { get_study(req, res); });
+  svr.Get(R"(/v1/studies/([^/]+)/events)", [this](const Request& req, Response& res) { study_events(req, res); });
+  svr.Delete(R"(/v1/studies/([^/]+))", [this](const Request& req, Response& res) { remove_study(req, res); });
+
   // ---- uploaded meshes
   svr.Post("/v1/meshes", [this](const Request& req, Response& res, const httplib::ContentReader& reader) {
     upload_mesh(req, res, reader);
@@ -512,31 +537,8 @@ void HttpServer::Impl::submit(const Request& req, Response& res, const httplib::
                    "this server is reading as many scenes as its memory budget allows; nothing was accepted; "
                    "retry after 5 s");  // after 2 minutes of waiting
   }
-  std::string text;
-  if (!read_body(req, res, reader, options.max_body_bytes, text)) return;
-  const std::string type = lower(req.get_header_value("Content-Type"));
-  const std::string media = type.substr(0, type.find(';'));
-  auto trimmed = media;
-  trimmed.erase(std::remove_if(trimmed.begin(), trimmed.end(), ::isspace), trimmed.end());
-  if (trimmed != "application/json" && !(trimmed.size() > 5 && trimmed.compare(trimmed.size() - 5, 5, "+json") == 0)) {
-    res.set_header("Accept-Post", "application/json");
-    return problem(
-        res, req, 415, "unsupported-media-type", "Unsupported media type",
-        "a scene is submitted as application/json, not '" + (media.empty() ? std::string("(none)") : media) + "'");
-  }
-  if (nested_deeper_than(text, kMaxJsonDepth))
-    return problem(res, req, 400, "malformed-json", "Malformed JSON",
-                   "arrays and objects are nested deeper than " + std::to_string(kMaxJsonDepth) + " levels");
   json body;
-  try {
-    body = json::parse(text);
-  } catch (const json::parse_error& e) {
-    return problem(res, req, 400, "malformed-json", "Malformed JSON", "the body is not JSON: " + std::string(e.what()),
-                   error_list("parse error at byte " + std::to_string(e.byte) + ": " + e.what()));
-  } catch (const json::exception& e) {  // a number out of range (1e400): out_of_range.406
-    return problem(res, req, 400, "malformed-json", "Malformed JSON",
-                   "the body is not JSON that this server can read: " + std::string(e.what()));
-  }
+  if (!read_json_body(req, res, reader, "a scene", body)) return;
   // OGC execute request: {"inputs": {"scene": {...}}} (or the scene's fields as inputs).
   std::string prefix;
   json scene = std::move(body);
@@ -563,23 +565,7 @@ void HttpServer::Impl::submit(const Request& req, Response& res, const httplib::
     if (r.replayed) res.set_header("Idempotent-Replayed", "true");
     send_json(res, 201, job_document(r.job));
   } catch (const SceneErrors& e) {
-    // Listed up to a bound: 8 MB of equal nodes made a million errors, a 99 MB answer and a
-    // peak of 1.9 GB.
-    // The reader and the validator stop at kMaxSceneIssues (more() then).
-    constexpr size_t kMaxListed = kMaxSceneIssues;
-    const auto& issues = e.issues();
-    json errors = json::array();
-    for (size_t i = 0; i < std::min(issues.size(), kMaxListed); ++i)
-      errors.push_back(
-          {{"pointer", prefix + (issues[i].pointer == "/" ? "" : issues[i].pointer)}, {"detail", issues[i].detail}});
-    const size_t listed = std::min(issues.size(), kMaxListed);
-    problem(res, req, 422, "invalid-scene", "Invalid scene",
-            e.more()
-                ? "more than " + std::to_string(listed) + " problems in the scene; the first " +
-                      std::to_string(listed) + " found are listed"
-                : std::to_string(issues.size()) + " problem(s) in the scene" +
-                      (issues.size() > kMaxListed ? "; the first " + std::to_string(kMaxListed) + " are listed" : ""),
-            std::move(errors));
+    invalid(req, res, e, prefix, "scene");
   } catch (const QueueFull& e) {
     res.set_header("Retry-After", std::to_string(e.retry_after_seconds));
     problem(res, req, 503, "queue-full", "Queue full",
@@ -590,6 +576,40 @@ void HttpServer::Impl::submit(const Request& req, Response& res, const httplib::
   } catch (const IdempotencyConflict& e) {
     problem(res, req, 422, "idempotency-key-reused", "Idempotency-Key reused", e.what());
   }
+}
+
+bool HttpServer::Impl::read_json_body(const Request& req, Response& res, const httplib::ContentReader& reader,
+                                      const char* what, json& body) {
+  std::string text;
+  if (!read_body(req, res, reader, options.max_body_bytes, text)) return false;
+  const std::string type = lower(req.get_header_value("Content-Type"));
+  const std::string media = type.substr(0, type.find(';'));
+  auto trimmed = media;
+  trimmed.erase(std::remove_if(trimmed.begin(), trimmed.end(), ::isspace), trimmed.end());
+  if (trimmed != "application/json" && !(trimmed.size() > 5 && trimmed.compare(trimmed.size() - 5, 5, "+json") == 0)) {
+    res.set_header("Accept-Post", "application/json");
+    problem(res, req, 415, "unsupported-media-type", "Unsupported media type",
+            std::string(what) + " is submitted as application/json, not '" +
+                (media.empty() ? std::string("(none)") : media) + "'");
+    return false;
+  }
+  if (nested_deeper_than(text, kMaxJsonDepth)) {
+    problem(res, req, 400, "malformed-json", "Malformed JSON",
+            "arrays and objects are nested deeper than " + std::to_string(kMaxJsonDepth) + " levels");
+    return false;
+  }
+  try {
+    body = json::parse(text);
+  } catch (const json::parse_error& e) {
+    problem(res, req, 400, "malformed-json", "Malformed JSON", "the body is not JSON: " + std::string(e.what()),
+            error_list("parse error at byte " + std::to_string(e.byte) + ": " + e.what()));
+    return false;
+  } catch (const json::exception& e) {  // a number out of range (1e400): out_of_range.406
+    problem(res, req, 400, "malformed-json", "Malformed JSON",
+            "the body is not JSON that this server can read: " + std::string(e.what()));
+    return false;
+  }
+  return true;
 }
 
 bool HttpServer::Impl::read_body(const Request& req, Response& res, const httplib::ContentReader& reader,
@@ -657,6 +677,140 @@ void HttpServer::Impl::upload_mesh(const Request& req, Response& res, const http
   json doc = mesh_document(up.record, std::move(up.summary));
   res.set_header("Location", "/v1/meshes/" + up.record.id);
   send_json(res, up.created ? 201 : 200, doc);
+}
+
+void HttpServer::Impl::invalid(const Request& req, Response& res, const SceneErrors& e, const std::string& prefix,
+                               const std::string& what) {
+  // Listed up to a bound: 8 MB of equal nodes made a million errors, a 99 MB answer and a
+  // peak of 1.9 GB.
+  // The reader and the validator stop at kMaxSceneIssues (more() then).
+  constexpr size_t kMaxListed = kMaxSceneIssues;
+  const auto& issues = e.issues();
+  json errors = json::array();
+  for (size_t i = 0; i < std::min(issues.size(), kMaxListed); ++i)
+    errors.push_back(
+        {{"pointer", prefix + (issues[i].pointer == "/" ? "" : issues[i].pointer)}, {"detail", issues[i].detail}});
+  const size_t listed = std::min(issues.size(), kMaxListed);
+  std::string title = "Invalid " + what;
+  problem(res, req, 422, "invalid-" + what, title,
+          e.more()
+              ? "more than " + std::to_string(listed) + " problems in the " + what + "; the first " +
+                    std::to_string(listed) + " found are listed"
+              : std::to_string(issues.size()) + " problem(s) in the " + what +
+                    (issues.size() > kMaxListed ? "; the first " + std::to_string(kMaxListed) + " are listed" : ""),
+          std::move(errors));
+}
+
+void HttpServer::Impl::submit_study(const Request& req, Response& res, const httplib::ContentReader& reader) {
+  const auto declared = parse_count(req.get_header_value("Content-Length"));
+  auto hold = budget.take(std::min<std::size_t>(declared.value_or(options.max_body_bytes), options.max_body_bytes),
+                          std::chrono::seconds(120));
+  if (!hold) {
+    res.set_header("Retry-After", "5");
+    return problem(res, req, 503, "busy", "Busy",
+                   "this server is reading as many scenes as its memory budget allows; nothing was accepted; "
+                   "retry after 5 s");
+  }
+  json body;
+  if (!read_json_body(req, res, reader, "a study", body)) return;
+  try {
+    const json doc = studies.submit(body, res.get_header_value("X-Request-Id"));
+    res.set_header("Location", "/v1/studies/" + doc["id"].get<std::string>());
+    send_json(res, 201, doc);
+  } catch (const SceneErrors& e) {
+    invalid(req, res, e, "", "study");
+  } catch (const QueueFull& e) {
+    res.set_header("Retry-After", std::to_string(e.retry_after_seconds));
+    problem(res, req, 503, "queue-full", "Queue full",
+            "the job queue has no room for the study's levels; nothing was accepted; retry after " +
+                std::to_string(e.retry_after_seconds) + " s");
+  } catch (const ShuttingDown&) {
+    res.set_header("Retry-After", "10");
+    problem(res, req, 503, "shutting-down", "Shutting down", "the server is shutting down; nothing was accepted");
+  }
+}
+
+void HttpServer::Impl::get_study(const Request& req, Response& res) {
+  const std::string id = req.matches[1];
+  const auto doc = studies.study(id);
+  if (!doc) return problem(res, req, 404, "study-not-found", "Study not found", "no study has id '" + id + "'");
+  const std::string format = req.has_param("format") ? req.get_param_value("format") : "json";
+  if (format == "csv") {
+    res.set_header("Content-Disposition", "attachment; filename=\"study-" + id + ".csv\"");
+    res.set_content(objects_csv(study_rows(*doc)), "text/csv; charset=utf-8");
+    return;
+  }
+  if (format != "json")
+    return problem(res, req, 400, "bad-parameter", "Bad query parameter", "format must be json or csv");
+  send_json(res, 200, *doc);
+}
+
+void HttpServer::Impl::study_events(const Request& req, Response& res) {
+  const std::string id = req.matches[1];
+  if (!studies.study(id))
+    return problem(res, req, 404, "study-not-found", "Study not found", "no study has id '" + id + "'");
+  if (service.draining()) {
+    res.set_header("Retry-After", "10");
+    return problem(res, req, 503, "shutting-down", "Shutting down", "the server is shutting down");
+  }
+  if (open_streams.fetch_add(1) >= options.max_streams) {  // counted with the jobs' streams
+    --open_streams;
+    res.set_header("Retry-After", "5");
+    return problem(res, req, 503, "too-many-streams", "Too many event streams",
+                   "this server has " + std::to_string(options.max_streams) +
+                       " event streams open; retry later or poll the study");
+  }
+  struct State {
+    std::string last;  // the table last sent
+    std::int64_t seq = 0;
+    std::chrono::steady_clock::time_point last_write;
+  };
+  auto state = std::make_shared<State>();
+  state->last_write = std::chrono::steady_clock::now();
+  res.set_header("Cache-Control", "no-cache");
+  res.set_header("X-Accel-Buffering", "no");
+  const auto heartbeat = options.heartbeat;
+  res.set_chunked_content_provider(
+      "text/event-stream",
+      [this, id, state, heartbeat](size_t, httplib::DataSink& sink) {
+        if (stopping || service.draining()) {
+          sink.done();
+          return true;
+        }
+        if (!sink.is_writable()) return false;
+        // The table is read from the jobs (server/studies.hpp); a look every 500 ms at most.
+        if (state->seq > 0) std::this_thread::sleep_for(std::chrono::milliseconds(500));
+        const auto doc = studies.study(id);
+        if (!doc) {  // removed meanwhile
+          sink.done();
+          return true;
+        }
+        const std::string text = doc->dump();
+        const std::string status = (*doc)["status"];
+        const bool ended = status != "accepted" && status != "running";
+        std::string out;
+        if (text != state->last) {
+          out = "id: " + std::to_string(++state->seq) + "\nevent: " + (ended ? "study_finished" : "study") +
+                "\ndata: " + text + "\n\n";
+          state->last = text;
+        }
+        const auto now = std::chrono::steady_clock::now();
+        if (out.empty() && now - state->last_write >= heartbeat) out = ": ping\n\n";
+        if (!out.empty()) {
+          if (!sink.write(out.data(), out.size())) return false;
+          state->last_write = now;
+        }
+        if (ended) sink.done();
+        return true;
+      },
+      [this](bool) { --open_streams; });
+}
+
+void HttpServer::Impl::remove_study(const Request& req, Response& res) {
+  const std::string id = req.matches[1];
+  if (!studies.remove(id))
+    return problem(res, req, 404, "study-not-found", "Study not found", "no study has id '" + id + "'");
+  res.status = 204;
 }
 
 void HttpServer::Impl::get_mesh(const Request& req, Response& res) {

@@ -186,24 +186,20 @@ std::optional<SubmitResult> JobService::replay(const std::optional<std::string>&
   return SubmitResult{JobView{*existing, std::nullopt}, true};
 }
 
-SubmitResult JobService::submit(const json& scene_json, const std::optional<std::string>& idempotency_key,
-                                const std::string& request_id) {
-  if (draining_) throw ShuttingDown();
-  const std::string canonical = scene_json.dump();
-  if (auto earlier = replay(idempotency_key, canonical)) return *earlier;
+JobService::Checked JobService::check_scene(const json& scene_json) {
   const JobLimits& lim = options_.limits;
   if (const auto least = least_generated_nodes(scene_json); least && *least > lim.max_nodes)
     throw SceneErrors(std::vector<SceneIssue>{{"/body/mesh", "the body has at least " + std::to_string(*least) +
                                                                  " nodes; this service takes at most " +
                                                                  std::to_string(lim.max_nodes)}});
-  struct {
-    int nodes, steps;
-  } size;
+  Checked size;
   MeshUse meshes;
   {
     const Scene scene = read_with_meshes(meshes_, scene_json, meshes);  // throws SceneErrors
-    size = {scene.problem.body->node_count(), static_cast<int>(scene.steps.size())};
+    size.nodes = scene.problem.body->node_count();
+    size.steps = static_cast<int>(scene.steps.size());
   }
+  size.meshes = std::move(meshes.ids);
   std::vector<SceneIssue> issues;
   if (size.nodes > lim.max_nodes)
     issues.push_back({"/body/mesh", "the body has " + std::to_string(size.nodes) +
@@ -213,6 +209,17 @@ SubmitResult JobService::submit(const json& scene_json, const std::optional<std:
                       "the scene has " + std::to_string(size.steps) + " load steps; this service takes at most " +
                           std::to_string(lim.max_steps)});
   if (!issues.empty()) throw SceneErrors(std::move(issues));
+  return size;
+}
+
+int JobService::check(const json& scene) { return check_scene(scene).nodes; }
+
+SubmitResult JobService::submit(const json& scene_json, const std::optional<std::string>& idempotency_key,
+                                const std::string& request_id) {
+  if (draining_) throw ShuttingDown();
+  const std::string canonical = scene_json.dump();
+  if (auto earlier = replay(idempotency_key, canonical)) return *earlier;
+  Checked size = check_scene(scene_json);
 
   const std::int64_t waiting = store_.count_accepted();
   {
@@ -237,7 +244,7 @@ SubmitResult JobService::submit(const json& scene_json, const std::optional<std:
   rec.nodes = size.nodes;
   rec.idempotency_key = idempotency_key;
   rec.request_id = request_id;
-  rec.meshes = std::move(meshes.ids);
+  rec.meshes = std::move(size.meshes);
   try {
     store_.insert_job(rec);
   } catch (const StoreUnavailable&) {
@@ -748,7 +755,7 @@ void JobService::run_job(const std::shared_ptr<ActiveJob>& job, const JobRecord&
     job->progress->iterations = iterations;
   };
   observer.step_finished = [&](const StepRecord& step) {
-    emit(job, ++seq, step_finished_event(step));
+    emit(job, ++seq, step_finished_event(scene->problem, step, scene->output));
     std::lock_guard lock(job->progress_mutex);
     if (step.converged) job->progress->steps_done = step.index;
   };

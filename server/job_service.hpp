@@ -150,6 +150,9 @@ class JobService {
   // `request_id`: the submitting request's, kept with the job.
   SubmitResult submit(const nlohmann::json& scene, const std::optional<std::string>& idempotency_key = std::nullopt,
                       const std::string& request_id = "");
+  // submit's checks of a scene (schema, reader, job limits) without storing it: its nodes.
+  // Throws grip::SceneErrors.
+  int check(const nlohmann::json& scene);
   std::optional<JobView> job(const std::string& id);
   std::vector<JobView> with_progress(std::vector<JobRecord> records);
   JobPage list(std::optional<JobStatus> status, int limit, std::optional<std::int64_t> before);
@@ -172,6 +175,8 @@ class JobService {
   const ServiceOptions& options() const { return options_; }
   // Uploaded meshes (POST /v1/meshes), and the parsed ones shared by submissions and workers.
   MeshLibrary& meshes() { return meshes_; }
+  // The store the jobs live in (studies keep their plans there: server/studies.hpp).
+  Store& store() { return store_; }
 
   // Refuses new submissions and releases every event reader at once.
   void begin_drain();
@@ -182,6 +187,11 @@ class JobService {
 
  private:
   struct ActiveJob;
+  struct Checked {
+    int nodes = 0, steps = 0;
+    std::vector<std::string> meshes;  // the uploads it names
+  };
+  Checked check_scene(const nlohmann::json& scene);
   // The earlier submission with this idempotency key, if any (same scene, else it throws).
   std::optional<SubmitResult> replay(const std::optional<std::string>& key, const std::string& scene);
   void on_change(const StoreChange& change);

@@ -72,6 +72,9 @@ std::string route_template(const std::string& path) {
       {std::regex(R"(/ui(/[^/]+)?)"), "/ui"},
       {std::regex(R"(/v1/meshes)"), ""},
       {std::regex(R"(/v1/meshes/[^/]+)"), "/v1/meshes/{id}"},
+      {std::regex(R"(/v1/studies)"), ""},
+      {std::regex(R"(/v1/studies/[^/]+)"), "/v1/studies/{id}"},
+      {std::regex(R"(/v1/studies/[^/]+/events)"), "/v1/studies/{id}/events"},
   };
   for (const auto& [pattern, name] : routes)
     if (std::regex_match(path, pattern)) return name.empty() ? path : name;

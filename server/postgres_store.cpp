@@ -73,6 +73,11 @@ CREATE TABLE IF NOT EXISTS grip_job_meshes (
   PRIMARY KEY (job_id, mesh_id)
 );
 CREATE INDEX IF NOT EXISTS grip_job_meshes_by_mesh ON grip_job_meshes (mesh_id);
+CREATE TABLE IF NOT EXISTS grip_studies (
+  id TEXT PRIMARY KEY,
+  created TEXT NOT NULL,
+  document TEXT NOT NULL
+);
 )sql";
 
 // Columns read by read_job, in this order.
@@ -738,6 +743,24 @@ bool PostgresStore::put_mesh(const MeshRecord& mesh, const std::string& data) {
       "ON CONFLICT (id) DO NOTHING RETURNING id",
       {mesh.id, num(mesh.bytes), bytea(data), mesh.summary, mesh.created});
   return r.rows() == 1;
+}
+
+void PostgresStore::insert_study(const StudyRecord& study) {
+  Session s(*pool_);
+  s.query("INSERT INTO grip_studies (id, created, document) VALUES ($1, $2, $3)",
+          {study.id, study.created, study.document});
+}
+
+std::optional<StudyRecord> PostgresStore::study(const std::string& id) {
+  Session s(*pool_);
+  const Result r = s.query("SELECT id, created, document FROM grip_studies WHERE id = $1", {id});
+  if (r.rows() == 0) return std::nullopt;
+  return StudyRecord{r.text(0, 0), r.text(0, 1), r.text(0, 2)};
+}
+
+bool PostgresStore::remove_study(const std::string& id) {
+  Session s(*pool_);
+  return s.query("DELETE FROM grip_studies WHERE id = $1 RETURNING id", {id}).rows() == 1;
 }
 
 std::optional<MeshRecord> PostgresStore::mesh(const std::string& id) {

@@ -68,6 +68,11 @@ CREATE TABLE IF NOT EXISTS job_meshes (
   PRIMARY KEY (job_id, mesh_id)
 ) WITHOUT ROWID;
 CREATE INDEX IF NOT EXISTS job_meshes_by_mesh ON job_meshes (mesh_id);
+CREATE TABLE IF NOT EXISTS studies (
+  id TEXT PRIMARY KEY,
+  created TEXT NOT NULL,
+  document TEXT NOT NULL
+);
 )sql";
 
 // Schema 1 (before leases) to 2.
@@ -635,6 +640,29 @@ bool SqliteStore::put_mesh(const MeshRecord& mesh, const std::string& data) {
       .bind(4, mesh.summary)
       .bind(5, mesh.created)
       .run();
+  return writer_->changes() == 1;
+}
+
+void SqliteStore::insert_study(const StudyRecord& study) {
+  std::lock_guard lock(write_mutex_);
+  writer_->prepare("INSERT INTO studies (id, created, document) VALUES (?, ?, ?)")
+      .bind(1, study.id)
+      .bind(2, study.created)
+      .bind(3, study.document)
+      .run();
+}
+
+std::optional<StudyRecord> SqliteStore::study(const std::string& id) {
+  std::lock_guard lock(read_mutex_);
+  auto st = reader_->prepare("SELECT id, created, document FROM studies WHERE id = ?");
+  st.bind(1, id);
+  if (!st.step()) return std::nullopt;
+  return StudyRecord{st.text(0), st.text(1), st.text(2)};
+}
+
+bool SqliteStore::remove_study(const std::string& id) {
+  std::lock_guard lock(write_mutex_);
+  writer_->prepare("DELETE FROM studies WHERE id = ?").bind(1, id).run();
   return writer_->changes() == 1;
 }
 

@@ -46,6 +46,9 @@ class SqliteStore final : public Store {
   std::optional<MeshRecord> mesh(const std::string& id) override;
   std::optional<std::string> mesh_data(const std::string& id) override;
   MeshRemoval remove_mesh(const std::string& id) override;
+  void insert_study(const StudyRecord& study) override;
+  std::optional<StudyRecord> study(const std::string& id) override;
+  bool remove_study(const std::string& id) override;
   std::pair<std::int64_t, std::int64_t> mesh_totals() override;
   std::int64_t prune(const Retention& retention, const std::string& now) override;
   std::int64_t disk_bytes() override;

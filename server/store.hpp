@@ -84,6 +84,14 @@ struct MeshRecord {
 
 enum class MeshRemoval { not_found, in_use, removed };
 
+// A study (POST /v1/studies): its plan and the jobs it submitted, as one JSON document. Its
+// table is read from its jobs when asked (server/studies.hpp); the record itself never changes.
+struct StudyRecord {
+  std::string id;
+  std::string created;   // ISO 8601 UTC
+  std::string document;  // compact JSON
+};
+
 // Which finished jobs the store keeps; 0: no bound of that kind. Beyond a bound the
 // dismissed jobs go first, then the oldest.
 struct Retention {
@@ -217,6 +225,12 @@ class Store {
   virtual MeshRemoval remove_mesh(const std::string& id) = 0;
   // Meshes stored and their stored bytes.
   virtual std::pair<std::int64_t, std::int64_t> mesh_totals() = 0;
+
+  // Studies. insert_study throws std::runtime_error when the id exists; remove_study: whether
+  // it was there. A study's jobs are removed (dismissed) by the caller.
+  virtual void insert_study(const StudyRecord& study) = 0;
+  virtual std::optional<StudyRecord> study(const std::string& id) = 0;
+  virtual bool remove_study(const std::string& id) = 0;
 
   // Removes the finished jobs beyond `retention` at `now` (ISO 8601), with their events and
   // results, and hands their space back (SQLite: incremental vacuum). Returns how many. With an

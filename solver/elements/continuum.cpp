@@ -7,14 +7,13 @@
 namespace grip {
 namespace {
 
-// The 4 x 4 small-strain law of (rr, zz, rz, tt) from the plane-strain block and the hoop row.
-Eigen::Matrix4d axisymmetric_D(const MaterialResponse& r) {
-  Eigen::Matrix4d D = Eigen::Matrix4d::Zero();
-  D.topLeftCorner<3, 3>() = r.D;
-  D.block<1, 3>(3, 0) = r.dS33;
-  D.block<3, 1>(0, 3) = r.dS33.transpose();
-  D(3, 3) = r.dS33_dE33;
-  return D;
+// The small strain (11, 22, 2 x 12, 33) = B u (4 x 2n): 33 the hoop strain u_r / r in
+// axisymmetry, zero in plane strain and plane stress (where the law finds it).
+Matrix strain_matrix4(const ElementPoint& point, const ShapeGradients* mean_dN) {
+  if (point.radius > 0) return axisymmetric_strain_matrix(point);
+  Matrix B = Matrix::Zero(4, 2 * point.dN.rows());
+  B.topRows(3) = strain_matrix(point, mean_dN);
+  return B;
 }
 
 }  // namespace
@@ -68,6 +67,10 @@ ContinuumBody::ContinuumBody(PlaneMesh mesh, const std::vector<int>& contact_set
   if (options_.element == ContinuumElement::q4_bbar && options_.kinematics == ContinuumKinematics::finite)
     throw std::invalid_argument("q4_bbar is implemented for linear kinematics (use q9 for finite strain)");
   if (!(options_.thickness > 0)) throw std::invalid_argument("thickness must be positive");
+  for (const auto& m : materials_) has_history_ |= m->has_history();
+  if (has_history_ && options_.kinematics == ContinuumKinematics::finite)
+    throw std::invalid_argument(
+        "a law with history (j2_plasticity) is implemented for small strain: linear kinematics");
   if (options_.analysis == PlaneAnalysis::axisymmetric) {
     if (options_.kinematics == ContinuumKinematics::finite || options_.element == ContinuumElement::q4_bbar)
       throw std::invalid_argument("axisymmetric is implemented for linear kinematics and t3, t6, q4, q8, q9");
@@ -83,6 +86,7 @@ ContinuumBody::ContinuumBody(PlaneMesh mesh, const std::vector<int>& contact_set
     hi = hi.cwiseMax(x);
   }
   length_ = (hi - lo).norm();
+  if (has_history_) history_.resize(mesh_.elements.size() * gauss_rule(shape_).size());
 }
 
 const ContinuumBody::Integration& ContinuumBody::integration() const {
@@ -102,12 +106,11 @@ const ContinuumBody::Integration& ContinuumBody::integration() const {
       }
       if (options_.element == ContinuumElement::q4_bbar) in->mean_dN.push_back(mean_gradients(in->points.back()));
     }
-    if (options_.kinematics == ContinuumKinematics::linear) {
+    if (options_.kinematics == ContinuumKinematics::linear && !has_history_) {
       for (int e = 0; e < element_count(); ++e) {
-        const Matrix Ke = axisymmetric
-                              ? axisymmetric_stiffness(in->points[e], axisymmetric_D(material(e).small_strain()))
-                              : small_strain_stiffness(in->points[e], material(e).small_strain().D,
-                                                       in->mean_dN.empty() ? nullptr : &in->mean_dN[e]);
+        const Matrix Ke = axisymmetric ? axisymmetric_stiffness(in->points[e], material(e).small_strain_D4())
+                                       : small_strain_stiffness(in->points[e], material(e).small_strain().D,
+                                                                in->mean_dN.empty() ? nullptr : &in->mean_dN[e]);
         const auto& el = mesh_.elements[e];
         for (int i = 0; i < 2 * n; ++i)
           for (int j = 0; j < 2 * n; ++j)
@@ -133,7 +136,51 @@ ShapeGradients ContinuumBody::element_displacements(const Vector& q, int e) cons
   return u;
 }
 
+std::vector<PointResponse> ContinuumBody::point_responses(const Vector& q, int e) const {
+  const std::vector<ElementPoint>& points = integration().points[e];
+  const ShapeGradients u = element_displacements(q, e);
+  Vector ue(2 * u.rows());
+  for (int a = 0; a < u.rows(); ++a) ue.segment<2>(2 * a) = u.row(a).transpose();
+  std::vector<PointResponse> out;
+  for (size_t k = 0; k < points.size(); ++k)
+    out.push_back(material(e).small_strain_response(strain_matrix4(points[k], mean_gradient(e)) * ue,
+                                                    history_[e * points.size() + k]));
+  return out;
+}
+
+void ContinuumBody::commit(const Vector& q) {
+  if (!has_history_) return;
+  for (int e = 0; e < element_count(); ++e) {
+    const std::vector<PointResponse> r = point_responses(q, e);
+    for (size_t k = 0; k < r.size(); ++k) history_[e * r.size() + k] = r[k].history;
+  }
+}
+
 void ContinuumBody::internal_force(const Vector& q, Vector& force, Triplets* tangent) const {
+  if (has_history_) {
+    const Integration& in = integration();
+    for (int e = 0; e < element_count(); ++e) {
+      const std::vector<PointResponse> r = point_responses(q, e);
+      const auto& el = mesh_.elements[e];
+      const int m = 2 * static_cast<int>(el.size());
+      Vector fe = Vector::Zero(m);
+      Matrix Ke = Matrix::Zero(m, m);
+      for (size_t k = 0; k < r.size(); ++k) {
+        const ElementPoint& p = in.points[e][k];
+        const Matrix B = strain_matrix4(p, mean_gradient(e));
+        fe.noalias() += p.dV * B.transpose() * r[k].stress;
+        if (tangent) Ke.noalias() += p.dV * B.transpose() * r[k].D * B;
+      }
+      for (int i = 0; i < m; ++i) {
+        const int gi = node_dof(el[i / 2], i % 2);
+        force[gi] += fe[i];
+        if (tangent)
+          for (int j = 0; j < m; ++j)
+            tangent->emplace_back(gi, node_dof(el[j / 2], j % 2), 0.5 * (Ke(i, j) + Ke(j, i)));
+      }
+    }
+    return;
+  }
   if (options_.kinematics == ContinuumKinematics::linear) {
     const Integration& in = integration();
     force += in.linear_K * q;
@@ -177,9 +224,13 @@ Vector ContinuumBody::rigid_rotation() const {
   return q;
 }
 
+Vector ContinuumBody::own_rotation_at(const Vector& /*q*/) const {
+  return options_.kinematics == ContinuumKinematics::linear ? rigid_rotation() : Vector();
+}
+
 Body::Traits ContinuumBody::traits() const {
   const bool linear = options_.kinematics == ContinuumKinematics::linear;
-  return {.geometric_nonlinearity = !linear, .plasticity = false, .constant_tangent = linear};
+  return {.geometric_nonlinearity = !linear, .plasticity = has_history_, .constant_tangent = linear && !has_history_};
 }
 
 std::vector<std::array<int, 2>> ContinuumBody::surface_segments() const {
@@ -264,7 +315,7 @@ Eigen::Vector4d ContinuumBody::centroid_stress(const Vector& q, int e) const {
     Vector ue(2 * u.rows());
     for (int a = 0; a < u.rows(); ++a) ue.segment<2>(2 * a) = u.row(a).transpose();
     if (options_.analysis == PlaneAnalysis::axisymmetric)
-      return axisymmetric_D(r) * (axisymmetric_strain_matrix(c) * ue);
+      return material(e).small_strain_D4() * (axisymmetric_strain_matrix(c) * ue);
     const Eigen::Vector3d eps = strain_matrix(c, mean_gradient(e)) * ue;
     const Eigen::Vector3d s = r.D * eps;
     return {s[0], s[1], s[2], r.dS33 * eps};
@@ -274,6 +325,24 @@ Eigen::Vector4d ContinuumBody::centroid_stress(const Vector& q, int e) const {
 }
 
 FieldTable ContinuumBody::element_fields(const Vector& q) const {
+  if (has_history_) {
+    FieldTable t{{"sxx", "syy", "sxy", "szz", "equivalent_plastic_strain", "yielding"}, {}};
+    for (int e = 0; e < element_count(); ++e) {
+      const std::vector<PointResponse> r = point_responses(q, e);
+      const std::vector<ElementPoint>& points = integration().points[e];
+      Eigen::Vector4d s = Eigen::Vector4d::Zero();
+      double volume = 0.0, alpha = 0.0, yielding = 0.0;
+      for (size_t k = 0; k < r.size(); ++k) {
+        const double dV = points[k].dV;
+        volume += dV;
+        s += dV * r[k].stress;
+        alpha += dV * r[k].history.equivalent_plastic_strain;
+        yielding += r[k].yielding ? dV : 0.0;
+      }
+      t.rows.push_back({s[0] / volume, s[1] / volume, s[2] / volume, s[3] / volume, alpha / volume, yielding / volume});
+    }
+    return t;
+  }
   FieldTable t{{"sxx", "syy", "sxy", "szz"}, {}};
   for (int e = 0; e < element_count(); ++e) {
     const Eigen::Vector4d s = centroid_stress(q, e);

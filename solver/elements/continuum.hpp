@@ -6,6 +6,9 @@
 //   linear: small strain, sigma = D eps; K is constant, assembled once and reused (traits()
 //   says so, and the equilibrium oracle then factorizes it once).
 //   finite: total Lagrangian, S(E) of the law, exact tangent.
+// A law with history (j2_plasticity, small strain only) makes the linear body's tangent change:
+// every integration point answers from its committed history, which commit() advances to an
+// accepted state (docs/algorithm.md#j2-plasticity).
 // Elements: t3 (1 Gauss point), t6 (6 points), q4 (2 x 2 Gauss), q4_bbar (q4 with the mean
 // dilatation of B-bar: for nu -> 1/2 in plane strain, linear kinematics), q8 and q9 (3 x 3).
 //
@@ -48,8 +51,8 @@ const char* element_name(ContinuumElement element);  // as the scene names it: "
 class ContinuumBody final : public Body {
  public:
   // The mesh must pass check_mesh (InvalidMesh otherwise); contact_set is a node set on the
-  // boundary (boundary_part). Throws std::invalid_argument otherwise, or for q4_bbar with
-  // finite kinematics.
+  // boundary (boundary_part). Throws std::invalid_argument otherwise, for q4_bbar with
+  // finite kinematics, or for a law with history under finite kinematics.
   // `materials`: one for every element, or one per element (a body of several materials: the
   // physical surfaces of a mesh file).
   ContinuumBody(PlaneMesh mesh, const std::vector<int>& contact_set,
@@ -78,14 +81,21 @@ class ContinuumBody final : public Body {
 
   Vector rigid_translation(const Vec2& d) const override;
   Vector rigid_rotation() const override;
+  // Small strain with history: the linear rotation, which leaves every small strain unchanged.
+  Vector own_rotation_at(const Vector& q) const override;
   Traits traits() const override;
+  // The integration points' history advances to the state at q (a law with history).
+  void commit(const Vector& q) override;
   bool axisymmetric() const override { return options_.analysis == PlaneAnalysis::axisymmetric; }
   std::optional<ElementQuality> element_quality() const override { return grip::element_quality(mesh_); }
   std::vector<std::vector<int>> cells() const override;  // element corners (node ids): 3 or 4
   // Per node: x, y (deformed), ux, uy.
   FieldTable site_fields(const Vector& q) const override;
   // Per element, at its centroid: Cauchy stress sxx, syy, sxy, szz (axisymmetric: srr, szz,
-  // srz under the names sxx, syy, sxy, and the hoop stress under szz).
+  // srz under the names sxx, syy, sxy, and the hoop stress under szz). A body with history:
+  // the stresses are the element's volume averages over its integration points, and two more
+  // columns follow: equivalent_plastic_strain (volume average) and yielding (the volume
+  // fraction of the element whose points flow plastically at q: 0 elastic, 1 all of it).
   FieldTable element_fields(const Vector& q) const override;
 
   static int node_dof(int node, int component) { return 2 * node + component; }
@@ -101,6 +111,8 @@ class ContinuumBody final : public Body {
  private:
   ShapeGradients element_displacements(const Vector& q, int e) const;
   const ShapeGradients* mean_gradient(int e) const;
+  // A law with history: the response of each integration point of element e at q.
+  std::vector<PointResponse> point_responses(const Vector& q, int e) const;
 
   // Integration points and the linear stiffness: built at the first solve, not by the
   // constructor, so that reading and validating a large scene stays cheap (the service reads
@@ -121,6 +133,8 @@ class ContinuumBody final : public Body {
   std::vector<std::shared_ptr<const PlaneMaterial>> materials_;
   BoundaryPart contact_;
   double length_ = 0.0;
+  bool has_history_ = false;           // some element's law keeps history
+  std::vector<PointHistory> history_;  // committed, per element and point (element e from e x points)
   mutable std::once_flag integration_once_;
   mutable std::unique_ptr<const Integration> integration_;
 };

@@ -44,7 +44,7 @@ json step_started_event(int step, double load_factor) {
   return {{"type", "step_started"}, {"step", step}, {"load_factor", load_factor}};
 }
 
-json step_finished_event(const StepRecord& rec) {
+json step_finished_event(const Problem& problem, const StepRecord& rec, const OutputOptions& output) {
   json j = {{"type", "step_finished"},
             {"step", rec.index},
             {"load_factor", rec.load_factor},
@@ -60,6 +60,7 @@ json step_finished_event(const StepRecord& rec) {
     j["failure"] = failure_json(rec.failure, rec.reason, rec.index);
   }
   if (!rec.warning.empty()) j["warning"] = rec.warning;
+  if (!output.quantities.empty() && rec.converged) j["outputs"] = quantity_values(problem, rec, output.quantities);
   return j;
 }
 
@@ -278,7 +279,7 @@ void write_contact_points(JsonWriter& w, const std::vector<ContactPointRow>& row
 json step_json(const Problem& problem, const StepRecord& rec, const OutputOptions& output,
                std::optional<std::vector<ContactPointRow>>* rows) {
   const Body& body = *problem.body;
-  json j = step_finished_event(rec);
+  json j = step_finished_event(problem, rec, output);
   j.erase("type");
   j["inner_iterations"] = rec.inner_iterations;
   j["cuts"] = rec.cuts;

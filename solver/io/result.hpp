@@ -15,7 +15,8 @@ namespace grip {
 
 nlohmann::json iteration_event(const IterationEvent& ev);
 nlohmann::json step_started_event(int step, double load_factor);
-nlohmann::json step_finished_event(const StepRecord& rec);
+// With the scene's outputs (OutputOptions::quantities) at a converged step, as "outputs".
+nlohmann::json step_finished_event(const Problem& problem, const StepRecord& rec, const OutputOptions& output);
 // The failure member of a failed step, run or job: {kind, message, step}; step 0 where the
 // failure is no step's (a dismissal, an invalid scene, a node or step limit).
 nlohmann::json failure_json(FailureKind kind, const std::string& message, int step);

@@ -686,6 +686,11 @@ Scene read_checked_scene(const nlohmann::json& input, const MeshResolver& meshes
     for (size_t k = 0; k < r.cases.size(); ++k) scene_io::case_load(scene.problem, static_cast<int>(k));
   read_solver(r, e, scene.params);
   read_output(r, e, scene);
+  if (r.issues.empty() && scene.problem.body) {
+    const auto& recorded = scene.params.record_fields;
+    scene.output.quantities =
+        scene_io::read_outputs(r, e, scene.problem, std::find(recorded.begin(), recorded.end(), 0) == recorded.end());
+  }
   if (r.issues.empty() && scene.problem.body) check_rigid_modes(r, scene.problem);
   if (r.issues.empty()) read_start(r, e, scene.problem);
   if (!r.issues.empty()) throw SceneErrors(std::move(r.issues));

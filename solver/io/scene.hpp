@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "solver/io/quantities.hpp"
 #include "solver/problem/problem.hpp"
 #include "solver/stepping/load_stepping.hpp"
 
@@ -43,6 +44,7 @@ struct OutputOptions {
                                                              "history"};
   std::vector<std::string> fields = kAllFields;
   bool wants(const std::string& field) const { return std::find(fields.begin(), fields.end(), field) != fields.end(); }
+  std::vector<Quantity> quantities;  // the scene's `outputs`, computed at every converged step
 };
 
 struct GmshMesh;

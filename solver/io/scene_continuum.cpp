@@ -1,7 +1,10 @@
 // body.model "continuum": plane triangles and quadrilaterals (solver/elements/continuum.hpp).
 //   "kinematics": "finite" (default) | "linear";  "analysis": "plane_strain" | "plane_stress" | "axisymmetric"
 //   "element": "t3" | "t6" | "q4" | "q4_bbar" | "q8" | "q9";  "thickness" (default 1)
-//   "material": {"young", "poisson", "law": "neo_hookean" | "saint_venant_kirchhoff"}
+//   "material": {"young", "poisson", "law": "neo_hookean" | "saint_venant_kirchhoff" | "j2_plasticity"}
+//     j2_plasticity (linear kinematics): "yield_stress", "hardening": {"linear": H} |
+//     {"power": {"K", "n"}} | {"table": [[eps_p, sigma_y], ...]} (default perfectly plastic),
+//     "kinematic_hardening": H_k (default 0)
 //   "mesh": one of
 //     {"nodes": [[x, y], ...], "elements": [[n0, n1, n2(, ...9)], ...], "sets": {name: [ids]}}
 //     {"rectangle": {"origin", "size", "divisions": [nx, ny], "refine": {"towards", "size", "extent"}}}
@@ -18,9 +21,56 @@
 
 #include "solver/elements/continuum.hpp"
 #include "solver/io/scene_reader.hpp"
+#include "solver/materials/j2_plasticity.hpp"
 
 namespace grip::scene_io {
 namespace {
+
+// The J2 law of material `mp` (law j2_plasticity); nullptr after an error.
+std::shared_ptr<const PlaneMaterial> read_j2_material(Reader& r, json& mat, const std::string& mp, double young,
+                                                      double poisson, const ContinuumOptions& options,
+                                                      const std::string& body_ptr) {
+  const size_t before = r.issues.size();
+  if (options.kinematics != ContinuumKinematics::linear)
+    r.error(body_ptr + "/kinematics",
+            "j2_plasticity is implemented for small strain: give \"linear\" (finite-strain plasticity is not "
+            "implemented)");
+  const double yield_stress = r.positive(mat, mp, "yield_stress");
+  const double kinematic = r.number(mat, mp, "kinematic_hardening", 0.0);
+  IsotropicHardening h;
+  if (json* hard = r.object(mat, mp, "hardening", false)) {
+    const std::string hp = mp + "/hardening";
+    if (hard->empty()) (*hard)["linear"] = 0.0;
+    if (hard->size() != 1 || !(hard->contains("linear") || hard->contains("power") || hard->contains("table"))) {
+      r.error(hp, "needs exactly one of \"linear\", \"power\" and \"table\"");
+    } else if (hard->contains("linear")) {
+      h.modulus = r.number(*hard, hp, "linear");
+    } else if (hard->contains("power")) {
+      h.kind = IsotropicHardening::Kind::power;
+      if (json* pw = r.object(*hard, hp, "power", true)) {
+        h.K = r.number(*pw, hp + "/power", "K");
+        h.n = r.number(*pw, hp + "/power", "n");
+      }
+    } else if (json* table = r.array(*hard, hp, "table", true)) {
+      h.kind = IsotropicHardening::Kind::table;
+      for (size_t k = 0; k < table->size(); ++k) {
+        const json& row = (*table)[k];
+        if (!row.is_array() || row.size() != 2 || !row[0].is_number() || !row[1].is_number()) {
+          r.error(hp + "/table/" + std::to_string(k), show(row) + " is not a pair [eps_p, sigma_y]");
+          continue;
+        }
+        h.table.emplace_back(row[0].get<double>(), row[1].get<double>());
+      }
+    }
+  }
+  if (r.issues.size() > before) return nullptr;
+  if (const std::string why = j2_data_issue(yield_stress, h, kinematic); !why.empty()) {
+    const size_t colon = why.find(':');
+    r.error(mp + "/" + why.substr(0, colon), why.substr(colon + 2));
+    return nullptr;
+  }
+  return std::make_shared<J2Material>(young, poisson, yield_stress, std::move(h), kinematic, options.analysis);
+}
 
 // [a, b] of integers in [lo, hi].
 std::optional<std::pair<int, int>> integer_pair(Reader& r, json& obj, const std::string& ptr, const char* key, int lo,
@@ -369,7 +419,11 @@ void read_continuum(Reader& r, json& body, Problem& problem, const std::string& 
     const double young = r.positive(mat, mp, "young");
     const double poisson = r.number(mat, mp, "poisson", 0.3);
     if (!(poisson > -1 && poisson < 0.5)) r.error(mp + "/poisson", show(mat["poisson"]) + " is not in (-1, 0.5)");
-    const std::string law = r.choice(mat, mp, "law", {"neo_hookean", "saint_venant_kirchhoff"}, "neo_hookean");
+    const std::string law =
+        r.choice(mat, mp, "law", {"neo_hookean", "saint_venant_kirchhoff", "j2_plasticity"}, "neo_hookean");
+    if (law == "j2_plasticity") return read_j2_material(r, mat, mp, young, poisson, options, ptr);
+    for (const char* key : {"yield_stress", "hardening", "kinematic_hardening"})
+      if (mat.contains(key)) r.error(mp + "/" + key, "belongs to law \"j2_plasticity\" (this law is elastic)");
     if (law == "neo_hookean") return std::make_shared<NeoHookeMaterial>(young, poisson, options.analysis);
     return std::make_shared<HookeMaterial>(young, poisson, options.analysis);
   };
@@ -463,6 +517,7 @@ void read_continuum(Reader& r, json& body, Problem& problem, const std::string& 
   }
   const PlaneMesh& checked = continuum->mesh();
   problem.body = std::move(continuum);
+  r.node_sets[r.body_index] = checked.sets;
   if (file) {
     file->tags.body = r.body_index;
     r.file_meshes.push_back(std::move(file->tags));

@@ -185,6 +185,9 @@ class Reader {
   std::vector<FileMeshTags> file_meshes;
   int body_index = 0;
   std::vector<AxisHold> axis_holds;  // the axisymmetric bodies' axis nodes (scene.hpp)
+  // The node sets of each body by its index (continuum bodies: their meshes' sets), which the
+  // scene's outputs name.
+  std::map<int, std::map<std::string, std::vector<int>>> node_sets;
 
   // Load cases by name, in order of first mention; "main" unless a value names another.
   std::vector<std::string> cases{"main"};
@@ -264,6 +267,10 @@ void read_bodies(Reader& r, json& bodies, Problem& problem);
 // (after the obstacles): a pair with a body master joins problem.obstacles (no shape); one with
 // an obstacle master restricts that obstacle to the slave sets that name it.
 void read_contacts(Reader& r, json& scene, Problem& problem);
+// scene["outputs"] (solver/io/quantities.hpp), after the bodies and obstacles: each quantity
+// with its nodes, dofs or obstacle resolved. `fields_every_step`: every step's fields are
+// recorded (a field output reads them).
+std::vector<Quantity> read_outputs(Reader& r, json& scene, const Problem& problem, bool fields_every_step);
 // The rigid motions of `body` (coefficients of translation x, y and rotation) that supports on
 // the dofs `fixed` leave free.
 Matrix free_motions(const Body& body, const std::vector<int>& fixed);

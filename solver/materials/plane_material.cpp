@@ -25,6 +25,24 @@ Vec3 voigt(const Mat2& A) { return {A(0, 0), A(1, 1), A(0, 1)}; }
 
 }  // namespace
 
+Eigen::Matrix4d PlaneMaterial::small_strain_D4() const {
+  const MaterialResponse r = small_strain();
+  Eigen::Matrix4d D = Eigen::Matrix4d::Zero();
+  D.topLeftCorner<3, 3>() = r.D;
+  D.block<1, 3>(3, 0) = r.dS33;
+  D.block<3, 1>(0, 3) = r.dS33.transpose();
+  D(3, 3) = r.dS33_dE33;
+  return D;
+}
+
+PointResponse PlaneMaterial::small_strain_response(const Eigen::Vector4d& strain, const PointHistory& committed) const {
+  PointResponse r;
+  r.D = small_strain_D4();
+  r.stress = r.D * strain;
+  r.history = committed;
+  return r;
+}
+
 HookeMaterial::HookeMaterial(double young, double poisson, PlaneAnalysis analysis)
     : lame_(Lame::from(young, poisson)), analysis_(analysis) {
   const double l = lame_.lambda, m = lame_.mu;

@@ -27,6 +27,26 @@ struct MaterialResponse {
   double dS33_dE33 = 0.0;                                // hoop stiffness at E33 = 0 (zero in plane stress)
 };
 
+// What a law with history (J2 plasticity) keeps at one integration point between accepted
+// steps; elastic laws keep nothing in it.
+struct PointHistory {
+  Eigen::Vector4d plastic_strain = Eigen::Vector4d::Zero();  // (11, 22, 2 x 12, 33)
+  Eigen::Vector4d back_stress = Eigen::Vector4d::Zero();     // (11, 22, 12, 33)
+  double equivalent_plastic_strain = 0.0;                    // alpha = integral of sqrt(2/3) |d eps_p|
+};
+
+// Small-strain response of a point with history, in the order (11, 22, 12, 33) of the
+// axisymmetric element (rr, zz, rz, tt): strain with the engineering shear, 33 the hoop strain
+// in axisymmetry and zero in plane strain.
+struct PointResponse {
+  Eigen::Vector4d stress = Eigen::Vector4d::Zero();
+  // d stress / d strain (the consistent tangent). Plane stress: the in-plane block condensed
+  // on s33 = 0, row and column 3 zero.
+  Eigen::Matrix4d D = Eigen::Matrix4d::Zero();
+  PointHistory history;   // the state at this strain: what a commit keeps
+  bool yielding = false;  // the point flows plastically from its committed state
+};
+
 class PlaneMaterial {
  public:
   virtual ~PlaneMaterial() = default;
@@ -34,6 +54,15 @@ class PlaneMaterial {
   virtual MaterialResponse response(const Mat2& E) const = 0;
   // The small-strain law: the response at E = 0 (the same Hooke's law for every law here).
   MaterialResponse small_strain() const { return response(Mat2::Zero()); }
+  // The small-strain 4 x 4 law of (11, 22, 12, 33) from the plane block and the row of S33
+  // (plane stress: row and column 3 zero).
+  Eigen::Matrix4d small_strain_D4() const;
+  // Whether the law keeps history at its points (small strain only): then the body evaluates
+  // small_strain_response at every integration point and commits what it answers.
+  virtual bool has_history() const { return false; }
+  // The small-strain response to `strain` (11, 22, 2 x 12, 33; 33 ignored in plane stress)
+  // from the committed history. Elastic laws: Hooke's law, history unchanged.
+  virtual PointResponse small_strain_response(const Eigen::Vector4d& strain, const PointHistory& committed) const;
 };
 
 // Lame constants from Young's modulus and Poisson's ratio (3D values: plane stress is

@@ -490,6 +490,23 @@ TEST_P(StoreContract, PruningHandsTheSpaceBackToTheFileSystem) {
   EXPECT_LT(store->disk_bytes(), full / 5);
 }
 
+TEST_P(StoreContract, StudiesAreStoredOnceAndReadByEveryInstance) {
+  auto store = open();
+  auto other = open();  // another replica
+  const StudyRecord study{"study-a", "2025-01-01T00:00:00.000Z", R"({"levels":[{"job":"job-a"}]})"};
+  store->insert_study(study);
+  EXPECT_THROW(other->insert_study(study), std::runtime_error);
+  const auto read = other->study("study-a");
+  ASSERT_TRUE(read);
+  EXPECT_EQ(read->id, "study-a");
+  EXPECT_EQ(read->created, study.created);
+  EXPECT_EQ(read->document, study.document);
+  EXPECT_FALSE(store->study("nope"));
+  EXPECT_TRUE(other->remove_study("study-a"));
+  EXPECT_FALSE(store->remove_study("study-a"));
+  EXPECT_FALSE(store->study("study-a"));
+}
+
 INSTANTIATE_TEST_SUITE_P(Stores, StoreContract, ::testing::Values(Kind::sqlite, Kind::postgresql),
                          [](const auto& info) {
                            return info.param == Kind::sqlite ? std::string("sqlite") : std::string("postgresql");

@@ -517,7 +517,9 @@ Produced solve_with_events(json scene) {
   SteppingObserver observer;
   observer.step_started = [&](int step, double lf) { out.events.push_back(step_started_event(step, lf)); };
   observer.iteration = [&](const IterationEvent& ev) { out.events.push_back(iteration_event(ev)); };
-  observer.step_finished = [&](const StepRecord& rec) { out.events.push_back(step_finished_event(rec)); };
+  observer.step_finished = [&](const StepRecord& rec) {
+    out.events.push_back(step_finished_event(s.problem, rec, s.output));
+  };
   const RunResult run = run_load_steps(s.problem, s.steps, s.params, observer);
   // The terminal event as `grip solve --events` and the service write it.
   out.events.push_back(run.completed ? json{{"type", "job_finished"}}

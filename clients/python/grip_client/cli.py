@@ -534,6 +534,33 @@ def cmd_sweep(client: Client, args, out: TextIO) -> int:
     return code
 
 
+def cmd_study(client: Client, args, out: TextIO) -> int:
+    scene = load_scene_with_meshes(client, args.scene, args.mesh)
+    doc = client.study(scene, levels=args.levels, outputs=args.output or None)
+    sys.stderr.write(f"study {doc['id']}: {len(doc['levels'])} levels\n")
+    doc = client.wait_study(doc["id"], timeout=args.timeout)
+    if args.json:
+        out.write(json.dumps(doc, indent=2) + "\n")
+    else:
+        names = [q["name"] for q in doc["quantities"]]
+        rows = []
+        for k, level in enumerate(doc["levels"]):
+            row: List[Any] = [level["level"], level["nodes"], level.get("seconds"), level["status"]]
+            for q in doc["quantities"]:
+                row += [q["values"][k], q["estimated_error"][k]]
+            rows.append(row)
+        table(rows, ["level", "nodes", "seconds", "status"]
+              + [h for n in names for h in (n, n + " error")], out)
+        out.write("\n")
+        summary = []
+        for q in doc["quantities"]:
+            cheapest = [c["level"]["level"] if c["level"] else None for c in q["cheapest"]]
+            summary.append([q["name"], q["order"], q["extrapolated"], q["asymptotic"]] + cheapest)
+        table(summary, ["quantity", "order", "extrapolated", "asymptotic"]
+              + [f"level < {100 * b:g} %" for b in doc["thresholds"]], out)
+    return EXIT_OK if doc["status"] == "successful" else EXIT_FAILED
+
+
 # ---- parser
 
 
@@ -614,6 +641,19 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--csv", help="also write the table as CSV")
     s.add_argument("--json", action="store_true", help="print the table as JSON")
     s.set_defaults(func=cmd_sweep)
+
+    s = sub.add_parser("study", parents=[common],
+                       help="a refinement study: the scene's outputs on finer meshes, their "
+                            "observed order, Richardson value and what each accuracy costs")
+    s.add_argument("scene", help="scene JSON file (with outputs), or example:NAME")
+    s.add_argument("--levels", type=int, default=3, help="mesh levels, divisions x 2^j (default 3)")
+    s.add_argument("--output", action="append", metavar="NAME",
+                   help="one of the scene's outputs to study (repeatable; default all)")
+    s.add_argument("--mesh", action="append", default=[], metavar="PART.msh",
+                   help="a gmsh mesh the scene names, uploaded first (as submit)")
+    s.add_argument("--timeout", type=float, help="give up waiting after this many seconds")
+    s.add_argument("--json", action="store_true", help="print the study's document")
+    s.set_defaults(func=cmd_study)
     return p
 
 

@@ -242,6 +242,36 @@ class Client:
             raise ValueError("; ".join(missing))
         return out
 
+    # ---- studies
+
+    def study(self, scene: dict, levels: Optional[int] = None,
+              meshes: Optional[List[dict]] = None, outputs: Optional[List[str]] = None) -> dict:
+        """Starts a refinement study (POST /v1/studies): the scene at `levels` mesh levels
+        (generated meshes: divisions x 2^j), or on each of `meshes` ({"id": ...} of uploads,
+        coarse to fine). The scene names its quantities in `outputs`; `outputs` here picks some.
+        Returns the study's document (its id, levels and table so far)."""
+        body: Dict[str, Any] = {"scene": scene,
+                                "refine": {"meshes": meshes} if meshes else {"levels": levels}}
+        if outputs:
+            body["outputs"] = list(outputs)
+        return self.request("POST", "/v1/studies", json.dumps(body).encode("utf-8"),
+                            {"Content-Type": "application/json"})
+
+    def study_table(self, study_id: str) -> dict:
+        """The study's table as far as its jobs have finished (GET /v1/studies/ID)."""
+        return self.get("/v1/studies/" + urllib.parse.quote(study_id))
+
+    def wait_study(self, study_id: str, poll: float = 0.5, timeout: Optional[float] = None) -> dict:
+        """Polls the study until no level is queued or running; its final table."""
+        deadline = None if timeout is None else time.monotonic() + timeout
+        while True:
+            doc = self.study_table(study_id)
+            if doc.get("status") not in ("accepted", "running"):
+                return doc
+            if deadline is not None and time.monotonic() > deadline:
+                raise TimeoutError(f"study {study_id} still {doc.get('status')}")
+            time.sleep(poll)
+
     # ---- jobs
 
     def submit(self, scene: Union[dict, str, os.PathLike, bytes],

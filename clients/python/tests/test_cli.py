@@ -235,5 +235,38 @@ class Meshes(unittest.TestCase):
         os.remove(bad)
 
 
+class Study(unittest.TestCase):
+    def test_study_tabulates_each_level_and_the_extrapolation(self):
+        # Lame's thick cylinder, axisymmetric q4 at 2 x 1, 4 x 2 and 8 x 4 elements: u_r at the
+        # inner radius converges at about q4's order 2 toward the closed form.
+        scene = {
+            "body": {"model": "continuum", "kinematics": "linear", "analysis": "axisymmetric",
+                     "element": "q4",
+                     "material": {"young": 1000, "poisson": 0.3, "law": "saint_venant_kirchhoff"},
+                     "mesh": {"rectangle": {"origin": [1, 0], "size": [1, 0.5], "divisions": [2, 1]}},
+                     "contact_set": "right",
+                     "supports": [{"set": "bottom", "fix": ["y"]}, {"set": "top", "fix": ["y"]}],
+                     "loads": [{"set": "left", "traction": [10, 0]}]},
+            "obstacles": [{"name": "far", "shape": {"type": "segment", "from": [100, 50],
+                                                    "to": [200, 50]}}],
+            "solver": {"contact": {"reach": 0.01}},
+            "outputs": [{"name": "u_inner", "kind": "displacement", "at": [1, 0], "component": "x"}]}
+        tmp = tempfile.TemporaryDirectory()
+        self.addCleanup(tmp.cleanup)
+        path = write_json(tmp.name, "cylinder.json", scene)
+        p = support.cli("study", path, "--levels", "3", "--json")
+        self.assertEqual(p.returncode, 0, p.stdout + p.stderr)
+        doc = json.loads(p.stdout)
+        self.assertEqual(doc["status"], "successful")
+        q = doc["quantities"][0]
+        exact = 10 * 1 / (1000 * 3) * 1.3 * (0.4 * 1 + 4 / 1)
+        self.assertTrue(1.5 <= q["order"] <= 2.5, q)
+        self.assertLess(abs(q["extrapolated"] - exact), abs(q["values"][2] - exact))
+        p = support.cli("study", path, "--levels", "3")
+        self.assertEqual(p.returncode, 0, p.stdout + p.stderr)
+        self.assertIn("u_inner error", p.stdout)
+        self.assertIn("level < 1 %", p.stdout)
+
+
 if __name__ == "__main__":
     unittest.main()

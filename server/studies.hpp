@@ -1,0 +1,73 @@
+#pragma once
+// Studies (docs/design.md#studies): one request that runs a scene at several mesh levels (or
+// with parameters swept) as
+// ordinary jobs (the same queue, store and replicas) and answers, for each of the scene's
+// outputs, its value per level, the observed order of convergence, the Richardson-extrapolated
+// value with each level's estimated error (server/richardson.hpp), and the cheapest level whose
+// estimated error is below 10 %, 1 % and 0.1 %. The study keeps only its plan and its jobs'
+// ids (Store::insert_study); its table is read from the jobs whenever it is asked for, so it
+// grows as they finish, on whichever replica.
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "server/job_service.hpp"
+
+namespace grip::server {
+
+// The most levels of one refinement study (each a job; the finest has 4^(levels - 1) times the
+// coarsest's elements).
+inline constexpr int kMaxStudyLevels = 6;
+// The most jobs of one sweep.
+inline constexpr int kMaxStudyJobs = 100;
+
+// A level of a refinement plan: its scene and its mesh size relative to the coarsest (1).
+struct StudyLevel {
+  nlohmann::json scene;
+  double h = 1.0;
+  nlohmann::json parameters;  // a sweep's variant: the values of its pointers
+};
+
+// The levels of a request {"scene", "refine": {"levels": k} | {"meshes": [ref, ...]}, "outputs"?},
+// coarse to fine, and the outputs it studies: generated meshes (rectangle, half_disc) of every
+// body with their divisions x 2^j and refine.size / 2^j (h = 2^-j); a gmsh mesh
+// (body.mesh.gmsh) replaced by each reference of the list in turn (h from the node counts,
+// filled in later). Throws SceneErrors whose pointers start at the request's root.
+// A sweep {"scene", "sweep": [{"pointer", "values" | "range": {from, to, count}}], "mode": "grid" |
+// "zip", "outputs"?}: a variant per combination (grid) or per index (zip) with each pointer's
+// value set; each pointer must name a value of the scene, and the variants are at most
+// kMaxStudyJobs.
+struct StudyPlan {
+  std::string kind = "refinement";    // or "sweep"
+  std::vector<std::string> pointers;  // a sweep's, in the order of each variant's parameters
+  std::vector<StudyLevel> levels;
+  std::vector<std::string> outputs;
+  bool h_from_nodes = false;  // a list of meshes: h_j = sqrt(nodes_0 / nodes_j)
+};
+StudyPlan plan_study(const nlohmann::json& request);
+
+// The thresholds of "the cheapest level whose estimated error is below": 10 %, 1 %, 0.1 %.
+inline const std::vector<double> kStudyThresholds = {0.1, 0.01, 0.001};
+
+// A study's table as rows, one per level (or variant), for CSV (objects_csv): level, job,
+// status, nodes, seconds, h or parameters, outputs.NAME, estimated_error.NAME.
+std::vector<nlohmann::json> study_rows(const nlohmann::json& study);
+
+class Studies {
+ public:
+  explicit Studies(JobService& jobs) : jobs_(jobs) {}
+  // Checks every level's scene (as a job submission would), then submits them and stores the
+  // study; its document (as study() answers). Throws SceneErrors (the plan, or a level's
+  // scene: pointers under /scene), QueueFull, ShuttingDown (the levels submitted are dismissed).
+  nlohmann::json submit(const nlohmann::json& request, const std::string& request_id);
+  // The study's table as far as its jobs have finished; none when no study has this id.
+  std::optional<nlohmann::json> study(const std::string& id);
+  // Dismisses its jobs (queued and running ones stop, finished ones are removed) and removes it.
+  bool remove(const std::string& id);
+
+ private:
+  JobService& jobs_;
+};
+
+}  // namespace grip::server

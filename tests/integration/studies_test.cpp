@@ -1,0 +1,290 @@
+// Refinement studies (POST /v1/studies, server/studies.hpp) through the real binary: a 3-level
+// study of Lame's thick cylinder (axisymmetric, q4, internal pressure: u_r closed form) runs
+// as three jobs, and its table gives an observed order near q4's 2 and a Richardson value
+// closer to the closed form than the finest level's; bad plans are refused before any job is
+// stored, with the pointer of the field at fault; deleting the study dismisses its jobs. A sweep
+// runs a job per variant and tabulates each as that job gives it.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "grip_process.hpp"
+
+namespace grip::testing {
+namespace {
+
+constexpr double kE = 1000.0, kNu = 0.3, kP = 10.0, kA = 1.0, kB = 2.0;
+
+// u_r at r of the cylinder a <= r <= b under internal pressure p, u_z held (plane strain).
+double lame(double r) {
+  return kP * kA * kA / (kE * (kB * kB - kA * kA)) * (1 + kNu) * ((1 - 2 * kNu) * r + kB * kB / r);
+}
+
+// The cylinder's r-z section on a 2 x 1 grid of q4 (the study doubles it), pressure on the
+// inner side, u_z held at both ends; u_r at the inner and outer radius as outputs.
+json cylinder() {
+  return json::parse(R"({
+    "body": {
+      "model": "continuum", "kinematics": "linear", "analysis": "axisymmetric", "element": "q4",
+      "material": {"young": 1000, "poisson": 0.3, "law": "saint_venant_kirchhoff"},
+      "mesh": {"rectangle": {"origin": [1, 0], "size": [1, 0.5], "divisions": [2, 1]}},
+      "contact_set": "right",
+      "supports": [{"set": "bottom", "fix": ["y"]}, {"set": "top", "fix": ["y"]}],
+      "loads": [{"set": "left", "traction": [10, 0]}]
+    },
+    "obstacles": [{"name": "far", "shape": {"type": "segment", "from": [100, 50], "to": [200, 50]}}],
+    "steps": 1,
+    "solver": {"contact": {"reach": 0.01}},
+    "outputs": [
+      {"name": "u_inner", "kind": "displacement", "at": [1, 0], "component": "x"},
+      {"name": "u_outer", "kind": "displacement", "at": [2, 0], "component": "x"}
+    ]
+  })");
+}
+
+json post_study(const Api& api, const json& request, int status) {
+  const auto r = api.post_json("/v1/studies", request.dump());
+  if (!r) throw std::runtime_error("no response");
+  EXPECT_EQ(r->status, status) << r->body;
+  return json::parse(r->body);
+}
+
+TEST(Studies, ThreeLevelsOfLamesCylinderGiveQ4sOrderAndABetterExtrapolation) {
+  TempDir dir;
+  ServerProcess server(dir.path() / "grip.sqlite", {"--workers", "2"}, dir.path() / "serve.log");
+  const Api api(server.port());
+  const json accepted = post_study(api, {{"scene", cylinder()}, {"refine", {{"levels", 3}}}}, 201);
+  const std::string id = accepted["id"];
+  ASSERT_EQ(accepted["levels"].size(), 3u);
+  // The study's stream: its table each time it changes, study_finished last (then it ends).
+  std::string stream;
+  const auto streamed = api.client(120).Get("/v1/studies/" + id + "/events", [&](const char* data, size_t n) {
+    stream.append(data, n);
+    return true;
+  });
+  ASSERT_TRUE(streamed);
+  EXPECT_EQ(streamed->get_header_value("Content-Type"), "text/event-stream");
+  std::vector<std::pair<std::string, json>> events;  // type, table
+  for (size_t at = stream.find("event: "); at != std::string::npos; at = stream.find("event: ", at + 1)) {
+    const size_t data = stream.find("data: ", at), end = stream.find("\n", data);
+    events.emplace_back(stream.substr(at + 7, stream.find('\n', at) - at - 7),
+                        json::parse(stream.substr(data + 6, end - data - 6)));
+  }
+  ASSERT_FALSE(events.empty()) << stream;
+  for (size_t k = 0; k + 1 < events.size(); ++k) EXPECT_EQ(events[k].first, "study");
+  EXPECT_EQ(events.back().first, "study_finished");
+  const json study = json::parse(api.get("/v1/studies/" + id)->body);
+  ASSERT_EQ(study["status"], "successful") << study.dump(2);
+  EXPECT_EQ(events.back().second, study);
+  std::printf("%zu study events\n", events.size());
+  // Each level is a job of its own; its table row holds the job's last step's outputs.
+  for (int j = 0; j < 3; ++j) {
+    const json& level = study["levels"][j];
+    EXPECT_EQ(level["h"], std::ldexp(1.0, -j));
+    const json job = api.job(level["job"]);
+    EXPECT_EQ(job["status"], "successful");
+    EXPECT_EQ(job["nodes"], (2 * (1 << j) + 1) * ((1 << j) + 1));
+    const auto result = api.get("/v1/jobs/" + level["job"].get<std::string>() + "/result");
+    ASSERT_TRUE(result && result->status == 200);
+    EXPECT_EQ(json::parse(result->body)["steps"].back()["outputs"], level["outputs"]);
+    EXPECT_GT(level["seconds"].get<double>(), 0.0);
+  }
+  // Bilinear elements on a smooth solution: the displacement's error goes as h^2 (its L2 norm,
+  // and at the nodes of a uniformly refined grid), so the observed order should be near 2;
+  // [1.5, 2.5] leaves room for the coarse grid's pre-asymptotic terms.
+  for (const json& q : study["quantities"]) {
+    const double r = q["name"] == "u_inner" ? kA : kB, exact = lame(r);
+    const double finest = q["values"][2], extrapolated = q["extrapolated"], order = q["order"];
+    std::printf(
+        "%s: values %s; order %.3f; extrapolated %.8f; exact %.8f; error finest %.2e, extrapolated %.2e; "
+        "estimated %.2e\n",
+        q["name"].get<std::string>().c_str(), q["values"].dump().c_str(), order, extrapolated, exact,
+        std::abs(finest / exact - 1), std::abs(extrapolated / exact - 1), q["estimated_error"][2].get<double>());
+    EXPECT_GE(order, 1.5);
+    EXPECT_LE(order, 2.5);
+    EXPECT_LT(std::abs(extrapolated - exact), std::abs(finest - exact));
+    EXPECT_TRUE(q["asymptotic"].is_null());  // three levels: one order, nothing to compare it with
+    // The finest level's estimated error brackets its true error within a factor 2.
+    const double estimated = q["estimated_error"][2], true_error = std::abs(finest / exact - 1);
+    EXPECT_LT(estimated, 2 * true_error);
+    EXPECT_GT(estimated, 0.5 * true_error);
+    // The cheapest level under each threshold is one whose estimate is below it.
+    for (const json& c : q["cheapest"])
+      if (!c["level"].is_null()) EXPECT_LT(c["level"]["estimated_error"].get<double>(), c["below"].get<double>());
+  }
+  // The table as CSV: a header and a row per level, the values as in the JSON.
+  const auto csv = api.get("/v1/studies/" + id + "?format=csv");
+  ASSERT_TRUE(csv && csv->status == 200);
+  const std::string text = csv->body;
+  EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 4);
+  const std::string header = text.substr(0, text.find('\n'));
+  for (const char* column : {"level", "job", "nodes", "seconds", "h", "outputs.u_inner", "estimated_error.u_outer"})
+    EXPECT_NE(header.find(column), std::string::npos) << header;
+  EXPECT_NE(text.find(study["levels"][2]["job"].get<std::string>()), std::string::npos);
+  // Deleting the study dismisses its jobs (finished ones are removed).
+  const auto removed = api.del("/v1/studies/" + id);
+  ASSERT_TRUE(removed);
+  EXPECT_EQ(removed->status, 204);
+  EXPECT_EQ(api.get("/v1/studies/" + id)->status, 404);
+  for (const json& level : study["levels"])
+    EXPECT_EQ(api.get("/v1/jobs/" + level["job"].get<std::string>())->status, 404);
+}
+
+TEST(Studies, BadPlansAreRefusedWithThePointerBeforeAnyJobIsStored) {
+  TempDir dir;
+  ServerProcess server(dir.path() / "grip.sqlite", {"--workers", "1", "--max-nodes", "2000"}, dir.path() / "serve.log");
+  const Api api(server.port());
+  struct Case {
+    json request;
+    std::string pointer, says;
+  };
+  json by_node = cylinder();
+  by_node["outputs"][0] = {{"name", "u"}, {"kind", "displacement"}, {"node", 0}, {"component", "x"}};
+  json unknown_set = cylinder();
+  unknown_set["outputs"][0] = {{"name", "r"}, {"kind", "reaction"}, {"set", "rim"}, {"component", "y"}};
+  json explicit_mesh = cylinder();
+  explicit_mesh["body"]["mesh"] = {{"nodes", {{1, 0}, {2, 0}, {2, 1}, {1, 1}}}, {"elements", {{0, 1, 2, 3}}}};
+  json no_outputs = cylinder();
+  no_outputs.erase("outputs");
+  json large = cylinder();
+  large["body"]["mesh"]["rectangle"]["divisions"] = {16, 8};  // level 3: 64 x 32, 2145 nodes
+  const Case cases[] = {
+      {{{"scene", cylinder()}, {"refine", {{"levels", 10000}}}}, "/refine/levels", "[2, 6]"},
+      {{{"scene", by_node}, {"refine", {{"levels", 3}}}}, "/scene/outputs/0/node", "at"},
+      {{{"scene", unknown_set}, {"refine", {{"levels", 3}}}}, "/scene/outputs/0/set", "level 1 of 3"},
+      {{{"scene", explicit_mesh}, {"refine", {{"levels", 3}}}}, "/scene/body/mesh", "not generated"},
+      {{{"scene", no_outputs}, {"refine", {{"levels", 3}}}}, "/scene/outputs", "name at least one"},
+      {{{"scene", cylinder()}, {"refine", {{"levels", 3}}}, {"outputs", {"u_middle"}}},
+       "/outputs/0",
+       "names no output"},
+      {{{"scene", cylinder()}, {"refine", {{"levels", 3}}}, {"accuracy", 0.01}}, "/accuracy", "not a member"},
+      {{{"scene", cylinder()}, {"refine", {{"levels", 3}}}, {"sweep", json::array()}}, "/sweep", "goes without refine"},
+      {{{"scene", large}, {"refine", {{"levels", 3}}}}, "/scene/body/mesh", "level 3 of 3"},
+  };
+  for (const Case& c : cases) {
+    const json p = post_study(api, c.request, 422);
+    ASSERT_TRUE(p.contains("errors")) << p.dump();
+    EXPECT_EQ(p["type"], "urn:grip:problem:invalid-study");
+    EXPECT_EQ(p["errors"][0]["pointer"], c.pointer) << p.dump();
+    EXPECT_NE(p["errors"][0]["detail"].get<std::string>().find(c.says), std::string::npos) << p.dump();
+  }
+  // Nothing was stored.
+  const auto jobs = api.get("/v1/jobs");
+  ASSERT_TRUE(jobs);
+  EXPECT_TRUE(json::parse(jobs->body)["jobs"].empty()) << jobs->body;
+}
+
+// A sweep of the pressure and the modulus (a grid of 3 x 2 variants of the 8 x 4 cylinder):
+// linear elasticity makes u_r proportional to p / E, and each variant's row is its job's
+// result, bit for bit, as is a job submitted on its own with the same scene.
+TEST(Studies, ASweepTabulatesEveryVariantAsItsOwnJobWouldGiveIt) {
+  TempDir dir;
+  ServerProcess server(dir.path() / "grip.sqlite", {"--workers", "2"}, dir.path() / "serve.log");
+  const Api api(server.port());
+  json scene = cylinder();
+  scene["body"]["mesh"]["rectangle"]["divisions"] = {8, 4};
+  const json request = {
+      {"scene", scene},
+      {"sweep",
+       {{{"pointer", "/body/loads/0/traction/0"}, {"values", {5, 10, 20}}},
+        {{"pointer", "/body/material/young"}, {"range", {{"from", 1000}, {"to", 2000}, {"count", 2}}}}}}};
+  const json accepted = post_study(api, request, 201);
+  ASSERT_EQ(accepted["levels"].size(), 6u);
+  json study;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  do {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    study = json::parse(api.get("/v1/studies/" + accepted["id"].get<std::string>())->body);
+  } while (study["status"] != "successful" && std::chrono::steady_clock::now() < deadline);
+  ASSERT_EQ(study["status"], "successful") << study.dump(2);
+  EXPECT_EQ(study["pointers"], json({"/body/loads/0/traction/0", "/body/material/young"}));
+  const double reference = study["levels"][0]["outputs"]["u_inner"].get<double>() * 1000 / 5;
+  for (size_t k = 0; k < 6; ++k) {
+    const json& level = study["levels"][k];
+    const double p = level["parameters"][0], E = level["parameters"][1];
+    EXPECT_EQ(p, (std::vector<double>{5, 10, 20})[k / 2]);  // the last pointer fastest
+    EXPECT_EQ(E, k % 2 ? 2000 : 1000);
+    EXPECT_NEAR(level["outputs"]["u_inner"].get<double>() * E / p, reference, 1e-9 * reference);
+    EXPECT_EQ(study["quantities"][0]["values"][k], level["outputs"]["u_inner"]);
+    const auto result = api.get("/v1/jobs/" + level["job"].get<std::string>() + "/result");
+    EXPECT_EQ(json::parse(result->body)["steps"].back()["outputs"], level["outputs"]);
+  }
+  // The variant (10, 2000) submitted as a job of its own gives the same numbers.
+  json own = scene;
+  own["body"]["loads"][0]["traction"][0] = 10;
+  own["body"]["material"]["young"] = 2000.0;
+  const std::string id = api.submit(own);
+  api.wait_status(id, {"successful"});
+  EXPECT_EQ(json::parse(api.get("/v1/jobs/" + id + "/result")->body)["steps"].back()["outputs"],
+            study["levels"][3]["outputs"]);
+
+  // Bad sweeps, refused before any job is stored.
+  const size_t jobs_before = json::parse(api.get("/v1/jobs?limit=1000")->body)["jobs"].size();
+  struct Case {
+    json sweep;
+    std::string mode, pointer, says;
+  };
+  const Case cases[] = {
+      {{{{"pointer", "/obstacles/0/friction"}, {"values", {0.1, 0.2}}}}, "grid", "/sweep/0/pointer", "names no value"},
+      {{{{"pointer", "/body/material/young"}, {"values", {1000, -1}}}},
+       "grid",
+       "/scene/body/material/young",
+       "variant 2 of 2 ([-1])"},
+      {{{{"pointer", "/body/material/young"}, {"values", {1000, 2000}}},
+        {{"pointer", "/body/material/poisson"}, {"values", {0.2, 0.3, 0.4}}}},
+       "zip",
+       "/sweep/1",
+       "zipped"},
+      {{{{"pointer", "/body/material/young"}, {"range", {{"from", 1}, {"to", 2}, {"count", 100}}}},
+        {{"pointer", "/body/material/poisson"}, {"values", {0.2, 0.3}}}},
+       "grid",
+       "/sweep",
+       "makes 200 jobs"},
+  };
+  for (const Case& c : cases) {
+    const json p = post_study(api, {{"scene", scene}, {"sweep", c.sweep}, {"mode", c.mode}}, 422);
+    ASSERT_TRUE(p.contains("errors")) << p.dump();
+    EXPECT_EQ(p["errors"][0]["pointer"], c.pointer) << p.dump();
+    EXPECT_NE(p["errors"][0]["detail"].get<std::string>().find(c.says), std::string::npos) << p.dump();
+  }
+  EXPECT_EQ(json::parse(api.get("/v1/jobs?limit=1000")->body)["jobs"].size(), jobs_before);
+}
+
+// A sweep of the friction coefficient over the sliding block (schemas/examples/sliding-block.json,
+// the flat moved 0.01 mm under the pressed block): once every contact node slips, the
+// tangential force the top's supports carry is mu times the normal one, for every mu of 0, 0.1,
+// ..., 0.5 (to what the contact tolerance pins the forces).
+TEST(Studies, AFrictionSweepOfTheSlidingBlockSlipsAtMuN) {
+  TempDir dir;
+  ServerProcess server(dir.path() / "grip.sqlite", {"--workers", "2"}, dir.path() / "serve.log");
+  const Api api(server.port());
+  json scene = json::parse(read_text(examples_dir() / "sliding-block.json"));
+  scene["outputs"] = {{{"name", "Q"}, {"kind", "reaction"}, {"set", "top"}, {"component", "x"}},
+                      {{"name", "N"}, {"kind", "reaction"}, {"set", "top"}, {"component", "y"}},
+                      {{"name", "contact_x"}, {"kind", "resultant"}, {"component", "x"}}};
+  const json accepted = post_study(
+      api,
+      {{"scene", scene},
+       {"sweep", {{{"pointer", "/obstacles/0/friction"}, {"range", {{"from", 0}, {"to", 0.5}, {"count", 6}}}}}}},
+      201);
+  json study;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  do {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    study = json::parse(api.get("/v1/studies/" + accepted["id"].get<std::string>())->body);
+  } while (study["status"] != "successful" && std::chrono::steady_clock::now() < deadline);
+  ASSERT_EQ(study["status"], "successful") << study.dump(2);
+  for (const json& level : study["levels"]) {
+    const double mu = level["parameters"][0], Q = level["outputs"]["Q"], N = level["outputs"]["N"];
+    std::printf("mu %.1f: N %.3f N/mm, Q %.6f N/mm, Q / N %.8f\n", mu, N, Q, std::abs(Q / N));
+    EXPECT_GT(std::abs(N), 0.0);
+    EXPECT_NEAR(std::abs(Q), mu * std::abs(N), 1e-6 * std::abs(N)) << "mu " << mu;
+    // The supports carry what the contact carries.
+    EXPECT_NEAR(level["outputs"]["contact_x"].get<double>(), -Q, 1e-8 * std::abs(N));
+  }
+}
+
+}  // namespace
+}  // namespace grip::testing
