@@ -29,7 +29,17 @@ struct Grid {
   int step = 0;
   // The bodies' rows: first point, points, first cell, cells (one piece over all for one body).
   std::vector<std::array<size_t, 4>> pieces;
+  // Axisymmetric: the section in the x-z plane, (r, 0, z), so that ParaView's Rotational
+  // Extrusion (about z) revolves it into the body.
+  bool section_in_xz = false;
+  std::string point_text(const std::array<double, 2>& p) const;
 };
+
+std::string number(double v);
+
+std::string Grid::point_text(const std::array<double, 2>& p) const {
+  return section_in_xz ? number(p[0]) + " 0 " + number(p[1]) : number(p[0]) + ' ' + number(p[1]) + " 0";
+}
 
 int cell_type(size_t sites) {
   switch (sites) {
@@ -77,6 +87,7 @@ Grid grid_of(const json& result, size_t k) {
   Grid g;
   g.step = step.value("step", static_cast<int>(k) + 1);
   g.load_factor = step.value("load_factor", 0.0);
+  g.section_in_xz = result.contains("effects") && result["effects"].contains("axisymmetric");
   const json& nodes = step["nodes"];
   for (const json& n : nodes) g.points.push_back({n.value("x", 0.0), n.value("y", 0.0)});
   if (result.contains("mesh") && result["mesh"].contains("cells"))
@@ -202,7 +213,7 @@ std::string step_legacy_vtk(const json& result, std::size_t k) {
      << "ASCII\nDATASET UNSTRUCTURED_GRID\n";
   os << "FIELD FieldData 1\nTimeValue 1 1 double\n" << number(g.load_factor) << "\n";
   os << "POINTS " << g.points.size() << " double\n";
-  for (const auto& p : g.points) os << number(p[0]) << ' ' << number(p[1]) << " 0\n";
+  for (const auto& p : g.points) os << g.point_text(p) << '\n';
   size_t size = 0;
   for (const auto& c : g.cells) size += c.size() + 1;
   os << "CELLS " << g.cells.size() << ' ' << size << "\n";
@@ -256,7 +267,7 @@ std::string step_vtu(const json& result, std::size_t k) {
     arrays("CellData", g.cell_data, first_cell, cells);
     os << "<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
     for (size_t i = first_point; i < first_point + points; ++i)
-      os << number(g.points[i][0]) << ' ' << number(g.points[i][1]) << " 0\n";
+      os << g.point_text(g.points[i]) << '\n';
     os << "</DataArray>\n</Points>\n<Cells>\n"
        << "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
     for (size_t c = first_cell; c < first_cell + cells; ++c)

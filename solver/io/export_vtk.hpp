@@ -10,7 +10,8 @@
 // points, cells and array rows; result.bodies[] gives the rows), and both formats carry a cell
 // array `body` (the index in bodies[]); the legacy .vtk is one grid. Bodies meshed from gmsh
 // files carry point and cell arrays `gmsh_tag` (result mesh.gmsh; -1 elsewhere). Steps without node fields
-// (a failed step) are skipped.
+// (a failed step) are skipped. An axisymmetric result (effects.axisymmetric) puts the section
+// in the x-z plane, points (r, 0, z), so that ParaView's Rotational Extrusion (about z) revolves it.
 #include <nlohmann/json.hpp>
 #include <string>
 #include <utility>

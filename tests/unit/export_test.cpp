@@ -104,6 +104,18 @@ TEST(ExportVtk, QuadrilateralsWithPointAndCellArrays) {
   EXPECT_NE(files[2].content.find("timestep=\"0.5\" group=\"\" part=\"0\" file=\"run_0001.vtu\""), std::string::npos);
 }
 
+// Axisymmetric: the section (r, z) goes to the x-z plane, (r, 0, z), which ParaView's Rotational
+// Extrusion revolves about z; a plane result stays in x-y.
+TEST(ExportVtk, AxisymmetricSectionLiesInTheXZPlane) {
+  json r = two_quads();
+  const std::string plane = step_legacy_vtk(r, 0);
+  EXPECT_NE(plane.find("POINTS 6 double\n0 0 0\n1 0 0\n2 0 0\n0 1 0\n"), std::string::npos) << plane;
+  r["effects"] = {{"axisymmetric", json::array()}};
+  const std::string revolved = step_legacy_vtk(r, 0);
+  EXPECT_NE(revolved.find("POINTS 6 double\n0 0 0\n1 0 0\n2 0 0\n0 0 1\n1 0 1\n"), std::string::npos) << revolved;
+  EXPECT_NE(step_vtu(r, 0).find("\n2 0 1\n"), std::string::npos);
+}
+
 TEST(ExportVtk, StepsWithoutNodeFieldsAreSkipped) {
   json r = two_quads();
   r["steps"].push_back({{"step", 2}, {"load_factor", 1.0}, {"converged", false}});
