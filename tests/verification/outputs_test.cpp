@@ -8,8 +8,10 @@
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <numbers>
 #include <sstream>
 
+#include "solver/io/gmsh_mesh.hpp"
 #include "solver/io/result.hpp"
 #include "solver/io/schema_validation.hpp"
 #include "tests/support/contact_profile.hpp"
@@ -139,6 +141,66 @@ TEST(Outputs, StickWidthIsCattaneoMindlins) {
     EXPECT_LT(std::abs(0.5 * stick - c), 0.03 * hertz.a);
     EXPECT_LT(stick, out["width"].get<double>());
   }
+}
+
+// The press fit (schemas/examples/press-fit.json) once the interference is closed (step 1): the
+// hub's pressure on each half of the shaft's surface (a contact pair of two bodies) adds up to
+// 2 p R across the diameter with Lame's p = 209.5 MPa of the example, the halves balance, the
+// whole half-circle presses, and the peak pressure is p.
+TEST(Outputs, PressFitPairsCarryLamesPressure) {
+  json j = example_scene("press-fit");
+  j["outputs"] = json::parse(R"([
+    {"name": "upper", "kind": "resultant", "obstacle": "shaft.shaft_upper on hub.hub_upper", "component": "y"},
+    {"name": "lower", "kind": "resultant", "obstacle": "shaft.shaft_lower on hub.hub_lower", "component": "y"},
+    {"name": "width", "kind": "contact_width", "obstacle": "shaft.shaft_upper on hub.hub_upper"},
+    {"name": "peak", "kind": "peak_pressure"}
+  ])");
+  const std::string folder = std::string(GRIP_SOURCE_DIR) + "/schemas/examples/";
+  Scene scene = read_scene(j, [&](const json& ref) {
+    return std::make_shared<const GmshMesh>(read_gmsh_file(folder + ref["file"].get<std::string>()));
+  });
+  const RunResult run = run_load_steps(scene.problem, scene.steps, scene.params);
+  ASSERT_TRUE(run.completed) << run.reason;
+  const json out = quantity_values(scene.problem, run.steps[0], scene.output.quantities);
+  const double p = 209.5, R = 10.0, upper = out["upper"], lower = out["lower"];
+  std::printf("upper %.2f, lower %.2f N/mm (2 p R = %.1f); width %.4f mm (pi R %.4f); peak %.2f MPa\n", upper, lower,
+              2 * p * R, out["width"].get<double>(), std::numbers::pi * R, out["peak"].get<double>());
+  EXPECT_NEAR(upper, -lower, 1e-8 * lower);
+  EXPECT_NEAR(lower, 2 * p * R, 0.01 * 2 * p * R);
+  EXPECT_NEAR(out["width"].get<double>(), std::numbers::pi * R, 0.002 * std::numbers::pi * R);
+  EXPECT_NEAR(out["peak"].get<double>(), p, 0.01 * p);
+}
+
+// A plastic strain as a field output: the shipped Hertz scene with a von Mises material
+// (yield 2000 MPa, as tests/verification/j2_contact_test.cpp) pressed in 2 steps and released in
+// 2. Below the pole, where yield starts (0.78 a deep), the equivalent plastic strain is the
+// elements table's value, grows while loading, is positive at the peak load, and is kept when
+// the load is released (it never decreases).
+TEST(Outputs, APlasticStrainBelowTheContactGrowsAndIsKept) {
+  json j = example_scene("hertz");
+  j["body"]["element"] = "q4_bbar";
+  j["body"]["material"].update(
+      {{"law", "j2_plasticity"}, {"yield_stress", 2000.0}, {"hardening", {{"linear", 20000.0}}}});
+  j.erase("steps");
+  j["stages"] = json::array({{{"steps", 2}, {"factors", {{"main", 1}}}}, {{"steps", 2}, {"factors", {{"main", 0}}}}});
+  j["outputs"] = json::parse(R"([
+    {"name": "alpha", "kind": "field", "at": [0, -9.6], "component": "equivalent_plastic_strain"}
+  ])");
+  const Solve r = solve_with_events(j);
+  ASSERT_TRUE(r.solved.run.completed) << r.solved.run.reason;
+  double before = 0.0;
+  for (size_t k = 0; k < r.solved.run.steps.size(); ++k) {
+    const json& step = r.result["steps"][k];
+    const double alpha = step["outputs"]["alpha"];
+    std::printf("step %zu: load factor %.2f, alpha %.4e\n", k + 1, step["load_factor"].get<double>(), alpha);
+    bool found = false;
+    for (const json& e : step["elements"])
+      found |= std::abs(e["equivalent_plastic_strain"].get<double>() - alpha) <= 5e-7 * alpha;
+    EXPECT_TRUE(found) << "step " << k + 1;
+    EXPECT_GE(alpha, before) << "step " << k + 1;
+    before = alpha;
+  }
+  EXPECT_GT(r.result["steps"][1]["outputs"]["alpha"].get<double>(), 0.0);
 }
 
 // The first issue of reading `scene` (with outputs `outputs`): its pointer and detail.
