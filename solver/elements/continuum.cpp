@@ -67,6 +67,10 @@ ContinuumBody::ContinuumBody(PlaneMesh mesh, const std::vector<int>& contact_set
   if (options_.element == ContinuumElement::q4_bbar && options_.kinematics == ContinuumKinematics::finite)
     throw std::invalid_argument("q4_bbar is implemented for linear kinematics (use q9 for finite strain)");
   if (!(options_.thickness > 0)) throw std::invalid_argument("thickness must be positive");
+  if (options_.incompressibility == Incompressibility::f_bar &&
+      (options_.kinematics != ContinuumKinematics::finite || options_.element != ContinuumElement::q4 ||
+       options_.analysis != PlaneAnalysis::plane_strain))
+    throw std::invalid_argument("f_bar is implemented for finite kinematics, q4 and plane strain");
   for (const auto& m : materials_) has_history_ |= m->has_history();
   if (has_history_ && options_.kinematics == ContinuumKinematics::finite)
     throw std::invalid_argument(
@@ -191,7 +195,10 @@ void ContinuumBody::internal_force(const Vector& q, Vector& force, Triplets* tan
   Vector fe;
   Matrix Ke;
   for (int e = 0; e < element_count(); ++e) {
-    total_lagrangian(in.points[e], element_displacements(q, e), material(e), fe, tangent ? &Ke : nullptr);
+    if (options_.incompressibility == Incompressibility::f_bar)
+      f_bar_total_lagrangian(in.points[e], in.centroids[e], element_displacements(q, e), material(e), fe,
+                             tangent ? &Ke : nullptr);
+    else total_lagrangian(in.points[e], element_displacements(q, e), material(e), fe, tangent ? &Ke : nullptr);
     const auto& el = mesh_.elements[e];
     const int m = static_cast<int>(fe.size());
     for (int i = 0; i < m; ++i) {

@@ -32,12 +32,16 @@ namespace grip {
 
 enum class ContinuumElement { q4, q4_bbar, q9, t3, t6, q8 };
 enum class ContinuumKinematics { linear, finite };
+// Against volumetric locking: none, or F-bar (finite kinematics, q4, plane strain;
+// plane_element.hpp). Linear kinematics has q4_bbar.
+enum class Incompressibility { none, f_bar };
 
 struct ContinuumOptions {
   ContinuumElement element = ContinuumElement::q4;
   ContinuumKinematics kinematics = ContinuumKinematics::finite;
   PlaneAnalysis analysis = PlaneAnalysis::plane_strain;
   double thickness = 1.0;  // out-of-plane depth (plane strain: the length the results are per)
+  Incompressibility incompressibility = Incompressibility::none;
 };
 
 ElementShape element_shape(ContinuumElement element);

@@ -298,6 +298,52 @@ void total_lagrangian(const std::vector<ElementPoint>& points, const ShapeGradie
   }
 }
 
+void f_bar_total_lagrangian(const std::vector<ElementPoint>& points, const ElementPoint& centre,
+                            const ShapeGradients& u, const PlaneMaterial& material, Vector& fe, Matrix* Ke) {
+  const int n = static_cast<int>(u.rows());
+  fe = Vector::Zero(2 * n);
+  if (Ke) *Ke = Matrix::Zero(2 * n, 2 * n);
+  const Mat2 F0 = deformation_gradient(centre, u);
+  const ShapeGradients h0 = centre.dN * F0.inverse();  // row a: (F0^-T dN_a)^T
+  const auto sym = [](const Mat2& A) { return Mat2(0.5 * (A + A.transpose())); };
+  for (const ElementPoint& p : points) {
+    const Mat2 F = deformation_gradient(p, u);
+    const double alpha = std::sqrt(F0.determinant() / F.determinant());
+    const Mat2 Fb = alpha * F;
+    const MaterialResponse r = material.response(0.5 * (Fb.transpose() * Fb - Mat2::Identity()));
+    Mat2 S;
+    S << r.S[0], r.S[2], r.S[2], r.S[1];
+    const Mat2 tau = Fb * S * Fb.transpose();
+    const double half_trace = 0.5 * tau.trace();
+    const ShapeGradients h = p.dN * F.inverse();  // row a: (F^-T dN_a)^T
+    for (int a = 0; a < n; ++a)
+      fe.segment<2>(2 * a) +=
+          p.dV * ((tau - half_trace * Mat2::Identity()) * h.row(a).transpose() + half_trace * h0.row(a).transpose());
+    if (!Ke) continue;
+    for (int b = 0; b < n; ++b)
+      for (int k = 0; k < 2; ++k) {
+        const Vec2 w = Vec2::Unit(k);
+        // d alpha = alpha / 2 (w . h0_b - w . h_b); d F_bar = alpha (w (x) g_b) + F d alpha.
+        const double s = 0.5 * (h0(b, k) - h(b, k));
+        const Mat2 dFb = alpha * (w * p.dN.row(b) + F * s);
+        const Mat2 dE = sym(Fb.transpose() * dFb);
+        const Eigen::Vector3d dS_voigt = r.D * Eigen::Vector3d(dE(0, 0), dE(1, 1), 2 * dE(0, 1));
+        Mat2 dS;
+        dS << dS_voigt[0], dS_voigt[2], dS_voigt[2], dS_voigt[1];
+        const Mat2 dtau = dFb * S * Fb.transpose() + Fb * dS * Fb.transpose() + Fb * S * dFb.transpose();
+        const double dhalf = 0.5 * dtau.trace();
+        for (int a = 0; a < n; ++a) {
+          // d h_a = -h_b (w . h_a), d h0_a = -h0_b (w . h0_a).
+          const Vec2 ha = h.row(a).transpose(), h0a = h0.row(a).transpose();
+          const Vec2 dha = -h.row(b).transpose() * ha[k], dh0a = -h0.row(b).transpose() * h0a[k];
+          const Vec2 df = (dtau - dhalf * Mat2::Identity()) * ha + (tau - half_trace * Mat2::Identity()) * dha +
+                          dhalf * h0a + half_trace * dh0a;
+          Ke->block<2, 1>(2 * a, 2 * b + k) += p.dV * df;
+        }
+      }
+  }
+}
+
 Eigen::Vector4d cauchy_stress(const Mat2& F, const MaterialResponse& r) {
   Mat2 S;
   S << r.S[0], r.S[2], r.S[2], r.S[1];

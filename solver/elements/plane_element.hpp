@@ -80,6 +80,15 @@ Mat2 deformation_gradient(const ElementPoint& point, const ShapeGradients& u);
 void total_lagrangian(const std::vector<ElementPoint>& points, const ShapeGradients& u, const PlaneMaterial& material,
                       Vector& fe, Matrix* Ke);
 
+// F-bar in plane strain: the law sees F_bar = (J0 / J)^(1/2) F, whose in-plane determinant is
+// J0 = det F at the element's centre (`centre`), so that every point changes volume as the
+// centre does (no volumetric locking as the law nears incompressibility). The element's energy
+// is sum W(F_bar) dV; its gradient, f_a = sum [dev(tau) h_a + tr(tau) / 2 h0_a] dV with tau =
+// F_bar S F_bar^T, h_a = F^-T dN_a/dX and h0_a that of the centre, and Ke its exact (symmetric)
+// derivative.
+void f_bar_total_lagrangian(const std::vector<ElementPoint>& points, const ElementPoint& centre,
+                            const ShapeGradients& u, const PlaneMaterial& material, Vector& fe, Matrix* Ke);
+
 // The Cauchy stress (sxx, syy, sxy, szz) for a deformation gradient F (in-plane) and the
 // material response at E = (F^T F - I) / 2.
 Eigen::Vector4d cauchy_stress(const Mat2& F, const MaterialResponse& response);

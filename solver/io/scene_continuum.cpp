@@ -1,6 +1,7 @@
 // body.model "continuum": plane triangles and quadrilaterals (solver/elements/continuum.hpp).
 //   "kinematics": "finite" (default) | "linear";  "analysis": "plane_strain" | "plane_stress" | "axisymmetric"
 //   "element": "t3" | "t6" | "q4" | "q4_bbar" | "q8" | "q9";  "thickness" (default 1)
+//   "incompressibility": "none" (default) | "f_bar" (finite kinematics, q4, plane strain)
 //   "material": {"young", "poisson", "law": "neo_hookean" | "saint_venant_kirchhoff" | "j2_plasticity"}
 //     j2_plasticity (linear kinematics): "yield_stress", "hardening": {"linear": H} |
 //     {"power": {"K", "n"}} | {"table": [[eps_p, sigma_y], ...]} (default perfectly plastic),
@@ -399,6 +400,18 @@ void read_continuum(Reader& r, json& body, Problem& problem, const std::string& 
                              ContinuumElement::q4_bbar, ContinuumElement::q8, ContinuumElement::q9})
     if (element == element_name(e)) options.element = e;
   options.thickness = r.positive(body, ptr, "thickness", 1.0);
+  if (r.choice(body, ptr, "incompressibility", {"none", "f_bar"}, "none") == "f_bar") {
+    options.incompressibility = Incompressibility::f_bar;
+    if (options.kinematics != ContinuumKinematics::finite)
+      r.error(ptr + "/incompressibility",
+              "\"f_bar\" is for finite kinematics; with linear kinematics use element \"q4_bbar\"");
+    else if (options.element != ContinuumElement::q4)
+      r.error(ptr + "/incompressibility", "\"f_bar\" is implemented for element \"q4\" (" + element +
+                                              " has no single centre "
+                                              "dilatation to share; q9 locks little)");
+    else if (options.analysis != PlaneAnalysis::plane_strain)
+      r.error(ptr + "/incompressibility", "\"f_bar\" is implemented for plane strain (plane stress does not lock)");
+  }
   if (options.element == ContinuumElement::q4_bbar) {
     if (options.kinematics == ContinuumKinematics::finite)
       r.error(ptr + "/element",

@@ -343,5 +343,67 @@ TEST(Scaleout, ThreeReplicasOnePostgresNothingLostNothingRunTwice) {
   EXPECT_GT(streams_checked.load(), 0);
 }
 
+// A study (a sweep of Hertz's contact tolerance, 6 jobs of 8 steps) submitted to one replica of
+// two on one PostgreSQL; that replica is killed with -9 while it runs one of the study's jobs.
+// The other replica serves the study's table, takes the lost job over when its lease expires,
+// and the study completes with every level successful once: the lost job ran twice (attempts
+// 2) and its outputs are the same as a level that ran once with the same scene would give.
+TEST(Scaleout, AStudySurvivesTheLossOfAReplica) {
+  std::unique_ptr<PostgresCluster> cluster;
+  try {
+    cluster = std::make_unique<PostgresCluster>();
+  } catch (const std::exception& e) {
+    GTEST_SKIP() << "no PostgreSQL cluster could be started: " << e.what();
+  }
+  TempDir dir;
+  const std::string url = cluster->new_database();
+  std::vector<std::unique_ptr<ServerProcess>> replicas;
+  for (int i = 0; i < 2; ++i)
+    replicas.push_back(std::make_unique<ServerProcess>(
+        url, std::vector<std::string>{"--workers", "1", "--lease", "2", "--replica", "r" + std::to_string(i)},
+        dir.path() / ("replica" + std::to_string(i) + ".log")));
+  const Api a(replicas[0]->port()), b(replicas[1]->port());
+  json scene = json::parse(read_text(examples_dir() / "hertz.json"));
+  scene["steps"] = 8;
+  scene["outputs"] = {{{"name", "P"}, {"kind", "resultant"}, {"component", "y"}},
+                      {{"name", "width"}, {"kind", "contact_width"}}};
+  const json request = {
+      {"scene", scene},
+      {"sweep", {{{"pointer", "/solver/contact/tolerance"}, {"values", {1e-8, 1e-8, 1e-8, 1e-8, 1e-8, 1e-8}}}}}};
+  const auto posted = a.post_json("/v1/studies", request.dump());
+  ASSERT_TRUE(posted && posted->status == 201) << (posted ? posted->body : "no response");
+  const json accepted = json::parse(posted->body);
+  const std::string id = accepted["id"];
+  // Kill r0 while it runs one of the study's jobs.
+  std::string lost;
+  const auto deadline = std::chrono::steady_clock::now() + 60s;
+  while (lost.empty() && std::chrono::steady_clock::now() < deadline) {
+    for (const json& level : accepted["levels"]) {
+      // Asked of r0 itself, whose document has the run's step: killed with half its steps to go.
+      const json job = a.job(level["job"]);
+      if (job["status"] == "running" && job.value("replica", "") == "r0" && job.value("step", 99) <= 4)
+        lost = level["job"];
+    }
+    if (lost.empty()) std::this_thread::sleep_for(20ms);
+  }
+  ASSERT_FALSE(lost.empty()) << "r0 ran none of the study's jobs";
+  replicas[0]->kill9();
+  json study;
+  const auto end = std::chrono::steady_clock::now() + 180s;
+  do {
+    std::this_thread::sleep_for(200ms);
+    study = json::parse(b.get("/v1/studies/" + id)->body);
+  } while (study["status"] != "successful" && std::chrono::steady_clock::now() < end);
+  ASSERT_EQ(study["status"], "successful") << study.dump(2);
+  const json reference = study["levels"][0]["outputs"];
+  for (const json& level : study["levels"]) {
+    const json job = b.job(level["job"]);
+    EXPECT_EQ(job["status"], "successful");
+    EXPECT_EQ(job["attempts"], level["job"] == lost ? 2 : 1) << level["job"];
+    EXPECT_EQ(level["outputs"], reference);  // the same scene: the same numbers, however often run
+    EXPECT_EQ(job["steps_completed"], 8);
+  }
+}
+
 }  // namespace
 }  // namespace grip::testing

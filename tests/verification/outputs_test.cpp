@@ -171,6 +171,38 @@ TEST(Outputs, PressFitPairsCarryLamesPressure) {
   EXPECT_NEAR(out["peak"].get<double>(), p, 0.01 * p);
 }
 
+// A plastic strain as a field output: the shipped Hertz scene with a von Mises material
+// (yield 2000 MPa, as tests/verification/j2_contact_test.cpp) pressed in 2 steps and released in
+// 2. Below the pole, where yield starts (0.78 a deep), the equivalent plastic strain is the
+// elements table's value, grows while loading, is positive at the peak load, and is kept when
+// the load is released (it never decreases).
+TEST(Outputs, APlasticStrainBelowTheContactGrowsAndIsKept) {
+  json j = example_scene("hertz");
+  j["body"]["element"] = "q4_bbar";
+  j["body"]["material"].update(
+      {{"law", "j2_plasticity"}, {"yield_stress", 2000.0}, {"hardening", {{"linear", 20000.0}}}});
+  j.erase("steps");
+  j["stages"] = json::array({{{"steps", 2}, {"factors", {{"main", 1}}}}, {{"steps", 2}, {"factors", {{"main", 0}}}}});
+  j["outputs"] = json::parse(R"([
+    {"name": "alpha", "kind": "field", "at": [0, -9.6], "component": "equivalent_plastic_strain"}
+  ])");
+  const Solve r = solve_with_events(j);
+  ASSERT_TRUE(r.solved.run.completed) << r.solved.run.reason;
+  double before = 0.0;
+  for (size_t k = 0; k < r.solved.run.steps.size(); ++k) {
+    const json& step = r.result["steps"][k];
+    const double alpha = step["outputs"]["alpha"];
+    std::printf("step %zu: load factor %.2f, alpha %.4e\n", k + 1, step["load_factor"].get<double>(), alpha);
+    bool found = false;
+    for (const json& e : step["elements"])
+      found |= std::abs(e["equivalent_plastic_strain"].get<double>() - alpha) <= 5e-7 * alpha;
+    EXPECT_TRUE(found) << "step " << k + 1;
+    EXPECT_GE(alpha, before) << "step " << k + 1;
+    before = alpha;
+  }
+  EXPECT_GT(r.result["steps"][1]["outputs"]["alpha"].get<double>(), 0.0);
+}
+
 // The first issue of reading `scene` (with outputs `outputs`): its pointer and detail.
 SceneIssue first_issue(json outputs, json scene = example_scene("hertz")) {
   scene["outputs"] = std::move(outputs);
