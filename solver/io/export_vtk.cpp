@@ -266,8 +266,7 @@ std::string step_vtu(const json& result, std::size_t k) {
     arrays("PointData", g.point_data, first_point, points);
     arrays("CellData", g.cell_data, first_cell, cells);
     os << "<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
-    for (size_t i = first_point; i < first_point + points; ++i)
-      os << g.point_text(g.points[i]) << '\n';
+    for (size_t i = first_point; i < first_point + points; ++i) os << g.point_text(g.points[i]) << '\n';
     os << "</DataArray>\n</Points>\n<Cells>\n"
        << "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
     for (size_t c = first_cell; c < first_cell + cells; ++c)
