@@ -166,7 +166,6 @@ TEST(FBar, CooksMembraneDoesNotLock) {
 }  // namespace
 }  // namespace grip
 
-
 namespace grip {
 namespace {
 
