@@ -56,6 +56,9 @@ json error_list(std::string detail, std::string pointer = "") {
 }
 
 // RFC 9457 problem details with grip's `errors[]` of {pointer, detail}.
+constexpr const char* kBusyReadingScenes =
+    "this server is reading as many scenes as its memory budget allows; nothing was accepted; retry after 5 s";
+
 void problem(Response& res, const Request& req, int status, const std::string& slug, const std::string& title,
              const std::string& detail, json errors = nullptr) {
   if (errors.is_null() || errors.empty()) errors = error_list(detail);
@@ -246,6 +249,10 @@ struct HttpServer::Impl {
   void invalid(const Request& req, Response& res, const SceneErrors& e, const std::string& prefix,
                const std::string& what);
   void submit_study(const Request& req, Response& res, const httplib::ContentReader& reader);
+  // The body's share of the memory budget (server/body_budget.hpp): its declared length, at most
+  // `limit`, waited for up to 2 minutes; else a 503 with Retry-After saying `busy`, and none.
+  std::optional<BodyBudget::Hold> take_budget(const Request& req, Response& res, std::size_t limit,
+                                              const std::string& busy);
   void get_study(const Request& req, Response& res);
   // The study's table as Server-Sent Events: `study` each time it changes, `study_finished` last.
   void study_events(const Request& req, Response& res);
@@ -526,17 +533,9 @@ void HttpServer::Impl::routes() {
 }
 
 void HttpServer::Impl::submit(const Request& req, Response& res, const httplib::ContentReader& reader, bool ogc) {
-  // The body's length of the memory budget (server/body_budget.hpp), held until the answer is
-  // built (destroyed last).
-  const auto declared = parse_count(req.get_header_value("Content-Length"));
-  auto hold = budget.take(std::min<std::size_t>(declared.value_or(options.max_body_bytes), options.max_body_bytes),
-                          std::chrono::seconds(120));
-  if (!hold) {
-    res.set_header("Retry-After", "5");
-    return problem(res, req, 503, "busy", "Busy",
-                   "this server is reading as many scenes as its memory budget allows; nothing was accepted; "
-                   "retry after 5 s");  // after 2 minutes of waiting
-  }
+  // Held until the answer is built (destroyed last).
+  const auto hold = take_budget(req, res, options.max_body_bytes, kBusyReadingScenes);
+  if (!hold) return;
   json body;
   if (!read_json_body(req, res, reader, "a scene", body)) return;
   // OGC execute request: {"inputs": {"scene": {...}}} (or the scene's fields as inputs).
@@ -649,7 +648,6 @@ void HttpServer::Impl::upload_mesh(const Request& req, Response& res, const http
   const std::string type = lower(req.get_header_value("Content-Type"));
   std::string media = type.substr(0, type.find(';'));
   media.erase(std::remove_if(media.begin(), media.end(), ::isspace), media.end());
-  const auto declared = parse_count(req.get_header_value("Content-Length"));
   if (media != "application/octet-stream" && media != "text/plain") {
     reader([](const char*, size_t) { return true; });  // drained unkept: the connection stays in step
     res.set_header("Accept-Post", "application/octet-stream, text/plain");
@@ -658,14 +656,10 @@ void HttpServer::Impl::upload_mesh(const Request& req, Response& res, const http
                        (media.empty() ? std::string("(none)") : media) + "'");
   }
   // Reading a mesh takes some 3 times its file (the file, the reader's arrays, the compressed copy).
-  auto hold = budget.take(std::min<std::size_t>(declared.value_or(options.max_mesh_bytes), options.max_mesh_bytes),
-                          std::chrono::seconds(120));
-  if (!hold) {
-    res.set_header("Retry-After", "5");
-    return problem(res, req, 503, "busy", "Busy",
-                   "this server is reading as many bodies as its memory budget allows; nothing was stored; "
-                   "retry after 5 s");
-  }
+  const auto hold = take_budget(req, res, options.max_mesh_bytes,
+                                "this server is reading as many bodies as its memory budget allows; nothing was "
+                                "stored; retry after 5 s");
+  if (!hold) return;
   std::string bytes;
   if (!read_body(req, res, reader, options.max_mesh_bytes, bytes)) return;
   MeshLibrary::Upload up;
@@ -701,16 +695,20 @@ void HttpServer::Impl::invalid(const Request& req, Response& res, const SceneErr
           std::move(errors));
 }
 
-void HttpServer::Impl::submit_study(const Request& req, Response& res, const httplib::ContentReader& reader) {
+std::optional<BodyBudget::Hold> HttpServer::Impl::take_budget(const Request& req, Response& res, std::size_t limit,
+                                                              const std::string& busy) {
   const auto declared = parse_count(req.get_header_value("Content-Length"));
-  auto hold = budget.take(std::min<std::size_t>(declared.value_or(options.max_body_bytes), options.max_body_bytes),
-                          std::chrono::seconds(120));
+  auto hold = budget.take(std::min<std::size_t>(declared.value_or(limit), limit), std::chrono::seconds(120));
   if (!hold) {
     res.set_header("Retry-After", "5");
-    return problem(res, req, 503, "busy", "Busy",
-                   "this server is reading as many scenes as its memory budget allows; nothing was accepted; "
-                   "retry after 5 s");
+    problem(res, req, 503, "busy", "Busy", busy);
   }
+  return hold;
+}
+
+void HttpServer::Impl::submit_study(const Request& req, Response& res, const httplib::ContentReader& reader) {
+  const auto hold = take_budget(req, res, options.max_body_bytes, kBusyReadingScenes);
+  if (!hold) return;
   json body;
   if (!read_json_body(req, res, reader, "a study", body)) return;
   try {

@@ -51,6 +51,17 @@ json post_study(const Api& api, const json& request, int status) {
   return json::parse(r->body);
 }
 
+// The study's document once it is successful, or as it stands after 2 minutes.
+json study_when_successful(const Api& api, const std::string& id) {
+  json study;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  do {
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    study = json::parse(api.get("/v1/studies/" + id)->body);
+  } while (study["status"] != "successful" && std::chrono::steady_clock::now() < deadline);
+  return study;
+}
+
 TEST(Studies, ThreeLevelsOfLamesCylinderGiveQ4sOrderAndABetterExtrapolation) {
   TempDir dir;
   ServerProcess server(dir.path() / "grip.sqlite", {"--workers", "2"}, dir.path() / "serve.log");
@@ -192,12 +203,7 @@ TEST(Studies, ASweepTabulatesEveryVariantAsItsOwnJobWouldGiveIt) {
         {{"pointer", "/body/material/young"}, {"range", {{"from", 1000}, {"to", 2000}, {"count", 2}}}}}}};
   const json accepted = post_study(api, request, 201);
   ASSERT_EQ(accepted["levels"].size(), 6u);
-  json study;
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
-  do {
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    study = json::parse(api.get("/v1/studies/" + accepted["id"].get<std::string>())->body);
-  } while (study["status"] != "successful" && std::chrono::steady_clock::now() < deadline);
+  const json study = study_when_successful(api, accepted["id"]);
   ASSERT_EQ(study["status"], "successful") << study.dump(2);
   EXPECT_EQ(study["pointers"], json({"/body/loads/0/traction/0", "/body/material/young"}));
   const double reference = study["levels"][0]["outputs"]["u_inner"].get<double>() * 1000 / 5;
@@ -269,12 +275,7 @@ TEST(Studies, AFrictionSweepOfTheSlidingBlockSlipsAtMuN) {
       {{"scene", scene},
        {"sweep", {{{"pointer", "/obstacles/0/friction"}, {"range", {{"from", 0}, {"to", 0.5}, {"count", 6}}}}}}},
       201);
-  json study;
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
-  do {
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    study = json::parse(api.get("/v1/studies/" + accepted["id"].get<std::string>())->body);
-  } while (study["status"] != "successful" && std::chrono::steady_clock::now() < deadline);
+  const json study = study_when_successful(api, accepted["id"]);
   ASSERT_EQ(study["status"], "successful") << study.dump(2);
   for (const json& level : study["levels"]) {
     const double mu = level["parameters"][0], Q = level["outputs"]["Q"], N = level["outputs"]["N"];
@@ -314,12 +315,7 @@ TEST(Studies, AListOfGmshMeshesTakesItsSizesFromTheNodeCounts) {
   const json refused = post_study(api, {{"scene", generated}, {"refine", {{"meshes", meshes}}}}, 422);
   EXPECT_EQ(refused["errors"][0]["pointer"], "/scene/body/mesh/gmsh");
   const json accepted = post_study(api, {{"scene", scene}, {"refine", {{"meshes", meshes}}}}, 201);
-  json study;
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
-  do {
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    study = json::parse(api.get("/v1/studies/" + accepted["id"].get<std::string>())->body);
-  } while (study["status"] != "successful" && std::chrono::steady_clock::now() < deadline);
+  const json study = study_when_successful(api, accepted["id"]);
   ASSERT_EQ(study["status"], "successful") << study.dump(2);
   const double n0 = study["levels"][0]["nodes"];
   for (const json& level : study["levels"])
