@@ -258,14 +258,16 @@ class ConnectionThreads final : public httplib::TaskQueue {
   }
 
  private:
-  void start_thread() {  // holding mutex_
+  // Holding mutex_. The thread counts as idle from here: enqueue() hands it a connection
+  // even before it reaches its first wait (else that connection went to the reserved threads).
+  void start_thread() {
+    ++idle_;
     threads_.emplace_back([this] { run(jobs_, cv_, true); });
   }
 
   void run(std::deque<std::function<void()>>& queue, std::condition_variable& cv, bool pooled) {
     std::unique_lock lock(mutex_);
     while (true) {
-      if (pooled) ++idle_;
       cv.wait(lock, [&] { return stopping_ || !queue.empty(); });
       if (pooled) --idle_;
       if (queue.empty()) break;  // stopping
@@ -274,6 +276,7 @@ class ConnectionThreads final : public httplib::TaskQueue {
       lock.unlock();
       fn();
       lock.lock();
+      if (pooled) ++idle_;
     }
   }
 
