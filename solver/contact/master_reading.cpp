@@ -21,6 +21,14 @@ std::vector<MasterReading> master_readings(const Problem& problem, const Vector&
     slave[c.site] = {p[c.eta] / area, c.xi >= 0 ? p[c.xi] / area : 0.0,
                      contact_state(problem, i, p, tau) != ContactState::open ? 1.0 : 0.0};
   }
+  // A slave site that sweeps no area (the axis corner of a quadratic side in axisymmetry) has
+  // no stress of its own: it reads its neighbour's along the slave surface, as the result does.
+  for (const std::vector<int>& chain : pair.master->slave_chains)
+    for (size_t e = 0; e < chain.size(); ++e)
+      if (chain.size() > 1 && slave.count(chain[e]) && !(all.tributary_area(chain[e]) > 0)) {
+        const int next = chain[e + 1 < chain.size() ? e + 1 : e - 1];
+        slave[chain[e]] = slave.count(next) ? slave[next] : std::array<double, 3>{0, 0, 0};
+      }
   const auto at = [&](int site) { return all.surface_point(q, site, 0).x; };
   const auto of = [&](int site) { return slave.count(site) ? slave[site] : std::array<double, 3>{0, 0, 0}; };
   std::vector<MasterReading> readings;

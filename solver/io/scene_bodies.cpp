@@ -65,6 +65,16 @@ void read_bodies(Reader& r, json& bodies, Problem& problem) {
     named.insert(names.back());
     parts.push_back(std::move(part));
   }
+  if (!r.issues.empty()) return;  // every body read: parts[b] is /bodies/b
+  // A section of revolution and a plane body do not meet: its forces are totals over the circle,
+  // the plane body's per unit thickness (docs/algorithm.md#axisymmetric).
+  for (size_t b = 1; b < parts.size(); ++b)
+    if (parts[b].body->axisymmetric() != parts[0].body->axisymmetric())
+      r.error("/bodies/" + std::to_string(b) + (bodies[b].contains("analysis") ? "/analysis" : ""),
+              std::string("body \"") + names[b] + "\" is " + (parts[b].body->axisymmetric() ? "" : "not ") +
+                  "axisymmetric and body \"" + names[0] + "\" is " + (parts[0].body->axisymmetric() ? "" : "not ") +
+                  "axisymmetric: the bodies of a scene are all sections of revolution (analysis: axisymmetric) or "
+                  "all plane");
   if (!r.issues.empty()) return;
   std::vector<std::unique_ptr<Body>> bodies_owned;
   for (Problem& part : parts) bodies_owned.push_back(std::move(part.body));

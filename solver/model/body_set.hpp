@@ -44,6 +44,8 @@ class BodySet final : public Body {
   Vector rigid_translation(const Vec2& d) const override;
   Vector rigid_rotation() const override;
   Traits traits() const override;
+  // The scene reader refuses a set that mixes sections of revolution with plane bodies.
+  bool axisymmetric() const override { return !parts_.empty() && parts_[0]->axisymmetric(); }
   std::optional<ElementQuality> element_quality() const override;
   std::vector<std::vector<int>> cells() const override;
   FieldTable site_fields(const Vector& q) const override;

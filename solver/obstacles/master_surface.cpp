@@ -61,15 +61,24 @@ P2<S> smoothed_normal(const At& at, int n, int k, const S& along) {
 }
 
 // The mortar integrals of the slave segment a -> b against the master segments k_first..k_last
-// of a chain (`at(k)` the master sites): add(end, k, int psi_end N_k) for end 0 (a) and 1 (b).
-// Each master segment is cut to the part of the slave segment its ends project onto (along
-// the slave's normal); on each piece the integrand is quadratic, and two Gauss points make it
-// exact.
+// of a chain (`at(k)` the master sites): add(end, k, int psi_end N_k w ds) for end 0 (a) and 1
+// (b), w = 1 in the plane and w = r (x) on a section of revolution (2 pi cancels in the weights
+// w_jk = M_jk / D_j). The dual basis psi = A N is biorthogonal in that measure: A = D M^-1,
+// M_ij = int N_i N_j w ds, D = diag(int N_j w ds); in the plane psi_a = 2 N_a - N_b. Each master
+// segment is cut to the part of the slave segment its ends project onto (along the slave's
+// normal); on each piece the integrand is at most cubic, and two Gauss points make it exact.
 template <class S, class At, class Add>
-void segment_mortar(const P2<S>& a, const P2<S>& b, const At& at, int k_first, int k_last, const Add& add) {
+void segment_mortar(const P2<S>& a, const P2<S>& b, const At& at, int k_first, int k_last, bool revolved,
+                    const Add& add) {
   const double gauss = 1.0 / std::sqrt(3.0);
   const S length = grip::length(b - a);
   const P2<S> along = (S(1.0) / length) * (b - a);
+  const S ra = revolved ? a.x : S(1.0), rb = revolved ? b.x : S(1.0);
+  if (!(value(ra) + value(rb) > 0.0)) return;  // a slave side on the axis sweeps no area
+  const S m11 = (S(3.0) * ra + rb) / S(12.0), m12 = (ra + rb) / S(12.0), m22 = (ra + S(3.0) * rb) / S(12.0);
+  const S d1 = (S(2.0) * ra + rb) / S(6.0), d2 = (ra + S(2.0) * rb) / S(6.0);
+  const S det = m11 * m22 - m12 * m12;
+  const S a11 = d1 * m22 / det, a12 = -(d1 * m12 / det), a21 = -(d2 * m12 / det), a22 = d2 * m11 / det;
   for (int k = k_first; k <= k_last; ++k) {
     const S xp = dot(at(k) - a, along) / length, xq = dot(at(k + 1) - a, along) / length;
     const S& low = value(xp) <= value(xq) ? xp : xq;
@@ -77,9 +86,10 @@ void segment_mortar(const P2<S>& a, const P2<S>& b, const At& at, int k_first, i
     const S lo = value(low) > 0.0 ? low : S(0.0), hi = value(high) < 1.0 ? high : S(1.0);
     if (!(value(hi) > value(lo)) || std::abs(value(xq) - value(xp)) < 1e-12) continue;
     for (double g : {-gauss, gauss}) {
-      const S xi = S(0.5) * (lo + hi) + S(0.5 * g) * (hi - lo), weight = S(0.5) * (hi - lo) * length;
+      const S xi = S(0.5) * (lo + hi) + S(0.5 * g) * (hi - lo);
+      const S na = S(1.0) - xi, r = ra * na + rb * xi, weight = S(0.5) * (hi - lo) * length * r;
       const S t = (xi - xp) / (xq - xp);
-      const S psi_a = S(2.0) - S(3.0) * xi, psi_b = S(3.0) * xi - S(1.0);  // the dual basis on the segment
+      const S psi_a = a11 * na + a12 * xi, psi_b = a21 * na + a22 * xi;  // the dual basis on the segment
       add(0, k, psi_a * (S(1.0) - t) * weight);
       add(0, k + 1, psi_a * t * weight);
       add(1, k, psi_b * (S(1.0) - t) * weight);
@@ -96,6 +106,7 @@ MasterSurface make_master_surface(const Body& body, int body_index, const std::v
   m.body = body_index;
   m.side = side;
   m.slave_side = slave_side;
+  m.axisymmetric = body.part(body_index).axisymmetric();
   m.chains = chains_of(segments);
   m.slave_chains = chains_of(slave_segments);
   double zeta = 0.0;
@@ -158,14 +169,16 @@ void DeformedMaster::integrate_mortar(const Body& body, const Vector& q, const M
       const Vec2 a = slave_points_[slave[e]].x, b = slave_points_[slave[e + 1]].x;
       const double length = (b - a).norm();
       if (!(length > 0)) continue;
-      tributary[slave[e]] += 0.5 * length;
-      tributary[slave[e + 1]] += 0.5 * length;
+      // int N_j w ds (w = r on a section of revolution, as in segment_mortar)
+      const double ra = surface.axisymmetric ? a.x() : 1.0, rb = surface.axisymmetric ? b.x() : 1.0;
+      tributary[slave[e]] += length * (2 * ra + rb) / 6;
+      tributary[slave[e + 1]] += length * (ra + 2 * rb) / 6;
       const auto range = mortar_range(a, b);
       if (!range) continue;
       const int chain = (*range)[0];
       const auto at = [&](int k) { return p2(chains_[chain].points[k].x); };
       const std::array<int, 2> ends{slave[e], slave[e + 1]};
-      segment_mortar(p2(a), p2(b), at, (*range)[1], (*range)[2], [&](int end, int k, double v) {
+      segment_mortar(p2(a), p2(b), at, (*range)[1], (*range)[2], surface.axisymmetric, [&](int end, int k, double v) {
         m[ends[end]][{chain, k}] += v;
       });
     }
@@ -302,7 +315,7 @@ DeformedMaster::DualPairing DeformedMaster::dual_pairing(const SurfacePoint& sla
       const int chain = piece.range[0];
       const int end = piece.a == slave_site ? 0 : 1;
       segment_mortar(seeded(slave_slot.at(piece.a)), seeded(slave_slot.at(piece.b)), master_at(chain), piece.range[1],
-                     piece.range[2], [&](int e, int k, const Dual& v) {
+                     piece.range[2], surface_->axisymmetric, [&](int e, int k, const Dual& v) {
                        if (e == end) m[{chain, k}] += v;
                      });
     }

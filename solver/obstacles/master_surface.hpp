@@ -14,6 +14,8 @@
 // The gap of site j is (x_j - x_m) . n with the mortar point x_m = sum_k w_jk x_k (the
 // psi_j-weighted mean of the master surface over the slave segments around j: int psi_j
 // (x_slave - x_master) . n / D_j), so T p = J^T f with the Jacobian of x_j - x_m.
+// Axisymmetric bodies: every integral weighs by r (the dual basis biorthogonal in r ds), so
+// p_j and the master's share are totals over the circle, as the slave's tributary areas.
 // Integration: each slave segment is cut at the projections of the master sites onto its
 // line; on each piece the integrand is quadratic, and two Gauss points make it exact.
 // A slave site whose slave segments the master covers by less than half of D_j (a surface
@@ -48,6 +50,9 @@ struct MasterSurface {
   // The sides (Body::surface_point) of the master's and the slave's sites: 0 for a continuum's
   // boundary nodes; +1 (upper) or -1 (lower) for a beam's surface, its axis offset by half its depth.
   int side = 0, slave_side = 0;
+  // Sections of revolution (the scene refuses to mix them with plane bodies): the mortar
+  // integrals weigh by r, the 2 pi r of docs/algorithm.md#axisymmetric.
+  bool axisymmetric = false;
 };
 
 // The chains through the given segments ([a, b], body on the left of a -> b), each followed
