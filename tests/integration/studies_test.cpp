@@ -345,7 +345,6 @@ TEST(Studies, AListOfGmshMeshesTakesItsSizesFromTheNodeCounts) {
   EXPECT_LT(P["order"].get<double>(), 5.0);
 }
 
-
 // A refinement study with contact methods and tolerances: Hertz's half-cylinder
 // (schemas/examples/hertz.json, one step) at three mesh levels, each with cev and ssn at three
 // contact tolerances (18 jobs). The mesh levels' series is cev's at the tightest tolerance, as
