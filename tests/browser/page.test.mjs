@@ -2,7 +2,8 @@
 // puppeteer-core (tests/browser/package-lock.json, installed by scripts/setup.sh with npm ci).
 // Against a live `grip serve` on a free loopback port: a running job watched live and across a
 // server restart, the beam example submitted and shown, a bad scene's pointer errors, gmsh
-// meshes uploaded beside a scene, studies followed (table and plots). Screenshots go to $GRIP_ARTIFACTS (default build/browser-artifacts), never committed.
+// meshes uploaded beside a scene, studies followed (table and plots). Screenshots go to
+// $GRIP_ARTIFACTS (default build/browser-artifacts), never committed.
 //   GRIP_BINARY=build/apps/grip node --test tests/browser/page.test.mjs
 import { test, before, after } from "node:test";
 import assert from "node:assert/strict";
