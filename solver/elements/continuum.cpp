@@ -76,8 +76,8 @@ ContinuumBody::ContinuumBody(PlaneMesh mesh, const std::vector<int>& contact_set
     throw std::invalid_argument(
         "a law with history (j2_plasticity) is implemented for small strain: linear kinematics");
   if (options_.analysis == PlaneAnalysis::axisymmetric) {
-    if (options_.kinematics == ContinuumKinematics::finite || options_.element == ContinuumElement::q4_bbar)
-      throw std::invalid_argument("axisymmetric is implemented for linear kinematics and t3, t6, q4, q8, q9");
+    if (options_.element == ContinuumElement::q4_bbar)
+      throw std::invalid_argument("axisymmetric is implemented for t3, t6, q4, q8, q9");
     if (const std::vector<int> off = nodes_off_half_plane(mesh_); !off.empty())
       throw std::invalid_argument("axisymmetric: nodes at r = x < 0: " + id_list(off));
   }
@@ -328,7 +328,15 @@ Eigen::Vector4d ContinuumBody::centroid_stress(const Vector& q, int e) const {
     return {s[0], s[1], s[2], r.dS33 * eps};
   }
   const Mat2 F = deformation_gradient(c, u);
-  return cauchy_stress(F, material(e).response(0.5 * (F.transpose() * F - Mat2::Identity())));
+  const Mat2 E = 0.5 * (F.transpose() * F - Mat2::Identity());
+  if (options_.analysis != PlaneAnalysis::axisymmetric) return cauchy_stress(F, material(e).response(E));
+  const double F33 = 1 + c.N.dot(u.col(0)) / c.radius;
+  const HoopResponse h = material(e).hoop_response(E, 0.5 * (F33 * F33 - 1));
+  MaterialResponse r;
+  r.S = h.S.head<3>();
+  r.S33 = h.S[3];
+  r.C33 = F33 * F33;
+  return cauchy_stress(F, r);
 }
 
 FieldTable ContinuumBody::element_fields(const Vector& q) const {

@@ -75,7 +75,9 @@ Matrix small_strain_stiffness(const std::vector<ElementPoint>& points, const Eig
 
 // Total Lagrangian: F = I + sum u_a (x) dN_a/dX; internal force f_a = sum F S dN_a dV and, if
 // Ke is given, its exact derivative B^T D B + (dN_a . S dN_b) I. u holds the nodal
-// displacements, one row per node.
+// displacements, one row per node. Axisymmetric points (radius R > 0): F33 = 1 + u_r / R, the
+// hoop strain E33 = (F33^2 - 1) / 2 from the law's hoop_response; f_a gains F33 S33 N_a / R in
+// r, B the row dE33 = F33 N_a / R du_r, and Ke the hoop geometric term S33 N_a N_b / R^2 (r-r).
 Mat2 deformation_gradient(const ElementPoint& point, const ShapeGradients& u);
 void total_lagrangian(const std::vector<ElementPoint>& points, const ShapeGradients& u, const PlaneMaterial& material,
                       Vector& fe, Matrix* Ke);

@@ -493,10 +493,6 @@ void read_continuum(Reader& r, json& body, Problem& problem, const std::string& 
     if (options.analysis == PlaneAnalysis::axisymmetric)
       r.error(ptr + "/element", "\"q4_bbar\" is for plane strain: in axisymmetry use t3, t6, q4, q8 or q9");
   }
-  if (options.analysis == PlaneAnalysis::axisymmetric) {
-    if (options.kinematics == ContinuumKinematics::finite)
-      r.error(ptr + "/kinematics", "\"axisymmetric\" is implemented for linear kinematics: give \"linear\"");
-  }
   const ElementShape shape = element_shape(options.element);
 
   const auto read_material = [&](json& mat, const std::string& mp) -> std::shared_ptr<const PlaneMaterial> {
