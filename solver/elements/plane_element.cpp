@@ -265,14 +265,21 @@ Mat2 deformation_gradient(const ElementPoint& point, const ShapeGradients& u) {
 
 void total_lagrangian(const std::vector<ElementPoint>& points, const ShapeGradients& u, const PlaneMaterial& material,
                       Vector& fe, Matrix* Ke) {
+  total_lagrangian(
+      points, u, [&](int, const Mat2& E) { return material.response(E); }, fe, Ke);
+}
+
+void total_lagrangian(const std::vector<ElementPoint>& points, const ShapeGradients& u, const PointLaw& law, Vector& fe,
+                      Matrix* Ke) {
   const int n = static_cast<int>(u.rows());
   fe = Vector::Zero(2 * n);
   if (Ke) *Ke = Matrix::Zero(2 * n, 2 * n);
   Matrix B(3, 2 * n);
-  for (const ElementPoint& p : points) {
+  for (size_t k = 0; k < points.size(); ++k) {
+    const ElementPoint& p = points[k];
     const Mat2 F = deformation_gradient(p, u);
     const Mat2 E = 0.5 * (F.transpose() * F - Mat2::Identity());
-    const MaterialResponse r = material.response(E);
+    const MaterialResponse r = law(static_cast<int>(k), E);
     Mat2 S;
     S << r.S[0], r.S[2], r.S[2], r.S[1];
     const Mat2 P = F * S;  // first Piola-Kirchhoff stress
@@ -300,17 +307,29 @@ void total_lagrangian(const std::vector<ElementPoint>& points, const ShapeGradie
 
 void f_bar_total_lagrangian(const std::vector<ElementPoint>& points, const ElementPoint& centre,
                             const ShapeGradients& u, const PlaneMaterial& material, Vector& fe, Matrix* Ke) {
+  f_bar_total_lagrangian(
+      points, centre, u, [&](int, const Mat2& E) { return material.response(E); }, fe, Ke);
+}
+
+Mat2 f_bar(const ElementPoint& point, const ElementPoint& centre, const ShapeGradients& u) {
+  const Mat2 F = deformation_gradient(point, u);
+  return std::sqrt(deformation_gradient(centre, u).determinant() / F.determinant()) * F;
+}
+
+void f_bar_total_lagrangian(const std::vector<ElementPoint>& points, const ElementPoint& centre,
+                            const ShapeGradients& u, const PointLaw& law, Vector& fe, Matrix* Ke) {
   const int n = static_cast<int>(u.rows());
   fe = Vector::Zero(2 * n);
   if (Ke) *Ke = Matrix::Zero(2 * n, 2 * n);
   const Mat2 F0 = deformation_gradient(centre, u);
   const ShapeGradients h0 = centre.dN * F0.inverse();  // row a: (F0^-T dN_a)^T
   const auto sym = [](const Mat2& A) { return Mat2(0.5 * (A + A.transpose())); };
-  for (const ElementPoint& p : points) {
+  for (size_t i = 0; i < points.size(); ++i) {
+    const ElementPoint& p = points[i];
     const Mat2 F = deformation_gradient(p, u);
     const double alpha = std::sqrt(F0.determinant() / F.determinant());
     const Mat2 Fb = alpha * F;
-    const MaterialResponse r = material.response(0.5 * (Fb.transpose() * Fb - Mat2::Identity()));
+    const MaterialResponse r = law(static_cast<int>(i), 0.5 * (Fb.transpose() * Fb - Mat2::Identity()));
     Mat2 S;
     S << r.S[0], r.S[2], r.S[2], r.S[1];
     const Mat2 tau = Fb * S * Fb.transpose();

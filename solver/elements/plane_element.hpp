@@ -10,6 +10,7 @@
 // Local dofs are (u0x, u0y, u1x, ...). Strains and stresses in Voigt order (11, 22, 12) with
 // the engineering shear strain.
 #include <Eigen/Core>
+#include <functional>
 #include <vector>
 
 #include "solver/materials/plane_material.hpp"
@@ -77,6 +78,11 @@ Matrix small_strain_stiffness(const std::vector<ElementPoint>& points, const Eig
 // Ke is given, its exact derivative B^T D B + (dN_a . S dN_b) I. u holds the nodal
 // displacements, one row per node.
 Mat2 deformation_gradient(const ElementPoint& point, const ShapeGradients& u);
+// The law at each integration point (index into `points`): its response to the Green-Lagrange
+// strain E there (a law with history answers from that point's committed state).
+using PointLaw = std::function<MaterialResponse(int point, const Mat2& E)>;
+void total_lagrangian(const std::vector<ElementPoint>& points, const ShapeGradients& u, const PointLaw& law, Vector& fe,
+                      Matrix* Ke);
 void total_lagrangian(const std::vector<ElementPoint>& points, const ShapeGradients& u, const PlaneMaterial& material,
                       Vector& fe, Matrix* Ke);
 
@@ -87,7 +93,11 @@ void total_lagrangian(const std::vector<ElementPoint>& points, const ShapeGradie
 // F_bar S F_bar^T, h_a = F^-T dN_a/dX and h0_a that of the centre, and Ke its exact (symmetric)
 // derivative.
 void f_bar_total_lagrangian(const std::vector<ElementPoint>& points, const ElementPoint& centre,
+                            const ShapeGradients& u, const PointLaw& law, Vector& fe, Matrix* Ke);
+void f_bar_total_lagrangian(const std::vector<ElementPoint>& points, const ElementPoint& centre,
                             const ShapeGradients& u, const PlaneMaterial& material, Vector& fe, Matrix* Ke);
+// F-bar's F_bar = (J0 / J)^(1/2) F at a point, J0 = det F at the centre.
+Mat2 f_bar(const ElementPoint& point, const ElementPoint& centre, const ShapeGradients& u);
 
 // The Cauchy stress (sxx, syy, sxy, szz) for a deformation gradient F (in-plane) and the
 // material response at E = (F^T F - I) / 2.
