@@ -6,7 +6,7 @@
 // limit on a request head's size, and cannot tell that an event stream's client went away.
 // HttpFront keeps httplib's parser and routing (Server::process_request) and replaces the
 // loop around them (the virtual process_and_close_socket) and the socket stream:
-// - a thread per connection, started on demand up to `max_connections`; beyond them a
+// - a thread per connection, `max_connections` of them started at start-up; beyond them a
 //   connection goes to one of two reserved threads, which answer /v1/health and /v1/ready
 //   and refuse the rest with 503 and Retry-After;
 // - a deadline for a whole request head and for a whole body (408 when missed);

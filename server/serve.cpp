@@ -77,7 +77,8 @@ const std::vector<Flag>& flags() {
        [](ServeConfig& c, const std::string& v) {
          c.http.max_streams = static_cast<int>(integer(v, "--streams", 1, 10000));
        }},
-      {"http-threads", "GRIP_HTTP_THREADS", "N", "connections served at once, a thread each (default 1024)",
+      {"http-threads", "GRIP_HTTP_THREADS", "N",
+       "connections served at once, a thread each, all started with the server (default 1024)",
        [](ServeConfig& c, const std::string& v) {
          c.http.front.max_connections = static_cast<int>(integer(v, "--http-threads", 2, 20000));
        }},

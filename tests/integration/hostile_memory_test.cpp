@@ -16,13 +16,15 @@ namespace grip::testing {
 namespace {
 
 // VmHWM or VmRSS of a process, in MB.
-double status_mb(pid_t pid, const std::string& field) {
+double status_value(pid_t pid, const std::string& field) {
   std::ifstream in("/proc/" + std::to_string(pid) + "/status");
   std::string line;
   while (std::getline(in, line))
-    if (line.rfind(field + ":", 0) == 0) return std::stod(line.substr(field.size() + 1)) / 1024.0;
+    if (line.rfind(field + ":", 0) == 0) return std::stod(line.substr(field.size() + 1));
   throw std::runtime_error("no " + field + " in /proc/" + std::to_string(pid) + "/status");
 }
+
+double status_mb(pid_t pid, const std::string& field) { return status_value(pid, field) / 1024.0; }
 
 // The sliding block with `key` of `where` replaced by `entry` repeated to about `target` bytes.
 std::string padded(const json& scene, json& where, const std::string& key, const json& entry, size_t target) {
@@ -69,6 +71,9 @@ TEST(HostileMemory, EightLargeAdversarialScenesAtOnceStayUnder500MbAndMemoryCome
     ASSERT_TRUE(warm);
     ASSERT_EQ(warm->status, 422) << warm->body;
   }
+  // The server starts its 1,024 connection threads in the background: idle means all there.
+  for (int i = 0; i < 100 && status_value(server.pid(), "Threads") < 1024; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   const double idle = status_mb(server.pid(), "VmRSS");
 

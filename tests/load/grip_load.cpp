@@ -14,6 +14,7 @@
 // server share the machine's clock). Only live events count: those whose estimated time is
 // after the stream was opened (replayed ones are not a delay).
 #include <httplib.h>
+#include <sys/resource.h>
 #include <unistd.h>
 #include <nlohmann/json.hpp>
 
@@ -26,6 +27,7 @@
 #include <ctime>
 #include <fstream>
 #include <iostream>
+#include <iterator>
 #include <map>
 #include <mutex>
 #include <optional>
@@ -123,6 +125,29 @@ std::optional<long> proc_status_kib(int pid, const std::string& field) {
   while (std::getline(in, line))
     if (line.rfind(field + ":", 0) == 0) return std::stol(line.substr(field.size() + 1));
   return std::nullopt;
+}
+
+// A process's CPU time (user + system) in seconds, from /proc/PID/stat; 0 if it cannot be read.
+double proc_cpu_seconds(int pid) {
+  std::ifstream in("/proc/" + std::to_string(pid) + "/stat");
+  std::string stat((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const auto close = stat.rfind(')');  // the command name may hold spaces
+  if (close == std::string::npos) return 0;
+  std::istringstream rest(stat.substr(close + 2));
+  std::string field;
+  double utime = 0, stime = 0;
+  for (int i = 3; i <= 15 && rest >> field; ++i) {  // fields 14 and 15 (1-based): utime, stime
+    if (i == 14) utime = std::stod(field);
+    if (i == 15) stime = std::stod(field);
+  }
+  return (utime + stime) / static_cast<double>(sysconf(_SC_CLK_TCK));
+}
+
+double own_cpu_seconds() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  const auto s = [](timeval t) { return t.tv_sec + t.tv_usec * 1e-6; };
+  return s(u.ru_utime) + s(u.ru_stime);
 }
 
 int retry_after(const httplib::Response& r) {
@@ -426,6 +451,7 @@ int main(int argc, char** argv) {
     }
   });
 
+  const double server_cpu0 = o.server_pid > 0 ? proc_cpu_seconds(o.server_pid) : 0, own_cpu0 = own_cpu_seconds();
   const auto t0 = Steady::now();
   run.submitters_left = o.clients;
   std::vector<std::thread> threads;
@@ -448,6 +474,10 @@ int main(int argc, char** argv) {
   sampling = false;
   sampler.join();
 
+  const double server_cpu_ms = o.server_pid > 0 ? 1e3 * (proc_cpu_seconds(o.server_pid) - server_cpu0) /
+                                                      std::max(1L, static_cast<long>(run.accepted.size()))
+                                                : 0;
+  const double own_cpu_ms = 1e3 * (own_cpu_seconds() - own_cpu0) / std::max(1L, static_cast<long>(run.accepted.size()));
   const long hwm_kib = o.server_pid > 0 ? proc_status_kib(o.server_pid, "VmHWM").value_or(0) : 0;
   const long accepted = static_cast<long>(run.accepted.size());
   const double server_span_s =
@@ -469,14 +499,15 @@ int main(int argc, char** argv) {
                 "| streams followed to the end (incomplete) | %ld (%ld) |\n"
                 "| events received, live iteration events measured | %ld, %ld |\n"
                 "| iteration -> event delay p50 / p99 / max (upper bound, see below) | %.1f / %.1f / %.1f ms |\n"
-                "| server peak memory VmHWM (max VmRSS sampled) | %.1f MiB (%.1f MiB) |\n",
+                "| server peak memory VmHWM (max VmRSS sampled) | %.1f MiB (%.1f MiB) |\n"
+                "| CPU time per accepted job: server / this load client | %.1f / %.1f ms |\n",
                 o.jobs, accepted, v.successful, v.failed, v.unfinished, v.missing, v.incomplete, o.clients, o.streams,
                 run.steps, server_span_s > 0 ? accepted / server_span_s : 0.0, server_span_s, accepted / done_s, done_s,
                 percentile(run.submit_ms, 0.5), percentile(run.submit_ms, 0.99), percentile(run.submit_ms, 1.0),
                 run.rejected_503.load(), run.stream_503.load(), run.other_status.load(), run.transport_errors.load(),
                 run.replays.load(), run.streams_followed, run.streams_incomplete, run.events_received,
                 run.live_iterations, percentile(run.delay_ms, 0.5), percentile(run.delay_ms, 0.99),
-                percentile(run.delay_ms, 1.0), hwm_kib / 1024.0, rss_max_kib / 1024.0);
+                percentile(run.delay_ms, 1.0), hwm_kib / 1024.0, rss_max_kib / 1024.0, server_cpu_ms, own_cpu_ms);
   const std::string table = std::string("| | |\n|---|---|\n") + buf;
   std::printf("%s", table.c_str());
   std::printf("submission phase %.2f s; all %s\n", submit_s, all_ok ? "successful" : "NOT successful");
