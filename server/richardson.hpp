@@ -46,6 +46,12 @@ inline std::optional<double> observed_order(double f1, double f2, double f3, dou
   return p;
 }
 
+// The estimated error of a value: |value - extrapolated| / |extrapolated| (absolute where the
+// extrapolated value is 0).
+inline double error_against(double value, double extrapolated) {
+  return std::abs(value - extrapolated) / (extrapolated != 0 ? std::abs(extrapolated) : 1.0);
+}
+
 // values[k] on mesh size h[k], coarse to fine (h decreasing).
 inline Richardson richardson(const std::vector<double>& values, const std::vector<double>& h) {
   Richardson out;
@@ -66,10 +72,7 @@ inline Richardson richardson(const std::vector<double>& values, const std::vecto
     out.asymptotic = std::abs(*out.order_ratio - 1) <= kAsymptoticSpread;
   }
   if (out.extrapolated && std::isfinite(*out.extrapolated))
-    for (size_t k = 0; k < n; ++k) {
-      const double scale = *out.extrapolated != 0 ? std::abs(*out.extrapolated) : 1.0;
-      out.estimated_error[k] = std::abs(values[k] - *out.extrapolated) / scale;
-    }
+    for (size_t k = 0; k < n; ++k) out.estimated_error[k] = error_against(values[k], *out.extrapolated);
   else out.extrapolated.reset();
   return out;
 }

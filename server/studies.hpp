@@ -22,36 +22,46 @@ inline constexpr int kMaxStudyLevels = 6;
 // The most jobs of one sweep.
 inline constexpr int kMaxStudyJobs = 100;
 
-// A level of a refinement plan: its scene and its mesh size relative to the coarsest (1).
+// A job of a study: its scene and its mesh size relative to the coarsest (1). A refinement
+// plan with tolerances or methods has a job per (mesh level, method, tolerance).
 struct StudyLevel {
   nlohmann::json scene;
   double h = 1.0;
   nlohmann::json parameters;  // a sweep's variant: the values of its pointers
+  int mesh_level = 0;         // a refinement's level, from 1 (coarsest)
+  nlohmann::json tolerance;   // solver.contact.tolerance where the plan gives tolerances, else null
+  nlohmann::json method;      // solver.contact.method where the plan gives methods, else null
 };
 
-// The levels of a request {"scene", "refine": {"levels": k} | {"meshes": [ref, ...]}, "outputs"?},
+// The levels of a request {"scene", "refine": {"levels": k} | {"meshes": [ref, ...]},
+// "tolerances"?: [t, ...], "methods"?: [method, ...], "outputs"?},
 // coarse to fine, and the outputs it studies: generated meshes (rectangle, half_disc) of every
 // body with their divisions x 2^j and refine.size / 2^j (h = 2^-j); a gmsh mesh
 // (body.mesh.gmsh) replaced by each reference of the list in turn (h from the node counts,
-// filled in later). Throws SceneErrors whose pointers start at the request's root.
+// filled in later); with tolerances or methods, every level with each method at each
+// tolerance (loosest first). Throws SceneErrors whose pointers start at the request's root.
 // A sweep {"scene", "sweep": [{"pointer", "values" | "range": {from, to, count}}], "mode": "grid" |
 // "zip", "outputs"?}: a variant per combination (grid) or per index (zip) with each pointer's
 // value set; each pointer must name a value of the scene, and the variants are at most
 // kMaxStudyJobs.
+// An accuracy study {"scene", "accuracy": {"output", "relative", "levels"? (3 to 6, default 6),
+// "budget_seconds"?}}: the generated levels, made three first and then one at a time until the
+// output's estimated error at the finest is below `relative` (Studies::advance).
 struct StudyPlan {
-  std::string kind = "refinement";    // or "sweep"
+  std::string kind = "refinement";    // or "sweep", or "accuracy"
   std::vector<std::string> pointers;  // a sweep's, in the order of each variant's parameters
   std::vector<StudyLevel> levels;
   std::vector<std::string> outputs;
   bool h_from_nodes = false;  // a list of meshes: h_j = sqrt(nodes_0 / nodes_j)
+  nlohmann::json accuracy;    // an accuracy study's target: {output, relative, levels, budget_seconds?}
 };
 StudyPlan plan_study(const nlohmann::json& request);
 
 // The thresholds of "the cheapest level whose estimated error is below": 10 %, 1 %, 0.1 %.
 inline const std::vector<double> kStudyThresholds = {0.1, 0.01, 0.001};
 
-// A study's table as rows, one per level (or variant), for CSV (objects_csv): level, job,
-// status, nodes, seconds, h or parameters, outputs.NAME, estimated_error.NAME.
+// A study's table as rows, one per job, for CSV (objects_csv): level, job, status, nodes,
+// seconds, h (and method, tolerance) or parameters, outputs.NAME, estimated_error.NAME.
 std::vector<nlohmann::json> study_rows(const nlohmann::json& study);
 
 class Studies {
@@ -67,6 +77,12 @@ class Studies {
   bool remove(const std::string& id);
 
  private:
+  // The table of a study as far as its jobs have finished.
+  nlohmann::json table(const StudyRecord& rec, const nlohmann::json& plan);
+  // An accuracy study whose levels are done: its answer (reached, or why not) in `doc`, or
+  // the next level made (true: read the table again).
+  bool advance(const StudyRecord& rec, const nlohmann::json& plan, nlohmann::json& doc);
+
   JobService& jobs_;
 };
 

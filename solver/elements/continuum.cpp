@@ -77,8 +77,8 @@ ContinuumBody::ContinuumBody(PlaneMesh mesh, const std::vector<int>& contact_set
       if (const std::string why = m->finite_strain_issue(); !why.empty()) throw std::invalid_argument(why);
   }
   if (options_.analysis == PlaneAnalysis::axisymmetric) {
-    if (options_.kinematics == ContinuumKinematics::finite || options_.element == ContinuumElement::q4_bbar)
-      throw std::invalid_argument("axisymmetric is implemented for linear kinematics and t3, t6, q4, q8, q9");
+    if (options_.element == ContinuumElement::q4_bbar)
+      throw std::invalid_argument("axisymmetric is implemented for t3, t6, q4, q8, q9");
     if (const std::vector<int> off = nodes_off_half_plane(mesh_); !off.empty())
       throw std::invalid_argument("axisymmetric: nodes at r = x < 0: " + id_list(off));
   }
@@ -221,13 +221,13 @@ void ContinuumBody::internal_force(const Vector& q, Vector& force, Triplets* tan
   for (int e = 0; e < element_count(); ++e) {
     // A law with history answers from the committed state of each point.
     const size_t np = in.points[e].size();
-    const PointLaw law = [&](int k, const Mat2& E) {
-      return has_history_ ? material(e).finite_response(E, history_[e * np + k]).law : material(e).response(E);
-    };
+    PointLaw law;
+    if (has_history_)
+      law = [&](int k, const Mat2& E) { return material(e).finite_response(E, history_[e * np + k]).law; };
     if (options_.incompressibility == Incompressibility::f_bar)
-      f_bar_total_lagrangian(in.points[e], in.centroids[e], element_displacements(q, e), law, fe,
-                             tangent ? &Ke : nullptr);
-    else total_lagrangian(in.points[e], element_displacements(q, e), law, fe, tangent ? &Ke : nullptr);
+      f_bar_total_lagrangian(in.points[e], in.centroids[e], element_displacements(q, e), material(e), fe,
+                             tangent ? &Ke : nullptr, law);
+    else total_lagrangian(in.points[e], element_displacements(q, e), material(e), fe, tangent ? &Ke : nullptr, law);
     const auto& el = mesh_.elements[e];
     const int m = static_cast<int>(fe.size());
     for (int i = 0; i < m; ++i) {
@@ -357,7 +357,15 @@ Eigen::Vector4d ContinuumBody::centroid_stress(const Vector& q, int e) const {
     return {s[0], s[1], s[2], r.dS33 * eps};
   }
   const Mat2 F = deformation_gradient(c, u);
-  return cauchy_stress(F, material(e).response(0.5 * (F.transpose() * F - Mat2::Identity())));
+  const Mat2 E = 0.5 * (F.transpose() * F - Mat2::Identity());
+  if (options_.analysis != PlaneAnalysis::axisymmetric) return cauchy_stress(F, material(e).response(E));
+  const double F33 = 1 + c.N.dot(u.col(0)) / c.radius;
+  const HoopResponse h = material(e).hoop_response(E, 0.5 * (F33 * F33 - 1));
+  MaterialResponse r;
+  r.S = h.S.head<3>();
+  r.S33 = h.S[3];
+  r.C33 = F33 * F33;
+  return cauchy_stress(F, r);
 }
 
 FieldTable ContinuumBody::element_fields(const Vector& q) const {

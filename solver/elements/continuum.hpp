@@ -1,6 +1,6 @@
 #pragma once
 // A plane continuum body: isoparametric triangles and quadrilaterals (plane_element.hpp) in
-// plane strain, plane stress or axisymmetry (linear kinematics; x = r, y = z, every point
+// plane strain, plane stress or axisymmetry (x = r, y = z, every point
 // weighted by 2 pi r so that forces are totals over the full circle, `thickness` unused), with
 // an elastic law (plane_material.hpp).
 //   linear: small strain, sigma = D eps; K is constant, assembled once and reused (traits()

@@ -264,51 +264,59 @@ Mat2 deformation_gradient(const ElementPoint& point, const ShapeGradients& u) {
 }
 
 void total_lagrangian(const std::vector<ElementPoint>& points, const ShapeGradients& u, const PlaneMaterial& material,
-                      Vector& fe, Matrix* Ke) {
-  total_lagrangian(
-      points, u, [&](int, const Mat2& E) { return material.response(E); }, fe, Ke);
-}
-
-void total_lagrangian(const std::vector<ElementPoint>& points, const ShapeGradients& u, const PointLaw& law, Vector& fe,
-                      Matrix* Ke) {
+                      Vector& fe, Matrix* Ke, const PointLaw& law) {
   const int n = static_cast<int>(u.rows());
   fe = Vector::Zero(2 * n);
   if (Ke) *Ke = Matrix::Zero(2 * n, 2 * n);
-  Matrix B(3, 2 * n);
   for (size_t k = 0; k < points.size(); ++k) {
     const ElementPoint& p = points[k];
     const Mat2 F = deformation_gradient(p, u);
     const Mat2 E = 0.5 * (F.transpose() * F - Mat2::Identity());
-    const MaterialResponse r = law(static_cast<int>(k), E);
+    // Axisymmetric: the hoop stretch F33 = r / R = 1 + u_r / R and its strain (F33^2 - 1) / 2.
+    const bool hoop = p.radius > 0;
+    const double F33 = hoop ? 1 + p.N.dot(u.col(0)) / p.radius : 1.0;
+    Eigen::Vector3d S_voigt;
+    Matrix D;
+    double S33 = 0.0;
+    if (hoop) {
+      const HoopResponse r = material.hoop_response(E, 0.5 * (F33 * F33 - 1));
+      S_voigt = r.S.head<3>();
+      S33 = r.S[3];
+      D = r.D;
+    } else {
+      const MaterialResponse r = law ? law(static_cast<int>(k), E) : material.response(E);
+      S_voigt = r.S;
+      D = r.D;
+    }
     Mat2 S;
-    S << r.S[0], r.S[2], r.S[2], r.S[1];
+    S << S_voigt[0], S_voigt[2], S_voigt[2], S_voigt[1];
     const Mat2 P = F * S;  // first Piola-Kirchhoff stress
+    // dE = B du: rows E11, E22, 2 E12 (and E33 in axisymmetry); column pair of node a.
+    Matrix B = Matrix::Zero(D.rows(), 2 * n);
     for (int a = 0; a < n; ++a) {
       const Vec2 g = p.dN.row(a).transpose();
       fe.segment<2>(2 * a) += p.dV * P * g;
-      // dE = B du: rows E11, E22, 2 E12; column pair of node a.
       B(0, 2 * a) = F(0, 0) * g.x();
       B(0, 2 * a + 1) = F(1, 0) * g.x();
       B(1, 2 * a) = F(0, 1) * g.y();
       B(1, 2 * a + 1) = F(1, 1) * g.y();
       B(2, 2 * a) = F(0, 0) * g.y() + F(0, 1) * g.x();
       B(2, 2 * a + 1) = F(1, 0) * g.y() + F(1, 1) * g.x();
+      if (hoop) {
+        B(3, 2 * a) = F33 * p.N[a] / p.radius;  // dE33 = F33 du_r / R
+        fe[2 * a] += p.dV * S33 * B(3, 2 * a);
+      }
     }
     if (!Ke) continue;
-    Ke->noalias() += p.dV * B.transpose() * r.D * B;
+    Ke->noalias() += p.dV * B.transpose() * D * B;
     const Matrix G = p.dN * S * p.dN.transpose();  // geometric stiffness dN_a . S dN_b
     for (int a = 0; a < n; ++a)
       for (int b = 0; b < n; ++b) {
         (*Ke)(2 * a, 2 * b) += p.dV * G(a, b);
         (*Ke)(2 * a + 1, 2 * b + 1) += p.dV * G(a, b);
+        if (hoop) (*Ke)(2 * a, 2 * b) += p.dV * S33 * p.N[a] * p.N[b] / (p.radius * p.radius);
       }
   }
-}
-
-void f_bar_total_lagrangian(const std::vector<ElementPoint>& points, const ElementPoint& centre,
-                            const ShapeGradients& u, const PlaneMaterial& material, Vector& fe, Matrix* Ke) {
-  f_bar_total_lagrangian(
-      points, centre, u, [&](int, const Mat2& E) { return material.response(E); }, fe, Ke);
 }
 
 Mat2 f_bar(const ElementPoint& point, const ElementPoint& centre, const ShapeGradients& u) {
@@ -317,7 +325,8 @@ Mat2 f_bar(const ElementPoint& point, const ElementPoint& centre, const ShapeGra
 }
 
 void f_bar_total_lagrangian(const std::vector<ElementPoint>& points, const ElementPoint& centre,
-                            const ShapeGradients& u, const PointLaw& law, Vector& fe, Matrix* Ke) {
+                            const ShapeGradients& u, const PlaneMaterial& material, Vector& fe, Matrix* Ke,
+                            const PointLaw& law) {
   const int n = static_cast<int>(u.rows());
   fe = Vector::Zero(2 * n);
   if (Ke) *Ke = Matrix::Zero(2 * n, 2 * n);
@@ -329,7 +338,8 @@ void f_bar_total_lagrangian(const std::vector<ElementPoint>& points, const Eleme
     const Mat2 F = deformation_gradient(p, u);
     const double alpha = std::sqrt(F0.determinant() / F.determinant());
     const Mat2 Fb = alpha * F;
-    const MaterialResponse r = law(static_cast<int>(i), 0.5 * (Fb.transpose() * Fb - Mat2::Identity()));
+    const Mat2 Eb = 0.5 * (Fb.transpose() * Fb - Mat2::Identity());
+    const MaterialResponse r = law ? law(static_cast<int>(i), Eb) : material.response(Eb);
     Mat2 S;
     S << r.S[0], r.S[2], r.S[2], r.S[1];
     const Mat2 tau = Fb * S * Fb.transpose();

@@ -17,6 +17,17 @@
 // with a clearance of half the current thickness toward the obstacle (frozen in T), and the
 // contact force acts on the node (virtual work at the node: the friction force is not scaled
 // by R / (R + t/2)).
+//
+// Axisymmetric (docs/algorithm.md#axisymmetric-membrane): the polyline is a meridian in the
+// r-z half-plane (x = r >= 0, y = z), each element a conical frustum. Two strain increments,
+// meridional d1 = ln(l / L0) and hoop d2 = ln(rm / Rm0) (rm the element's mid radius), and
+// Hill's effective strain increment for normal anisotropy (the work conjugate of Hill 1979),
+//   phi = A [ |d1 + d2|^m + B |d1 - d2|^m ]^(1/m),  m = M / (M - 1),
+//   A = [2(1+r)]^(1/M) / 2, B = (1 + 2r)^(-1/(M-1))   (phi = c |d1| at d2 = 0),
+// regularized as d_eps_bar = sqrt(phi^2 + e0^2) - e0. The element's work of the step,
+// V int_0^d_eps_bar sigma_bar(eps_bar + s) ds with V = 2 pi Rm t L its volume, is the
+// potential of its nodal forces (forces are totals over the circle); thickness t = V / (2 pi
+// rm l) = t0 exp(-(e1 + e2)). M < 2 makes the Hessian of phi singular at equal increments.
 #include <vector>
 
 #include "solver/model/body.hpp"
@@ -34,12 +45,17 @@ struct HillMaterial {
   double plane_strain_factor() const;
   double flow_stress(double eps_bar) const;
   double hardening_slope(double eps_bar) const;
+  // Half the square of Hill's effective strain increment, psi = phi^2 / 2, of the meridional
+  // and hoop increments d = (d1, d2), with its gradient and Hessian.
+  double half_square_increment(const Vec2& d, Vec2* gradient, Mat2* hessian) const;
 };
 
 class RigidPlasticMembrane final : public Body {
  public:
-  // Nodes in order along the sheet; `thickness` initial; `width` out of plane.
-  RigidPlasticMembrane(std::vector<Vec2> nodes, double thickness, HillMaterial material, double width = 1.0);
+  // Nodes in order along the sheet; `thickness` initial; `width` out of plane (plane strain).
+  // Axisymmetric: the nodes at x = r >= 0, no element on the axis; `width` unused.
+  RigidPlasticMembrane(std::vector<Vec2> nodes, double thickness, HillMaterial material, double width = 1.0,
+                       bool axisymmetric = false);
 
   int dof_count() const override { return 2 * node_count(); }
   Vector dof_length_scales() const override { return Vector::Ones(dof_count()); }
@@ -53,6 +69,7 @@ class RigidPlasticMembrane final : public Body {
   // flat sheet is free until tension stiffens it; solver.start handles that state.
   Vector rigid_translation(const Vec2& d) const override;
   Traits traits() const override { return {true, true, false}; }
+  bool axisymmetric() const override { return axisymmetric_; }
   std::vector<std::vector<int>> cells() const override;
   FieldTable site_fields(const Vector& q) const override;
   FieldTable element_fields(const Vector& q) const override;
@@ -78,15 +95,31 @@ class RigidPlasticMembrane final : public Body {
   };
   ElementState element_state(const Vector& q, int element) const;
 
+  // Axisymmetric: the element's strain increments, its nodal forces (xa, ya, xb, yb) and,
+  // if K is given, their derivative.
+  struct FrustumState {
+    double l = 0.0, rm = 0.0;        // current length and mid radius
+    double d1 = 0.0, d2 = 0.0;       // meridional and hoop strain increments of the step
+    double deps = 0.0, sigma = 0.0;  // regularized effective strain increment, flow stress
+    double thickness = 0.0;          // current
+    double tension = 0.0;            // meridional force per unit length of the circle
+    Eigen::Vector4d force = Eigen::Vector4d::Zero();
+  };
+  FrustumState frustum_state(const VectorRef& q, int element, Eigen::Matrix4d* K) const;
+
  private:
+  double current_thickness(const VectorRef& q, int element) const;
   std::vector<Vec2> nodes_;
   double width_;
   HillMaterial material_;
   double c_;  // plane-strain factor
   double initial_thickness_;
   std::vector<double> initial_length_;
+  bool axisymmetric_ = false;
+  std::vector<double> initial_radius_, volume_;  // axisymmetric: mid radius, 2 pi Rm t L
+  std::vector<Vec2> committed_x_;                // axisymmetric: node positions at the last commit
   // Committed state (end of the last converged step).
-  std::vector<double> eps_bar_, thickness_, length_;
+  std::vector<double> eps_bar_, thickness_, length_, radius_;
 };
 
 }  // namespace grip

@@ -66,7 +66,7 @@ std::shared_ptr<const PlaneMaterial> read_j2_material(Reader& r, json& mat, cons
     return nullptr;
   }
   auto law = std::make_shared<J2Material>(young, poisson, yield_stress, std::move(h), kinematic, options.analysis);
-  if (options.kinematics == ContinuumKinematics::finite && options.analysis != PlaneAnalysis::axisymmetric)
+  if (options.kinematics == ContinuumKinematics::finite)
     if (const std::string why = law->finite_strain_issue(); !why.empty()) {
       const size_t colon = why.find(':');
       r.error(mp + "/" + why.substr(0, colon), why.substr(colon + 2));
@@ -423,10 +423,6 @@ void read_continuum(Reader& r, json& body, Problem& problem, const std::string& 
       r.error(ptr + "/element", "\"q4_bbar\" is for plane strain: plane stress does not lock, use \"q4\"");
     if (options.analysis == PlaneAnalysis::axisymmetric)
       r.error(ptr + "/element", "\"q4_bbar\" is for plane strain: in axisymmetry use t3, t6, q4, q8 or q9");
-  }
-  if (options.analysis == PlaneAnalysis::axisymmetric) {
-    if (options.kinematics == ContinuumKinematics::finite)
-      r.error(ptr + "/kinematics", "\"axisymmetric\" is implemented for linear kinematics: give \"linear\"");
   }
   const ElementShape shape = element_shape(options.element);
 

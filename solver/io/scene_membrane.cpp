@@ -1,10 +1,11 @@
+#include "solver/elements/continuum.hpp"  // id_list
 #include "solver/elements/rigid_plastic_membrane.hpp"
 #include "solver/io/scene_reader.hpp"
 
 namespace grip::scene_io {
 
 // body: {"model": "rigid_plastic_membrane", "material": {r, M, H, a0, n, regularization},
-//        "thickness", "width", "mesh": {"origin", "length", "elements"} | {"nodes": [[x, y]...]},
+//        "thickness", "width", "analysis": "plane_strain" | "axisymmetric", "mesh": {"origin", "length", "elements"} | {"nodes": [[x, y]...]},
 //        "supports": [{"node", "fix": ["x", "y"]}], "loads": [{"node", "force", "case"}]}
 void read_rigid_plastic_membrane(Reader& r, json& body, Problem& problem, const std::string& ptr) {
   json* mat = r.object(body, ptr, "material", true);
@@ -22,7 +23,11 @@ void read_rigid_plastic_membrane(Reader& r, json& body, Problem& problem, const 
     m.regularization = r.positive(*mat, mp, "regularization", 1e-5);
   }
   const double thickness = r.positive(body, ptr, "thickness");
-  const double width = r.positive(body, ptr, "width", 1.0);
+  const bool axisymmetric =
+      r.choice(body, ptr, "analysis", {"plane_strain", "axisymmetric"}, "plane_strain") == "axisymmetric";
+  if (axisymmetric && body.contains("width"))
+    r.error(ptr + "/width", "is not used in axisymmetry (forces are totals over the circle): leave it out");
+  const double width = axisymmetric ? 1.0 : r.positive(body, ptr, "width", 1.0);
   std::vector<Vec2> nodes;
   if (mesh) {
     const std::string mp = ptr + "/mesh";
@@ -45,10 +50,32 @@ void read_rigid_plastic_membrane(Reader& r, json& body, Problem& problem, const 
       for (int i = 0; i <= elements; ++i) nodes.push_back(origin + Vec2(length * i / elements, 0));
     }
   }
+  if (axisymmetric) {
+    std::vector<int> off;
+    for (size_t i = 0; i < nodes.size(); ++i)
+      if (!(nodes[i].x() >= 0)) off.push_back(static_cast<int>(i));
+    if (!off.empty())
+      r.error(ptr + "/mesh",
+              "axisymmetric: the meridian lies in the half-plane r = x >= 0; nodes at x < 0: " + id_list(off));
+    for (size_t i = 1; i < nodes.size(); ++i)
+      if (nodes[i].x() == 0 && nodes[i - 1].x() == 0)
+        r.error(ptr + "/mesh", "axisymmetric: element " + std::to_string(i - 1) + " lies on the axis");
+  }
   if (!r.issues.empty()) return;
-  problem.body = std::make_unique<RigidPlasticMembrane>(nodes, thickness, m, width);
+  problem.body = std::make_unique<RigidPlasticMembrane>(nodes, thickness, m, width, axisymmetric);
   const int count = static_cast<int>(nodes.size());
   read_supports(r, body, ptr, count, {"x", "y"}, &RigidPlasticMembrane::node_dof, problem);
+  if (axisymmetric) {  // u_r = 0 on the axis, as for the continuum (docs/algorithm.md#axisymmetric)
+    std::vector<char> fixed(2 * nodes.size(), 0);
+    for (const Constraint& c : problem.constraints) fixed[c.dof] = 1;
+    AxisHold hold{r.body_index, {}};
+    for (int k = 0; k < count; ++k)
+      if (nodes[k].x() == 0 && !fixed[RigidPlasticMembrane::node_dof(k, 0)]) {
+        problem.constraints.push_back({RigidPlasticMembrane::node_dof(k, 0), 0.0, 0});
+        hold.nodes.push_back(k);
+      }
+    r.axis_holds.push_back(std::move(hold));
+  }
   if (json* loads = r.array(body, ptr, "loads", false))
     for (size_t i = 0; i < loads->size(); ++i) {
       const std::string lp = ptr + "/loads/" + std::to_string(i);

@@ -2,6 +2,7 @@
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <stdexcept>
 
 namespace grip {
 namespace {
@@ -43,6 +44,10 @@ PointResponse PlaneMaterial::small_strain_response(const Eigen::Vector4d& strain
   return r;
 }
 
+HoopResponse PlaneMaterial::hoop_response(const Mat2& /*E*/, double /*E33*/) const {
+  throw std::logic_error("hoop_response: this law has no finite-strain form");
+}
+
 HookeMaterial::HookeMaterial(double young, double poisson, PlaneAnalysis analysis)
     : lame_(Lame::from(young, poisson)), analysis_(analysis) {
   const double l = lame_.lambda, m = lame_.mu;
@@ -63,6 +68,13 @@ MaterialResponse HookeMaterial::response(const Mat2& E) const {
   } else {
     r.C33 = 1 - 2 * l / (l + 2 * m) * (e[0] + e[1]);  // 1 + 2 E33, E33 from S33 = 0
   }
+  return r;
+}
+
+HoopResponse HookeMaterial::hoop_response(const Mat2& E, double E33) const {
+  HoopResponse r;
+  r.D = small_strain_D4();
+  r.S = r.D * Eigen::Vector4d(E(0, 0), E(1, 1), 2 * E(0, 1), E33);
   return r;
 }
 
@@ -102,6 +114,25 @@ MaterialResponse NeoHookeMaterial::response(const Mat2& E) const {
     // Condense E33 out: dS33 = 0 = l/C33 ci . dE + (l + 2 b)/C33^2 dE33.
     r.D -= l * l / (l + 2 * b) * ci * ci.transpose();
   }
+  return r;
+}
+
+HoopResponse NeoHookeMaterial::hoop_response(const Mat2& E, double E33) const {
+  // The 3D law with C = diag(C_plane, C33): S = mu (I - C^-1) + lambda ln J C^-1, J^2 = det C.
+  const double l = lame_.lambda, m = lame_.mu;
+  const Mat2 C = Mat2::Identity() + 2 * E;
+  const double C33 = 1 + 2 * E33;
+  const Mat2 Ci = C.inverse();
+  const double lnJ = 0.5 * std::log(C.determinant() * C33);
+  const double b = m - l * lnJ;
+  const Vec3 ci = voigt(Ci);
+  HoopResponse r;
+  r.S.head<3>() = voigt(m * (Mat2::Identity() - Ci) + l * lnJ * Ci);
+  r.S[3] = m * (1 - 1 / C33) + l * lnJ / C33;
+  r.D.topLeftCorner<3, 3>() = voigt_tangent(Ci, l, b);
+  r.D.block<3, 1>(0, 3) = l / C33 * ci;
+  r.D.block<1, 3>(3, 0) = l / C33 * ci.transpose();
+  r.D(3, 3) = (l + 2 * b) / (C33 * C33);
   return r;
 }
 

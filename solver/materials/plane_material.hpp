@@ -6,7 +6,8 @@
 // Plane strain: E33 = 0, S33 follows. Plane stress: S33 = 0, E33 follows (condensed out of
 // the tangent). Axisymmetric: the section in the r-z half-plane (x = r, y = z), direction 3 the
 // hoop direction; the laws answer as in plane strain at E33 = 0 (S33 the hoop stress there) and
-// give the hoop stiffness dS33/dE33, which the axisymmetric element (small strain) needs.
+// give the hoop stiffness dS33/dE33, which the axisymmetric element (small strain) needs;
+// under finite kinematics the axisymmetric element asks hoop_response with the hoop strain E33.
 // Units are the scene's: young in force / length^2.
 #include <Eigen/Core>
 #include <memory>
@@ -46,6 +47,13 @@ struct FinitePointResponse {
   bool yielding = false;  // the point flows plastically from its committed state
 };
 
+// Response of a law to the in-plane and the hoop strain (axisymmetric finite kinematics), in the
+// order (11, 22, 12, 33) with E as (E11, E22, 2 E12, E33).
+struct HoopResponse {
+  Eigen::Vector4d S = Eigen::Vector4d::Zero();
+  Eigen::Matrix4d D = Eigen::Matrix4d::Zero();
+};
+
 // Small-strain response of a point with history, in the order (11, 22, 12, 33) of the
 // axisymmetric element (rr, zz, rz, tt): strain with the engineering shear, 33 the hoop strain
 // in axisymmetry and zero in plane strain.
@@ -80,6 +88,10 @@ class PlaneMaterial {
   }
   // Why the law cannot run under finite kinematics, as "field: reason" (empty if it can).
   virtual std::string finite_strain_issue() const { return {}; }
+  // Axisymmetric finite strain: S (11, 22, 12, 33) and dS/dE (4 x 4, symmetric) for the
+  // in-plane E and the hoop E33 = (F33^2 - 1) / 2 (F33 = r / R). Laws with history: not
+  // defined (the body refuses them under finite kinematics).
+  virtual HoopResponse hoop_response(const Mat2& E, double E33) const;
 };
 
 // Lame constants from Young's modulus and Poisson's ratio (3D values: plane stress is
@@ -96,6 +108,7 @@ class HookeMaterial final : public PlaneMaterial {
  public:
   HookeMaterial(double young, double poisson, PlaneAnalysis analysis);
   MaterialResponse response(const Mat2& E) const override;
+  HoopResponse hoop_response(const Mat2& E, double E33) const override;
 
  private:
   Lame lame_;
@@ -110,6 +123,7 @@ class NeoHookeMaterial final : public PlaneMaterial {
  public:
   NeoHookeMaterial(double young, double poisson, PlaneAnalysis analysis);
   MaterialResponse response(const Mat2& E) const override;
+  HoopResponse hoop_response(const Mat2& E, double E33) const override;
 
  private:
   Lame lame_;

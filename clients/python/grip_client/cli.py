@@ -536,7 +536,13 @@ def cmd_sweep(client: Client, args, out: TextIO) -> int:
 
 def cmd_study(client: Client, args, out: TextIO) -> int:
     scene = load_scene_with_meshes(client, args.scene, args.mesh)
-    doc = client.study(scene, levels=args.levels, outputs=args.output or None)
+    accuracy = None
+    if args.accuracy:
+        name, _, relative = args.accuracy.partition("=")
+        accuracy = {"output": name, "relative": float(relative or 0)}
+    doc = client.study(scene, levels=args.levels, outputs=args.output or None,
+                       tolerances=args.tolerance or None, methods=args.method or None,
+                       accuracy=accuracy)
     sys.stderr.write(f"study {doc['id']}: {len(doc['levels'])} levels\n")
     doc = client.wait_study(doc["id"], timeout=args.timeout)
     if args.json:
@@ -545,19 +551,35 @@ def cmd_study(client: Client, args, out: TextIO) -> int:
         names = [q["name"] for q in doc["quantities"]]
         rows = []
         for k, level in enumerate(doc["levels"]):
-            row: List[Any] = [level["level"], level["nodes"], level.get("seconds"), level["status"]]
+            row: List[Any] = [level["level"], level.get("method"), level.get("tolerance"),
+                              level["nodes"], level.get("seconds"), level["status"]]
             for q in doc["quantities"]:
                 row += [q["values"][k], q["estimated_error"][k]]
             rows.append(row)
-        table(rows, ["level", "nodes", "seconds", "status"]
+        table(rows, ["level", "method", "tolerance", "nodes", "seconds", "status"]
               + [h for n in names for h in (n, n + " error")], out)
         out.write("\n")
         summary = []
+
+        def job_name(c: Optional[dict]) -> Optional[str]:
+            if not c:
+                return None
+            parts = [f"level {c['level']}"] + [f"{c[k]}" for k in ("method", "tolerance") if k in c]
+            return ", ".join(parts) + f" ({c['seconds']:.3g} s)"
         for q in doc["quantities"]:
-            cheapest = [c["level"]["level"] if c["level"] else None for c in q["cheapest"]]
+            cheapest = [job_name(c["level"]) for c in q["cheapest"]]
             summary.append([q["name"], q["order"], q["extrapolated"], q["asymptotic"]] + cheapest)
         table(summary, ["quantity", "order", "extrapolated", "asymptotic"]
-              + [f"level < {100 * b:g} %" for b in doc["thresholds"]], out)
+              + [f"cheapest < {100 * b:g} %" for b in doc["thresholds"]], out)
+        answer = doc.get("answer")
+        if answer:
+            out.write("\n")
+            if answer.get("reached"):
+                out.write(f"accurate: {doc['accuracy']['output']} = {answer['value']} at level "
+                          f"{answer['level']} (job {answer['job']}), estimated error "
+                          f"{answer['estimated_error']:.3g}\n")
+            else:
+                out.write(f"not reached: {answer.get('reason')}\n")
     return EXIT_OK if doc["status"] == "successful" else EXIT_FAILED
 
 
@@ -647,6 +669,13 @@ def build_parser() -> argparse.ArgumentParser:
                             "observed order, Richardson value and what each accuracy costs")
     s.add_argument("scene", help="scene JSON file (with outputs), or example:NAME")
     s.add_argument("--levels", type=int, default=3, help="mesh levels, divisions x 2^j (default 3)")
+    s.add_argument("--tolerance", type=float, action="append", metavar="T",
+                   help="a contact tolerance to run every level at (repeatable)")
+    s.add_argument("--method", action="append", choices=["cev", "uzawa", "penalty", "ssn"],
+                   help="a contact method to run every level with (repeatable)")
+    s.add_argument("--accuracy", metavar="NAME=RELATIVE",
+                   help="refine until output NAME's estimated error is below RELATIVE "
+                        "(instead of --levels)")
     s.add_argument("--output", action="append", metavar="NAME",
                    help="one of the scene's outputs to study (repeatable; default all)")
     s.add_argument("--mesh", action="append", default=[], metavar="PART.msh",

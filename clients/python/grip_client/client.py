@@ -245,13 +245,25 @@ class Client:
     # ---- studies
 
     def study(self, scene: dict, levels: Optional[int] = None,
-              meshes: Optional[List[dict]] = None, outputs: Optional[List[str]] = None) -> dict:
-        """Starts a refinement study (POST /v1/studies): the scene at `levels` mesh levels
-        (generated meshes: divisions x 2^j), or on each of `meshes` ({"id": ...} of uploads,
-        coarse to fine). The scene names its quantities in `outputs`; `outputs` here picks some.
+              meshes: Optional[List[dict]] = None, outputs: Optional[List[str]] = None,
+              tolerances: Optional[List[float]] = None, methods: Optional[List[str]] = None,
+              accuracy: Optional[dict] = None) -> dict:
+        """Starts a study (POST /v1/studies): the scene at `levels` mesh levels (generated
+        meshes: divisions x 2^j), or on each of `meshes` ({"id": ...} of uploads, coarse to
+        fine), each level with every one of `methods` at every one of `tolerances` (contact
+        methods and tolerances) where given; or, with `accuracy` ({"output", "relative",
+        "levels"?, "budget_seconds"?}), refined until that output's estimated error is below
+        `relative`. The scene names its quantities in `outputs`; `outputs` here picks some.
         Returns the study's document (its id, levels and table so far)."""
-        body: Dict[str, Any] = {"scene": scene,
-                                "refine": {"meshes": meshes} if meshes else {"levels": levels}}
+        body: Dict[str, Any] = {"scene": scene}
+        if accuracy:
+            body["accuracy"] = dict(accuracy)
+        else:
+            body["refine"] = {"meshes": meshes} if meshes else {"levels": levels}
+        if tolerances:
+            body["tolerances"] = list(tolerances)
+        if methods:
+            body["methods"] = list(methods)
         if outputs:
             body["outputs"] = list(outputs)
         return self.request("POST", "/v1/studies", json.dumps(body).encode("utf-8"),

@@ -9,6 +9,9 @@ user) can compare them with the result's numbers.
     strain(result)             strain along the sheet (membrane; Fig. 5)
     contact_stress(result, "normal" | "friction")   contact stress along the body (Figs. 7, 8)
     load_deflection(result)    load against end deflection (bodies with loads; Fig. 9)
+    punch_force(result)        the moving tool's force against its travel (punch stretching)
+    radial_strains(result)     meridional, hoop and thickness strains over the radius at
+                               several punch depths (axisymmetric membrane)
 
 `write_all(result, out_dir, prefix)` writes every figure that applies and returns
 {name: path}.
@@ -603,10 +606,102 @@ def load_deflection(result: dict, node: Optional[int] = None):
     return fig, data
 
 
+def tool_force(step: dict, obstacle: str) -> Tuple[float, float]:
+    """The force the body puts on `obstacle` in a step: minus the sum of the contact forces
+    on the body, p_n (-n) + p_t t with t = (-n_y, n_x) (docs/design.md#scenes-results-and-events)."""
+    fx = fy = 0.0
+    for c in step.get("contact_points") or []:
+        if c["obstacle"] != obstacle:
+            continue
+        nx, ny = c["normal"]
+        fx += c["p_n"] * nx + c["p_t"] * ny
+        fy += c["p_n"] * ny - c["p_t"] * nx
+    return fx, fy
+
+
+def tool_travel(step: dict, obstacle: str) -> float:
+    for o in step.get("obstacles", []) or []:
+        if o["name"] == obstacle:
+            return math.hypot(*o["offset"])
+    return 0.0
+
+
+def punch_force(result: dict):
+    """The moving tool's force along its travel against the travel (punch stretching; a total
+    over the circle in axisymmetry).
+
+    data = {"obstacle", "travel": [0, ...], "force": [0, ...]}"""
+    plt = pyplot()
+    mover = moving_obstacle(result)
+    steps = [s for s in field_steps(result) if s.get("contact_points") is not None]
+    if not mover or not steps:
+        raise ValueError("the result has no moving obstacle with contact points")
+    travel, force = [0.0], [0.0]
+    for s in steps:
+        d = tool_travel(s, mover)
+        off = next(o["offset"] for o in s["obstacles"] if o["name"] == mover)
+        fx, fy = tool_force(s, mover)
+        travel.append(d)
+        # The force resisting the motion: along the unit travel direction, opposed.
+        force.append(-(fx * off[0] + fy * off[1]) / d if d > 0 else 0.0)
+    data = {"obstacle": mover, "travel": travel, "force": force}
+    fig, ax = plt.subplots(figsize=(7, 5))
+    ax.plot(travel, force, "-o", ms=3, gid="force", label=f"{mover} force")
+    u = units(result)
+    ax.set_xlabel(f"{mover} travel" + _unit(u["length"]))
+    ax.set_ylabel(f"{mover} force" + _unit(u["force"]))
+    ax.set_title(f"{mover.capitalize()} force against travel")
+    ax.grid(True, alpha=0.25)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    return fig, data
+
+
+def radial_strains(result: dict, depths: Sequence[float] = (10.0, 20.0, 30.0)):
+    """Meridional, hoop and thickness true strains against the initial radius at the steps
+    where the moving tool has travelled each of `depths` (the nearest recorded step).
+
+    data = {"steps": {step: {"travel", "r0", "meridional_strain", "hoop_strain",
+    "thickness_strain"}}}"""
+    plt = pyplot()
+    steps = field_steps(result)
+    if not steps or "hoop_strain" not in (steps[-1].get("elements") or [{}])[0]:
+        raise ValueError("the result has no axisymmetric membrane strains (elements.hoop_strain)")
+    mover = moving_obstacle(result)
+    picked = []
+    for d in depths:
+        s = min(steps, key=lambda st: abs(tool_travel(st, mover) - d)) if mover else steps[-1]
+        if s not in picked:
+            picked.append(s)
+    fig, ax = plt.subplots(figsize=(8, 6))
+    data = {"steps": {}}
+    styles = {"meridional_strain": "-", "hoop_strain": "--", "thickness_strain": ":"}
+    cmap = plt.get_cmap("viridis")
+    for i, s in enumerate(picked):
+        els = s["elements"]
+        r0 = [e["s0"] for e in els]  # the blank is flat: s0 is the initial radius
+        entry = {"travel": tool_travel(s, mover) if mover else None, "r0": r0}
+        color = cmap(i / max(len(picked) - 1, 1))
+        for key, ls in styles.items():
+            entry[key] = [e[key] for e in els]
+            ax.plot(r0, entry[key], ls, color=color, lw=1.3, gid=f"{key}-{s['step']}",
+                    label=f"{key.split('_')[0]}, {step_label(result, s)}")
+        data["steps"][s["step"]] = entry
+    ax.axhline(0, color="0.5", lw=0.6)
+    u = units(result)
+    ax.set_xlabel("initial radius r0" + _unit(u["length"]))
+    ax.set_ylabel("true strain")
+    ax.set_title("Strains over the radius")
+    ax.grid(True, alpha=0.25)
+    ax.legend(fontsize=7, ncol=len(picked), loc="upper center", bbox_to_anchor=(0.5, -0.14))
+    fig.tight_layout()
+    return fig, data
+
+
 # ---- all at once
 
 FIGURES = ("convergence", "shapes", "strain", "contact_normal", "contact_friction",
-           "load_deflection")
+           "load_deflection", "punch_force", "radial_strains")
 
 
 def applicable(result: dict) -> List[str]:
@@ -618,6 +713,10 @@ def applicable(result: dict) -> List[str]:
     last = field_steps(result)[-1]
     if (last.get("elements") or [{}])[0].get("major_strain") is not None:
         names.append("strain")
+    if (last.get("elements") or [{}])[0].get("hoop_strain") is not None:
+        names.append("radial_strains")
+        if moving_obstacle(result) and last.get("contact_points") is not None:
+            names.append("punch_force")
     if last.get("contact_points"):
         names.append("contact_normal")
         if any(c.get("sigma_t", 0) != 0 for c in last["contact_points"]) or any(
@@ -642,6 +741,10 @@ def make(result: dict, name: str, history=None, step: Optional[int] = None):
         return contact_stress(result, "friction", step)
     if name == "load_deflection":
         return load_deflection(result)
+    if name == "punch_force":
+        return punch_force(result)
+    if name == "radial_strains":
+        return radial_strains(result)
     raise ValueError(f"unknown figure {name!r}; figures: {', '.join(FIGURES)}")
 
 

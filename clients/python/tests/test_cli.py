@@ -265,7 +265,14 @@ class Study(unittest.TestCase):
         p = support.cli("study", path, "--levels", "3")
         self.assertEqual(p.returncode, 0, p.stdout + p.stderr)
         self.assertIn("u_inner error", p.stdout)
-        self.assertIn("level < 1 %", p.stdout)
+        self.assertIn("cheapest < 1 %", p.stdout)
+        # Refined until u_inner's estimate is below 0.5 %: three levels give 2.9e-3.
+        p = support.cli("study", path, "--accuracy", "u_inner=0.005", "--json")
+        self.assertEqual(p.returncode, 0, p.stdout + p.stderr)
+        doc = json.loads(p.stdout)
+        self.assertTrue(doc["answer"]["reached"], doc["answer"])
+        self.assertEqual(doc["answer"]["level"], 3)
+        self.assertLess(doc["answer"]["estimated_error"], 0.005)
 
 
 if __name__ == "__main__":

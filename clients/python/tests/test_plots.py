@@ -246,5 +246,48 @@ class TwoBodyPlots(PlotCase):
         self.assertIn("contact_normal", self.plots.applicable(self.result))
 
 
+class PunchStretchingPlots(PlotCase):
+    """The axisymmetric punch stretching (schemas/examples/punch-stretching-axisymmetric.json,
+    solved by `grip solve`): the punch force against the depth, and the strains over the radius
+    at 10, 20 and 30 mm, each series the result's numbers."""
+
+    @classmethod
+    def produce(cls):
+        import subprocess
+
+        out = os.path.join(cls.tmp.name, "result.json")
+        scene = os.path.join(support.EXAMPLES, "punch-stretching-axisymmetric.json")
+        subprocess.run([support.grip_binary(), "solve", scene, "--out", out], check=True,
+                       capture_output=True, timeout=300)
+        with open(out, encoding="utf-8") as f:
+            cls.result = json.load(f)
+
+    def test_punch_force_against_depth(self):
+        fig, data = self.plots.punch_force(self.result)
+        line = lines_by_gid(fig)["force"]
+        steps = self.result["steps"]
+        self.assertEqual(floats(line.get_xdata()), [0.0] + [-s["obstacles"][0]["offset"][1] for s in steps])
+        # The force on the punch: minus the contact forces on the sheet, -p_n n + p_t (-n_y, n_x).
+        expected = [0.0] + [sum(c["p_n"] * c["normal"][1] - c["p_t"] * c["normal"][0]
+                                for c in s["contact_points"] if c["obstacle"] == "punch") for s in steps]
+        for got, want in zip(floats(line.get_ydata()), expected):
+            self.assertAlmostEqual(got, want, delta=1e-9 * max(expected))
+        self.assertTrue(all(b > a for a, b in zip(expected, expected[1:])))  # rises with the depth
+        self.assertIn("punch_force", self.plots.applicable(self.result))
+
+    def test_strains_over_the_radius(self):
+        fig, data = self.plots.radial_strains(self.result)
+        self.assertEqual(sorted(data["steps"]), [10, 20, 30])
+        lines = lines_by_gid(fig)
+        for k in (10, 20, 30):
+            els = self.result["steps"][k - 1]["elements"]
+            for key in ("meridional_strain", "hoop_strain", "thickness_strain"):
+                line = lines[f"{key}-{k}"]
+                self.assertEqual(floats(line.get_xdata()), [e["s0"] for e in els])
+                self.assertEqual(floats(line.get_ydata()), [e[key] for e in els])
+        self.assertIn("radial_strains", self.plots.applicable(self.result))
+        self.assertNotIn("strain", self.plots.applicable(self.result))
+
+
 if __name__ == "__main__":
     unittest.main()
