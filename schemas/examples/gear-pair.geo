@@ -3,8 +3,9 @@
 // backlash), the driver z1 = 20 (centre at the origin, pitch radius 20), the driven z2 = 30
 // (centre at (50, 0), pitch radius 30). Each sector holds 3 teeth and a rim down to its hub (the
 // inner arc, radius 12 and 22), which the scene turns. Drawn at the first mesh position: the
-// driver turned by -12 degrees from the position where its middle tooth touches at the pitch
-// point, the driven by +8 degrees (-12 z1 / z2) plus a preload angle `preload`, which presses
+// driver turned by -12 degrees from the position where its middle tooth's axis lies on the line
+// of centres (its leading flank touches at the pitch point half a tooth's thickness, 4.5
+// degrees, before that), the driven by +8 degrees (-12 z1 / z2) plus a preload angle `preload`, which presses
 // the meshing flanks together (the transmitted load). The driven teeth are the three that the
 // driver's leading (counter-clockwise) flanks push while the driver turns counter-clockwise.
 // Mesh it with

@@ -110,11 +110,12 @@ function parseEvents(buffer) {
   return [events, rest];
 }
 
-// Follows a job's events until job_finished or job_failed, or until `signal` aborts. Calls
+// Follows an event stream (`path`) until an event of `endTypes`, or until `signal` aborts. Calls
 // onEvent(seq, type, data) once per event in order, and onState(text) when the connection
 // drops or comes back. After a drop it reconnects with Last-Event-ID = the last event seen,
-// so no event is lost or repeated; it keeps trying while the server is away.
-export async function followEvents(id, { onEvent, onState, signal }) {
+// so no event of a job is lost or repeated (a study's stream sends its whole table again);
+// it keeps trying while the server is away.
+async function followStream(path, endTypes, { onEvent, onState, signal }) {
   let last = 0;
   let retryMs = 1000;
   let failures = 0;
@@ -123,7 +124,7 @@ export async function followEvents(id, { onEvent, onState, signal }) {
     try {
       const h = headers({ Accept: "text/event-stream" });
       if (last > 0) h["Last-Event-ID"] = String(last);
-      const res = await fetch(`/v1/jobs/${encodeURIComponent(id)}/events`, { headers: h, signal, cache: "no-store" });
+      const res = await fetch(path, { headers: h, signal, cache: "no-store" });
       if (res.status === 404 || res.status === 401) {
         const doc = await res.json().catch(() => ({}));
         throw new ApiError(res.status, doc);
@@ -145,7 +146,7 @@ export async function followEvents(id, { onEvent, onState, signal }) {
             if (ev.id !== null) last = ev.id;
             const data = JSON.parse(ev.data);
             onEvent(ev.id, ev.type, data);
-            if (ev.type === "job_finished" || ev.type === "job_failed") ended = true;
+            if (endTypes.includes(ev.type)) ended = true;
           }
           if (ended) { reader.cancel().catch(() => {}); return; }
         }
@@ -162,3 +163,12 @@ export async function followEvents(id, { onEvent, onState, signal }) {
     await sleep(Math.min(retryMs * failures, 5000), signal);
   }
 }
+
+// A job's events, until job_finished or job_failed.
+export const followEvents = (id, options) =>
+  followStream(`/v1/jobs/${encodeURIComponent(id)}/events`, ["job_finished", "job_failed"], options);
+
+// A study's table (docs/design.md#studies): a `study` event each time it changes, then
+// `study_finished`; each event's data is the whole table, as GET /v1/studies/{id}.
+export const followStudy = (id, options) =>
+  followStream(`/v1/studies/${encodeURIComponent(id)}/events`, ["study_finished"], options);

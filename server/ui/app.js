@@ -2,6 +2,7 @@
 // iteration, its step table) and then shown (deformed body, contact stresses, downloads).
 import { ApiError, dismissJob, download, followEvents, getBlob, getJson, setToken, submitScene, token, uploadMesh } from "./api.js";
 import { STATE_COLOURS, bodyBounds, drawBody, drawConvergence, drawStress } from "./charts.js";
+import { closeStudy, openStudy } from "./study.js";
 
 const $ = (id) => document.getElementById(id);
 const PAGE_SIZE = 10;
@@ -372,9 +373,18 @@ function showStep() {
 }
 
 // ---- wiring
+// #job=ID or #study=ID: one of them shown in the main column.
 function route() {
-  const m = location.hash.match(/^#job=([^&]+)$/);
-  if (m && m[1] !== watched.id) openJob(decodeURIComponent(m[1]));
+  const job = location.hash.match(/^#job=([^&]+)$/);
+  const study = location.hash.match(/^#study=([^&]+)$/);
+  if (job) closeStudy();
+  if (job && decodeURIComponent(job[1]) !== watched.id) openJob(decodeURIComponent(job[1]));
+  if (study) {
+    watched.abort?.abort();
+    watched.id = null;
+    $("job-panel").hidden = true;
+    openStudy(decodeURIComponent(study[1]));
+  }
 }
 
 function init() {
@@ -412,6 +422,11 @@ function init() {
     }
   });
   $("submit-form").addEventListener("submit", submit);
+  $("study-form").addEventListener("submit", (ev) => {
+    ev.preventDefault();
+    const id = $("study-open-id").value.trim();
+    if (id) location.hash = "study=" + encodeURIComponent(id);
+  });
   $("step-slider").addEventListener("input", showStep);
   window.addEventListener("hashchange", route);
   loadExamples();

@@ -214,3 +214,65 @@ export function drawStress(svg, result, step) {
     }
   }
 }
+
+// Points against points, each axis linear or log10 (a study's error against h or against solve
+// seconds, a sweep's quantity against its parameter). series: [{name, points: [{x, y, title}]}],
+// one colour each, joined by a line when `lines`. Points that a log axis cannot show (<= 0, not
+// finite) are left out. One <circle class="pt"> per point drawn; the svg's data-points counts them.
+export function drawXY(svg, series, { xLabel, yLabel, xLog = false, yLog = false, lines = true }) {
+  clear(svg);
+  const b = box(svg);
+  const ok = (v, log) => Number.isFinite(v) && (!log || v > 0);
+  const shown = series.map((s) => ({ ...s, points: s.points.filter((p) => ok(p.x, xLog) && ok(p.y, yLog)) }));
+  const all = shown.flatMap((s) => s.points);
+  svg.dataset.points = String(all.length);
+  if (!all.length) {
+    el(svg, "text", { x: b.w / 2, y: b.h / 2, "text-anchor": "middle", class: "label" }, "nothing to plot yet");
+    return;
+  }
+  // An axis in the plot's units (log10 for a log axis); decades as ticks on a log axis.
+  const axis = (values, log) => {
+    const t = values.map((v) => (log ? Math.log10(v) : v));
+    let lo = Math.min(...t), hi = Math.max(...t);
+    if (log) { lo = Math.floor(lo); hi = Math.ceil(hi); if (hi - lo < 1) hi = lo + 1; }
+    if (!log && hi === lo) { lo -= Math.abs(lo) * 0.1 || 1; hi += Math.abs(hi) * 0.1 || 1; }
+    const ticks = log ? Array.from({ length: hi - lo + 1 }, (_, k) => lo + k).filter((d, k, a) => k % Math.ceil(a.length / 8) === 0)
+                      : [lo, (lo + hi) / 2, hi];  // the data's ends and middle
+    if (!log) { const pad = 0.05 * (hi - lo); lo -= pad; hi += pad; }
+    return { lo, hi, log, ticks, t: (v) => (log ? Math.log10(v) : v), label: (d) => (log ? `1e${d}` : d.toPrecision(3)) };
+  };
+  const ax = axis(all.map((p) => p.x), xLog), ay = axis(all.map((p) => p.y), yLog);
+  const x = (v) => b.left + ((ax.t(v) - ax.lo) / (ax.hi - ax.lo)) * (b.right - b.left);
+  const y = (v) => b.bottom - ((ay.t(v) - ay.lo) / (ay.hi - ay.lo)) * (b.bottom - b.top);
+  for (const d of ay.ticks) {
+    const yy = b.bottom - ((d - ay.lo) / (ay.hi - ay.lo)) * (b.bottom - b.top);
+    el(svg, "line", { x1: b.left, x2: b.right, y1: yy, y2: yy, stroke: "#e3e5e8" });
+    el(svg, "text", { x: b.left - 6, y: yy + 4, "text-anchor": "end", class: "tick" }, ay.label(d));
+  }
+  for (const d of ax.ticks) {
+    const xx = b.left + ((d - ax.lo) / (ax.hi - ax.lo)) * (b.right - b.left);
+    el(svg, "line", { x1: xx, x2: xx, y1: b.top, y2: b.bottom, stroke: "#eef0f2" });
+    el(svg, "text", { x: xx, y: b.bottom + 14, "text-anchor": "middle", class: "tick" }, ax.label(d));
+  }
+  el(svg, "line", { x1: b.left, x2: b.left, y1: b.top, y2: b.bottom, stroke: "#555" });
+  el(svg, "line", { x1: b.left, x2: b.right, y1: b.bottom, y2: b.bottom, stroke: "#555" });
+  el(svg, "text", { x: (b.left + b.right) / 2, y: b.h - 4, "text-anchor": "middle", class: "label" }, xLabel);
+  el(svg, "text", { x: 14, y: (b.top + b.bottom) / 2, "text-anchor": "middle", class: "label",
+                    transform: `rotate(-90 14 ${(b.top + b.bottom) / 2})` }, yLabel);
+  shown.forEach((s, k) => {
+    const colour = STEP_COLOURS[k % STEP_COLOURS.length];
+    const pts = [...s.points].sort((p, q) => p.x - q.x);
+    if (lines && pts.length > 1)
+      el(svg, "polyline", { points: pts.map((p) => `${x(p.x).toFixed(1)},${y(p.y).toFixed(1)}`).join(" "),
+                            fill: "none", stroke: colour, "stroke-width": 1.4 });
+    for (const p of pts) {
+      const c = el(svg, "circle", { class: "pt", cx: x(p.x).toFixed(1), cy: y(p.y).toFixed(1), r: 3.2, fill: colour,
+                                    "data-series": s.name, "data-x": p.x, "data-y": p.y });
+      el(c, "title", {}, p.title || `${s.name}: ${fmt(p.x)}, ${fmt(p.y)}`);
+    }
+    if (shown.length > 1) {  // the key, top right, one line per series (text colour is the stylesheet's)
+      el(svg, "circle", { cx: b.right - 8, cy: b.top + 8 + 14 * k, r: 3.2, fill: colour });
+      el(svg, "text", { x: b.right - 16, y: b.top + 12 + 14 * k, "text-anchor": "end", class: "tick" }, s.name);
+    }
+  });
+}

@@ -40,6 +40,7 @@ std::string friction_limit_exceeded(const Problem& problem, const EquilibriumSta
   const Matrix R = rigid_modes_at(problem, state.q);
   // The generalized force of the load and of the normal forces on the free motions.
   Vector w = R.transpose() * problem.load(factors);
+  Vector normal_rates = Vector::Zero(R.cols());  // the normal forces' work along each free motion
   std::vector<Rubbing> rubbing;
   for (int i = 0; i < n; ++i) {
     const Candidate& c = problem.candidates[i];
@@ -47,7 +48,7 @@ std::string friction_limit_exceeded(const Problem& problem, const EquilibriumSta
     const PairedPoint& pp = state.points[i];
     Rubbing r{i, pp.point.x, Matrix::Zero(2, R.cols()), Vector()};
     for (const auto& j : pp.point.jacobian) r.velocity += j.dx * R.row(j.dof);
-    w += p[c.eta] * (pp.eta.transpose() * r.velocity).transpose();
+    normal_rates += p[c.eta] * (pp.eta.transpose() * r.velocity).transpose();
     if (c.xi < 0 || problem.obstacles[c.obstacle].friction <= 0) continue;
     r.slip_rate = (pp.xi.transpose() * r.velocity).transpose();
     rubbing.push_back(std::move(r));
@@ -62,6 +63,7 @@ std::string friction_limit_exceeded(const Problem& problem, const EquilibriumSta
     G.row(r) = rubbing[r].slip_rate.transpose();
     slips[r] = state.s[problem.candidates[rubbing[r].candidate].xi];
   }
+  w += normal_rates;
   const Vector c = G.completeOrthogonalDecomposition().solve(slips);
   const Vector rates = G * c;
   const double largest_rate = rates.lpNorm<Eigen::Infinity>();
@@ -81,6 +83,10 @@ std::string friction_limit_exceeded(const Problem& problem, const EquilibriumSta
     if (std::abs(p[cand.xi]) < bound * (1 - kBoundTolerance) || p[cand.xi] * rates[r] >= 0) return "";
   }
   if (!(capacity > 0) || work <= capacity) return "";
+  // Where c presses the points more than it slides them (the normal forces do more work along it
+  // than friction can oppose: a gear turned against its mate's flank), the normal forces change
+  // along c and balance the load there: W > D shows nothing.
+  if (std::abs(normal_rates.dot(c)) > capacity) return "";
   // Worded as a turn about its centre (moments) or as a slide (forces): the fit of a rigid
   // velocity t + omega (x - centre)^perp to the points' velocities along c.
   Vec2 mean = Vec2::Zero();

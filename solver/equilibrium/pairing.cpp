@@ -46,7 +46,7 @@ void Equilibrium::pair(const Vector& q, EquilibriumState& state) const {
     // A column of T that vanishes on the free dofs (a force on a support) is never active.
     state.enabled[c.eta] = eta_col > 1e-12;
     if (c.xi >= 0) {
-      state.s[c.xi] = obstacle.master ? pp.projection.zeta - zeta_previous_[i]
+      state.s[c.xi] = obstacle.master ? master_zeta_difference(*obstacle.master, pp.projection.zeta, zeta_previous_[i])
                                       : obstacle.shape->zeta_difference(pp.projection.zeta, zeta_previous_[i]);
       state.enabled[c.xi] = xi_col > 1e-12;
     }

@@ -14,6 +14,7 @@
 
 #include "solver/contact/contact_error.hpp"
 #include "solver/contact/master_reading.hpp"
+#include "solver/elements/rigid_hubs.hpp"
 #include "solver/model/body_set.hpp"
 #include "solver/problem/rigid_modes.hpp"
 
@@ -110,6 +111,27 @@ namespace {
 // "bodies"), null for a scene of one body: the result takes the scene's form ("bodies",
 // "rigid_motions", "master_points"), so io asks for the type it built (docs/design.md).
 const BodySet* body_set_of(const Body& body) { return dynamic_cast<const BodySet*>(&body); }
+
+// Each rigid hub's angle and the moment on it about its centre (the internal forces' on its
+// theta: the moment load where the hub turns freely, the reaction where its angle is held), at q.
+json hubs_json(const Body& body, const Vector& q) {
+  json out = json::array();
+  const auto* all = body_set_of(body);
+  for (int b = 0; b < std::max(1, body.part_count()); ++b) {
+    const auto* hubbed = dynamic_cast<const RigidHubs*>(&body.part(b));
+    if (!hubbed) continue;
+    const Vector qb = q.segment(body.dof_offset(b), hubbed->dof_count());
+    Vector force = Vector::Zero(qb.size());
+    hubbed->internal_force(qb, force, nullptr);
+    for (size_t h = 0; h < hubbed->hubs().size(); ++h) {
+      const int theta = hubbed->hub_dof(static_cast<int>(h), 2);
+      json hub = {{"set", hubbed->hubs()[h].name}, {"angle", qb[theta]}, {"moment", force[theta]}};
+      if (all) hub["body"] = all->name(b);
+      out.push_back(hub);
+    }
+  }
+  return out;
+}
 
 json table_json(const FieldTable& t, const char* index_name) {
   json rows = json::array();
@@ -353,6 +375,7 @@ json step_json(const Problem& problem, const StepRecord& rec, const OutputOption
       reactions.push_back({{"dof", c.dof}, {"force", field_value(rec.reactions[c.dof])}});
     j["reactions"] = reactions;
   }
+  if (json hubs = hubs_json(body, rec.state.q); !hubs.empty()) j["hubs"] = hubs;
   if (!output.wants("contact_points")) return j;
   std::vector<ContactPointRow> points = contact_point_rows(problem, rec);
   if (rows) *rows = std::move(points);

@@ -5,6 +5,7 @@
 #include <unordered_map>
 
 #include "solver/elements/continuum.hpp"
+#include "solver/elements/rigid_hubs.hpp"
 #include "solver/elements/timoshenko_beam.hpp"
 #include "solver/io/scene_reader.hpp"
 #include "solver/model/body_set.hpp"
@@ -116,7 +117,9 @@ std::optional<SetRef> find_set(Reader& r, const BodySet& all, const std::string&
         ref.segments.push_back(ref.side < 0 ? std::array<int, 2>{s, s + 1} : std::array<int, 2>{s + 1, s});
       return ref;
     }
-    const auto* continuum = dynamic_cast<const ContinuumBody*>(&all.part(b));
+    const Body* part = &all.part(b);
+    if (const auto* hubbed = dynamic_cast<const RigidHubs*>(part)) part = &hubbed->inner();  // same sites
+    const auto* continuum = dynamic_cast<const ContinuumBody*>(part);
     if (!continuum) {
       r.error(ptr,
               "body \"" + body + "\" has no surface that pairs with another body's (continuum and beam bodies do)");

@@ -16,11 +16,14 @@
 //   "supports": [{"set" | "node", "fix": ["x", "y"], "values": {"x", "y"} | "rotation": {"about", "angle"}, "case"}]
 //   "loads": [{"set" | "node", "force": [fx, fy] (on each node) | "traction": [tx, ty] (per
 //     unit area of the set's boundary sides), "case"}]
+//   "hubs": [{"set", "centre": [xc, yc], "angle" | "moment", "case"}]: rigid hubs on fixed centres
+//     (solver/elements/rigid_hubs.hpp), turned by a prescribed angle or loaded by a moment
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
 
 #include "solver/elements/continuum.hpp"
+#include "solver/elements/rigid_hubs.hpp"
 #include "solver/io/scene_reader.hpp"
 #include "solver/materials/j2_plasticity.hpp"
 
@@ -375,6 +378,74 @@ void read_continuum_loads(Reader& r, json& body, const std::string& ptr, const P
   });
 }
 
+// body.hubs: each a node set turned rigidly about its centre, which stays put, by a prescribed
+// angle or loaded by a moment (neither: free to turn, no moment); the hubs' nodes leave the
+// body's dofs for three per hub (RigidHubs), so the constraints and loads read so far are
+// carried over. The hub dofs' supports and loads: x and y of the centre at zero, theta at
+// the angle (exact at any angle: theta is the angle), or a moment on theta.
+void read_hubs(Reader& r, json& body, const std::string& ptr, const PlaneMesh& mesh, Problem& problem) {
+  struct Drive {
+    double angle = 0.0, moment = 0.0;
+    bool turned = false;
+    int load_case = 0;
+  };
+  std::vector<RigidHub> hubs;
+  std::vector<Drive> drives;
+  std::vector<int> hub_of(mesh.nodes.size(), -1);
+  std::vector<std::string> pointers;
+  for_each_object(r, body, ptr, "hubs", [&](json& h, const std::string& hp) {
+    if (!h.contains("set")) {
+      r.error(hp + "/set", "is required: the node set that turns as the hub");
+      return;
+    }
+    const auto nodes = read_target(r, h, hp, mesh);
+    const Vec2 centre = r.vec2(h, hp, "centre");
+    Drive d;
+    d.load_case = r.load_case(h, hp);
+    if (h.contains("angle") && h.contains("moment"))
+      r.error(hp, "needs at most one of \"angle\" (a prescribed turn) and \"moment\" (a moment load; the angle free)");
+    d.turned = h.contains("angle");
+    if (d.turned) d.angle = r.number(h, hp, "angle");
+    if (h.contains("moment")) d.moment = r.number(h, hp, "moment");
+    if (!nodes) return;
+    for (int node : *nodes)
+      if (hub_of[node] >= 0) {
+        r.error(hp + "/set", "node " + std::to_string(node) + " is in hub " + pointers[hub_of[node]] + " already");
+        return;
+      }
+    for (int node : *nodes) hub_of[node] = static_cast<int>(hubs.size());
+    pointers.push_back(hp);
+    hubs.push_back({h["set"].get<std::string>(), *nodes, centre});
+    drives.push_back(d);
+  });
+  if (hubs.empty() || !r.issues.empty()) return;
+  if (problem.body->axisymmetric()) {
+    r.error(ptr + "/hubs", "turn in the plane: a section of a body of revolution has no hub to turn");
+    return;
+  }
+  for (const Constraint& c : problem.constraints)
+    if (hub_of[c.dof / 2] >= 0) {
+      r.error(ptr + "/supports", "hold node " + std::to_string(c.dof / 2) + ", which hub " +
+                                     pointers[hub_of[c.dof / 2]] + " turns: hold the hub (its angle) instead");
+      return;
+    }
+  auto hubbed = std::make_unique<RigidHubs>(std::move(problem.body), std::move(hubs));
+  for (Constraint& c : problem.constraints) c.dof = hubbed->reduced_dof(c.dof);
+  for (Vector& load : problem.loads) load = hubbed->reduce_force(load);
+  for (size_t h = 0; h < drives.size(); ++h) {
+    const int k = static_cast<int>(h);
+    problem.constraints.push_back({hubbed->hub_dof(k, 0), 0.0, 0});
+    problem.constraints.push_back({hubbed->hub_dof(k, 1), 0.0, 0});
+    if (drives[h].turned) problem.constraints.push_back({hubbed->hub_dof(k, 2), drives[h].angle, drives[h].load_case});
+  }
+  problem.body = std::move(hubbed);
+  for (size_t h = 0; h < drives.size(); ++h)
+    if (drives[h].moment != 0.0) {
+      const int theta = static_cast<const RigidHubs&>(*problem.body).hub_dof(static_cast<int>(h), 2);
+      case_load(problem, drives[h].load_case)[theta] += drives[h].moment;
+    }
+}
+
 }  // namespace
 
 void read_continuum(Reader& r, json& body, Problem& problem, const std::string& ptr) {
@@ -541,14 +612,20 @@ void read_continuum(Reader& r, json& body, Problem& problem, const std::string& 
   if (options.analysis == PlaneAnalysis::axisymmetric) hold_axis(checked, r, problem);
   // docs/algorithm.md#bodies-held-only-by-contact: contact holds the free rigid motions of one
   // connected body (scene.cpp); a mesh of several parts must have each part held by its supports.
+  // A hub holds its nodes.
   std::vector<char> fixed(problem.body->dof_count(), 0);
   for (const Constraint& c : problem.constraints) fixed[c.dof] = 1;
+  if (const json* hubs = body.contains("hubs") ? &body["hubs"] : nullptr; hubs && hubs->is_array())
+    for (const json& h : *hubs)
+      if (h.is_object() && h.contains("set") && h["set"].is_string() && checked.sets.count(h["set"].get<std::string>()))
+        for (int node : checked.sets.at(h["set"].get<std::string>())) fixed[2 * node] = fixed[2 * node + 1] = 1;
   const std::string free = free_rigid_motion(checked, fixed);
   if (free.rfind("the part containing", 0) == 0)
     r.error(ptr + "/supports",
             "leave " + free +
                 ": contact holds the free rigid motions of a connected body only; add supports to each part, "
                 "or prescribe the displacement of a boundary set");
+  read_hubs(r, body, ptr, checked, problem);
 }
 
 }  // namespace grip::scene_io

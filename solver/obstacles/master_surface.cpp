@@ -45,19 +45,21 @@ P2<S> side_normal(const P2<S>& a, const P2<S>& b) {
 }
 
 // The outward normal at site k of a chain of n sites (`at(k)` its position): the mean of its
-// sides' normals.
+// sides' normals; at the seam of a closed chain (site 0 = site n - 1) both sides' too.
 template <class S, class At>
-P2<S> site_normal(const At& at, int n, int k) {
+P2<S> site_normal(const At& at, int n, int k, bool closed) {
   P2<S> sum{S(0.0), S(0.0)};
   if (k > 0) sum = sum + side_normal<S>(at(k - 1), at(k));
+  else if (closed) sum = sum + side_normal<S>(at(n - 2), at(n - 1));
   if (k + 1 < n) sum = sum + side_normal<S>(at(k), at(k + 1));
+  else if (closed) sum = sum + side_normal<S>(at(0), at(1));
   return unit(sum);
 }
 
 // The normal at `along` (in [0, 1]) of segment k: interpolated between its sites' normals.
 template <class S, class At>
-P2<S> smoothed_normal(const At& at, int n, int k, const S& along) {
-  return unit((S(1.0) - along) * site_normal<S>(at, n, k) + along * site_normal<S>(at, n, k + 1));
+P2<S> smoothed_normal(const At& at, int n, int k, const S& along, bool closed) {
+  return unit((S(1.0) - along) * site_normal<S>(at, n, k, closed) + along * site_normal<S>(at, n, k + 1, closed));
 }
 
 // The mortar integrals of the slave segment a -> b against the master segments k_first..k_last
@@ -100,6 +102,7 @@ MasterSurface make_master_surface(const Body& body, int body_index, const std::v
   m.slave_chains = chains_of(slave_segments);
   double zeta = 0.0;
   for (const auto& chain : m.chains) {
+    m.closed.push_back(chain.size() > 3 && chain.front() == chain.back());
     std::vector<double> z{zeta};
     for (size_t i = 1; i < chain.size(); ++i)
       z.push_back(zeta += (body.site_reference(chain[i]) - body.site_reference(chain[i - 1])).norm());
@@ -108,10 +111,30 @@ MasterSurface make_master_surface(const Body& body, int body_index, const std::v
   return m;
 }
 
+double master_zeta_difference(const MasterSurface& surface, double zeta1, double zeta0) {
+  double d = zeta1 - zeta0;
+  for (size_t c = 0; c < surface.chains.size(); ++c) {
+    const std::vector<double>& z = surface.reference_zeta[c];
+    if (!surface.closed[c] || zeta0 < z.front() || zeta0 > z.back()) continue;
+    const double length = z.back() - z.front();
+    d -= length * std::round(d / length);
+    if (d <= -0.5 * length) d += length;
+  }
+  return d;
+}
+
+double DeformedMaster::Chain::reference_near(int k, double near) const {
+  double r = (*reference)[k];
+  if (!closed) return r;
+  const double length = reference->back() - reference->front();
+  return r + length * std::round((near - r) / length);
+}
+
 DeformedMaster::DeformedMaster(const Body& body, const Vector& q, const MasterSurface& surface) {
   for (size_t c = 0; c < surface.chains.size(); ++c) {
     Chain chain;
     chain.reference = &surface.reference_zeta[c];
+    chain.closed = surface.closed[c];
     std::vector<ProfilePiece> pieces;
     chain.zeta.push_back(0.0);
     for (int site : surface.chains[c]) {
@@ -122,7 +145,7 @@ DeformedMaster::DeformedMaster(const Body& body, const Vector& q, const MasterSu
       pieces.push_back(SegmentPiece{a, b});
       chain.zeta.push_back(chain.zeta.back() + (b - a).norm());
     }
-    chain.profile = make_profile(std::move(pieces));
+    chain.profile = make_profile(std::move(pieces), chain.closed);
     chains_.push_back(std::move(chain));
   }
   integrate_mortar(body, q, surface);
@@ -160,14 +183,14 @@ void DeformedMaster::integrate_mortar(const Body& body, const Vector& q, const M
       if (!(length > 0)) continue;
       tributary[slave[e]] += 0.5 * length;
       tributary[slave[e + 1]] += 0.5 * length;
-      const auto range = mortar_range(a, b);
-      if (!range) continue;
-      const int chain = (*range)[0];
-      const auto at = [&](int k) { return p2(chains_[chain].points[k].x); };
-      const std::array<int, 2> ends{slave[e], slave[e + 1]};
-      segment_mortar(p2(a), p2(b), at, (*range)[1], (*range)[2], [&](int end, int k, double v) {
-        m[ends[end]][{chain, k}] += v;
-      });
+      for (const auto& range : mortar_ranges(a, b)) {
+        const int chain = range[0];
+        const auto at = [&](int k) { return p2(chains_[chain].points[k].x); };
+        const std::array<int, 2> ends{slave[e], slave[e + 1]};
+        segment_mortar(p2(a), p2(b), at, range[1], range[2], [&](int end, int k, double v) {
+          m[ends[end]][{chain, k}] += v;
+        });
+      }
     }
   }
   for (const auto& [site, row] : m) {
@@ -179,13 +202,24 @@ void DeformedMaster::integrate_mortar(const Body& body, const Vector& q, const M
   }
 }
 
-std::optional<std::array<int, 3>> DeformedMaster::mortar_range(const Vec2& a, const Vec2& b) const {
+std::vector<std::array<int, 3>> DeformedMaster::mortar_ranges(const Vec2& a, const Vec2& b) const {
   const Closest from = closest(a), to = closest(b);
-  if (from.chain != to.chain) return std::nullopt;
+  if (from.chain != to.chain) return {};
   // The master segments between the ends' closest points, and one more on either side.
-  const int last = static_cast<int>(chains_[from.chain].points.size()) - 2;
-  return std::array<int, 3>{from.chain, std::max(0, std::min(from.segment, to.segment) - 1),
-                            std::min(last, std::max(from.segment, to.segment) + 1)};
+  const int chain = from.chain, count = static_cast<int>(chains_[chain].points.size()) - 1;
+  int lo = std::min(from.segment, to.segment), hi = std::max(from.segment, to.segment);
+  if (!chains_[chain].closed) return {{chain, std::max(0, lo - 1), std::min(count - 1, hi + 1)}};
+  // A closed chain: the short way round, which may cross the seam (segment count - 1 to 0).
+  if (hi - lo > count / 2) {  // from hi forward across the seam to lo
+    const int first = hi;
+    hi = lo + count;
+    lo = first;
+  }
+  --lo, ++hi;
+  if (hi - lo + 1 >= count) return {{chain, 0, count - 1}};
+  const int start = (lo % count + count) % count, end = start + (hi - lo);
+  if (end < count) return {{chain, start, end}};
+  return {{chain, start, count - 1}, {chain, 0, end - count}};
 }
 
 MasterPoint DeformedMaster::project(const Vec2& x, int slave_site) const {
@@ -197,7 +231,7 @@ MasterPoint DeformedMaster::project(const Vec2& x, int slave_site) const {
   MasterPoint best;
   Projection& p = best.projection;
   p = c.projection;
-  p.normal = vec2(smoothed_normal<double>([&](int i) { return p2(on.points[i].x); }, n, k, along));
+  p.normal = vec2(smoothed_normal<double>([&](int i) { return p2(on.points[i].x); }, n, k, along, on.closed));
   p.tangent = rot90(p.normal);
   p.dnormal_dx = Mat2::Zero();  // the normal's turn is in force_derivative()
   p.zeta_rate *= (ref[k + 1] - ref[k]) / length;
@@ -205,10 +239,11 @@ MasterPoint DeformedMaster::project(const Vec2& x, int slave_site) const {
   if (mortar != mortar_.end()) {  // the mortar point sum_k w_k x_k
     p.point = Vec2::Zero();
     p.zeta = 0.0;
+    const double near = ref[k] + t * (ref[k + 1] - ref[k]);
     for (const auto& [at, w] : mortar->second) {
       const SurfacePoint& sp = chains_[at[0]].points[at[1]];
       p.point += w * sp.x;
-      p.zeta += w * (*chains_[at[0]].reference)[at[1]];
+      p.zeta += w * chains_[at[0]].reference_near(at[1], near);
       for (const auto& j : sp.jacobian) best.jacobian.push_back({j.dof, -w * j.dx});
     }
   } else {
@@ -252,7 +287,18 @@ DeformedMaster::DualPairing DeformedMaster::dual_pairing(const SurfacePoint& sla
   };
   const Closest c = closest(slave.x);
   const int n = static_cast<int>(chains_[c.chain].points.size());
-  for (int k = std::max(0, c.segment - 1); k <= std::min(n - 1, c.segment + 2); ++k) use_master(c.chain, k);
+  const bool closed = chains_[c.chain].closed;
+  for (int k = c.segment - 1; k <= c.segment + 2; ++k) {
+    if (closed) {  // across the seam: site 0 is site n - 1, both read
+      const int wrapped = ((k % (n - 1)) + (n - 1)) % (n - 1);
+      use_master(c.chain, wrapped);
+      if (wrapped == 0) use_master(c.chain, n - 1);
+    } else if (k >= 0 && k < n) {
+      use_master(c.chain, k);
+    }
+  }
+  if (closed && c.segment <= 1) use_master(c.chain, n - 2);  // site 0's other side
+  if (closed && c.segment >= n - 3) use_master(c.chain, 1);
   struct Piece {
     int a, b;
     std::array<int, 3> range;
@@ -265,12 +311,14 @@ DeformedMaster::DualPairing DeformedMaster::dual_pairing(const SurfacePoint& sla
         if (chain[e] != slave_site && chain[e + 1] != slave_site) continue;
         const Vec2 a = slave_points_.at(chain[e]).x, b = slave_points_.at(chain[e + 1]).x;
         if (!((b - a).norm() > 0)) continue;
-        const auto range = mortar_range(a, b);
-        if (!range) continue;
-        pieces.push_back({chain[e], chain[e + 1], *range});
-        for (int k = (*range)[1]; k <= (*range)[2] + 1; ++k) use_master((*range)[0], k);
-        for (int site : {chain[e], chain[e + 1]})
-          if (slave_slot.emplace(site, static_cast<int>(vars.size())).second) vars.push_back(&slave_points_.at(site));
+        const auto ranges = mortar_ranges(a, b);
+        for (const auto& range : ranges) {
+          pieces.push_back({chain[e], chain[e + 1], range});
+          for (int k = range[1]; k <= range[2] + 1; ++k) use_master(range[0], k);
+        }
+        if (!ranges.empty())
+          for (int site : {chain[e], chain[e + 1]})
+            if (slave_slot.emplace(site, static_cast<int>(vars.size())).second) vars.push_back(&slave_points_.at(site));
       }
   const int count = 2 * static_cast<int>(vars.size());
   const auto seeded = [&](int slot) {
@@ -292,7 +340,7 @@ DeformedMaster::DualPairing DeformedMaster::dual_pairing(const SurfacePoint& sla
   const P2<Dual> from = on(c.segment), segment = on(c.segment + 1) - from;
   const Dual t = c.t != 0.0 ? dot(x - from, segment) / dot(segment, segment) : Dual(0.0);
   const Dual along = c.t > 0.0 && c.t < 1.0 ? t : Dual(std::clamp(c.t, 0.0, 1.0));
-  out.normal = smoothed_normal<Dual>(on, n, c.segment, along);
+  out.normal = smoothed_normal<Dual>(on, n, c.segment, along, closed);
   out.shares.push_back({&slave, Dual(1.0)});
   const std::vector<double>& ref = *chains_[c.chain].reference;
   P2<Dual> x_m{Dual(0.0), Dual(0.0)};
@@ -308,11 +356,12 @@ DeformedMaster::DualPairing DeformedMaster::dual_pairing(const SurfacePoint& sla
     }
     Dual covered(0.0);
     for (const auto& entry : m) covered += entry.second;
+    const double near = ref[c.segment] + c.t * (ref[c.segment + 1] - ref[c.segment]);
     for (const auto& [k, value] : m) {
       const Dual w = value / covered;
       out.shares.push_back({&chains_[k[0]].points[k[1]], -w});
       x_m = x_m + w * master_at(k[0])(k[1]);
-      out.zeta += w * Dual((*chains_[k[0]].reference)[k[1]]);
+      out.zeta += w * Dual(chains_[k[0]].reference_near(k[1], near));
     }
   } else {
     out.shares.push_back({&chains_[c.chain].points[c.segment], t - Dual(1.0)});

@@ -44,7 +44,11 @@ struct MasterSurface {
   int body = -1;                                    // the master body (index into the scene's bodies)
   std::vector<std::vector<int>> chains;             // sites of the problem's body along each run, body on the left
   std::vector<std::vector<double>> reference_zeta;  // per chain and site: reference arc length
-  std::vector<std::vector<int>> slave_chains;       // the slave surface's runs (sites, body on the left)
+  // Per chain: a closed loop (a ring's boundary: its last site is its first again). Its seam is
+  // a joint like the others: normals, mortar integrals and zeta run across it (zeta modulo the
+  // loop's length).
+  std::vector<char> closed;
+  std::vector<std::vector<int>> slave_chains;  // the slave surface's runs (sites, body on the left)
   // The sides (Body::surface_point) of the master's and the slave's sites: 0 for a continuum's
   // boundary nodes; +1 (upper) or -1 (lower) for a beam's surface, its axis offset by half its depth.
   int side = 0, slave_side = 0;
@@ -56,6 +60,9 @@ struct MasterSurface {
 MasterSurface make_master_surface(const Body& body, int body_index, const std::vector<std::array<int, 2>>& segments,
                                   const std::vector<std::array<int, 2>>& slave_segments, int side = 0,
                                   int slave_side = 0);
+
+// zeta1 - zeta0 on the master: on a closed chain taken modulo its length (into (-L/2, L/2]).
+double master_zeta_difference(const MasterSurface& surface, double zeta1, double zeta0);
 
 struct MasterPoint {
   Projection projection;                     // zeta: the master's reference arc length (material, for slips)
@@ -89,6 +96,10 @@ class DeformedMaster {
     std::vector<SurfacePoint> points;
     std::vector<double> zeta;  // current arc length at each site
     const std::vector<double>* reference;
+    bool closed = false;
+    // The reference zeta of site k, on a closed chain the one of its values (k's, plus or minus
+    // the loop's length) nearest to `near`.
+    double reference_near(int k, double near) const;
   };
   struct Closest {
     Projection projection;
@@ -100,9 +111,10 @@ class DeformedMaster {
   struct DualPairing;
   DualPairing dual_pairing(const SurfacePoint& slave, int slave_site) const;
   void integrate_mortar(const Body& body, const Vector& q, const MasterSurface& surface);
-  // The master chain and segments (first, last) that slave segment a -> b integrates against;
-  // none where its ends are closest to different chains.
-  std::optional<std::array<int, 3>> mortar_range(const Vec2& a, const Vec2& b) const;
+  // The master chain and runs of segments (first, last) that slave segment a -> b integrates
+  // against (two runs where it spans a closed chain's seam); none where its ends are closest to
+  // different chains.
+  std::vector<std::array<int, 3>> mortar_ranges(const Vec2& a, const Vec2& b) const;
   std::vector<Chain> chains_;
   const MasterSurface* surface_ = nullptr;
   std::map<int, SurfacePoint> slave_points_;  // the slave surface's sites (their surface points)

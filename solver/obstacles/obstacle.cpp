@@ -81,6 +81,7 @@ class Circle final : public Obstacle {
   }
 
   double period() const override { return kTwoPi * radius_; }
+
   double smallest_radius() const override { return radius_; }
 
  private:
@@ -205,7 +206,7 @@ Piece make_piece(const ProfilePiece& input, std::size_t index) {
 
 class Profile final : public Obstacle {
  public:
-  explicit Profile(const std::vector<ProfilePiece>& input) {
+  Profile(const std::vector<ProfilePiece>& input, bool closed) : closed_(closed) {
     if (input.empty()) throw std::invalid_argument("make_profile: a profile needs at least one piece");
     for (std::size_t i = 0; i < input.size(); ++i) pieces_.push_back(make_piece(input[i], i));
 
@@ -219,23 +220,31 @@ class Profile final : public Obstacle {
       if (i > 0 && safe_norm(pieces_[i].start - pieces_[i - 1].end) > kJointTolerance * scale_)
         throw piece_error(i, "does not start where piece " + std::to_string(i - 1) + " ends");
     }
+    if (closed_ && safe_norm(pieces_.front().start - pieces_.back().end) > kJointTolerance * scale_)
+      throw piece_error(pieces_.size() - 1, "does not end where piece 0 starts (a closed profile)");
 
     double zeta = 0.0;
     for (std::size_t i = 0; i < pieces_.size(); ++i) {
       Piece& p = pieces_[i];
       p.zeta0 = zeta;
-      const Vec2 before = i == 0 ? p.normal_at_start() : pieces_[i - 1].normal_at_end();
+      const Vec2 before = i > 0     ? pieces_[i - 1].normal_at_end()
+                          : closed_ ? pieces_.back().normal_at_end()
+                                    : p.normal_at_start();
       vertices_.push_back(make_vertex(p.start, before, p.normal_at_start(), zeta));
       zeta += p.length;
     }
     const Piece& last = pieces_.back();
-    vertices_.push_back(make_vertex(last.end, last.normal_at_end(), last.normal_at_end(), zeta));
+    vertices_.push_back(make_vertex(last.end, last.normal_at_end(),
+                                    closed_ ? pieces_.front().normal_at_start() : last.normal_at_end(), zeta));
+    length_ = zeta;
 
     const Vec2 n0 = pieces_.front().normal_at_start();
     start_ = Extension{pieces_.front().start, -rot90(n0), n0, 0.0, -1.0};
     const Vec2 n1 = last.normal_at_end();
     end_ = Extension{last.end, rot90(n1), n1, zeta, 1.0};
   }
+
+  double period() const override { return closed_ ? length_ : 0.0; }
 
   double smallest_radius() const override {
     double r = std::numeric_limits<double>::infinity();
@@ -265,9 +274,9 @@ class Profile final : public Obstacle {
         best_distance = std::abs(p->gap);
       }
     };
-    consider(start_.project(x, tol));
+    if (!closed_) consider(start_.project(x, tol));
     for (const Piece& piece : pieces_) consider(piece.project(x, tol));
-    consider(end_.project(x, tol));
+    if (!closed_) consider(end_.project(x, tol));
     for (const Vertex& v : vertices_) {
       const double d = safe_norm(x - v.position);
       if (!best || d < best_distance) {
@@ -315,6 +324,8 @@ class Profile final : public Obstacle {
   std::vector<Vertex> vertices_;  // pieces_.size() + 1: start, joints, end
   Extension start_, end_;
   double scale_ = 1.0;
+  bool closed_ = false;
+  double length_ = 0.0;
 };
 
 }  // namespace
@@ -325,6 +336,8 @@ std::unique_ptr<Obstacle> make_circle(Vec2 centre, double radius) {
   return std::make_unique<Circle>(centre, radius);
 }
 
-std::unique_ptr<Obstacle> make_profile(std::vector<ProfilePiece> pieces) { return std::make_unique<Profile>(pieces); }
+std::unique_ptr<Obstacle> make_profile(std::vector<ProfilePiece> pieces, bool closed) {
+  return std::make_unique<Profile>(pieces, closed);
+}
 
 }  // namespace grip

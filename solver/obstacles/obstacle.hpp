@@ -65,8 +65,11 @@ using ProfilePiece = std::variant<SegmentPiece, ArcPiece>;
 
 // An open chain of pieces, each starting where the previous one ends. A lone segment or arc
 // is a profile of one piece. Beyond its ends the surface continues along the end tangents.
+// `closed`: the last piece ends where the first starts (a ring's boundary): no ends and no
+// extensions (a tangent extension at the seam would cut through the loop's own neighbourhood),
+// the seam a joint like the others, zeta periodic with the loop's length.
 // Throws std::invalid_argument (with the piece index) on a gap between pieces, a zero-length
 // piece or a non-positive radius.
-std::unique_ptr<Obstacle> make_profile(std::vector<ProfilePiece> pieces);
+std::unique_ptr<Obstacle> make_profile(std::vector<ProfilePiece> pieces, bool closed = false);
 
 }  // namespace grip

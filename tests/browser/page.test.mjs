@@ -2,7 +2,8 @@
 // puppeteer-core (tests/browser/package-lock.json, installed by scripts/setup.sh with npm ci).
 // Against a live `grip serve` on a free loopback port: a running job watched live and across a
 // server restart, the beam example submitted and shown, a bad scene's pointer errors, gmsh
-// meshes uploaded beside a scene. Screenshots go to $GRIP_ARTIFACTS (default build/browser-artifacts), never committed.
+// meshes uploaded beside a scene, studies followed (table and plots). Screenshots go to
+// $GRIP_ARTIFACTS (default build/browser-artifacts), never committed.
 //   GRIP_BINARY=build/apps/grip node --test tests/browser/page.test.mjs
 import { test, before, after } from "node:test";
 import assert from "node:assert/strict";
@@ -474,6 +475,113 @@ test("with a bearer token: the page asks for it, keeps it in sessionStorage, and
     await secured.stop();
     rmSync(secured.dir, { recursive: true, force: true });
   }
+});
+
+// Lame's thick cylinder (axisymmetric, inner pressure), as tests/integration/studies_test.cpp.
+function cylinder() {
+  return {
+    body: {
+      model: "continuum", kinematics: "linear", analysis: "axisymmetric", element: "q4",
+      material: { young: 1000, poisson: 0.3, law: "saint_venant_kirchhoff" },
+      mesh: { rectangle: { origin: [1, 0], size: [1, 0.5], divisions: [2, 1] } },
+      contact_set: "right",
+      supports: [{ set: "bottom", fix: ["y"] }, { set: "top", fix: ["y"] }],
+      loads: [{ set: "left", traction: [10, 0] }],
+    },
+    obstacles: [{ name: "far", shape: { type: "segment", from: [100, 50], to: [200, 50] } }],
+    steps: 1,
+    solver: { contact: { reach: 0.01 } },
+    outputs: [
+      { name: "u_inner", kind: "displacement", at: [1, 0], component: "x" },
+      { name: "u_outer", kind: "displacement", at: [2, 0], component: "x" },
+    ],
+  };
+}
+
+test("a study: its table as GET /v1/studies/{id} says, its error plots a point per job with an estimate", async () => {
+  const post = async (request) => {
+    const r = await server.api("/v1/studies", { method: "POST", headers: { "Content-Type": "application/json" }, body: JSON.stringify(request) });
+    assert.equal(r.status, 201, JSON.stringify(r.body));
+    return r.body.id;
+  };
+  await page.bringToFront();
+  await page.goto(server.url + "/ui");
+  const openFinished = async (id) => {
+    await page.$eval("#study-open-id", (e) => { e.value = ""; });
+    await page.type("#study-open-id", id);
+    await page.click("#study-form button");
+    await page.waitForFunction((sid) => document.getElementById("study-shown-id").textContent === sid &&
+      document.getElementById("study-panel").dataset.state === "finished", { timeout: 60000 }, id);
+    const study = (await server.api(`/v1/studies/${id}`)).body;
+    assert.equal(study.status, "successful");
+    return study;
+  };
+  const withEstimate = (q) => q.estimated_error.filter((e) => Number.isFinite(e) && e > 0).length;
+  const plotted = (q, plot) => count(`#study-quantities .quantity[data-quantity="${q}"] svg.${plot} circle.pt`);
+
+  // Three levels of the cylinder: every number of the table is the server's.
+  const study = await openFinished(await post({ scene: cylinder(), refine: { levels: 3 } }));
+  assert.equal(await page.evaluate(() => location.hash), `#study=${study.id}`);
+  assert.equal(await page.$eval("#job-panel", (e) => e.hidden), true);
+  const rows = await page.$$eval("#study-levels tbody tr", (trs) => trs.map((tr) => ({
+    job: tr.dataset.job,
+    cells: [...tr.cells].map((c) => c.textContent),
+    values: [...tr.cells].map((c) => c.dataset.value),
+    outputs: Object.fromEntries([...tr.querySelectorAll("td[data-quantity]")].map((c) => [c.dataset.quantity, Number(c.dataset.value)])),
+    errors: Object.fromEntries([...tr.querySelectorAll("td[data-error]")].map((c) => [c.dataset.error, Number(c.dataset.value)])),
+  })));
+  assert.equal(rows.length, 3);
+  const head = await page.$$eval("#study-levels thead th", (ths) => ths.map((th) => th.textContent));
+  assert.deepEqual(head, ["level", "h", "nodes", "seconds", "status", "u_inner", "u_inner est. error", "u_outer", "u_outer est. error"]);
+  study.levels.forEach((level, i) => {
+    assert.equal(rows[i].job, level.job);
+    assert.equal(Number(rows[i].cells[0]), level.level);
+    assert.equal(Number(rows[i].cells[1]), level.h);
+    assert.equal(Number(rows[i].cells[2]), level.nodes);
+    assert.equal(Number(rows[i].values[3]), level.seconds);
+    assert.equal(rows[i].cells[4], "successful");
+    assert.deepEqual(rows[i].outputs, level.outputs);
+    for (const q of study.quantities) assert.equal(rows[i].errors[q.name], q.estimated_error[i]);
+  });
+  for (const q of study.quantities) {
+    const summary = await page.$$eval(`#study-quantities .quantity[data-quantity="${q.name}"] dd`, (dds) =>
+      Object.fromEntries(dds.map((d) => [d.dataset.key, d.dataset.value ?? d.textContent])));
+    assert.equal(Number(summary.order), q.order);
+    assert.equal(Number(summary.extrapolated), q.extrapolated);
+    assert.equal(summary.asymptotic, "not known");  // three levels: nothing tells
+    const cheapest = await page.$$eval(`#study-quantities .quantity[data-quantity="${q.name}"] .cheapest li`, (lis) => lis.map((li) => li.textContent));
+    assert.equal(cheapest.length, 3);
+    q.cheapest.forEach((c, k) => assert.match(cheapest[k], c.level ? new RegExp(`level ${c.level.level},`) : /none/));
+    assert.equal(withEstimate(q), 3);
+    assert.equal(await plotted(q.name, "error-h"), withEstimate(q));
+    assert.equal(await plotted(q.name, "error-seconds"), withEstimate(q));
+  }
+  // The error against h: the finest level lowest, as the estimates say.
+  const ys = await page.$$eval('.quantity[data-quantity="u_inner"] svg.error-h circle.pt', (cs) => cs.map((c) => [Number(c.dataset.x), Number(c.dataset.y)]));
+  assert.deepEqual(ys.sort((a, b) => a[0] - b[0]).map((p) => p[1]), [...study.quantities[0].estimated_error].reverse());
+  await page.screenshot({ path: join(ARTIFACTS, "study.png"), fullPage: true });
+
+  // Two tolerances: a series each in the error plots, a point per job.
+  const tolerances = await openFinished(await post({ scene: cylinder(), refine: { levels: 3 }, tolerances: [1e-4, 1e-8] }));
+  assert.equal(await count("#study-levels tbody tr"), 6);
+  for (const q of tolerances.quantities) {
+    assert.equal(await plotted(q.name, "error-h"), withEstimate(q));
+    assert.equal(await plotted(q.name, "error-seconds"), withEstimate(q));
+    const series = await page.$$eval(`.quantity[data-quantity="${q.name}"] svg.error-h circle.pt`, (cs) => [...new Set(cs.map((c) => c.dataset.series))]);
+    assert.deepEqual(series.sort(), ["tol 0.0001", "tol 1e-8"]);
+  }
+
+  // A sweep of the inner pressure: the quantity against it, linear in the load.
+  const sweep = await openFinished(await post({ scene: cylinder(), sweep: [{ pointer: "/body/loads/0/traction/0", values: [5, 10, 20] }] }));
+  const points = await page.$$eval('.quantity[data-quantity="u_inner"] svg.sweep-plot circle.pt', (cs) => cs.map((c) => [Number(c.dataset.x), Number(c.dataset.y)]));
+  assert.deepEqual(points, sweep.levels.map((l, i) => [l.parameters[0], sweep.quantities[0].values[i]]));
+
+  // An accuracy study: its answer.
+  const accuracy = await openFinished(await post({ scene: cylinder(), accuracy: { output: "u_inner", relative: 0.01 } }));
+  assert.equal(accuracy.answer.reached, true);
+  const six = (x) => String(+x.toPrecision(6));
+  assert.equal(await text("#study-answer"), `reached: level ${accuracy.answer.level}, value ${six(accuracy.answer.value)}, ` +
+    `estimated error ${six(accuracy.answer.estimated_error)}`);
 });
 
 test("no console errors, page errors or CSP violations", () => {
