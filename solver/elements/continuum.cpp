@@ -71,10 +71,11 @@ ContinuumBody::ContinuumBody(PlaneMesh mesh, const std::vector<int>& contact_set
       (options_.kinematics != ContinuumKinematics::finite || options_.element != ContinuumElement::q4 ||
        options_.analysis != PlaneAnalysis::plane_strain))
     throw std::invalid_argument("f_bar is implemented for finite kinematics, q4 and plane strain");
-  for (const auto& m : materials_) has_history_ |= m->has_history();
-  if (has_history_ && options_.kinematics == ContinuumKinematics::finite)
-    throw std::invalid_argument(
-        "a law with history (j2_plasticity) is implemented for small strain: linear kinematics");
+  for (const auto& m : materials_) {
+    has_history_ |= m->has_history();
+    if (options_.kinematics == ContinuumKinematics::finite)
+      if (const std::string why = m->finite_strain_issue(); !why.empty()) throw std::invalid_argument(why);
+  }
   if (options_.analysis == PlaneAnalysis::axisymmetric) {
     if (options_.element == ContinuumElement::q4_bbar)
       throw std::invalid_argument("axisymmetric is implemented for t3, t6, q4, q8, q9");
@@ -152,16 +153,39 @@ std::vector<PointResponse> ContinuumBody::point_responses(const Vector& q, int e
   return out;
 }
 
+std::vector<Mat2> ContinuumBody::point_deformations(const Vector& q, int e) const {
+  const Integration& in = integration();
+  const ShapeGradients u = element_displacements(q, e);
+  std::vector<Mat2> F;
+  for (const ElementPoint& p : in.points[e])
+    F.push_back(options_.incompressibility == Incompressibility::f_bar ? f_bar(p, in.centroids[e], u)
+                                                                       : deformation_gradient(p, u));
+  return F;
+}
+
+std::vector<FinitePointResponse> ContinuumBody::finite_point_responses(const std::vector<Mat2>& F, int e) const {
+  std::vector<FinitePointResponse> out;
+  for (size_t k = 0; k < F.size(); ++k)
+    out.push_back(
+        material(e).finite_response(0.5 * (F[k].transpose() * F[k] - Mat2::Identity()), history_[e * F.size() + k]));
+  return out;
+}
+
 void ContinuumBody::commit(const Vector& q) {
   if (!has_history_) return;
   for (int e = 0; e < element_count(); ++e) {
+    if (options_.kinematics == ContinuumKinematics::finite) {
+      const std::vector<FinitePointResponse> r = finite_point_responses(point_deformations(q, e), e);
+      for (size_t k = 0; k < r.size(); ++k) history_[e * r.size() + k] = r[k].history;
+      continue;
+    }
     const std::vector<PointResponse> r = point_responses(q, e);
     for (size_t k = 0; k < r.size(); ++k) history_[e * r.size() + k] = r[k].history;
   }
 }
 
 void ContinuumBody::internal_force(const Vector& q, Vector& force, Triplets* tangent) const {
-  if (has_history_) {
+  if (has_history_ && options_.kinematics == ContinuumKinematics::linear) {
     const Integration& in = integration();
     for (int e = 0; e < element_count(); ++e) {
       const std::vector<PointResponse> r = point_responses(q, e);
@@ -195,10 +219,15 @@ void ContinuumBody::internal_force(const Vector& q, Vector& force, Triplets* tan
   Vector fe;
   Matrix Ke;
   for (int e = 0; e < element_count(); ++e) {
+    // A law with history answers from the committed state of each point.
+    const size_t np = in.points[e].size();
+    PointLaw law;
+    if (has_history_)
+      law = [&](int k, const Mat2& E) { return material(e).finite_response(E, history_[e * np + k]).law; };
     if (options_.incompressibility == Incompressibility::f_bar)
       f_bar_total_lagrangian(in.points[e], in.centroids[e], element_displacements(q, e), material(e), fe,
-                             tangent ? &Ke : nullptr);
-    else total_lagrangian(in.points[e], element_displacements(q, e), material(e), fe, tangent ? &Ke : nullptr);
+                             tangent ? &Ke : nullptr, law);
+    else total_lagrangian(in.points[e], element_displacements(q, e), material(e), fe, tangent ? &Ke : nullptr, law);
     const auto& el = mesh_.elements[e];
     const int m = static_cast<int>(fe.size());
     for (int i = 0; i < m; ++i) {
@@ -342,17 +371,25 @@ Eigen::Vector4d ContinuumBody::centroid_stress(const Vector& q, int e) const {
 FieldTable ContinuumBody::element_fields(const Vector& q) const {
   if (has_history_) {
     FieldTable t{{"sxx", "syy", "sxy", "szz", "equivalent_plastic_strain", "yielding"}, {}};
+    const bool finite = options_.kinematics == ContinuumKinematics::finite;
     for (int e = 0; e < element_count(); ++e) {
-      const std::vector<PointResponse> r = point_responses(q, e);
       const std::vector<ElementPoint>& points = integration().points[e];
       Eigen::Vector4d s = Eigen::Vector4d::Zero();
       double volume = 0.0, alpha = 0.0, yielding = 0.0;
-      for (size_t k = 0; k < r.size(); ++k) {
+      const auto add = [&](size_t k, const Eigen::Vector4d& stress, const PointHistory& h, bool flowing) {
         const double dV = points[k].dV;
         volume += dV;
-        s += dV * r[k].stress;
-        alpha += dV * r[k].history.equivalent_plastic_strain;
-        yielding += r[k].yielding ? dV : 0.0;
+        s += dV * stress;
+        alpha += dV * h.equivalent_plastic_strain;
+        yielding += flowing ? dV : 0.0;
+      };
+      if (finite) {
+        const std::vector<Mat2> F = point_deformations(q, e);
+        const std::vector<FinitePointResponse> r = finite_point_responses(F, e);
+        for (size_t k = 0; k < r.size(); ++k) add(k, cauchy_stress(F[k], r[k].law), r[k].history, r[k].yielding);
+      } else {
+        const std::vector<PointResponse> r = point_responses(q, e);
+        for (size_t k = 0; k < r.size(); ++k) add(k, r[k].stress, r[k].history, r[k].yielding);
       }
       t.rows.push_back({s[0] / volume, s[1] / volume, s[2] / volume, s[3] / volume, alpha / volume, yielding / volume});
     }

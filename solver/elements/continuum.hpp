@@ -6,9 +6,11 @@
 //   linear: small strain, sigma = D eps; K is constant, assembled once and reused (traits()
 //   says so, and the equilibrium oracle then factorizes it once).
 //   finite: total Lagrangian, S(E) of the law, exact tangent.
-// A law with history (j2_plasticity, small strain only) makes the linear body's tangent change:
-// every integration point answers from its committed history, which commit() advances to an
-// accepted state (docs/algorithm.md#j2-plasticity).
+// A law with history (j2_plasticity) makes the linear body's tangent change: every integration
+// point answers from its committed history, which commit() advances to an accepted state
+// (docs/algorithm.md#j2-plasticity); under finite kinematics the law's finite_response (the
+// multiplicative split, docs/algorithm.md#finite-strain-j2-plasticity), with F-bar's F_bar
+// where f_bar is on.
 // Elements: t3 (1 Gauss point), t6 (6 points), q4 (2 x 2 Gauss), q4_bbar (q4 with the mean
 // dilatation of B-bar: for nu -> 1/2 in plane strain, linear kinematics), q8 and q9 (3 x 3).
 //
@@ -56,7 +58,8 @@ class ContinuumBody final : public Body {
  public:
   // The mesh must pass check_mesh (InvalidMesh otherwise); contact_set is a node set on the
   // boundary (boundary_part). Throws std::invalid_argument otherwise, for q4_bbar with
-  // finite kinematics, or for a law with history under finite kinematics.
+  // finite kinematics, or for a law that cannot run under finite kinematics (its
+  // finite_strain_issue).
   // `materials`: one for every element, or one per element (a body of several materials: the
   // physical surfaces of a mesh file).
   ContinuumBody(PlaneMesh mesh, const std::vector<int>& contact_set,
@@ -109,6 +112,9 @@ class ContinuumBody final : public Body {
   const ContinuumOptions& options() const { return options_; }
   // The contact sides (boundary sides spanned by the contact set).
   const BoundaryPart& contact_surface() const { return contact_; }
+  // The committed history of a law with history, per element and point (element e's from
+  // e x its point count); empty otherwise.
+  const std::vector<PointHistory>& committed_history() const { return history_; }
   // Cauchy stress (sxx, syy, sxy, szz) at the centroid of element e.
   Eigen::Vector4d centroid_stress(const Vector& q, int e) const;
 
@@ -117,6 +123,10 @@ class ContinuumBody final : public Body {
   const ShapeGradients* mean_gradient(int e) const;
   // A law with history: the response of each integration point of element e at q.
   std::vector<PointResponse> point_responses(const Vector& q, int e) const;
+  // Finite kinematics: the deformation gradient the law sees at each point of element e (F_bar
+  // with f_bar), and the responses of a law with history to them.
+  std::vector<Mat2> point_deformations(const Vector& q, int e) const;
+  std::vector<FinitePointResponse> finite_point_responses(const std::vector<Mat2>& F, int e) const;
 
   // Integration points and the linear stiffness: built at the first solve, not by the
   // constructor, so that reading and validating a large scene stays cheap (the service reads

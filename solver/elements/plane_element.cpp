@@ -264,11 +264,12 @@ Mat2 deformation_gradient(const ElementPoint& point, const ShapeGradients& u) {
 }
 
 void total_lagrangian(const std::vector<ElementPoint>& points, const ShapeGradients& u, const PlaneMaterial& material,
-                      Vector& fe, Matrix* Ke) {
+                      Vector& fe, Matrix* Ke, const PointLaw& law) {
   const int n = static_cast<int>(u.rows());
   fe = Vector::Zero(2 * n);
   if (Ke) *Ke = Matrix::Zero(2 * n, 2 * n);
-  for (const ElementPoint& p : points) {
+  for (size_t k = 0; k < points.size(); ++k) {
+    const ElementPoint& p = points[k];
     const Mat2 F = deformation_gradient(p, u);
     const Mat2 E = 0.5 * (F.transpose() * F - Mat2::Identity());
     // Axisymmetric: the hoop stretch F33 = r / R = 1 + u_r / R and its strain (F33^2 - 1) / 2.
@@ -283,7 +284,7 @@ void total_lagrangian(const std::vector<ElementPoint>& points, const ShapeGradie
       S33 = r.S[3];
       D = r.D;
     } else {
-      const MaterialResponse r = material.response(E);
+      const MaterialResponse r = law ? law(static_cast<int>(k), E) : material.response(E);
       S_voigt = r.S;
       D = r.D;
     }
@@ -318,19 +319,27 @@ void total_lagrangian(const std::vector<ElementPoint>& points, const ShapeGradie
   }
 }
 
+Mat2 f_bar(const ElementPoint& point, const ElementPoint& centre, const ShapeGradients& u) {
+  const Mat2 F = deformation_gradient(point, u);
+  return std::sqrt(deformation_gradient(centre, u).determinant() / F.determinant()) * F;
+}
+
 void f_bar_total_lagrangian(const std::vector<ElementPoint>& points, const ElementPoint& centre,
-                            const ShapeGradients& u, const PlaneMaterial& material, Vector& fe, Matrix* Ke) {
+                            const ShapeGradients& u, const PlaneMaterial& material, Vector& fe, Matrix* Ke,
+                            const PointLaw& law) {
   const int n = static_cast<int>(u.rows());
   fe = Vector::Zero(2 * n);
   if (Ke) *Ke = Matrix::Zero(2 * n, 2 * n);
   const Mat2 F0 = deformation_gradient(centre, u);
   const ShapeGradients h0 = centre.dN * F0.inverse();  // row a: (F0^-T dN_a)^T
   const auto sym = [](const Mat2& A) { return Mat2(0.5 * (A + A.transpose())); };
-  for (const ElementPoint& p : points) {
+  for (size_t i = 0; i < points.size(); ++i) {
+    const ElementPoint& p = points[i];
     const Mat2 F = deformation_gradient(p, u);
     const double alpha = std::sqrt(F0.determinant() / F.determinant());
     const Mat2 Fb = alpha * F;
-    const MaterialResponse r = material.response(0.5 * (Fb.transpose() * Fb - Mat2::Identity()));
+    const Mat2 Eb = 0.5 * (Fb.transpose() * Fb - Mat2::Identity());
+    const MaterialResponse r = law ? law(static_cast<int>(i), Eb) : material.response(Eb);
     Mat2 S;
     S << r.S[0], r.S[2], r.S[2], r.S[1];
     const Mat2 tau = Fb * S * Fb.transpose();

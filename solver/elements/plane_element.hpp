@@ -10,6 +10,7 @@
 // Local dofs are (u0x, u0y, u1x, ...). Strains and stresses in Voigt order (11, 22, 12) with
 // the engineering shear strain.
 #include <Eigen/Core>
+#include <functional>
 #include <vector>
 
 #include "solver/materials/plane_material.hpp"
@@ -79,8 +80,12 @@ Matrix small_strain_stiffness(const std::vector<ElementPoint>& points, const Eig
 // hoop strain E33 = (F33^2 - 1) / 2 from the law's hoop_response; f_a gains F33 S33 N_a / R in
 // r, B the row dE33 = F33 N_a / R du_r, and Ke the hoop geometric term S33 N_a N_b / R^2 (r-r).
 Mat2 deformation_gradient(const ElementPoint& point, const ShapeGradients& u);
+// `law`, if given, answers for `material` in the plane at each integration point (index into
+// `points`) from the Green-Lagrange strain E there: a law with history answers from that
+// point's committed state.
+using PointLaw = std::function<MaterialResponse(int point, const Mat2& E)>;
 void total_lagrangian(const std::vector<ElementPoint>& points, const ShapeGradients& u, const PlaneMaterial& material,
-                      Vector& fe, Matrix* Ke);
+                      Vector& fe, Matrix* Ke, const PointLaw& law = {});
 
 // F-bar in plane strain: the law sees F_bar = (J0 / J)^(1/2) F, whose in-plane determinant is
 // J0 = det F at the element's centre (`centre`), so that every point changes volume as the
@@ -89,7 +94,10 @@ void total_lagrangian(const std::vector<ElementPoint>& points, const ShapeGradie
 // F_bar S F_bar^T, h_a = F^-T dN_a/dX and h0_a that of the centre, and Ke its exact (symmetric)
 // derivative.
 void f_bar_total_lagrangian(const std::vector<ElementPoint>& points, const ElementPoint& centre,
-                            const ShapeGradients& u, const PlaneMaterial& material, Vector& fe, Matrix* Ke);
+                            const ShapeGradients& u, const PlaneMaterial& material, Vector& fe, Matrix* Ke,
+                            const PointLaw& law = {});
+// F-bar's F_bar = (J0 / J)^(1/2) F at a point, J0 = det F at the centre.
+Mat2 f_bar(const ElementPoint& point, const ElementPoint& centre, const ShapeGradients& u);
 
 // The Cauchy stress (sxx, syy, sxy, szz) for a deformation gradient F (in-plane) and the
 // material response at E = (F^T F - I) / 2.

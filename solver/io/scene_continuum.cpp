@@ -3,9 +3,9 @@
 //   "element": "t3" | "t6" | "q4" | "q4_bbar" | "q8" | "q9";  "thickness" (default 1)
 //   "incompressibility": "none" (default) | "f_bar" (finite kinematics, q4, plane strain)
 //   "material": {"young", "poisson", "law": "neo_hookean" | "saint_venant_kirchhoff" | "j2_plasticity"}
-//     j2_plasticity (linear kinematics): "yield_stress", "hardening": {"linear": H} |
+//     j2_plasticity: "yield_stress", "hardening": {"linear": H} |
 //     {"power": {"K", "n"}} | {"table": [[eps_p, sigma_y], ...]} (default perfectly plastic),
-//     "kinematic_hardening": H_k (default 0)
+//     "kinematic_hardening": H_k (default 0; linear kinematics only)
 //   "mesh": one of
 //     {"nodes": [[x, y], ...], "elements": [[n0, n1, n2(, ...9)], ...], "sets": {name: [ids]}}
 //     {"rectangle": {"origin", "size", "divisions": [nx, ny], "refine": {"towards", "size", "extent"}}}
@@ -32,13 +32,8 @@ namespace {
 
 // The J2 law of material `mp` (law j2_plasticity); nullptr after an error.
 std::shared_ptr<const PlaneMaterial> read_j2_material(Reader& r, json& mat, const std::string& mp, double young,
-                                                      double poisson, const ContinuumOptions& options,
-                                                      const std::string& body_ptr) {
+                                                      double poisson, const ContinuumOptions& options) {
   const size_t before = r.issues.size();
-  if (options.kinematics != ContinuumKinematics::linear)
-    r.error(body_ptr + "/kinematics",
-            "j2_plasticity is implemented for small strain: give \"linear\" (finite-strain plasticity is not "
-            "implemented)");
   const double yield_stress = r.positive(mat, mp, "yield_stress");
   const double kinematic = r.number(mat, mp, "kinematic_hardening", 0.0);
   IsotropicHardening h;
@@ -73,7 +68,14 @@ std::shared_ptr<const PlaneMaterial> read_j2_material(Reader& r, json& mat, cons
     r.error(mp + "/" + why.substr(0, colon), why.substr(colon + 2));
     return nullptr;
   }
-  return std::make_shared<J2Material>(young, poisson, yield_stress, std::move(h), kinematic, options.analysis);
+  auto law = std::make_shared<J2Material>(young, poisson, yield_stress, std::move(h), kinematic, options.analysis);
+  if (options.kinematics == ContinuumKinematics::finite)
+    if (const std::string why = law->finite_strain_issue(); !why.empty()) {
+      const size_t colon = why.find(':');
+      r.error(mp + "/" + why.substr(0, colon), why.substr(colon + 2));
+      return nullptr;
+    }
+  return law;
 }
 
 // [a, b] of integers in [lo, hi].
@@ -501,7 +503,7 @@ void read_continuum(Reader& r, json& body, Problem& problem, const std::string& 
     if (!(poisson > -1 && poisson < 0.5)) r.error(mp + "/poisson", show(mat["poisson"]) + " is not in (-1, 0.5)");
     const std::string law =
         r.choice(mat, mp, "law", {"neo_hookean", "saint_venant_kirchhoff", "j2_plasticity"}, "neo_hookean");
-    if (law == "j2_plasticity") return read_j2_material(r, mat, mp, young, poisson, options, ptr);
+    if (law == "j2_plasticity") return read_j2_material(r, mat, mp, young, poisson, options);
     for (const char* key : {"yield_stress", "hardening", "kinematic_hardening"})
       if (mat.contains(key)) r.error(mp + "/" + key, "belongs to law \"j2_plasticity\" (this law is elastic)");
     if (law == "neo_hookean") return std::make_shared<NeoHookeMaterial>(young, poisson, options.analysis);

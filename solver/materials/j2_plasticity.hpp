@@ -8,6 +8,11 @@
 // The return is the radial return of Simo and Hughes (Computational Inelasticity, box 3.1)
 // with its consistent tangent; plane stress finds eps33 from s33 = 0 by Newton's method on
 // that return (and condenses the tangent), so that the plane-stress state is exact.
+// Finite strain (j2_finite.cpp; docs/algorithm.md#finite-strain-j2-plasticity): F = Fe Fp,
+// Hooke's law on the logarithmic elastic strain, and the same radial return on it, which is
+// the exponential-map return (plastic flow exact in volume: det Fp = 1); isotropic hardening
+// only, plane strain and plane stress.
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -41,6 +46,8 @@ class J2Material final : public PlaneMaterial {
   MaterialResponse response(const Mat2& E) const override;
   bool has_history() const override { return true; }
   PointResponse small_strain_response(const Eigen::Vector4d& strain, const PointHistory& committed) const override;
+  FinitePointResponse finite_response(const Mat2& E, const PointHistory& committed) const override;
+  std::string finite_strain_issue() const override;
 
   double yield_stress(double alpha) const;     // sigma_y(alpha)
   double hardening_slope(double alpha) const;  // d sigma_y / d alpha (right derivative)
@@ -48,6 +55,9 @@ class J2Material final : public PlaneMaterial {
  private:
   // The 3D return with eps33 given.
   PointResponse return_map(const Eigen::Vector4d& strain, const PointHistory& committed) const;
+  // Finite strain at the in-plane E and E33: S (11, 22, 12, 33) and dS/dE (4 x 4, E as
+  // (11, 22, 2 x 12, 33)) in `law.S`, `law.S33` and `D`.
+  FinitePointResponse finite_point(const Mat2& E, double E33, const PointHistory& committed, Eigen::Matrix4d& D) const;
 
   HookeMaterial elastic_;
   Lame lame_;

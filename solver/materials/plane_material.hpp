@@ -11,6 +11,7 @@
 // Units are the scene's: young in force / length^2.
 #include <Eigen/Core>
 #include <memory>
+#include <string>
 
 #include "solver/model/types.hpp"
 
@@ -31,9 +32,19 @@ struct MaterialResponse {
 // What a law with history (J2 plasticity) keeps at one integration point between accepted
 // steps; elastic laws keep nothing in it.
 struct PointHistory {
-  Eigen::Vector4d plastic_strain = Eigen::Vector4d::Zero();  // (11, 22, 2 x 12, 33)
-  Eigen::Vector4d back_stress = Eigen::Vector4d::Zero();     // (11, 22, 12, 33)
+  Eigen::Vector4d plastic_strain = Eigen::Vector4d::Zero();  // small strain: (11, 22, 2 x 12, 33)
+  Eigen::Vector4d back_stress = Eigen::Vector4d::Zero();     // small strain: (11, 22, 12, 33)
   double equivalent_plastic_strain = 0.0;                    // alpha = integral of sqrt(2/3) |d eps_p|
+  // Finite strain: Cp^-1 = Fp^-1 Fp^-T (11, 22, 12, 33), of determinant one (isochoric flow).
+  Eigen::Vector4d plastic_metric_inverse = Eigen::Vector4d(1, 1, 0, 1);
+};
+
+// Finite-strain response of a point with history: the law's answer to E from the committed
+// history, and the history at E (what a commit keeps).
+struct FinitePointResponse {
+  MaterialResponse law;
+  PointHistory history;
+  bool yielding = false;  // the point flows plastically from its committed state
 };
 
 // Response of a law to the in-plane and the hoop strain (axisymmetric finite kinematics), in the
@@ -65,12 +76,18 @@ class PlaneMaterial {
   // The small-strain 4 x 4 law of (11, 22, 12, 33) from the plane block and the row of S33
   // (plane stress: row and column 3 zero).
   Eigen::Matrix4d small_strain_D4() const;
-  // Whether the law keeps history at its points (small strain only): then the body evaluates
-  // small_strain_response at every integration point and commits what it answers.
+  // Whether the law keeps history at its points: then the body evaluates small_strain_response
+  // (linear kinematics) or finite_response at every integration point and commits what it answers.
   virtual bool has_history() const { return false; }
   // The small-strain response to `strain` (11, 22, 2 x 12, 33; 33 ignored in plane stress)
   // from the committed history. Elastic laws: Hooke's law, history unchanged.
   virtual PointResponse small_strain_response(const Eigen::Vector4d& strain, const PointHistory& committed) const;
+  // The finite-strain response to E from the committed history. Elastic laws: response(E).
+  virtual FinitePointResponse finite_response(const Mat2& E, const PointHistory& committed) const {
+    return {response(E), committed, false};
+  }
+  // Why the law cannot run under finite kinematics, as "field: reason" (empty if it can).
+  virtual std::string finite_strain_issue() const { return {}; }
   // Axisymmetric finite strain: S (11, 22, 12, 33) and dS/dE (4 x 4, symmetric) for the
   // in-plane E and the hoop E33 = (F33^2 - 1) / 2 (F33 = r / R). Laws with history: not
   // defined (the body refuses them under finite kinematics).

@@ -162,10 +162,11 @@ TEST(J2Contact, BadMaterialDataIsRefusedWithItsPointer) {
             "/body/material/hardening/power/n");
   EXPECT_EQ(refusal(plastic({{"hardening", {{"linear", 1.0}, {"table", {{0, 2000}}}}}})).first,
             "/body/material/hardening");
-  nlohmann::json finite = plastic(nlohmann::json::object());
+  // Finite strain takes isotropic hardening only.
+  nlohmann::json finite = plastic({{"kinematic_hardening", 1000.0}});
   finite["body"]["kinematics"] = "finite";
   finite["body"]["element"] = "q4";
-  EXPECT_EQ(refusal(finite).first, "/body/kinematics");
+  EXPECT_EQ(refusal(finite).first, "/body/material/kinematic_hardening");
   nlohmann::json elastic = pressed_and_released(false, "cev");
   elastic["body"]["material"]["yield_stress"] = 100.0;
   EXPECT_EQ(refusal(elastic).first, "/body/material/yield_stress");

@@ -1,0 +1,354 @@
+// J2 plasticity at finite strain (docs/algorithm.md#finite-strain-j2-plasticity), through the
+// total-Lagrangian continuum body:
+// - one q4 in uniaxial tension (plane stress) to 50 % logarithmic strain against the closed
+//   form in true stress against log strain: the Kirchhoff stress tau = sigma_y(alpha) with
+//   alpha = eps - tau / E (the small-strain curve, in log strain), the Cauchy stress tau / J with
+//   J = exp((1 - 2 nu) tau / E), the lateral log strain -nu tau / E - alpha / 2; linear and
+//   Swift hardening; det Fp = 1; released, the element keeps the plastic stretch exp(alpha);
+// - plane-strain simple shear to gamma = 1: the mean stress stays K ln Je = 0 (isochoric flow),
+//   the yield condition holds at every plastic state, det Fp = 1; released, C = Cp (Fe is a
+//   rotation: unloading takes back exactly the elastic part);
+// - the consistent tangent against central differences of the internal force (q4 and q8 in
+//   plane strain, q4 in plane stress, q4 with F-bar) and Newton's quadratic convergence on a
+//   plastic step;
+// - the small-strain limit: a bent block at strains of a few 1e-7 as the small-strain law, to 1e-6.
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <Eigen/SparseCore>
+
+#include <cmath>
+#include <cstdio>
+
+#include "solver/elements/continuum.hpp"
+#include "solver/materials/j2_plasticity.hpp"
+#include "tests/support/newton_driver.hpp"
+
+namespace grip {
+namespace {
+
+using testing::Driver;
+
+constexpr double kYoung = 200e3, kPoisson = 0.3, kYield = 250.0;
+
+struct Law {
+  const char* name;
+  IsotropicHardening hardening;
+};
+
+// Isotropic hardening (finite strain takes no kinematic hardening), the yield stress scaled by `scale`.
+std::vector<Law> laws(double scale = 1.0) {
+  IsotropicHardening linear;
+  linear.modulus = 2000.0 * scale;
+  IsotropicHardening power;
+  power.kind = IsotropicHardening::Kind::power;
+  power.K = 600.0 * scale;
+  power.n = 0.2;
+  return {{"linear", linear}, {"power", power}};
+}
+
+std::shared_ptr<J2Material> material(const Law& law, PlaneAnalysis analysis, double scale = 1.0) {
+  return std::make_shared<J2Material>(kYoung, kPoisson, kYield * scale, law.hardening, 0.0, analysis);
+}
+
+// The uniaxial Kirchhoff stress at log strain eps: tau = sigma_y(eps - tau / E) on the plastic
+// branch (bisection on alpha).
+double uniaxial_kirchhoff(const J2Material& m, double eps) {
+  if (eps * kYoung <= kYield) return kYoung * eps;
+  double lo = 0.0, hi = eps;
+  for (int it = 0; it < 200; ++it) {
+    const double a = 0.5 * (lo + hi);
+    (m.yield_stress(a) > kYoung * (eps - a) ? hi : lo) = a;
+  }
+  return kYoung * (eps - 0.5 * (lo + hi));
+}
+
+PlaneMesh unit_square() {
+  PlaneMesh m;
+  m.nodes = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  m.elements = {{0, 1, 2, 3}};
+  m.sets["bottom"] = {0, 1};
+  return m;
+}
+
+ContinuumOptions finite(PlaneAnalysis analysis, ContinuumElement element = ContinuumElement::q4,
+                        Incompressibility incompressibility = Incompressibility::none) {
+  return {element, ContinuumKinematics::finite, analysis, 1.0, incompressibility};
+}
+
+Mat2 tensor(const Eigen::Vector4d& v) { return (Mat2() << v[0], v[2], v[2], v[1]).finished(); }
+
+// The largest |det Fp - 1| = |det Cp^-1 - 1| over the body's points.
+double worst_plastic_volume(const ContinuumBody& body) {
+  double worst = 0.0;
+  for (const PointHistory& h : body.committed_history())
+    worst = std::max(worst, std::abs(tensor(h.plastic_metric_inverse).determinant() * h.plastic_metric_inverse[3] - 1));
+  return worst;
+}
+
+TEST(J2Finite, UniaxialTensionToHalfLogStrainFollowsTheClosedForm) {
+  for (const Law& law : laws()) {
+    SCOPED_TRACE(law.name);
+    const auto m = material(law, PlaneAnalysis::plane_stress);
+    ContinuumBody body(unit_square(), {0, 1}, {m}, finite(PlaneAnalysis::plane_stress));
+    // x held on the left, y at the bottom; the right side pulled along x.
+    std::vector<char> held(8, 0);
+    for (int dof : {0, 6, 1, 3, 2, 4}) held[dof] = 1;
+    Driver d(body, held);
+    double worst = 0.0, worst_lateral = 0.0, tau = 0.0, eps = 0.0;
+    const int steps = 25;
+    for (int k = 1; k <= steps; ++k) {
+      eps = 0.5 * k / steps;
+      d.solve([&](Vector& q) { q[2] = q[4] = std::exp(eps) - 1; }, 1e-9 * kYield);
+      tau = uniaxial_kirchhoff(*m, eps);
+      const double cauchy = tau * std::exp(-(1 - 2 * kPoisson) * tau / kYoung);
+      const std::vector<double> row = d.element_row(0);
+      worst = std::max(worst, std::abs(row[0] - cauchy) / cauchy);
+      EXPECT_NEAR(row[1], 0.0, 1e-9 * kYield);
+      EXPECT_NEAR(row[3], 0.0, 1e-9 * kYield);
+      const double lateral = -kPoisson * tau / kYoung - 0.5 * (eps - tau / kYoung);
+      worst_lateral = std::max(worst_lateral, std::abs(std::log(1 + d.q[5]) - lateral));
+    }
+    EXPECT_LT(worst, 1e-9);
+    EXPECT_LT(worst_lateral, 1e-9);
+    const double alpha = eps - tau / kYoung;
+    EXPECT_NEAR(d.element_row(0)[4], alpha, 1e-9);
+    const double volume_error = worst_plastic_volume(body);
+    EXPECT_LT(volume_error, 1e-12);
+    // Released (only the supports held): the elastic part comes back, the plastic stretch stays.
+    std::vector<char> supports(8, 0);
+    for (int dof : {0, 6, 1, 3}) supports[dof] = 1;
+    Driver release(body, supports);
+    release.q = d.q;
+    release.solve([](Vector&) {}, 1e-9 * kYield);
+    const std::vector<double> row = release.element_row(0);
+    for (int k = 0; k < 4; ++k) EXPECT_NEAR(row[k], 0.0, 1e-8 * kYield);
+    EXPECT_NEAR(std::log(1 + release.q[2]), alpha, 1e-9);
+    EXPECT_NEAR(std::log(1 + release.q[5]), -alpha / 2, 1e-9);
+    std::printf(
+        "uniaxial %-6s to log strain 0.5: worst |sigma - closed form| / sigma = %.1e, lateral log strain %.1e, "
+        "sigma = %.2f, alpha = %.4f, |det Fp - 1| = %.1e\n",
+        law.name, worst, worst_lateral, tau * std::exp(-(1 - 2 * kPoisson) * tau / kYoung), alpha, volume_error);
+  }
+}
+
+TEST(J2Finite, SimpleShearKeepsTheVolumeAndReleasesTheElasticPart) {
+  for (const Law& law : laws()) {
+    SCOPED_TRACE(law.name);
+    const auto m = material(law, PlaneAnalysis::plane_strain);
+    ContinuumBody body(unit_square(), {0, 1}, {m}, finite(PlaneAnalysis::plane_strain));
+    Driver d(body, std::vector<char>(8, 1));  // u = gamma y, v = 0 at every node
+    double worst_mean = 0.0, worst_yield = 0.0, alpha = 0.0;
+    for (int k = 1; k <= 20; ++k) {
+      const double gamma = 0.05 * k;
+      d.solve([&](Vector& q) { q[4] = q[6] = gamma; }, 1e-9 * kYield);
+      const std::vector<double> row = d.element_row(0);
+      EXPECT_GT(row[4], alpha);  // the plastic strain grows on every step
+      alpha = row[4];
+      const double mean = (row[0] + row[1] + row[3]) / 3;
+      worst_mean = std::max(worst_mean, std::abs(mean) / kYield);
+      // J = 1: Cauchy = Kirchhoff, whose von Mises stress is sigma_y(alpha) while it flows.
+      const double s[3][3] = {{row[0] - mean, row[2], 0}, {row[2], row[1] - mean, 0}, {0, 0, row[3] - mean}};
+      double ss = 0.0;
+      for (const auto& r : s)
+        for (double v : r) ss += v * v;
+      worst_yield = std::max(worst_yield, std::abs(std::sqrt(1.5 * ss) - m->yield_stress(alpha)) / kYield);
+    }
+    EXPECT_LT(worst_mean, 1e-9);
+    EXPECT_LT(worst_yield, 1e-9);
+    const double volume_error = worst_plastic_volume(body);
+    EXPECT_LT(volume_error, 1e-12);
+    // Released, one node held and one y: stress free, so F^T F = Cp at every point.
+    std::vector<char> pinned(8, 0);
+    pinned[0] = pinned[1] = pinned[3] = 1;
+    Driver release(body, pinned);
+    release.q = d.q;
+    release.solve([](Vector&) {}, 1e-9 * kYield);
+    const std::vector<double> row = release.element_row(0);
+    for (int k = 0; k < 4; ++k) EXPECT_NEAR(row[k], 0.0, 1e-8 * kYield);
+    const Mat2 F = Mat2::Identity() + (Mat2() << release.q[2] - release.q[0], release.q[6] - release.q[0],
+                                       release.q[3] - release.q[1], release.q[7] - release.q[1])
+                                          .finished();
+    const PointHistory& h = body.committed_history()[0];
+    const double mismatch = (tensor(h.plastic_metric_inverse) * F.transpose() * F - Mat2::Identity()).norm();
+    EXPECT_LT(mismatch, 1e-9);
+    std::printf(
+        "simple shear %-6s to gamma 1: |mean stress| / sigma_y <= %.1e, |q_mises - sigma_y| / sigma_y <= %.1e, "
+        "alpha = %.4f, |det Fp - 1| = %.1e; released |Cp^-1 C - I| = %.1e\n",
+        law.name, worst_mean, worst_yield, alpha, volume_error, mismatch);
+  }
+}
+
+// A 4 x 2 block held on its left side and bent by a prescribed tip displacement.
+struct Bent {
+  std::unique_ptr<ContinuumBody> body;
+  std::vector<char> held;
+  std::vector<int> tip;
+};
+
+Bent bent_block(std::shared_ptr<const PlaneMaterial> m, ContinuumOptions options) {
+  RectangleSpec spec;
+  spec.origin = {0.0, 0.0};
+  spec.size = {4.0, 1.0};
+  spec.nx = 4;
+  spec.ny = 2;
+  PlaneMesh mesh = rectangle_mesh(spec, element_shape(options.element));
+  Bent b;
+  b.tip = mesh.sets.at("right");
+  const std::vector<int> left = mesh.sets.at("left");
+  b.body = std::make_unique<ContinuumBody>(mesh, mesh.sets.at("bottom"),
+                                           std::vector<std::shared_ptr<const PlaneMaterial>>{std::move(m)}, options);
+  b.held.assign(b.body->dof_count(), 0);
+  for (int n : left) b.held[2 * n] = b.held[2 * n + 1] = 1;
+  for (int n : b.tip) b.held[2 * n + 1] = 1;
+  return b;
+}
+
+void bend(Driver& d, const Bent& b, double tip, double tolerance) {
+  d.solve(
+      [&](Vector& q) {
+        for (int n : b.tip) q[2 * n + 1] = tip;
+      },
+      tolerance);
+}
+
+// Bent in steps of 0.025 to 0.4 (plane strain: strains of ~4 %, 30 times the yield strain) or
+// 0.2 (plane stress). The driver's plain Newton (no line search, a predictor on the last
+// tangent) fails on q8 with steps of 0.05, as it does with the small-strain law; in plane
+// stress beyond 0.25 on q4, and on q8 from 0.075 on with either law: a question of the driver,
+// which the tests of the law need not answer.
+void bend_far(Driver& d, const Bent& b, PlaneAnalysis analysis, double tolerance) {
+  const int steps = analysis == PlaneAnalysis::plane_strain ? 16 : 8;
+  for (int k = 1; k <= steps; ++k) bend(d, b, 0.025 * k, tolerance);
+}
+
+struct Case {
+  const char* name;
+  PlaneAnalysis analysis;
+  ContinuumElement element;
+  Incompressibility incompressibility;
+};
+
+const Case kCases[] = {
+    {"q4 plane strain", PlaneAnalysis::plane_strain, ContinuumElement::q4, Incompressibility::none},
+    {"q8 plane strain", PlaneAnalysis::plane_strain, ContinuumElement::q8, Incompressibility::none},
+    {"q4 plane stress", PlaneAnalysis::plane_stress, ContinuumElement::q4, Incompressibility::none},
+    {"q4 f_bar plane strain", PlaneAnalysis::plane_strain, ContinuumElement::q4, Incompressibility::f_bar},
+};
+
+TEST(J2Finite, ConsistentTangentMatchesDifferencesOfTheForce) {
+  for (const Case& c : kCases)
+    for (const Law& law : laws()) {
+      SCOPED_TRACE(std::string(law.name) + " " + c.name);
+      Bent b = bent_block(material(law, c.analysis), finite(c.analysis, c.element, c.incompressibility));
+      Driver d(*b.body, b.held);
+      bend_far(d, b, c.analysis, 1e-9 * kYield);  // a committed plastic history
+      // A state beyond it, off equilibrium: every dof moved.
+      Vector q = d.q;
+      for (int i = 0; i < q.size(); ++i) q[i] += 0.01 * std::sin(1.0 + 3.7 * i);
+      Triplets t;
+      Vector f0 = Vector::Zero(q.size());
+      b.body->internal_force(q, f0, &t);
+      Eigen::SparseMatrix<double> K(q.size(), q.size());
+      K.setFromTriplets(t.begin(), t.end());
+      const Matrix Kd(K);
+      Matrix Kfd(q.size(), q.size());
+      const double h = 1e-7;
+      for (int j = 0; j < q.size(); ++j) {
+        Vector qp = q, qm = q, fp = Vector::Zero(q.size()), fm = Vector::Zero(q.size());
+        qp[j] += h;
+        qm[j] -= h;
+        b.body->internal_force(qp, fp, nullptr);
+        b.body->internal_force(qm, fm, nullptr);
+        Kfd.col(j) = (fp - fm) / (2 * h);
+      }
+      int flowing = 0;
+      for (const auto& row : b.body->element_fields(q).rows) flowing += row[5] > 0;
+      EXPECT_GT(flowing, 0);
+      const double error = (Kd - Kfd).norm() / Kd.norm();
+      EXPECT_LT(error, 1e-6);
+      EXPECT_LT((Kd - Kd.transpose()).norm(), 1e-9 * Kd.norm());
+      std::printf("tangent %-6s %-22s |K - K_fd| / |K| = %.1e (%d of %zu elements flowing)\n", law.name, c.name, error,
+                  flowing, b.body->element_fields(q).rows.size());
+    }
+}
+
+TEST(J2Finite, NewtonConvergesQuadraticallyOnAPlasticStep) {
+  for (const Case& c : kCases)
+    for (const Law& law : laws()) {
+      SCOPED_TRACE(std::string(law.name) + " " + c.name);
+      Bent b = bent_block(material(law, c.analysis), finite(c.analysis, c.element, c.incompressibility));
+      Driver d(*b.body, b.held);
+      bend_far(d, b, c.analysis, 1e-10 * kYield);
+      const std::vector<double>& r = d.residuals;
+      std::string line;
+      char buffer[32];
+      for (double v : r) {
+        std::snprintf(buffer, sizeof buffer, " %.1e", v / r[0]);
+        line += buffer;
+      }
+      std::printf("Newton %-6s %-22s relative residuals:%s\n", law.name, c.name, line.c_str());
+      // Near the solution (e_k < 1e-3): e_{k+1} <= 10 e_k^2 (relative to the first residual).
+      // Below 1e-11 the residual is round-off.
+      int quadratic = 0;
+      for (size_t k = 1; k + 1 < r.size(); ++k) {
+        const double ek = r[k] / r[0], next = r[k + 1] / r[0];
+        if (ek >= 1e-3) continue;
+        EXPECT_LE(next, std::max(10 * ek * ek, 1e-11)) << "iteration " << k;
+        quadratic += 10 * ek * ek >= 1e-11;
+      }
+      EXPECT_GE(quadratic, 1);
+      EXPECT_LE(r.size(), 10u);
+      EXPECT_LT(worst_plastic_volume(*b.body), 1e-12);
+    }
+}
+
+TEST(J2Finite, SmallStrainLimitIsTheSmallStrainLaw) {
+  // Yield strain 1.25e-8: the block yields at strains where the finite and small measures
+  // differ by 1e-7 relative.
+  const double scale = 1e-5;
+  for (PlaneAnalysis analysis : {PlaneAnalysis::plane_strain, PlaneAnalysis::plane_stress})
+    for (const Law& law : laws(scale)) {
+      SCOPED_TRACE(std::string(law.name) +
+                   (analysis == PlaneAnalysis::plane_strain ? " plane strain" : " plane stress"));
+      const auto m = material(law, analysis, scale);
+      Bent fin = bent_block(m, finite(analysis, ContinuumElement::q8));
+      Bent lin = bent_block(m, {ContinuumElement::q8, ContinuumKinematics::linear, analysis, 1.0});
+      Driver df(*fin.body, fin.held), dl(*lin.body, lin.held);
+      double worst_stress = 0.0, worst_alpha = 0.0, peak_alpha = 0.0;
+      // Loading to 6e-7 (4.5 times the tip deflection at first yield), unloading and reversing to -4e-7.
+      std::vector<double> path;
+      for (int k = 1; k <= 12; ++k) path.push_back(5e-8 * k);
+      for (int k = 1; k <= 20; ++k) path.push_back(6e-7 - 5e-8 * k);
+      for (double tip : path) {
+        // The finite measures lose ~1e-9 of these strains to round-off (F^T F - I).
+        bend(df, fin, tip, 1e-7 * kYield * scale);
+        bend(dl, lin, tip, 1e-7 * kYield * scale);
+        const auto rf = fin.body->element_fields(df.q).rows, rl = lin.body->element_fields(dl.q).rows;
+        double peak = 0.0;
+        for (const auto& row : rl)
+          for (int k = 0; k < 4; ++k) peak = std::max(peak, std::abs(row[k]));
+        for (size_t e = 0; e < rf.size(); ++e) {
+          for (int k = 0; k < 4; ++k) worst_stress = std::max(worst_stress, std::abs(rf[e][k] - rl[e][k]) / peak);
+          worst_alpha = std::max(worst_alpha, std::abs(rf[e][4] - rl[e][4]));
+          peak_alpha = std::max(peak_alpha, rl[e][4]);
+        }
+      }
+      EXPECT_GT(peak_alpha, 1e-8);
+      EXPECT_LT(worst_stress, 1e-6);
+      EXPECT_LT(worst_alpha, 1e-6 * peak_alpha);
+      std::printf("small-strain limit %-6s %s: |sigma_finite - sigma_small| / peak <= %.1e, alpha %.1e of %.1e\n",
+                  law.name, analysis == PlaneAnalysis::plane_strain ? "plane strain" : "plane stress", worst_stress,
+                  worst_alpha, peak_alpha);
+    }
+}
+
+TEST(J2Finite, KinematicHardeningIsRefusedUnderFiniteKinematics) {
+  const auto m =
+      std::make_shared<J2Material>(kYoung, kPoisson, kYield, IsotropicHardening{}, 1000.0, PlaneAnalysis::plane_strain);
+  EXPECT_EQ(m->finite_strain_issue().rfind("kinematic_hardening:", 0), 0u);
+  EXPECT_THROW(ContinuumBody(unit_square(), {0, 1}, {m}, finite(PlaneAnalysis::plane_strain)), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace grip
