@@ -206,7 +206,7 @@ void plan_sweep(const json& request, StudyPlan& plan, std::vector<SceneIssue>& i
   for (const auto& p : pointers) plan.pointers.push_back(p.to_string());
   std::vector<size_t> at(lists.size(), 0);
   for (size_t n = 0; n < static_cast<size_t>(jobs); ++n) {
-    StudyLevel level{scene, 1.0, json::array()};
+    StudyLevel level{.scene = scene, .parameters = json::array()};
     for (size_t i = 0; i < lists.size(); ++i) {
       const json& value = lists[i][mode == "zip" ? n : at[i]];
       level.scene[pointers[i]] = value;
@@ -350,7 +350,7 @@ StudyPlan plan_study(const json& request) {
     plan.accuracy = plan_accuracy(request["accuracy"], names, issues);
     if (!issues.empty()) fail();
     for (int j = 0; j < plan.accuracy["levels"].get<int>(); ++j) {
-      StudyLevel level{nullptr, std::ldexp(1.0, -j), nullptr, j + 1};
+      StudyLevel level{.h = std::ldexp(1.0, -j), .mesh_level = j + 1};
       if (!level_scene(scene, j, level.scene, issues)) fail();
       plan.levels.push_back(std::move(level));
     }
@@ -377,7 +377,7 @@ StudyPlan plan_study(const json& request) {
     }
     const int k = levels.get<int>();
     for (int j = 0; j < k; ++j) {
-      StudyLevel level{nullptr, std::ldexp(1.0, -j), nullptr};
+      StudyLevel level{.h = std::ldexp(1.0, -j)};
       if (!level_scene(scene, j, level.scene, issues)) fail();
       plan.levels.push_back(std::move(level));
     }
@@ -392,7 +392,7 @@ StudyPlan plan_study(const json& request) {
     if (!issues.empty()) fail();
     plan.h_from_nodes = true;
     for (const json& ref : meshes) {
-      StudyLevel level{scene, 1.0, nullptr};
+      StudyLevel level{.scene = scene};
       level.scene["body"]["mesh"]["gmsh"] = ref;
       plan.levels.push_back(std::move(level));
     }
