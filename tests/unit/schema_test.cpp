@@ -319,7 +319,7 @@ const InvalidScene kInvalidScenes[] = {
      R"([{"op": "replace", "path": "/body/material/young", "value": "210000"}])", "/body/material/young",
      "\"210000\" is not a number", Reader::same_pointer},
     {"an unknown model", "beam-on-cylinder", R"([{"op": "replace", "path": "/body/model", "value": "beam"}])",
-     "/body/model", "\"beam\" is not one of \"timoshenko_beam\", \"rigid_plastic_membrane\", \"continuum\"",
+     "/body/model", "\"beam\" is not one of \"timoshenko_beam\", \"reissner_beam\", \"rigid_plastic_membrane\", \"continuum\"",
      Reader::same_pointer},
     {"an unknown kinematics", "beam-on-cylinder", R"([{"op": "replace", "path": "/body/kinematics", "value": "vk"}])",
      "/body/kinematics", "\"vk\" is not one of \"von_karman\", \"linear\"", Reader::same_pointer},
