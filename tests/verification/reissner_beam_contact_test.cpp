@@ -3,12 +3,16 @@
 // belt pulled over a drum (the capstan) as its bending stiffness goes to zero.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
 #include "solver/elements/continuum.hpp"
 #include "solver/elements/reissner_beam.hpp"
 #include "tests/support/contact_checks.hpp"
+#include "tests/support/contact_profile.hpp"
+#include "tests/support/force_precision.hpp"
+#include "tests/support/held.hpp"
 #include "tests/support/scenes.hpp"
 
 namespace grip {
@@ -153,6 +157,56 @@ TEST(ReissnerBeamContact, CapstanRatioAsBendingStiffnessVanishes) {
     previous = deficit;
   }
   EXPECT_LT(previous, 4e-3);
+}
+
+// The beam lying free on a flat (tests/support/scenes.hpp, beam_lying_on_a_flat) with no support
+// at all, pressed by 10 a node and then by 100 more at x = 16, 6 right of its centre: contact
+// alone holds its two translations and its rotation (three free motions, the rotation the turn
+// of its current shape), the load is balanced on them to 1e-9, and the contact forces are the
+// von Karman beam's (whose own finite rotation holds it the same way) to 1e-6 of the largest
+// (measured 1e-10):
+// the flat keeps both beams straight (theta ~ 1e-10), where the two models are one.
+TEST(ReissnerBeamContact, BeamFreeOnAFlatIsHeldByContact) {
+  auto scene = [](const std::string& model) {
+    nlohmann::json j = testing::beam_lying_on_a_flat("von_karman");
+    j["body"].erase("supports");
+    if (model == "reissner_beam") {
+      j["body"]["model"] = model;
+      j["body"].erase("kinematics");
+    }
+    nlohmann::json loads = nlohmann::json::array();
+    for (const nlohmann::json& load : j["body"]["loads"])
+      if (load["case"] == "press") loads.push_back(load);
+    loads.push_back({{"node", 16}, {"force", {0.0, -100.0}}, {"case", "offset"}});
+    j["body"]["loads"] = loads;
+    j["stages"] = nlohmann::json::array(
+        {{{"steps", 1}, {"factors", {{"press", 1}}}}, {{"steps", 2}, {"factors", {{"press", 1}, {"offset", 1}}}}});
+    j["solver"]["contact"]["tolerance"] = 1e-9;
+    return j;
+  };
+  const auto exact = solve_scene(scene("reissner_beam"));
+  const auto von_karman = solve_scene(scene("timoshenko_beam"));
+  testing::expect_held(exact);
+  ASSERT_TRUE(exact.run.completed) << exact.run.reason;
+  ASSERT_TRUE(von_karman.run.completed) << von_karman.run.reason;
+  EXPECT_EQ(exact.scene.problem.rigid.count(), 3);
+  ASSERT_EQ(exact.run.steps.size(), von_karman.run.steps.size());
+  for (size_t k = 0; k < exact.run.steps.size(); ++k) {
+    const StepRecord &rec = exact.run.steps[k], &ref = von_karman.run.steps[k];
+    const Vec2 R = testing::contact_resultant(exact.scene.problem, rec, 0);
+    const auto& cases = exact.scene.problem.case_names;
+    const size_t offset = std::find(cases.begin(), cases.end(), "offset") - cases.begin();
+    ASSERT_LT(offset, cases.size());
+    const double P = 200.0 + 100.0 * rec.factors[offset];
+    double p_max = 0.0;
+    for (const Candidate& c : exact.scene.problem.candidates) p_max = std::max(p_max, std::abs(ref.p[c.eta]));
+    const double diff = testing::force_difference(exact.scene.problem, rec, ref);
+    std::printf("step %zu: contact resultant %.9f (load %.1f), forces differ from the von Karman beam's by %.1e\n",
+                k + 1, R.y(), P, diff / p_max);
+    EXPECT_NEAR(R.y(), P, 1e-9 * P) << k + 1;
+    EXPECT_NEAR(R.x(), 0.0, 1e-9 * P) << k + 1;
+    EXPECT_LT(diff, 1e-6 * p_max) << k + 1;
+  }
 }
 
 }  // namespace
