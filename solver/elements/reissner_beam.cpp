@@ -155,6 +155,25 @@ void ReissnerBeam::internal_force(const Vector& q, Vector& force, Triplets* tang
   }
 }
 
+void ReissnerBeam::follower_load(const Vector& q, const std::vector<double>& factors, Vector& force,
+                                 Triplets* tangent) const {
+  for (const FollowerLoad& l : followers_) {
+    const double t = l.load_case < static_cast<int>(factors.size()) ? factors[l.load_case] : 0.0;
+    const int du = node_dof(l.node, 0), dw = node_dof(l.node, 1), dt = node_dof(l.node, 2);
+    const double c = std::cos(q[dt]), s = std::sin(q[dt]);
+    // The force turned with the section (clockwise by theta); at height z its point moves by
+    // z (cos, -sin) dtheta, the same turn of e_x: its moment about the axis stays z F_x.
+    const Vec2 f = t * Vec2(c * l.force.x() + s * l.force.y(), -s * l.force.x() + c * l.force.y());
+    const Vec2 df = t * Vec2(-s * l.force.x() + c * l.force.y(), -c * l.force.x() - s * l.force.y());
+    force[du] += f.x();
+    force[dw] += f.y();
+    force[dt] += t * l.z * l.force.x();
+    if (!tangent) continue;
+    tangent->emplace_back(du, dt, df.x());
+    tangent->emplace_back(dw, dt, df.y());
+  }
+}
+
 SurfacePoint ReissnerBeam::surface_point(const VectorRef& q, int site, int side) const {
   const double z = side * section_.half_depth;
   const int du = node_dof(site, 0), dw = node_dof(site, 1), dt = node_dof(site, 2);

@@ -39,6 +39,18 @@ class ReissnerBeam final : public Body {
   // Three dofs a node (u, w, theta), the element ends first, then each b3's mid node.
   int dof_node(int dof) const override { return dof / 3; }
   Traits traits() const override { return {true, false, false}; }
+  // A force at an end node that turns with its section: `force` at theta = 0, of load case
+  // `load_case`, applied at height z (0: the axis; +-h/2: a face), whose arm turns with it.
+  struct FollowerLoad {
+    int node;
+    Vec2 force;
+    double z;
+    int load_case;
+  };
+  void add_follower_load(const FollowerLoad& load) { followers_.push_back(load); }
+  bool has_follower_loads() const override { return !followers_.empty(); }
+  void follower_load(const Vector& q, const std::vector<double>& factors, Vector& force,
+                     Triplets* tangent) const override;
   std::vector<std::vector<int>> cells() const override;
   FieldTable site_fields(const Vector& q) const override;
   FieldTable element_fields(const Vector& q) const override;
@@ -62,6 +74,7 @@ class ReissnerBeam final : public Body {
   double y0_;
   BeamSection section_;
   BeamElement element_;
+  std::vector<FollowerLoad> followers_;
 };
 
 }  // namespace grip

@@ -60,7 +60,12 @@ Vector Equilibrium::residual(const Vector& q, const EquilibriumState& paired, co
   const Vector p = penalty_ ? penalty_forces(q, paired, tangent) : p_given;
   Vector r = Vector::Zero(q.size());
   problem_.body->internal_force(q, r, body_tangent ? tangent : nullptr);
-  const Vector external = problem_.load(factors_);
+  Vector external = problem_.load(factors_);
+  if (problem_.body->has_follower_loads()) {
+    Triplets follow;  // r = A - F(q): the follower load's derivative enters with a minus
+    problem_.body->follower_load(q, factors_, external, body_tangent && tangent ? &follow : nullptr);
+    for (const auto& e : follow) tangent->emplace_back(e.row(), e.col(), -e.value());
+  }
   Vector contact = Vector::Zero(q.size());
   for (size_t i = 0; i < problem_.candidates.size(); ++i) {
     const Candidate& c = problem_.candidates[i];
@@ -111,6 +116,7 @@ Vector Equilibrium::residual(const Vector& q, const Vector& p, Triplets* tangent
 
 Vector Equilibrium::applied_forces(const EquilibriumState& paired, const Vector& p) const {
   Vector f = problem_.load(factors_);
+  problem_.body->follower_load(paired.q, factors_, f, nullptr);
   for (size_t i = 0; i < problem_.candidates.size(); ++i) {
     const Candidate& c = problem_.candidates[i];
     const PairedPoint& pp = paired.points[i];

@@ -698,6 +698,10 @@ Scene read_checked_scene(const nlohmann::json& input, const MeshResolver& meshes
       scene.params.contact_reach > 0 ? scene.params.contact_reach : scene.problem.body->characteristic_length();
   add_candidates(scene.problem, scene.steps, reach);
   hold_rigid_modes(r, scene.problem);
+  // A held body balances its loads on its free motions at the reference (held_by_contact.cpp):
+  // a follower load's turn is not in that balance.
+  if (r.issues.empty() && scene.problem.rigid.count() > 0 && scene.problem.body->has_follower_loads())
+    r.error("/body/loads", "a follower load on a body held only by contact is not supported: support the body");
   if (!r.issues.empty()) throw SceneErrors(std::move(r.issues));
   scene.file_meshes = std::move(r.file_meshes);
   scene.axis_holds = std::move(r.axis_holds);

@@ -7,6 +7,23 @@
 namespace grip::scene_io {
 namespace {
 
+// A load's `follower` flag: its force turns with the section (reissner_beam only, one body).
+bool follows(Reader& r, json& l, const std::string& lp, bool exact, const std::string& ptr) {
+  if (!l.contains("follower")) {
+    if (exact) l["follower"] = false;
+    return false;
+  }
+  if (!l["follower"].is_boolean()) {
+    r.error(lp + "/follower", show(l["follower"]) + " is not true or false");
+    return false;
+  }
+  if (!l["follower"].get<bool>()) return false;
+  if (!exact) r.error(lp + "/follower", "only a reissner_beam's loads turn with it (the von Karman beam's stay dead)");
+  else if (ptr != "/body")
+    r.error(lp + "/follower", "follower loads are for a one-body scene (body), not yet for a body of bodies");
+  return true;
+}
+
 // The two beam models share their section, mesh, supports and loads (node dofs u, w, theta);
 // the von Karman beam has its kinematics, the geometrically exact one its element.
 void read_beam(Reader& r, json& body, Problem& problem, const std::string& ptr, bool exact) {
@@ -62,11 +79,17 @@ void read_beam(Reader& r, json& body, Problem& problem, const std::string& ptr, 
       const double moment = r.number(l, lp, "moment", 0.0);
       const std::string at = r.choice(l, lp, "at", {"centre", "upper", "lower"}, "centre");
       const int side = at == "upper" ? 1 : at == "lower" ? -1 : 0;
-      Vector& load = case_load(problem, r.load_case(l, lp));
+      const int load_case = r.load_case(l, lp);
+      Vector& load = case_load(problem, load_case);
+      load[TimoshenkoBeam::node_dof(node, 2)] += moment;
+      if (follows(r, l, lp, exact, ptr)) {
+        if (r.issues.empty())
+          static_cast<ReissnerBeam&>(*problem.body).add_follower_load({node, f, side * section.half_depth, load_case});
+        continue;
+      }
       // Virtual work of the force at its point of application (a moment through the offset).
       const SurfacePoint sp = body_model.surface_point(Vector::Zero(load.size()), node, side);
       for (const auto& jac : sp.jacobian) load[jac.dof] += jac.dx.dot(f);
-      load[TimoshenkoBeam::node_dof(node, 2)] += moment;
     }
 }
 

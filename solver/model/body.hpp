@@ -137,6 +137,13 @@ class Body {
   // does not): the answer stands, with this warning (e.g. a von Karman beam rotated far).
   virtual std::string validity_warning(const Vector& /*q*/) const { return {}; }
 
+  // Loads that turn with the body (a reissner_beam's follower forces): adds their generalized
+  // force at q and the load cases' factors into `force` and, if `tangent` is given, the triplets
+  // of its derivative (unsymmetric: a follower load has no potential). Default: none.
+  virtual bool has_follower_loads() const { return false; }
+  virtual void follower_load(const Vector& /*q*/, const std::vector<double>& /*factors*/, Vector& /*force*/,
+                             Triplets* /*tangent*/) const {}
+
   // Bodies with history (plasticity) keep old/new state; commit after a converged step.
   virtual void commit(const Vector& /*q*/) {}
 };

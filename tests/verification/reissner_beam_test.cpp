@@ -103,6 +103,65 @@ TEST(ReissnerBeam, EndMomentRollsACircle) {
   }
 }
 
+// The cantilever under a follower end force F = alpha EI / L^2, perpendicular to the tip at
+// every state. With phi = theta_L - theta along s / L: phi'' = alpha cos(phi), phi(1) = phi'(1)
+// = 0, whose first integral phi'^2 = 2 alpha sin(phi) gives ds = dphi / sqrt(2 alpha sin phi):
+//   1 = int_0^theta_L ds,  x(1) = int cos(theta_L - phi) ds,  y(1) = -int sin(theta_L - phi) ds,
+// integrated here by Simpson's rule in u = sqrt(phi) (smooth at phi = 0), theta_L by bisection.
+struct FollowerTip {
+  double rotation, x, y;
+};
+
+FollowerTip follower_elastica(double alpha) {
+  auto integrals = [alpha](double theta, double& length, double& x, double& y) {
+    const int n = 4000;
+    const double top = std::sqrt(theta), h = top / n;
+    length = x = y = 0.0;
+    for (int i = 0; i <= n; ++i) {
+      const double u = i * h, phi = u * u, w = (i == 0 || i == n) ? 1 : (i % 2 ? 4 : 2);
+      const double ratio = u > 0 ? std::sin(phi) / phi : 1.0;  // sin(phi) / u^2, 1 at u = 0
+      const double ds = 2 / std::sqrt(2 * alpha * ratio);      // ds / du
+      length += w * ds;
+      x += w * ds * std::cos(theta - phi);
+      y -= w * ds * std::sin(theta - phi);
+    }
+    length *= h / 3, x *= h / 3, y *= h / 3;
+  };
+  double lo = 0.0, hi = 3.0, length, x, y;
+  for (int i = 0; i < 60; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    integrals(mid, length, x, y);
+    (length > 1 ? hi : lo) = mid;
+  }
+  integrals(0.5 * (lo + hi), length, x, y);
+  return {0.5 * (lo + hi), x, y};
+}
+
+// A follower end force to alpha = 8 in 16 steps turns the tip through 90 degrees (at alpha
+// 3.44) to 2.3 rad: at every step the tip's rotation and position are the closed form's within
+// 1e-4 (of L; t = 3e-3, so that shear and extension stay near 2e-5). The tangent of the load,
+// unsymmetric, is factorized by LU.
+TEST(ReissnerBeam, FollowerEndForceTurnsTheTipPastNinetyDegrees) {
+  const auto s =
+      solve_scene(cantilever(20, "b3", {{"node", 20}, {"force", {0.0, -8.0}}, {"follower", true}}, 16, 3e-3));
+  ASSERT_TRUE(s.run.completed) << s.run.reason;
+  for (size_t k = 0; k < s.run.steps.size(); ++k) {
+    const double alpha = 8.0 * s.run.steps[k].load_factor;
+    const FollowerTip exact = follower_elastica(alpha);
+    const Vec2 at = Vec2(1.0, 0.0) + tip(s, k, 20);
+    const double theta = s.run.steps[k].state.q[ReissnerBeam::node_dof(20, 2)];
+    std::printf("follower alpha %.1f: rotation %.5f (%+.1e), tip (%.5f, %.5f) (%+.1e, %+.1e), %d Newton\n", alpha,
+                theta, theta - exact.rotation, at.x(), at.y(), at.x() - exact.x, at.y() - exact.y,
+                s.run.steps[k].newton_iterations);
+    EXPECT_NEAR(theta, exact.rotation, 1e-4) << alpha;
+    EXPECT_NEAR(at.x(), exact.x, 1e-4) << alpha;
+    EXPECT_NEAR(at.y(), exact.y, 1e-4) << alpha;
+  }
+  EXPECT_GT(s.run.steps.back().state.q[ReissnerBeam::node_dof(20, 2)], 2.0);
+  // The closed form itself: 90 degrees at alpha = (int_0^(pi/2) dphi / sqrt(sin phi))^2 / 2 = 3.4376.
+  EXPECT_NEAR(follower_elastica(3.4376).rotation, kPi / 2, 1e-3);
+}
+
 // The paper's beam (schemas/examples/beam-on-cylinder.json) as reissner_beam against the von
 // Karman beam, where the latter holds: its axial strain keeps the arm of the moment at its
 // reference length, which moves the tip by about 0.45 theta^2 relative
