@@ -132,7 +132,6 @@ bool partial_solves_pay(const cholmod_factor* L, const std::vector<int>& rows) {
 
 }  // namespace
 
-
 bool FreeBlockSolver::inverse_block(const std::vector<int>& rows, Matrix& G) {
   if (!ok_ || !symmetric_) return false;
   if (split_) {  // K^-1 is block diagonal: each body's rows from its own factor

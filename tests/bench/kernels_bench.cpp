@@ -73,6 +73,6 @@ int main(int argc, char** argv) {
       "\"factorizations\": %ld, \"newton_factorizations\": %ld, \"body_factorizations\": %ld, "
       "\"dissected_factorizations\": %ld, \"ms_per_newton_iteration\": %.4f}\n",
       n, free_count, triplets.size(), assemble_ms, factorize_ms, run_s, run.completed ? "true" : "false", c.solves,
-      c.newton_iterations, c.factorizations, c.newton_factorizations, c.body_factorizations,
-      c.dissected_factorizations, c.newton_iterations ? 1e3 * run_s / c.newton_iterations : 0.0);
+      c.newton_iterations, c.factorizations, c.newton_factorizations, c.body_factorizations, c.dissected_factorizations,
+      c.newton_iterations ? 1e3 * run_s / c.newton_iterations : 0.0);
 }
