@@ -1,13 +1,17 @@
 #include <cmath>
 
+#include "solver/elements/reissner_beam.hpp"
 #include "solver/elements/timoshenko_beam.hpp"
 #include "solver/io/scene_reader.hpp"
 
 namespace grip::scene_io {
-namespace {}  // namespace
+namespace {
 
-void read_timoshenko_beam(Reader& r, json& body, Problem& problem, const std::string& ptr) {
-  const std::string kin = r.choice(body, ptr, "kinematics", {"von_karman", "linear"}, "von_karman");
+// The two beam models share their section, mesh, supports and loads (node dofs u, w, theta);
+// the von Karman beam has its kinematics, the geometrically exact one its element.
+void read_beam(Reader& r, json& body, Problem& problem, const std::string& ptr, bool exact) {
+  const std::string kin = exact ? "" : r.choice(body, ptr, "kinematics", {"von_karman", "linear"}, "von_karman");
+  const std::string element = exact ? r.choice(body, ptr, "element", {"b2", "b3"}, "b3") : "";
   json* mat = r.object(body, ptr, "material", true);
   json* sec = r.object(body, ptr, "section", true);
   json* mesh = r.object(body, ptr, "mesh", true);
@@ -34,11 +38,14 @@ void read_timoshenko_beam(Reader& r, json& body, Problem& problem, const std::st
     for (int i = 0; i <= elements; ++i) x.push_back(origin.x() + length * i / elements);
   }
   if (!r.issues.empty()) return;
-  auto beam = std::make_unique<TimoshenkoBeam>(x, origin.y(), section,
-                                               kin == "linear" ? Kinematics::linear : Kinematics::von_karman);
-  const int nodes = beam->node_count();
-  problem.body = std::move(beam);
-  const auto& body_model = static_cast<const TimoshenkoBeam&>(*problem.body);
+  if (exact)
+    problem.body =
+        std::make_unique<ReissnerBeam>(x, origin.y(), section, element == "b2" ? BeamElement::b2 : BeamElement::b3);
+  else
+    problem.body = std::make_unique<TimoshenkoBeam>(x, origin.y(), section,
+                                                    kin == "linear" ? Kinematics::linear : Kinematics::von_karman);
+  const int nodes = problem.body->site_count();
+  const Body& body_model = *problem.body;
 
   read_supports(r, body, ptr, nodes, {"u", "w", "theta"}, &TimoshenkoBeam::node_dof, problem);
 
@@ -61,6 +68,16 @@ void read_timoshenko_beam(Reader& r, json& body, Problem& problem, const std::st
       for (const auto& jac : sp.jacobian) load[jac.dof] += jac.dx.dot(f);
       load[TimoshenkoBeam::node_dof(node, 2)] += moment;
     }
+}
+
+}  // namespace
+
+void read_timoshenko_beam(Reader& r, json& body, Problem& problem, const std::string& ptr) {
+  read_beam(r, body, problem, ptr, false);
+}
+
+void read_reissner_beam(Reader& r, json& body, Problem& problem, const std::string& ptr) {
+  read_beam(r, body, problem, ptr, true);
 }
 
 }  // namespace grip::scene_io

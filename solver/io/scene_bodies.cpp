@@ -5,6 +5,7 @@
 #include <unordered_map>
 
 #include "solver/elements/continuum.hpp"
+#include "solver/elements/reissner_beam.hpp"
 #include "solver/elements/rigid_hubs.hpp"
 #include "solver/elements/timoshenko_beam.hpp"
 #include "solver/io/scene_reader.hpp"
@@ -17,6 +18,7 @@ void read_body(Reader& r, json& body, Problem& problem, const std::string& ptr) 
   using ModelReader = void (*)(Reader&, json&, Problem&, const std::string&);
   static const std::vector<std::pair<std::string, ModelReader>> models = {
       {"timoshenko_beam", read_timoshenko_beam},
+      {"reissner_beam", read_reissner_beam},
       {"rigid_plastic_membrane", read_rigid_plastic_membrane},
       {"continuum", read_continuum},
   };
@@ -114,7 +116,7 @@ std::optional<SetRef> find_set(Reader& r, const BodySet& all, const std::string&
     const int first = all.site_offset(b), count = all.part(b).site_count();
     // The body that read_body built from this scene: a set names a beam's surface or a node set
     // of the continuum's mesh, so io asks for the type it built (docs/design.md).
-    if (dynamic_cast<const TimoshenkoBeam*>(&all.part(b))) {
+    if (dynamic_cast<const TimoshenkoBeam*>(&all.part(b)) || dynamic_cast<const ReissnerBeam*>(&all.part(b))) {
       if (set != "upper" && set != "lower") {
         r.error(ptr, "\"" + set + "\" names no surface of the beam \"" + body +
                          "\" (surfaces: upper, lower: its axis "

@@ -240,6 +240,7 @@ void read_supports(Reader& r, json& body, const std::string& ptr, int nodes, con
 // Body model readers: fill problem.body, constraints and load from the body at `ptr`
 // (scene["body"], or an entry of scene["bodies"]).
 void read_timoshenko_beam(Reader& r, json& body, Problem& problem, const std::string& ptr = "/body");
+void read_reissner_beam(Reader& r, json& body, Problem& problem, const std::string& ptr = "/body");
 void read_rigid_plastic_membrane(Reader& r, json& body, Problem& problem, const std::string& ptr = "/body");
 // A continuum body's mesh from a gmsh file (scene_gmsh.cpp): the mesh, its element kind ("q4",
 // "t6", ...) and the gmsh tags of its nodes and elements; nullopt after an error.

@@ -357,7 +357,7 @@ def shapes(result: dict, steps: Optional[Sequence[int]] = None):
         if ranges[0][0] is not None:
             data["steps"][s["step"]]["bodies"] = {
                 name: {"x": x[first:first + count], "y": y[first:first + count]} for name, first, count in ranges}
-        if body_model(result) == "timoshenko_beam":
+        if body_model(result) in ("timoshenko_beam", "reissner_beam"):
             band = beam_band(s)
             if band:  # the beam's lower and upper surfaces, thin
                 for surface in band:
@@ -498,7 +498,7 @@ def contact_stress(result: dict, component: str = "normal", step: Optional[int] 
     fig, (ax_shape, ax_line) = plt.subplots(2, 1, figsize=(9, 8.5),
                                             gridspec_kw={"height_ratios": [1.25, 1]})
     x, y = node_xy(s)
-    if body_model(result) == "timoshenko_beam":
+    if body_model(result) in ("timoshenko_beam", "reissner_beam"):
         band = beam_band(s)
         if band:
             lower, upper = band
