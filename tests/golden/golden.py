@@ -5,7 +5,7 @@ rewritten element kernel, may move the last bits and nothing more).
 
 For each case of CASES this runs `grip solve SCENE --out R --events E --threads 1` and compares
 the result JSON and the event NDJSON with tests/golden/NAME.result.json.gz and
-NAME.events.ndjson.gz, member by member (same_document): strings, booleans, integers and the
+NAME.events.ndjson.gz, member by member (compare): strings, booleans, integers and the
 structure exactly; a number written with a fraction or exponent within 1e-12 of its own size,
 or of the largest size the same member takes in the stored document (a displacement near the
 clamp beside the tip's), or within one unit of its last written digit where the result rounds
@@ -18,9 +18,9 @@ was the round-off floor, and the inner loop's iterations, halvings and errors on
 iteration record's v2, v_inf). A sum taken in another order moves them (the slender strip: its
 inner loop takes 148 iterations at step 13, or 149) while every displacement stays the same to
 1e-13; the real solves, Newton iterations and passes that a change of the tangent would alter
-are compared exactly. Before the
-comparison both texts get two edits and nothing else (element and node fields are written to
-kFieldDigits = 7 digits, solver/io/result.hpp: for them the test is as tight as the result):
+are compared exactly. Element and node fields are written to kFieldDigits = 7 digits
+(solver/io/result.hpp): for them the test is as tight as the result. Before the comparison
+both texts get two edits and nothing else:
   - wall times are set to 0: the values of the members "seconds" (summary, steps,
     step_finished) and "elapsed_ms" (iteration events), the only timings the outputs carry;
   - every "failure" member (an object) is removed with its comma;
