@@ -553,7 +553,6 @@ bool Studies::advance(const StudyRecord& rec, const json& plan, json& doc) {
 }
 
 json Studies::table(const StudyRecord& record, const json& plan) {
-  const StudyRecord* rec = &record;
   json levels = json::array();
   std::vector<std::optional<json>> outputs;
   std::vector<std::optional<double>> seconds;
@@ -563,7 +562,7 @@ json Studies::table(const StudyRecord& record, const json& plan) {
     std::string job;
     if (l.contains("job")) {
       job = l["job"];
-    } else if (const auto made = jobs_.store().job_by_idempotency_key(level_key(rec->id, j))) {
+    } else if (const auto made = jobs_.store().job_by_idempotency_key(level_key(record.id, j))) {
       job = made->id;  // an accuracy study's level made as it went
     } else {
       break;
@@ -666,12 +665,12 @@ json Studies::table(const StudyRecord& record, const json& plan) {
   if (states.count("accepted") || states.count("running")) status = states.count("running") ? "running" : "accepted";
   else if (states.count("dismissed") || states.count("removed")) status = "dismissed";
   else if (states.count("failed")) status = "failed";
-  json links = json::array({{{"href", "/v1/studies/" + rec->id}, {"rel", "self"}, {"type", "application/json"}}});
+  json links = json::array({{{"href", "/v1/studies/" + record.id}, {"rel", "self"}, {"type", "application/json"}}});
   for (const json& l : levels)
     links.push_back(
         {{"href", "/v1/jobs/" + l["job"].get<std::string>()}, {"rel", "item"}, {"type", "application/json"}});
-  json doc = {{"id", rec->id},    {"created", rec->created},  {"kind", plan["kind"]}, {"status", status},
-              {"levels", levels}, {"quantities", quantities}, {"links", links}};
+  json doc = {{"id", record.id},  {"created", record.created}, {"kind", plan["kind"]}, {"status", status},
+              {"levels", levels}, {"quantities", quantities},  {"links", links}};
   if (sweep) doc["pointers"] = plan["pointers"];
   else doc["thresholds"] = kStudyThresholds;
   if (plan.contains("accuracy")) doc["accuracy"] = plan["accuracy"];

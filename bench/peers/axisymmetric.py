@@ -36,21 +36,13 @@ ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "bench"))
 from scaling import fewest_half_disc_divisions  # noqa: E402
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from compare import fit as fit_about_axis  # noqa: E402  a, p0 of a Hertz profile fitted about the axis
+
 E, NU, R, DELTA = 200000.0, 0.3, 10.0, 0.05
 ES = E / (1 - NU * NU)
 A_SPHERE = math.sqrt(R * DELTA)  # the closed-form contact radius at the nominal load
 OFF_AXIS = 0.25  # the second fit takes the nodes at r > a / 4 only (ccx's nearest the axis are off)
-
-
-def fit_about_axis(xs, sigma):
-    """a and p0 of p0 (1 - x^2 / a^2)^(1/2) fitted to (x, sigma > 0): a line in x^2, sigma^2."""
-    X = [x * x for x, s in zip(xs, sigma) if s > 0]
-    Y = [s * s for s in sigma if s > 0]
-    n = len(X)
-    sx, sy = sum(X), sum(Y)
-    slope = (n * sum(a * b for a, b in zip(X, Y)) - sx * sy) / (n * sum(a * a for a in X) - sx * sx)
-    intercept = (sy - slope * sx) / n
-    return math.sqrt(-intercept / slope), math.sqrt(intercept)
 
 
 def closed_form(analysis, P):

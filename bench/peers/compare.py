@@ -31,6 +31,7 @@ SIZES = {10: 0.05, 20: 0.0265, 40: 0.01325}  # as bench/scaling.py's hertz_scene
 
 
 def fit(xs, sigma):
+    """a and p0 of p0 (1 - x^2 / a^2)^(1/2) fitted to (x, sigma > 0): a line in x^2, sigma^2."""
     X = [x * x for x, s in zip(xs, sigma) if s > 0]
     Y = [s * s for s in sigma if s > 0]
     n = len(X)

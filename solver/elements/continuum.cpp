@@ -216,19 +216,23 @@ void ContinuumBody::internal_force(const Vector& q, Vector& force, Triplets* tan
     return;
   }
   const Integration& in = integration();
+  // Work storage kept across elements: the loop allocates nothing but the triplets, reserved once.
   Vector fe;
   Matrix Ke;
+  const int n = element_node_count(shape_);
+  ShapeGradients u(n, 2);
+  if (tangent) tangent->reserve(tangent->size() + static_cast<size_t>(element_count()) * 4 * n * n);
   for (int e = 0; e < element_count(); ++e) {
     // A law with history answers from the committed state of each point.
     const size_t np = in.points[e].size();
     PointLaw law;
     if (has_history_)
       law = [&](int k, const Mat2& E) { return material(e).finite_response(E, history_[e * np + k]).law; };
-    if (options_.incompressibility == Incompressibility::f_bar)
-      f_bar_total_lagrangian(in.points[e], in.centroids[e], element_displacements(q, e), material(e), fe,
-                             tangent ? &Ke : nullptr, law);
-    else total_lagrangian(in.points[e], element_displacements(q, e), material(e), fe, tangent ? &Ke : nullptr, law);
     const auto& el = mesh_.elements[e];
+    for (int a = 0; a < n; ++a) u.row(a) << q[node_dof(el[a], 0)], q[node_dof(el[a], 1)];
+    if (options_.incompressibility == Incompressibility::f_bar)
+      f_bar_total_lagrangian(in.points[e], in.centroids[e], u, material(e), fe, tangent ? &Ke : nullptr, law);
+    else total_lagrangian(in.points[e], u, material(e), fe, tangent ? &Ke : nullptr, law);
     const int m = static_cast<int>(fe.size());
     for (int i = 0; i < m; ++i) {
       const int gi = node_dof(el[i / 2], i % 2);

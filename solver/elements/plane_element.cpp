@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
+#include <string>
 
 namespace grip {
 namespace {
@@ -263,22 +264,32 @@ Mat2 deformation_gradient(const ElementPoint& point, const ShapeGradients& u) {
   return Mat2::Identity() + u.transpose() * point.dN;  // F_ij = delta_ij + sum_a u_ai dN_a/dX_j
 }
 
-void total_lagrangian(const std::vector<ElementPoint>& points, const ShapeGradients& u, const PlaneMaterial& material,
-                      Vector& fe, Matrix* Ke, const PointLaw& law) {
-  const int n = static_cast<int>(u.rows());
-  fe = Vector::Zero(2 * n);
-  if (Ke) *Ke = Matrix::Zero(2 * n, 2 * n);
+namespace {
+
+// total_lagrangian for N nodes and R strain rows (3 in the plane, 4 with the hoop strain), in
+// fixed-size matrices: no allocation, and B^T D B and the geometric stiffness as closed loops
+// over the upper triangle (Ke is symmetric: D is, and so is dN_a . S dN_b), mirrored once.
+template <int N, int R>
+void total_lagrangian_fixed(const std::vector<ElementPoint>& points, const ShapeGradients& u_dynamic,
+                            const PlaneMaterial& material, Vector& fe_out, Matrix* Ke_out, const PointLaw& law) {
+  constexpr int M = 2 * N;
+  using Nodes2 = Eigen::Matrix<double, N, 2>;
+  const Nodes2 u = u_dynamic;
+  Eigen::Matrix<double, M, 1> fe = Eigen::Matrix<double, M, 1>::Zero();
+  Eigen::Matrix<double, M, M> Ke;
+  if (Ke_out) Ke.setZero();
+  Eigen::Matrix<double, R, M> B, DB;
   for (size_t k = 0; k < points.size(); ++k) {
     const ElementPoint& p = points[k];
-    const Mat2 F = deformation_gradient(p, u);
+    const Eigen::Map<const Nodes2> dN(p.dN.data());
+    const Mat2 F = Mat2::Identity() + u.transpose() * dN;
     const Mat2 E = 0.5 * (F.transpose() * F - Mat2::Identity());
     // Axisymmetric: the hoop stretch F33 = r / R = 1 + u_r / R and its strain (F33^2 - 1) / 2.
-    const bool hoop = p.radius > 0;
-    const double F33 = hoop ? 1 + p.N.dot(u.col(0)) / p.radius : 1.0;
+    double F33 = 1.0, S33 = 0.0;
     Eigen::Vector3d S_voigt;
-    Matrix D;
-    double S33 = 0.0;
-    if (hoop) {
+    Eigen::Matrix<double, R, R> D;
+    if constexpr (R == 4) {
+      F33 = 1 + p.N.dot(u.col(0)) / p.radius;
       const HoopResponse r = material.hoop_response(E, 0.5 * (F33 * F33 - 1));
       S_voigt = r.S.head<3>();
       S33 = r.S[3];
@@ -292,31 +303,73 @@ void total_lagrangian(const std::vector<ElementPoint>& points, const ShapeGradie
     S << S_voigt[0], S_voigt[2], S_voigt[2], S_voigt[1];
     const Mat2 P = F * S;  // first Piola-Kirchhoff stress
     // dE = B du: rows E11, E22, 2 E12 (and E33 in axisymmetry); column pair of node a.
-    Matrix B = Matrix::Zero(D.rows(), 2 * n);
-    for (int a = 0; a < n; ++a) {
-      const Vec2 g = p.dN.row(a).transpose();
-      fe.segment<2>(2 * a) += p.dV * P * g;
-      B(0, 2 * a) = F(0, 0) * g.x();
-      B(0, 2 * a + 1) = F(1, 0) * g.x();
-      B(1, 2 * a) = F(0, 1) * g.y();
-      B(1, 2 * a + 1) = F(1, 1) * g.y();
-      B(2, 2 * a) = F(0, 0) * g.y() + F(0, 1) * g.x();
-      B(2, 2 * a + 1) = F(1, 0) * g.y() + F(1, 1) * g.x();
-      if (hoop) {
+    for (int a = 0; a < N; ++a) {
+      const double gx = dN(a, 0), gy = dN(a, 1);
+      fe[2 * a] += p.dV * (P(0, 0) * gx + P(0, 1) * gy);
+      fe[2 * a + 1] += p.dV * (P(1, 0) * gx + P(1, 1) * gy);
+      B(0, 2 * a) = F(0, 0) * gx;
+      B(0, 2 * a + 1) = F(1, 0) * gx;
+      B(1, 2 * a) = F(0, 1) * gy;
+      B(1, 2 * a + 1) = F(1, 1) * gy;
+      B(2, 2 * a) = F(0, 0) * gy + F(0, 1) * gx;
+      B(2, 2 * a + 1) = F(1, 0) * gy + F(1, 1) * gx;
+      if constexpr (R == 4) {
         B(3, 2 * a) = F33 * p.N[a] / p.radius;  // dE33 = F33 du_r / R
+        B(3, 2 * a + 1) = 0.0;
         fe[2 * a] += p.dV * S33 * B(3, 2 * a);
       }
     }
-    if (!Ke) continue;
-    Ke->noalias() += p.dV * B.transpose() * D * B;
-    const Matrix G = p.dN * S * p.dN.transpose();  // geometric stiffness dN_a . S dN_b
-    for (int a = 0; a < n; ++a)
-      for (int b = 0; b < n; ++b) {
-        (*Ke)(2 * a, 2 * b) += p.dV * G(a, b);
-        (*Ke)(2 * a + 1, 2 * b + 1) += p.dV * G(a, b);
-        if (hoop) (*Ke)(2 * a, 2 * b) += p.dV * S33 * p.N[a] * p.N[b] / (p.radius * p.radius);
+    if (!Ke_out) continue;
+    DB.noalias() = (p.dV * D) * B;
+    for (int j = 0; j < M; ++j)
+      for (int i = 0; i <= j; ++i) {
+        double sum = 0.0;
+        for (int r = 0; r < R; ++r) sum += B(r, i) * DB(r, j);
+        Ke(i, j) += sum;
       }
+    // Geometric stiffness dN_a . S dN_b on both components (and the hoop term S33 N_a N_b / R^2).
+    for (int b = 0; b < N; ++b) {
+      const double sx = p.dV * (S(0, 0) * dN(b, 0) + S(0, 1) * dN(b, 1));
+      const double sy = p.dV * (S(1, 0) * dN(b, 0) + S(1, 1) * dN(b, 1));
+      for (int a = 0; a <= b; ++a) {
+        const double g = dN(a, 0) * sx + dN(a, 1) * sy;
+        Ke(2 * a, 2 * b) += g;
+        Ke(2 * a + 1, 2 * b + 1) += g;
+        if constexpr (R == 4) Ke(2 * a, 2 * b) += p.dV * S33 * p.N[a] * p.N[b] / (p.radius * p.radius);
+      }
+    }
   }
+  fe_out = fe;
+  if (!Ke_out) return;
+  for (int j = 0; j < M; ++j)
+    for (int i = j + 1; i < M; ++i) Ke(i, j) = Ke(j, i);
+  *Ke_out = Ke;
+}
+
+template <int N>
+void total_lagrangian_nodes(const std::vector<ElementPoint>& points, const ShapeGradients& u,
+                            const PlaneMaterial& material, Vector& fe, Matrix* Ke, const PointLaw& law) {
+  if (points.front().radius > 0) total_lagrangian_fixed<N, 4>(points, u, material, fe, Ke, law);
+  else total_lagrangian_fixed<N, 3>(points, u, material, fe, Ke, law);
+}
+
+}  // namespace
+
+void total_lagrangian(const std::vector<ElementPoint>& points, const ShapeGradients& u, const PlaneMaterial& material,
+                      Vector& fe, Matrix* Ke, const PointLaw& law) {
+  switch (u.rows()) {
+    case 3:
+      return total_lagrangian_nodes<3>(points, u, material, fe, Ke, law);
+    case 4:
+      return total_lagrangian_nodes<4>(points, u, material, fe, Ke, law);
+    case 6:
+      return total_lagrangian_nodes<6>(points, u, material, fe, Ke, law);
+    case 8:
+      return total_lagrangian_nodes<8>(points, u, material, fe, Ke, law);
+    case 9:
+      return total_lagrangian_nodes<9>(points, u, material, fe, Ke, law);
+  }
+  throw std::logic_error("total_lagrangian: no element of " + std::to_string(u.rows()) + " nodes");
 }
 
 Mat2 f_bar(const ElementPoint& point, const ElementPoint& centre, const ShapeGradients& u) {

@@ -23,7 +23,9 @@ void Equilibrium::extend_surface_compliance(const std::vector<int>& added) {
   }
   const int m = static_cast<int>(surface_free_.size());
   counters_.compliance_columns += m - m0;
-  if (m0 == 0 && body_lu_.inverse_block(surface_free_, g_)) return;  // a new G: sparse solves
+  const bool sparse_solves = m0 == 0 && body_lu_.inverse_block(surface_free_, g_);
+  counters_.dissected_factorizations = body_lu_.dissected_factorizations();
+  if (sparse_solves) return;  // a new G: sparse solves
   g_.conservativeResize(m, m);
   // Unit right-hand sides in blocks: the work storage stays (free dofs) x kBlock.
   constexpr int kBlock = 64;
@@ -180,6 +182,7 @@ const Compliance& Equilibrium::sparse_compliance(const EquilibriumState& state, 
   sparse_.saddle.reset();
   sparse_version_ = tangent_version_;
   sparse_.diagonal_entries = body_lu_.quadratic_forms(sparse_.t);
+  counters_.dissected_factorizations = body_lu_.dissected_factorizations();
   return sparse_;
 }
 

@@ -153,6 +153,9 @@ class Equilibrium {
   // whole, since a low-rank correction of the bodies' own factors would need G on the pair's
   // dofs afresh at every iterate (13 such G's cost 6x one factorization, two cylinders).
   FreeBlockSolver lu_;
+  // The triplets of Newton's tangent and of the body's own, kept so that their storage (megabytes
+  // for a few thousand elements) is allocated once, not at every real solve.
+  Triplets newton_triplets_, body_triplets_;
   double body_tangent_norm_ = 0.0;  // |K|_inf of the constant body tangent (round-off scale)
   std::vector<int> surface_free_;   // surface row of G -> free index
   std::vector<int> surface_row_;    // free index -> surface row of G, -1 off the surface

@@ -39,9 +39,13 @@ struct EquilibriumState {
 struct EquilibriumCounters {
   long solves = 0;  // calls of solve(): real equilibrium solves
   long newton_iterations = 0;
+  // newton_ and body_factorizations together (docs/algorithm.md#where-factorizations-come-from)
   long factorizations = 0;
-  long compliance_forms = 0;    // G formed afresh (each on a factorization of its own)
-  long compliance_columns = 0;  // columns of G solved for, all forms together
+  long newton_factorizations = 0;     // Newton's tangent, and the penalty law's last correction
+  long body_factorizations = 0;       // the body's own tangent: the compliance's, or a constant one
+  long dissected_factorizations = 0;  // the body's tangent again, in nested-dissection order, for G only
+  long compliance_forms = 0;          // G formed afresh (each on a factorization of its own)
+  long compliance_columns = 0;        // columns of G solved for, all forms together
 };
 
 }  // namespace grip

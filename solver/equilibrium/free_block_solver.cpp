@@ -5,6 +5,22 @@
 
 namespace grip {
 
+namespace {
+
+// A second factorization of the same block in nested-dissection order: short elimination-tree
+// paths where the fill-reducing order of a thin strip is nearly banded.
+void order_by_nested_dissection(CholmodFactor& dissected) {
+  dissected.cholmod().nmethods = 1;
+  dissected.cholmod().method[0].ordering = CHOLMOD_NESDIS;
+}
+
+void factorize_dissected(CholmodFactor& dissected, const Eigen::SparseMatrix<double>& matrix) {
+  order_by_nested_dissection(dissected);
+  dissected.compute(matrix);
+}
+
+}  // namespace
+
 bool FreeBlockSolver::factorize(const Triplets& triplets, const std::vector<int>& free_index, int free_count,
                                 double near_symmetric_tolerance) {
   bool same = triplets.size() == rows_.size();
@@ -36,13 +52,14 @@ bool FreeBlockSolver::factorize(const Triplets& triplets, const std::vector<int>
         const double* t = &matrix_.coeffRef(it.col(), it.row());
         mirror_[&it.valueRef() - matrix_.valuePtr()] = static_cast<int>(t - matrix_.valuePtr());
       }
-    lu_analysed_ = llt_analysed_ = dissected_analysed_ = false;
+    lu_analysed_ = llt_analysed_ = dissected_analysed_ = llt_dissected_ = false;
     dissected_fails_at_ = 0;
     coupled_ = starts_.size() < 3;  // one body
     for (int col = 0; !coupled_ && col < matrix_.outerSize(); ++col)
       for (Eigen::SparseMatrix<double>::InnerIterator it(matrix_, col); it; ++it)
         if (block_of(static_cast<int>(it.row())) != block_of(col)) coupled_ = true;
   }
+  ++factorizations_;
   std::fill(matrix_.valuePtr(), matrix_.valuePtr() + matrix_.nonZeros(), 0.0);
   for (size_t k = 0; k < triplets.size(); ++k)
     if (slot_[k] >= 0) matrix_.valuePtr()[slot_[k]] += triplets[k].value();
@@ -68,6 +85,8 @@ bool FreeBlockSolver::factorize(const Triplets& triplets, const std::vector<int>
       // either way (inverse_block reads L).
       llt_.cholmod().supernodal = CHOLMOD_AUTO;
       llt_.cholmod().final_ll = 1;
+      llt_.cholmod().nmethods = 0;  // CHOLMOD's default choice of ordering
+      if (llt_dissected_) order_by_nested_dissection(llt_);
       llt_.analyzePattern(matrix_);
     }
     llt_analysed_ = true;
@@ -113,22 +132,6 @@ bool partial_solves_pay(const cholmod_factor* L, const std::vector<int>& rows) {
 
 }  // namespace
 
-namespace {
-
-// A second factorization of the same block in nested-dissection order: short elimination-tree
-// paths where the fill-reducing order of a thin strip is nearly banded.
-void order_by_nested_dissection(CholmodFactor& dissected) {
-  dissected.cholmod().nmethods = 1;
-  dissected.cholmod().method[0].ordering = CHOLMOD_NESDIS;
-}
-
-void factorize_dissected(CholmodFactor& dissected, const Eigen::SparseMatrix<double>& matrix) {
-  order_by_nested_dissection(dissected);
-  dissected.compute(matrix);
-}
-
-}  // namespace
-
 bool FreeBlockSolver::inverse_block(const std::vector<int>& rows, Matrix& G) {
   if (!ok_ || !symmetric_) return false;
   if (split_) {  // K^-1 is block diagonal: each body's rows from its own factor
@@ -158,8 +161,15 @@ bool FreeBlockSolver::inverse_block(const std::vector<int>& rows, Matrix& G) {
     dissected_.analyzePattern(matrix_);
     dissected_analysed_ = true;
   }
+  ++dissected_factorizations_;
   dissected_.factorize(matrix_);
-  if (dissected_.info() == Eigen::Success && dissected_.inverse_block(rows, G)) return true;
+  if (dissected_.info() == Eigen::Success && dissected_.inverse_block(rows, G)) {
+    // From now on the block's own factor takes this order: one factorization serves the solves
+    // and G (the dissected order costs the solves little more on a thin strip's block).
+    if (!llt_dissected_) llt_analysed_ = false;
+    llt_dissected_ = true;
+    return true;
+  }
   dissected_fails_at_ = dissected_fails_at_ ? std::min(dissected_fails_at_, rows.size()) : rows.size();
   return false;
 }
@@ -295,9 +305,16 @@ Vector FreeBlockSolver::quadratic_forms(const Eigen::SparseMatrix<double>& t) {
   // A path through more than 1/32 of the rows on average: the nested-dissection order instead.
   if (llt_.quadratic_forms(t, out, matrix_.rows() / 32.0)) return out;
   CholmodFactor dissected;
+  ++dissected_factorizations_;
   factorize_dissected(dissected, matrix_);
   if (dissected.info() == Eigen::Success && dissected.quadratic_forms(t, out, 0.0)) return out;
   return Vector();
+}
+
+long FreeBlockSolver::dissected_factorizations() const {
+  long count = dissected_factorizations_;
+  for (const auto& part : parts_) count += part->dissected_factorizations();
+  return count;
 }
 
 void FreeBlockSolver::set_blocks(std::vector<int> starts, ParallelFor parallel) {

@@ -62,12 +62,18 @@ class FreeBlockSolver {
   // nearly banded), a second factorization in nested-dissection order, for G only: analysed
   // once per pattern, and not tried again for as many rows or more once it did not pay (a
   // beam's or a membrane's band: its analysis and factorization were 21 % of the beam's time).
+  // Where it paid, the block's own later factorizations (a changing tangent's) take that order,
+  // and G comes from them without a second one.
   bool inverse_block(const std::vector<int>& rows, Matrix& G);
   // t_j^T K^-1 t_j for every column of t (free dofs x columns) where K is Cholesky-factorized
   // (partial forward solves; on a nested-dissection factorization where the body's own gives
   // long elimination-tree paths, as for G); an empty vector otherwise.
   Vector quadratic_forms(const Eigen::SparseMatrix<double>& t);
   bool ok() const { return ok_; }
+  // Numeric factorizations so far: of the block (one per factorize(), a split block's parts
+  // together), and the second ones in nested-dissection order that serve G or C's diagonal only.
+  long factorizations() const { return factorizations_; }
+  long dissected_factorizations() const;
   // Factorized body by body (set_blocks).
   bool split() const { return split_; }
   // Factorized by Cholesky (symmetric positive definite).
@@ -81,6 +87,7 @@ class FreeBlockSolver {
     ok_ = false;
     dissected_analysed_ = false;
     dissected_fails_at_ = 0;
+    llt_dissected_ = false;
     for (auto& part : parts_) part->forget_pattern();
   }
 
@@ -107,7 +114,11 @@ class FreeBlockSolver {
   CholmodFactor llt_;
   CholmodFactor dissected_;  // nested-dissection order, for inverse_block only
   bool lu_analysed_ = false, llt_analysed_ = false, dissected_analysed_ = false;
+  long factorizations_ = 0, dissected_factorizations_ = 0;
   size_t dissected_fails_at_ = 0;  // the fewest rows for which the dissected factor did not pay; 0: none yet
+  // The dissected factor paid for G on this pattern: the next factorizations take the
+  // nested-dissection order themselves, so that G needs no second factorization.
+  bool llt_dissected_ = false;
   bool symmetric_ = false;
   bool ok_ = false;
 };

@@ -174,7 +174,7 @@ EquilibriumState Equilibrium::newton(const Vector& q_guess, const Vector& p) {
   // A pair of bodies adds its stiffness, which moves with the pairing, on a few surface dofs:
   // kept as a low-rank correction of the constant body tangent (low_rank_step).
   const bool low_rank = reuse && has_pairs_;
-  Triplets triplets;
+  Triplets& triplets = newton_triplets_;  // kept from solve to solve: no allocation once grown
   double last_step = 0.0;
   std::vector<signed char> signs;  // the penalty law's trial signs at the last iterate
   for (int it = 1; it <= params_.max_iterations + 1; ++it) {
@@ -238,6 +238,7 @@ EquilibriumState Equilibrium::newton(const Vector& q_guess, const Vector& p) {
       }
     } else {
       ++counters_.factorizations;
+      ++counters_.newton_factorizations;
       if (!lu_.factorize(triplets, free_index_, free_count_, 1e-4)) {
         state.reason = "singular tangent stiffness in Newton iteration " + std::to_string(it);
         state.failure = FailureKind::newton_diverged;
@@ -326,10 +327,12 @@ double Equilibrium::line_search(const Vector& q, const Vector& dq, const Vector&
 
 bool Equilibrium::factorize_body_tangent(const Vector& q) {
   if (constant_tangent_ && body_factorized_) return body_lu_.ok();
-  Triplets triplets;
+  Triplets& triplets = body_triplets_;
+  triplets.clear();
   Vector force = Vector::Zero(q.size());
   problem_.body->internal_force(q, force, &triplets);
   ++counters_.factorizations;
+  ++counters_.body_factorizations;
   body_factorized_ = true;
   // Read by Newton only for a constant tangent (a changing one has its own triplets).
   if (constant_tangent_) body_tangent_norm_ = free_row_sum_norm(triplets, free_index_, free_count_, length_scales_);

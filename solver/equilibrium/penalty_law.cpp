@@ -113,6 +113,7 @@ EquilibriumState& Equilibrium::finish_penalty(EquilibriumState& state) {
   Triplets tangent;
   const Vector r = residual(state.q, state, state.p, &tangent);
   ++counters_.factorizations;
+  ++counters_.newton_factorizations;
   if (!lu_.factorize(tangent, free_index_, free_count_, 1e-4))
     return finish(state, penalty_forces(state.q, state, nullptr));
   Vector r_free(free_count_);

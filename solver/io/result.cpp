@@ -415,9 +415,17 @@ namespace {
 json counters_json(const RunResult& run) {
   long passes = 0;
   for (const auto& rec : run.steps) passes += rec.passes;
-  return {{"factorizations", run.counters.factorizations},
-          {"equilibrium_solves", run.counters.solves},
-          {"newton_iterations", run.counters.newton_iterations},
+  const EquilibriumCounters& c = run.counters;
+  const auto per = [](long count, long of) { return of > 0 ? static_cast<double>(count) / of : 0.0; };
+  const long all = c.factorizations + c.dissected_factorizations;
+  return {{"factorizations", c.factorizations},
+          {"newton_factorizations", c.newton_factorizations},
+          {"body_factorizations", c.body_factorizations},
+          {"dissected_factorizations", c.dissected_factorizations},
+          {"factorizations_per_newton_iteration", per(all, c.newton_iterations)},
+          {"factorizations_per_solve", per(all, c.solves)},
+          {"equilibrium_solves", c.solves},
+          {"newton_iterations", c.newton_iterations},
           {"tau_passes", passes}};
 }
 

@@ -2,7 +2,8 @@
 //   "kinematics": "finite" (default) | "linear";  "analysis": "plane_strain" | "plane_stress" | "axisymmetric"
 //   "element": "t3" | "t6" | "q4" | "q4_bbar" | "q8" | "q9";  "thickness" (default 1)
 //   "incompressibility": "none" (default) | "f_bar" (finite kinematics, q4, plane strain)
-//   "material": {"young", "poisson", "law": "neo_hookean" | "saint_venant_kirchhoff" | "j2_plasticity"}
+//   "material": {"young", "poisson", "law": "neo_hookean" | "saint_venant_kirchhoff" | "j2_plasticity"} |
+//     {"law": "mooney_rivlin", "c10", "c01" (default 0), "bulk"}
 //     j2_plasticity: "yield_stress", "hardening": {"linear": H} |
 //     {"power": {"K", "n"}} | {"table": [[eps_p, sigma_y], ...]} (default perfectly plastic),
 //     "kinematic_hardening": H_k (default 0; linear kinematics only)
@@ -23,9 +24,11 @@
 #include <stdexcept>
 
 #include "solver/elements/continuum.hpp"
+#include "solver/elements/element_pairs.hpp"
 #include "solver/elements/rigid_hubs.hpp"
 #include "solver/io/scene_reader.hpp"
 #include "solver/materials/j2_plasticity.hpp"
+#include "solver/materials/mooney_rivlin.hpp"
 
 namespace grip::scene_io {
 namespace {
@@ -76,6 +79,26 @@ std::shared_ptr<const PlaneMaterial> read_j2_material(Reader& r, json& mat, cons
       return nullptr;
     }
   return law;
+}
+
+// The Mooney-Rivlin law of material `mp` (c10, c01, bulk; no young or poisson); nullptr after
+// an error.
+std::shared_ptr<const PlaneMaterial> read_mooney_rivlin(Reader& r, json& mat, const std::string& mp,
+                                                        PlaneAnalysis analysis) {
+  const size_t before = r.issues.size();
+  for (const char* key : {"young", "poisson", "yield_stress", "hardening", "kinematic_hardening"})
+    if (mat.contains(key))
+      r.error(mp + "/" + key, "is not a constant of law \"mooney_rivlin\": give c10, c01 and bulk");
+  const double c10 = r.number(mat, mp, "c10");
+  const double c01 = r.number(mat, mp, "c01", 0.0);
+  const double bulk = r.positive(mat, mp, "bulk");
+  if (r.issues.size() > before) return nullptr;
+  if (const std::string why = mooney_rivlin_data_issue(c10, c01, bulk); !why.empty()) {
+    const size_t colon = why.find(':');
+    r.error(mp + "/" + why.substr(0, colon), why.substr(colon + 2));
+    return nullptr;
+  }
+  return std::make_shared<MooneyRivlinMaterial>(c10, c01, bulk, analysis);
 }
 
 // [a, b] of integers in [lo, hi].
@@ -498,11 +521,15 @@ void read_continuum(Reader& r, json& body, Problem& problem, const std::string& 
   const ElementShape shape = element_shape(options.element);
 
   const auto read_material = [&](json& mat, const std::string& mp) -> std::shared_ptr<const PlaneMaterial> {
+    const std::string law = r.choice(
+        mat, mp, "law", {"neo_hookean", "saint_venant_kirchhoff", "j2_plasticity", "mooney_rivlin"}, "neo_hookean");
+    if (law == "mooney_rivlin") return read_mooney_rivlin(r, mat, mp, options.analysis);
+    for (const char* key : {"c10", "c01", "bulk"})
+      if (mat.contains(key))
+        r.error(mp + "/" + key, "belongs to law \"mooney_rivlin\" (this law takes young and poisson)");
     const double young = r.positive(mat, mp, "young");
     const double poisson = r.number(mat, mp, "poisson", 0.3);
     if (!(poisson > -1 && poisson < 0.5)) r.error(mp + "/poisson", show(mat["poisson"]) + " is not in (-1, 0.5)");
-    const std::string law =
-        r.choice(mat, mp, "law", {"neo_hookean", "saint_venant_kirchhoff", "j2_plasticity"}, "neo_hookean");
     if (law == "j2_plasticity") return read_j2_material(r, mat, mp, young, poisson, options);
     for (const char* key : {"yield_stress", "hardening", "kinematic_hardening"})
       if (mat.contains(key)) r.error(mp + "/" + key, "belongs to law \"j2_plasticity\" (this law is elastic)");
@@ -531,6 +558,17 @@ void read_continuum(Reader& r, json& body, Problem& problem, const std::string& 
   if (body.contains("material") || by_surface.empty())
     if (json* mat = r.object(body, ptr, "material", true)) materials.push_back(read_material(*mat, ptr + "/material"));
 
+  // docs/algorithm.md#element-formulation-pairs: a pair that locks is refused with its reason.
+  if (r.issues.empty()) {
+    std::vector<const PlaneMaterial*> laws;
+    for (const auto& m : materials) laws.push_back(m.get());
+    for (const auto& [name, m] : by_surface) laws.push_back(m.get());
+    for (const PlaneMaterial* law : laws)
+      if (const std::string why = law ? element_pair_issue(options, *law) : ""; !why.empty()) {
+        r.error(ptr + "/element", why);
+        break;
+      }
+  }
   std::optional<PlaneMesh> mesh;
   std::string kind, default_contact;  // kind: "nodes", "rectangle" or "half_disc"
   const std::string mp = ptr + "/mesh";

@@ -43,25 +43,14 @@ class Reader {
     issues.push_back({pointer.empty() ? "/" : pointer, std::move(detail)});
   }
 
-  // obj[key] as an object (created empty when absent and optional).
+  // obj[key] as an object or an array (created empty when absent and optional).
   json* object(json& obj, const std::string& ptr, const char* key, bool required) {
-    const std::string p = ptr + "/" + token(key);
-    if (!obj.is_object()) return nullptr;
-    if (!obj.contains(key)) {
-      if (required) {
-        error(p, "is required");
-        return nullptr;
-      }
-      obj[key] = json::object();
-    }
-    if (!obj[key].is_object()) {
-      error(p, show(obj[key]) + " is not an object");
-      return nullptr;
-    }
-    return &obj[key];
+    return member(obj, ptr, key, required, json::object(), "an object");
   }
-
   json* array(json& obj, const std::string& ptr, const char* key, bool required) {
+    return member(obj, ptr, key, required, json::array(), "an array");
+  }
+  json* member(json& obj, const std::string& ptr, const char* key, bool required, json empty, const char* kind) {
     const std::string p = ptr + "/" + token(key);
     if (!obj.is_object()) return nullptr;
     if (!obj.contains(key)) {
@@ -69,10 +58,11 @@ class Reader {
         error(p, "is required");
         return nullptr;
       }
-      obj[key] = json::array();
+      obj[key] = std::move(empty);
+      return &obj[key];
     }
-    if (!obj[key].is_array()) {
-      error(p, show(obj[key]) + " is not an array");
+    if (obj[key].type() != empty.type()) {
+      error(p, show(obj[key]) + " is not " + kind);
       return nullptr;
     }
     return &obj[key];

@@ -45,6 +45,7 @@ class J2Material final : public PlaneMaterial {
   // The elastic law (Hooke's), what the material is until it yields.
   MaterialResponse response(const Mat2& E) const override;
   bool has_history() const override { return true; }
+  bool isochoric_flow() const override { return true; }
   PointResponse small_strain_response(const Eigen::Vector4d& strain, const PointHistory& committed) const override;
   FinitePointResponse finite_response(const Mat2& E, const PointHistory& committed) const override;
   std::string finite_strain_issue() const override;

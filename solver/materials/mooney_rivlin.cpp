@@ -4,6 +4,7 @@
 #include <cmath>
 #include <complex>
 #include <stdexcept>
+#include <utility>
 
 namespace grip {
 namespace {
@@ -31,8 +32,9 @@ std::array<T, 4> stress(double c10, double c01, double bulk, T C11, T C22, T C12
 }  // namespace
 
 std::string mooney_rivlin_data_issue(double c10, double c01, double bulk) {
-  if (!std::isfinite(c10) || !std::isfinite(c01) || !(c10 >= 0 && c01 >= 0))
-    return "c10: c10 and c01 must be >= 0 (a negative constant loses stability in some stretch)";
+  for (const auto& [name, c] : {std::pair{"c10", c10}, std::pair{"c01", c01}})
+    if (!(c >= 0 && std::isfinite(c)))
+      return std::string(name) + ": must be >= 0 (a negative constant loses stability in some stretch)";
   if (!(c10 + c01 > 0)) return "c10: c10 + c01 must be positive (the shear modulus is 2 (c10 + c01))";
   if (!(bulk >= 2 * (c10 + c01) && std::isfinite(bulk)))
     return "bulk: must be at least the shear modulus 2 (c10 + c01) (a nearly incompressible law has bulk >> "

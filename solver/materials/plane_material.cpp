@@ -36,6 +36,16 @@ Eigen::Matrix4d PlaneMaterial::small_strain_D4() const {
   return D;
 }
 
+double PlaneMaterial::bulk_over_shear() const {
+  const Eigen::Matrix4d D = small_strain_D4();
+  if (D(3, 3) == 0.0) return 0.0;  // plane stress
+  // K = (1/9) sum of the normal block (11, 22, 33), G = D_1212.
+  double k = 0.0;
+  for (int i : {0, 1, 3})
+    for (int j : {0, 1, 3}) k += D(i, j) / 9;
+  return k / D(2, 2);
+}
+
 PointResponse PlaneMaterial::small_strain_response(const Eigen::Vector4d& strain, const PointHistory& committed) const {
   PointResponse r;
   r.D = small_strain_D4();

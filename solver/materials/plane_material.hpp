@@ -86,6 +86,12 @@ class PlaneMaterial {
   virtual FinitePointResponse finite_response(const Mat2& E, const PointHistory& committed) const {
     return {response(E), committed, false};
   }
+  // K / G of the law at small strain, its nearness to incompressibility (plane strain and
+  // axisymmetric; 0 in plane stress, which does not lock).
+  double bulk_over_shear() const;
+  // Whether plastic flow keeps the volume (J2): in the plastic range the body is then
+  // incompressible whatever K / G (docs/algorithm.md#element-formulation-pairs).
+  virtual bool isochoric_flow() const { return false; }
   // Why the law cannot run under finite kinematics, as "field: reason" (empty if it can).
   virtual std::string finite_strain_issue() const { return {}; }
   // Axisymmetric finite strain: S (11, 22, 12, 33) and dS/dE (4 x 4, symmetric) for the

@@ -213,6 +213,9 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
             spent.solves += eq->counters().solves;
             spent.newton_iterations += eq->counters().newton_iterations;
             spent.factorizations += eq->counters().factorizations;
+            spent.newton_factorizations += eq->counters().newton_factorizations;
+            spent.body_factorizations += eq->counters().body_factorizations;
+            spent.dissected_factorizations += eq->counters().dissected_factorizations;
             spent.compliance_forms += eq->counters().compliance_forms;
             spent.compliance_columns += eq->counters().compliance_columns;
             eq = std::make_unique<Equilibrium>(problem, params.newton);
@@ -361,6 +364,9 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
   result.counters.solves += spent.solves;
   result.counters.newton_iterations += spent.newton_iterations;
   result.counters.factorizations += spent.factorizations;
+  result.counters.newton_factorizations += spent.newton_factorizations;
+  result.counters.body_factorizations += spent.body_factorizations;
+  result.counters.dissected_factorizations += spent.dissected_factorizations;
   result.counters.compliance_forms += spent.compliance_forms;
   result.counters.compliance_columns += spent.compliance_columns;
 }

@@ -27,4 +27,13 @@ inline PlaneMesh distorted_rectangle(const RectangleSpec& spec, ElementShape sha
   return mesh;
 }
 
+// The axisymmetric patch: a distorted 3 x 2 section whose left side lies on the axis.
+inline PlaneMesh axis_section(ElementShape shape) {
+  RectangleSpec spec;
+  spec.size = {3.0, 2.0};
+  spec.nx = 4;
+  spec.ny = 3;
+  return distorted_rectangle(spec, shape, 0.15, 7);
+}
+
 }  // namespace grip::testing

@@ -25,6 +25,7 @@
 #include "tests/support/contact_profile.hpp"
 #include "tests/support/distorted_mesh.hpp"
 #include "tests/support/scenes.hpp"
+#include "tests/support/tangent_check.hpp"
 
 namespace grip {
 namespace {
@@ -43,28 +44,9 @@ std::shared_ptr<const PlaneMaterial> law(bool neo_hookean) {
   return std::make_shared<HookeMaterial>(kYoung, kPoisson, PlaneAnalysis::axisymmetric);
 }
 
-// A distorted 3 x 2 section whose left side lies on the axis.
-PlaneMesh section(ElementShape shape) {
-  RectangleSpec spec;
-  spec.size = {3.0, 2.0};
-  spec.nx = 4;
-  spec.ny = 3;
-  return distorted_rectangle(spec, shape, 0.15, 7);
-}
-
 ContinuumBody finite_body(const PlaneMesh& mesh, ContinuumElement element, bool neo_hookean) {
   return ContinuumBody(mesh, mesh.sets.at("bottom"), {law(neo_hookean)},
                        {element, ContinuumKinematics::finite, PlaneAnalysis::axisymmetric, 1.0});
-}
-
-Matrix dense_tangent(const ContinuumBody& body, const Vector& q, Vector& f) {
-  const int n = body.dof_count();
-  f = Vector::Zero(n);
-  Triplets t;
-  body.internal_force(q, f, &t);
-  Eigen::SparseMatrix<double> K(n, n);
-  K.setFromTriplets(t.begin(), t.end());
-  return Matrix(K);
 }
 
 TEST(AxisymmetricFinite, HomogeneousStretchIsReproducedWithTheClosedFormReactions) {
@@ -76,7 +58,7 @@ TEST(AxisymmetricFinite, HomogeneousStretchIsReproducedWithTheClosedFormReaction
   const double Pzz = lz * (l.mu * (1 - 1 / (lz * lz)) + l.lambda * lnJ / (lz * lz));
   for (ContinuumElement element : kElements) {
     const ElementShape shape = element_shape(element);
-    const PlaneMesh mesh = section(shape);
+    const PlaneMesh mesh = axis_section(shape);
     const ContinuumBody body = finite_body(mesh, element, true);
     const int n = body.dof_count();
     Vector exact(n);
@@ -95,7 +77,7 @@ TEST(AxisymmetricFinite, HomogeneousStretchIsReproducedWithTheClosedFormReaction
       for (int i = 0; i < n; ++i)
         if (held[i]) q[i] = inc / 10.0 * exact[i];
       for (int it = 0; it < 30; ++it) {
-        const Matrix K = dense_tangent(body, q, f);
+        const Matrix K = assembled_tangent(body, q, f);
         Matrix Kff(free.size(), free.size());
         Vector rhs(free.size());
         for (size_t i = 0; i < free.size(); ++i) {
@@ -134,7 +116,7 @@ TEST(AxisymmetricFinite, HomogeneousStretchIsReproducedWithTheClosedFormReaction
 TEST(AxisymmetricFinite, TangentMatchesCentralDifferences) {
   for (const bool neo_hookean : {true, false})
     for (ContinuumElement element : kElements) {
-      const PlaneMesh mesh = section(element_shape(element));
+      const PlaneMesh mesh = axis_section(element_shape(element));
       const ContinuumBody body = finite_body(mesh, element, neo_hookean);
       const int n = body.dof_count();
       // A smooth field of strains near 10 % with u_r = 0 on the axis, and some noise off it.
@@ -146,23 +128,11 @@ TEST(AxisymmetricFinite, TangentMatchesCentralDifferences) {
         q.segment<2>(2 * k) = Vec2(0.1 * X.x() * (1 + 0.2 * X.y()) + (X.x() > 0 ? noise(rng) : 0.0),
                                    -0.05 * X.y() + 0.03 * X.x() * X.x() + noise(rng));
       }
-      Vector f;
-      const Matrix K = dense_tangent(body, q, f);
-      const double h = 1e-6;
-      double worst = 0.0;
-      for (int j = 0; j < n; ++j) {
-        Vector qp = q, qm = q, fp = Vector::Zero(n), fm = Vector::Zero(n);
-        qp[j] += h;
-        qm[j] -= h;
-        body.internal_force(qp, fp, nullptr);
-        body.internal_force(qm, fm, nullptr);
-        worst = std::max(worst, ((fp - fm) / (2 * h) - K.col(j)).lpNorm<Eigen::Infinity>());
-      }
-      const double scale = K.lpNorm<Eigen::Infinity>();
+      const TangentCheck c = check_tangent(body, q, 1e-6);
       std::printf("%s %s: |K - K_fd| / |K| = %.1e\n", neo_hookean ? "neo-Hookean" : "SVK", element_name(element),
-                  worst / scale);
-      EXPECT_LT(worst, 1e-6 * scale) << element_name(element);
-      EXPECT_LT((K - K.transpose()).lpNorm<Eigen::Infinity>(), 1e-12 * scale);  // hyperelastic: symmetric
+                  c.worst());
+      EXPECT_LT(c.worst(), 1e-6) << element_name(element);
+      EXPECT_LT((c.K - c.K.transpose()).lpNorm<Eigen::Infinity>(), 1e-12 * c.K.lpNorm<Eigen::Infinity>());  // symmetric
     }
 }
 

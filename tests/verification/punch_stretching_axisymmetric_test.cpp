@@ -19,6 +19,7 @@
 
 #include "solver/elements/rigid_plastic_membrane.hpp"
 #include "tests/support/scenes.hpp"
+#include "tests/support/tangent_check.hpp"
 
 namespace grip {
 namespace {
@@ -76,25 +77,10 @@ TEST(AxisymmetricMembrane, TangentMatchesCentralDifferences) {
     q.segment<2>(2 * k) = q0.segment<2>(2 * k) + Vec2(0.02 * r + (k ? noise(rng) : 0.0), -0.5 + 0.01 * r + noise(rng));
   }
   body.commit(q0);
-  Vector f = Vector::Zero(n);
-  Triplets t;
-  body.internal_force(q, f, &t);
-  Eigen::SparseMatrix<double> Ks(n, n);
-  Ks.setFromTriplets(t.begin(), t.end());
-  const Matrix K(Ks);
-  double worst = 0.0;
-  const double h = 1e-7;
-  for (int j = 0; j < n; ++j) {
-    Vector qp = q, qm = q, fp = Vector::Zero(n), fm = Vector::Zero(n);
-    qp[j] += h;
-    qm[j] -= h;
-    body.internal_force(qp, fp, nullptr);
-    body.internal_force(qm, fm, nullptr);
-    worst = std::max(worst, ((fp - fm) / (2 * h) - K.col(j)).lpNorm<Eigen::Infinity>());
-  }
-  std::printf("axisymmetric membrane: |K - K_fd| / |K| = %.1e\n", worst / K.lpNorm<Eigen::Infinity>());
-  EXPECT_LT(worst, 1e-6 * K.lpNorm<Eigen::Infinity>());
-  EXPECT_LT((K - K.transpose()).lpNorm<Eigen::Infinity>(), 1e-9 * K.lpNorm<Eigen::Infinity>());  // a potential
+  const auto c = testing::check_tangent(body, q, 1e-7);
+  std::printf("axisymmetric membrane: |K - K_fd| / |K| = %.1e\n", c.worst());
+  EXPECT_LT(c.worst(), 1e-6);
+  EXPECT_LT((c.K - c.K.transpose()).lpNorm<Eigen::Infinity>(), 1e-9 * c.K.lpNorm<Eigen::Infinity>());  // a potential
 }
 
 Vec2 obstacle_force(const Problem& problem, const StepRecord& rec, const std::string& name) {

@@ -1,0 +1,97 @@
+#pragma once
+// Prandtl's punch (docs/verification.md): a rigid flat punch of half-width b = 1 pressed into a
+// block of elastic-perfectly plastic von Mises material (E = 1000, nu = 0.3, sigma_y = 1, plane
+// strain, small strain, q4_bbar), 10 b wide and 10 b deep. The half model x >= 0: the symmetry
+// line x = 0 held in x, the base in x and y, the far side in x. The punch is the nodes of the
+// top with x <= b moved down together (smooth: y prescribed, x free; rough: x held too), as in
+// de Souza Neto, Peric and Owen (Computational Methods for Plasticity, 2008). The limit load of
+// the whole punch is (2 + pi) k 2b with k = sigma_y / sqrt(3) (Prandtl 1920; Hill 1950: the
+// same for a smooth and a rough punch on a weightless body): (2 + pi) k b on the half model.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <vector>
+
+#include "solver/elements/continuum.hpp"
+#include "solver/materials/j2_plasticity.hpp"
+#include "tests/support/newton_driver.hpp"
+
+namespace grip::testing {
+
+inline double prandtl_limit_half() { return (2 + std::numbers::pi) / std::sqrt(3.0); }
+
+struct PunchCurve {
+  std::vector<double> depth, load;  // the punch's penetration and force (half model), per step
+  std::vector<int> newton;          // Newton iterations per step
+  int punch_nodes = 0;
+};
+
+// The half model with elements of size h within 2.5 b of the punch's edge (growing beyond, nx x
+// ny in all), pressed to `depth` through the penetrations `fractions` of it.
+inline PunchCurve press_punch(double h, int nx, int ny, double depth, const std::vector<double>& fractions,
+                              bool rough) {
+  RectangleSpec spec;
+  spec.origin = {0, -10};
+  spec.size = {10, 10};
+  spec.nx = nx;
+  spec.ny = ny;
+  spec.refine = Refinement{h, 2.5};
+  spec.towards = {1, 0};
+  PlaneMesh mesh = rectangle_mesh(spec, ElementShape::q4);
+  std::vector<int> punch;
+  for (int n : mesh.sets.at("top"))
+    if (mesh.nodes[n].x() <= 1 + 1e-9) punch.push_back(n);
+  auto law = std::make_shared<J2Material>(1000.0, 0.3, 1.0, IsotropicHardening{}, 0.0, PlaneAnalysis::plane_strain);
+  ContinuumBody body(mesh, mesh.sets.at("top"), {law},
+                     {ContinuumElement::q4_bbar, ContinuumKinematics::linear, PlaneAnalysis::plane_strain, 1.0});
+  std::vector<char> held(body.dof_count(), 0);
+  for (int n : mesh.sets.at("left")) held[2 * n] = 1;
+  for (int n : mesh.sets.at("right")) held[2 * n] = 1;
+  for (int n : mesh.sets.at("bottom")) held[2 * n] = held[2 * n + 1] = 1;
+  for (int n : punch) held[2 * n + 1] = 1, held[2 * n] = held[2 * n] || rough;
+  Driver d(body, held);
+  d.line_search = true;  // a full Newton step can overshoot where the plastic zone first spreads
+  PunchCurve c;
+  c.punch_nodes = static_cast<int>(punch.size());
+  for (double t : fractions) {
+    d.solve(
+        [&](Vector& q) {
+          for (int n : punch) q[2 * n + 1] = -t * depth;
+        },
+        1e-9);
+    const Vector f = d.force(nullptr);
+    double load = 0.0;
+    for (int n : punch) load += f[2 * n + 1];
+    c.depth.push_back(t * depth);
+    c.load.push_back(-load);
+    c.newton.push_back(static_cast<int>(d.residuals.size()) - 1);
+  }
+  return c;
+}
+
+// The curve against the limit: the last load within `within` of it, the last three steps within
+// 0.5 % of each other (flat), at most 20 Newton iterations in each of them.
+inline void check_punch_curve(const PunchCurve& c, double within, const char* name) {
+  const double limit = prandtl_limit_half();
+  std::printf("%s (%d punch nodes): depth/b, load/limit, Newton:", name, c.punch_nodes);
+  for (size_t k = 0; k < c.load.size(); ++k) std::printf(" (%.3f %.4f %d)", c.depth[k], c.load[k] / limit, c.newton[k]);
+  std::printf("\n");
+  const size_t n = c.load.size();
+  EXPECT_NEAR(c.load.back() / limit, 1.0, within);
+  for (size_t k = n - 3; k < n; ++k) EXPECT_NEAR(c.load[k] / c.load.back(), 1.0, 0.005) << "step " << k + 1;
+  const int most = *std::max_element(c.newton.begin(), c.newton.end());
+  for (size_t k = n - 3; k < n; ++k) EXPECT_LE(c.newton[k], 20) << "step " << k + 1 << " (most " << most << ")";
+}
+
+// Penetrations as fractions of 0.1 b: fine steps while the plastic zone spreads, then coarser.
+inline std::vector<double> punch_path() {
+  std::vector<double> t;
+  for (int k = 1; k <= 10; ++k) t.push_back(0.02 * k);
+  for (int k = 5; k <= 10; ++k) t.push_back(0.1 * k);
+  return t;
+}
+
+}  // namespace grip::testing

@@ -1,0 +1,45 @@
+#pragma once
+// A body's tangent at q against central differences of its internal force: the check every
+// element and law test makes (a wrong tangent costs Newton its quadratic convergence silently).
+#include <Eigen/Dense>
+#include <Eigen/SparseCore>
+
+#include "solver/model/body.hpp"
+
+namespace grip::testing {
+
+struct TangentCheck {
+  Matrix K;     // the assembled tangent
+  Matrix K_fd;  // central differences of the internal force, column by column
+  Vector f;     // the internal force at q
+
+  double error() const { return (K - K_fd).norm() / K.norm(); }  // relative, Frobenius
+  double worst() const { return (K - K_fd).lpNorm<Eigen::Infinity>() / K.lpNorm<Eigen::Infinity>(); }  // largest entry
+  double asymmetry() const { return (K - K.transpose()).norm() / K.norm(); }
+};
+
+inline Matrix assembled_tangent(const Body& body, const Vector& q, Vector& f) {
+  f = Vector::Zero(q.size());
+  Triplets t;
+  body.internal_force(q, f, &t);
+  Eigen::SparseMatrix<double> K(q.size(), q.size());
+  K.setFromTriplets(t.begin(), t.end());
+  return Matrix(K);
+}
+
+inline TangentCheck check_tangent(const Body& body, const Vector& q, double h) {
+  TangentCheck c;
+  c.K = assembled_tangent(body, q, c.f);
+  c.K_fd.resize(q.size(), q.size());
+  for (int j = 0; j < q.size(); ++j) {
+    Vector qp = q, qm = q, fp = Vector::Zero(q.size()), fm = Vector::Zero(q.size());
+    qp[j] += h;
+    qm[j] -= h;
+    body.internal_force(qp, fp, nullptr);
+    body.internal_force(qm, fm, nullptr);
+    c.K_fd.col(j) = (fp - fm) / (2 * h);
+  }
+  return c;
+}
+
+}  // namespace grip::testing
