@@ -121,11 +121,7 @@ SectionForces centre_forces(const Vector& q, const int* nodes, double length, co
 }  // namespace
 
 ReissnerBeam::ReissnerBeam(std::vector<double> node_x, double y0, BeamSection section, BeamElement element)
-    : x_(std::move(node_x)), y0_(y0), section_(section), element_(element) {
-  if (x_.size() < 2) throw std::invalid_argument("a beam needs at least two nodes");
-  for (size_t i = 1; i < x_.size(); ++i)
-    if (!(x_[i] > x_[i - 1])) throw std::invalid_argument("beam node abscissae must increase");
-}
+    : StraightBeam(std::move(node_x), y0, section), element_(element) {}
 
 int ReissnerBeam::element_nodes(int e, int* nodes, double* x) const {
   nodes[0] = e;
@@ -136,12 +132,6 @@ int ReissnerBeam::element_nodes(int e, int* nodes, double* x) const {
   nodes[2] = node_count() + e;
   x[2] = 0.5 * (x[0] + x[1]);
   return 3;
-}
-
-Vector ReissnerBeam::dof_length_scales() const {
-  Vector scale = Vector::Ones(dof_count());
-  for (int k = 0; k < dof_count() / 3; ++k) scale[3 * k + 2] = characteristic_length();
-  return scale;
 }
 
 void ReissnerBeam::internal_force(const Vector& q, Vector& force, Triplets* tangent) const {
@@ -172,6 +162,50 @@ void ReissnerBeam::follower_load(const Vector& q, const std::vector<double>& fac
     tangent->emplace_back(du, dt, df.x());
     tangent->emplace_back(dw, dt, df.y());
   }
+  for (const FollowerTraction& l : follower_tractions_) {
+    const double t = l.load_case < static_cast<int>(factors.size()) ? factors[l.load_case] : 0.0;
+    if (t == 0.0) continue;
+    // f = T x' with T = [[ta, -tc], [tc, ta]]: linear in the axis' slope, so dT x' / dq is T
+    // times the shape functions' slopes.
+    const double ta = t * l.traction.x(), tc = t * l.traction.y();
+    over_span(l.from, l.to, [&](int e, double xi, double dx) {
+      int slots[3];
+      double N[3], dN[3];
+      const int n = axis_shape(e, xi, slots, N, dN);
+      const double to_x = 2 / (x_[e + 1] - x_[e]);
+      Vec2 slope(1.0, 0.0);
+      for (int k = 0; k < n; ++k) slope += to_x * dN[k] * Vec2(q[3 * slots[k]], q[3 * slots[k] + 1]);
+      const Vec2 f(ta * slope.x() - tc * slope.y(), tc * slope.x() + ta * slope.y());
+      for (int i = 0; i < n; ++i) {
+        force[3 * slots[i]] += N[i] * f.x() * dx;
+        force[3 * slots[i] + 1] += N[i] * f.y() * dx;
+        if (!tangent) continue;
+        for (int j = 0; j < n; ++j) {
+          const double c = N[i] * to_x * dN[j] * dx;
+          tangent->emplace_back(3 * slots[i], 3 * slots[j], c * ta);
+          tangent->emplace_back(3 * slots[i], 3 * slots[j] + 1, -c * tc);
+          tangent->emplace_back(3 * slots[i] + 1, 3 * slots[j], c * tc);
+          tangent->emplace_back(3 * slots[i] + 1, 3 * slots[j] + 1, c * ta);
+        }
+      }
+    });
+  }
+}
+
+int ReissnerBeam::axis_shape(int element, double xi, int* slots, double* N, double* dN_dxi) const {
+  slots[0] = element;
+  slots[1] = element + 1;
+  if (element_ == BeamElement::b2) {
+    Eigen::Vector2d n, d;
+    shape<2>(xi, n, d);
+    for (int k = 0; k < 2; ++k) N[k] = n[k], dN_dxi[k] = d[k];
+    return 2;
+  }
+  slots[2] = node_count() + element;
+  Eigen::Vector3d n, d;
+  shape<3>(xi, n, d);
+  for (int k = 0; k < 3; ++k) N[k] = n[k], dN_dxi[k] = d[k];
+  return 3;
 }
 
 SurfacePoint ReissnerBeam::surface_point(const VectorRef& q, int site, int side) const {
@@ -182,13 +216,6 @@ SurfacePoint ReissnerBeam::surface_point(const VectorRef& q, int site, int side)
   p.x = {x_[site] + q[du] + z * s, y0_ + q[dw] + z * c};
   p.jacobian = {{du, Vec2::UnitX()}, {dw, Vec2::UnitY()}, {dt, z * Vec2(c, -s)}};
   return p;
-}
-
-double ReissnerBeam::tributary_area(int site) const {
-  double length = 0.0;
-  if (site > 0) length += 0.5 * (x_[site] - x_[site - 1]);
-  if (site + 1 < node_count()) length += 0.5 * (x_[site + 1] - x_[site]);
-  return length * section_.width;
 }
 
 SectionForces ReissnerBeam::section_forces(const Vector& q, int e) const {
@@ -218,30 +245,6 @@ Vector ReissnerBeam::own_rotation_at(const Vector& q) const {
     rot[3 * k + 2] = -1.0;  // a counter-clockwise turn: theta is clockwise
   }
   return rot;
-}
-
-std::vector<std::vector<int>> ReissnerBeam::cells() const {
-  std::vector<std::vector<int>> c;
-  for (int e = 0; e < element_count(); ++e) c.push_back({e, e + 1});
-  return c;
-}
-
-FieldTable ReissnerBeam::site_fields(const Vector& q) const {
-  FieldTable t{{"x", "y", "u", "w", "theta"}, {}};
-  for (int k = 0; k < node_count(); ++k) {
-    const double u = q[node_dof(k, 0)], w = q[node_dof(k, 1)];
-    t.rows.push_back({x_[k] + u, y0_ + w, u, w, q[node_dof(k, 2)]});
-  }
-  return t;
-}
-
-FieldTable ReissnerBeam::element_fields(const Vector& q) const {
-  FieldTable t{{"N", "Q", "M"}, {}};
-  for (int e = 0; e < element_count(); ++e) {
-    const SectionForces f = section_forces(q, e);
-    t.rows.push_back({f.N, f.Q, f.M});
-  }
-  return t;
 }
 
 }  // namespace grip

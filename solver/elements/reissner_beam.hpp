@@ -11,33 +11,25 @@
 // (3 nodes, 2 points): uniform reduced integration, free of shear locking and of spurious modes.
 #include <vector>
 
-#include "solver/elements/timoshenko_beam.hpp"
-#include "solver/model/body.hpp"
+#include "solver/elements/straight_beam.hpp"
 
 namespace grip {
 
 enum class BeamElement { b2, b3 };
 
-class ReissnerBeam final : public Body {
+class ReissnerBeam final : public StraightBeam {
  public:
-  // Node abscissae (element ends) must increase strictly; one element between consecutive nodes.
+  // Node abscissae are the element ends; a b3 adds a mid node in each element.
   ReissnerBeam(std::vector<double> node_x, double y0, BeamSection section, BeamElement element);
 
   int dof_count() const override { return 3 * (node_count() + mid_node_count()); }
-  Vector dof_length_scales() const override;
   void internal_force(const Vector& q, Vector& force, Triplets* tangent) const override;
-  int site_count() const override { return node_count(); }
-  Vec2 site_reference(int site) const override { return {x_[site], y0_}; }
   SurfacePoint surface_point(const VectorRef& q, int site, int side) const override;
-  double tributary_area(int site) const override;
-  double characteristic_length() const override { return x_.back() - x_.front(); }
 
   Vector rigid_translation(const Vec2& d) const override;
   Vector rigid_rotation() const override;
   // The rigid turn of the current shape: (-y, x) at each node, theta -1 (its strains stay).
   Vector own_rotation_at(const Vector& q) const override;
-  // Three dofs a node (u, w, theta), the element ends first, then each b3's mid node.
-  int dof_node(int dof) const override { return dof / 3; }
   Traits traits() const override { return {true, false, false}; }
   // A force at an end node that turns with its section: `force` at theta = 0, of load case
   // `load_case`, applied at height z (0: the axis; +-h/2: a face), whose arm turns with it.
@@ -48,33 +40,32 @@ class ReissnerBeam final : public Body {
     int load_case;
   };
   void add_follower_load(const FollowerLoad& load) { followers_.push_back(load); }
-  bool has_follower_loads() const override { return !followers_.empty(); }
+  // A distributed load that turns and stretches with the axis: `traction` [along, across] per
+  // unit length at the reference state, (t_along x' + t_across x'^perp) per unit length of the
+  // undeformed axis with x' = (1 + u', w'): a pressure across stays normal to the deformed
+  // axis and acts on its current length. Over the abscissae [from, to], of load case `load_case`.
+  struct FollowerTraction {
+    Vec2 traction;
+    double from, to;
+    int load_case;
+  };
+  void add_follower_traction(const FollowerTraction& t) { follower_tractions_.push_back(t); }
+  bool has_follower_loads() const override { return !followers_.empty() || !follower_tractions_.empty(); }
   void follower_load(const Vector& q, const std::vector<double>& factors, Vector& force,
                      Triplets* tangent) const override;
-  std::vector<std::vector<int>> cells() const override;
-  FieldTable site_fields(const Vector& q) const override;
-  FieldTable element_fields(const Vector& q) const override;
 
-  int node_count() const override { return static_cast<int>(x_.size()); }
-  int element_count() const { return node_count() - 1; }
+  // The mid values (mid_dof) of a b3 are its mid node's u, w, theta.
   int mid_node_count() const { return element_ == BeamElement::b3 ? element_count() : 0; }
-  // Global dof of node k: component 0 = u, 1 = w, 2 = theta (the von Karman beam's numbering).
-  static int node_dof(int node, int component) { return 3 * node + component; }
-  // Global dof of element e's mid node (b3 only).
-  int mid_dof(int element, int component) const { return 3 * (node_count() + element) + component; }
-  // Section forces at the element's centre.
-  SectionForces section_forces(const Vector& q, int element) const;
-  const BeamSection& section() const { return section_; }
+  SectionForces section_forces(const Vector& q, int element) const override;
+  int axis_shape(int element, double xi, int* slots, double* N, double* dN_dxi) const override;
 
  private:
   // The element's nodes in local order (ends, then the mid node of a b3) and their abscissae.
   int element_nodes(int e, int* nodes, double* x) const;
 
-  std::vector<double> x_;
-  double y0_;
-  BeamSection section_;
   BeamElement element_;
   std::vector<FollowerLoad> followers_;
+  std::vector<FollowerTraction> follower_tractions_;
 };
 
 }  // namespace grip

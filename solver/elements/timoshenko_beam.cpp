@@ -27,20 +27,9 @@ const Gauss kGauss3{{-std::sqrt(0.6), 0, std::sqrt(0.6)}, {5.0 / 9, 8.0 / 9, 5.0
 }  // namespace
 
 TimoshenkoBeam::TimoshenkoBeam(std::vector<double> node_x, double y0, BeamSection section, Kinematics kinematics)
-    : x_(std::move(node_x)), y0_(y0), section_(section), kinematics_(kinematics) {
-  if (x_.size() < 2) throw std::invalid_argument("a beam needs at least two nodes");
-  for (size_t i = 1; i < x_.size(); ++i)
-    if (!(x_[i] > x_[i - 1])) throw std::invalid_argument("beam node abscissae must increase");
+    : StraightBeam(std::move(node_x), y0, section), kinematics_(kinematics) {
   if (kinematics_ == Kinematics::finite)
     throw std::invalid_argument("the beam supports linear and von_karman kinematics");
-}
-
-Vector TimoshenkoBeam::dof_length_scales() const {
-  Vector scale = Vector::Ones(dof_count());
-  const double L = characteristic_length();
-  for (int k = 0; k < node_count(); ++k) scale[node_dof(k, 2)] = L;
-  for (int e = 0; e < element_count(); ++e) scale[mid_dof(e, 2)] = L;
-  return scale;
 }
 
 void TimoshenkoBeam::internal_force(const Vector& q, Vector& force, Triplets* tangent) const {
@@ -107,13 +96,6 @@ SurfacePoint TimoshenkoBeam::surface_point(const VectorRef& q, int site, int sid
   return p;
 }
 
-double TimoshenkoBeam::tributary_area(int site) const {
-  double length = 0.0;
-  if (site > 0) length += 0.5 * (x_[site] - x_[site - 1]);
-  if (site + 1 < node_count()) length += 0.5 * (x_[site + 1] - x_[site]);
-  return length * section_.width;
-}
-
 SectionForces TimoshenkoBeam::section_forces(const Vector& q, int e) const {
   const double L = x_[e + 1] - x_[e];
   Vec3 u, w, t;
@@ -124,6 +106,17 @@ SectionForces TimoshenkoBeam::section_forces(const Vector& q, int e) const {
   const Vec3 b = shape_dx(0.0, L), h = shape(0.0);
   const double bw = kinematics_ == Kinematics::von_karman ? b.dot(w) : 0.0;
   return {section_.EA * (b.dot(u) + 0.5 * bw * bw), section_.kGA * (b.dot(w) + h.dot(t)), section_.EI * b.dot(t)};
+}
+
+int TimoshenkoBeam::axis_shape(int element, double xi, int* slots, double* N, double* dN_dxi) const {
+  const Vec3 h = shape(xi), b = shape_dx(xi, 1.0);
+  const int k[3] = {element, element + 1, node_count() + element};
+  for (int i = 0; i < 3; ++i) {
+    slots[i] = k[i];
+    N[i] = h[i];
+    dN_dxi[i] = 0.5 * b[i];
+  }
+  return 3;
 }
 
 Vector TimoshenkoBeam::rigid_translation(const Vec2& d) const {
@@ -170,30 +163,6 @@ std::string TimoshenkoBeam::validity_warning(const Vector& q) const {
                 largest, largest * 180 / std::acos(-1.0), kModerateRotation,
                 kinematics_ == Kinematics::linear ? "linear" : "von Karman");
   return text;
-}
-
-std::vector<std::vector<int>> TimoshenkoBeam::cells() const {
-  std::vector<std::vector<int>> c;
-  for (int e = 0; e < element_count(); ++e) c.push_back({e, e + 1});
-  return c;
-}
-
-FieldTable TimoshenkoBeam::site_fields(const Vector& q) const {
-  FieldTable t{{"x", "y", "u", "w", "theta"}, {}};
-  for (int k = 0; k < node_count(); ++k) {
-    const double u = q[node_dof(k, 0)], w = q[node_dof(k, 1)];
-    t.rows.push_back({x_[k] + u, y0_ + w, u, w, q[node_dof(k, 2)]});
-  }
-  return t;
-}
-
-FieldTable TimoshenkoBeam::element_fields(const Vector& q) const {
-  FieldTable t{{"N", "Q", "M"}, {}};
-  for (int e = 0; e < element_count(); ++e) {
-    const SectionForces f = section_forces(q, e);
-    t.rows.push_back({f.N, f.Q, f.M});
-  }
-  return t;
 }
 
 }  // namespace grip

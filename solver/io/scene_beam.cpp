@@ -1,6 +1,7 @@
 #include <cmath>
 
 #include "solver/elements/reissner_beam.hpp"
+#include "solver/elements/straight_beam.hpp"
 #include "solver/elements/timoshenko_beam.hpp"
 #include "solver/io/scene_reader.hpp"
 
@@ -22,6 +23,25 @@ bool follows(Reader& r, json& l, const std::string& lp, bool exact, const std::s
   else if (ptr != "/body")
     r.error(lp + "/follower", "follower loads are for a one-body scene (body), not yet for a body of bodies");
   return true;
+}
+
+// A distributed load over [from, to] of the undeformed axis (default: the whole beam): dead,
+// or turning and stretching with the axis (reissner_beam's follower).
+void read_line_load(Reader& r, json& l, const std::string& lp, bool exact, const std::string& ptr, Problem& problem) {
+  const auto& beam = static_cast<const StraightBeam&>(*problem.body);
+  const double start = beam.site_reference(0).x(), end = beam.site_reference(beam.node_count() - 1).x();
+  const Vec2 traction = r.vec2(l, lp, "traction");
+  const double from = r.number(l, lp, "from", start), to = r.number(l, lp, "to", end);
+  if (!(from >= start && from < end))
+    r.error(lp + "/from",
+            show(json(from)) + " is not in [" + show(json(start)) + ", " + show(json(end)) + ") along the beam");
+  else if (!(to > from && to <= end))
+    r.error(lp + "/to", show(json(to)) + " is not in (from, " + show(json(end)) + "] along the beam");
+  const int load_case = r.load_case(l, lp);
+  const bool follower = follows(r, l, lp, exact, ptr);
+  if (!r.issues.empty()) return;
+  if (follower) static_cast<ReissnerBeam&>(*problem.body).add_follower_traction({traction, from, to, load_case});
+  else beam.add_line_load(traction, from, to, case_load(problem, load_case));
 }
 
 // The two beam models share their section, mesh, supports and loads (node dofs u, w, theta);
@@ -72,6 +92,10 @@ void read_beam(Reader& r, json& body, Problem& problem, const std::string& ptr, 
       json& l = (*loads)[i];
       if (!l.is_object()) {
         r.error(lp, "is not an object");
+        continue;
+      }
+      if (l.contains("traction")) {
+        read_line_load(r, l, lp, exact, ptr, problem);
         continue;
       }
       const int node = r.integer(l, lp, "node", 0, nodes - 1);

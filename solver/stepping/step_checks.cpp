@@ -156,11 +156,14 @@ std::string StepChecker::state(const Equilibrium& eq, const EquilibriumState& s,
   force_level_ = std::max(force_level_, carried.maxCoeff());
   const double floor = 1e-8 * std::max(internal, force_level_);
   // Each resultant over what the body carries: along an axis that carries nothing (a vertical
-  // load), over what the other axis carries; a moment over that times the body's length.
+  // load), over what the other axis carries; a moment over that times the body's length. A
+  // body that carries only moments (a beam rolled up by end moments) scales its forces by the
+  // moment over its length.
   for (const BodyModes& b : body_modes_) {
     std::vector<double> scales;
     for (const Vector& m : b.modes) scales.push_back(m.cwiseAbs().dot(carried));
-    const double translations = std::max(scales[0], scales[1]);
+    const double moments = scales.size() > 2 ? scales[2] / b.length : 0.0;
+    const double translations = std::max({scales[0], scales[1], moments});
     for (size_t k = 0; k < b.modes.size(); ++k) {
       const double scale = std::max(scales[k], k < 2 ? translations : translations * b.length);
       const double off = std::abs(b.modes[k].dot(residual));

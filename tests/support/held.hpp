@@ -129,4 +129,20 @@ inline nlohmann::json with_strategy(nlohmann::json j, const Strategy& strategy) 
   return j;
 }
 
+// A test run once per strategy.
+class StrategyTest : public ::testing::TestWithParam<Strategy> {
+ protected:
+  nlohmann::json with(nlohmann::json j) const { return with_strategy(std::move(j), GetParam()); }
+  const char* name() const { return GetParam().name; }
+  bool runs_on(const std::string& scene) const {
+    const auto& no = GetParam().not_for;
+    return std::find(no.begin(), no.end(), scene) == no.end();
+  }
+  // Whether each linear model is solved to rounding (n = infinity), not to the tolerance.
+  bool exact_model() const {
+    const nlohmann::json& c = GetParam().contact;
+    return c.value("method", "cev") == "cev" && !c.contains("acceleration");
+  }
+};
+
 }  // namespace grip::testing

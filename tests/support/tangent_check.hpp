@@ -18,6 +18,12 @@ struct TangentCheck {
   double asymmetry() const { return (K - K.transpose()).norm() / K.norm(); }
 };
 
+inline Vector internal_force(const Body& body, const Vector& q) {
+  Vector f = Vector::Zero(q.size());
+  body.internal_force(q, f, nullptr);
+  return f;
+}
+
 inline Matrix assembled_tangent(const Body& body, const Vector& q, Vector& f) {
   f = Vector::Zero(q.size());
   Triplets t;
@@ -25,6 +31,11 @@ inline Matrix assembled_tangent(const Body& body, const Vector& q, Vector& f) {
   Eigen::SparseMatrix<double> K(q.size(), q.size());
   K.setFromTriplets(t.begin(), t.end());
   return Matrix(K);
+}
+
+inline Matrix assembled_tangent(const Body& body, const Vector& q) {
+  Vector f;
+  return assembled_tangent(body, q, f);
 }
 
 inline TangentCheck check_tangent(const Body& body, const Vector& q, double h) {

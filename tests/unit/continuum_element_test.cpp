@@ -11,6 +11,7 @@
 
 #include "solver/elements/continuum.hpp"
 #include "tests/support/distorted_mesh.hpp"
+#include "tests/support/tangent_check.hpp"
 
 namespace grip {
 namespace {
@@ -46,20 +47,8 @@ ContinuumBody body_of(const Variant& v, double nu = 0.3) {
   return ContinuumBody(mesh, mesh.sets.at("bottom"), {material(v.analysis, nu)}, options);
 }
 
-Vector force(const Body& body, const Vector& q) {
-  Vector f = Vector::Zero(body.dof_count());
-  body.internal_force(q, f, nullptr);
-  return f;
-}
-
-Matrix tangent(const Body& body, const Vector& q) {
-  Vector f = Vector::Zero(body.dof_count());
-  Triplets t;
-  body.internal_force(q, f, &t);
-  Eigen::SparseMatrix<double> K(body.dof_count(), body.dof_count());
-  K.setFromTriplets(t.begin(), t.end());
-  return Matrix(K);
-}
+using testing::assembled_tangent;
+using testing::internal_force;
 
 Vector random_state(const Body& body, double size, unsigned seed) {
   std::mt19937 rng(seed);
@@ -89,20 +78,20 @@ TEST_P(ContinuumVariants, RigidTranslationGivesNoForce) {
   const ContinuumBody body = body_of(GetParam());
   const Vector t = body.rigid_translation({0.3, -0.7});
   const Vector q = random_state(body, 0.02, 1);
-  const double scale = force(body, q).norm();
-  EXPECT_LT(force(body, t).norm(), 1e-12 * scale);
-  EXPECT_LT((force(body, q + t) - force(body, q)).norm(), 1e-11 * scale);
+  const double scale = internal_force(body, q).norm();
+  EXPECT_LT(internal_force(body, t).norm(), 1e-12 * scale);
+  EXPECT_LT((internal_force(body, q + t) - internal_force(body, q)).norm(), 1e-11 * scale);
 }
 
 TEST_P(ContinuumVariants, RigidRotationGivesNoForce) {
   const ContinuumBody body = body_of(GetParam());
-  const double scale = force(body, random_state(body, 0.02, 2)).norm();
+  const double scale = internal_force(body, random_state(body, 0.02, 2)).norm();
   if (GetParam().kinematics == ContinuumKinematics::linear) {
     // Infinitesimal rotation: exactly in the kernel of the constant K.
-    EXPECT_LT(force(body, 0.01 * body.rigid_rotation()).norm(), 1e-12 * scale);
+    EXPECT_LT(internal_force(body, 0.01 * body.rigid_rotation()).norm(), 1e-12 * scale);
   } else {
     // A finite rotation (and translation) strains nothing.
-    EXPECT_LT(force(body, rigid_motion(body, 0.6, {0.2, 0.1})).norm(), 1e-11 * scale);
+    EXPECT_LT(internal_force(body, rigid_motion(body, 0.6, {0.2, 0.1})).norm(), 1e-11 * scale);
   }
 }
 
@@ -116,7 +105,7 @@ TEST_P(ContinuumFinite, ForceRotatesWithTheBody) {
     const Vec2 X = body.mesh().nodes[k];
     rotated.segment<2>(2 * k) = R * (X + q.segment<2>(2 * k)) - X;
   }
-  const Vector f = force(body, q), fr = force(body, rotated);
+  const Vector f = internal_force(body, q), fr = internal_force(body, rotated);
   double diff = 0.0;
   for (int k = 0; k < body.node_count(); ++k)
     diff = std::max(diff, (fr.segment<2>(2 * k) - R * f.segment<2>(2 * k)).norm());
@@ -126,17 +115,9 @@ TEST_P(ContinuumFinite, ForceRotatesWithTheBody) {
 TEST_P(ContinuumVariants, TangentEqualsFiniteDifferenceOfForce) {
   const ContinuumBody body = body_of(GetParam());
   const Vector q = random_state(body, 0.05, 4);  // strains of several per cent
-  const Matrix K = tangent(body, q);
-  Matrix K_fd(q.size(), q.size());
-  const double h = 1e-6;
-  for (int j = 0; j < q.size(); ++j) {
-    Vector qp = q, qm = q;
-    qp[j] += h;
-    qm[j] -= h;
-    K_fd.col(j) = (force(body, qp) - force(body, qm)) / (2 * h);
-  }
-  EXPECT_LT((K - K_fd).norm(), 1e-7 * K.norm());
-  EXPECT_LT((K - K.transpose()).norm(), 1e-12 * K.norm());  // hyperelastic: a potential
+  const testing::TangentCheck c = testing::check_tangent(body, q, 1e-6);
+  EXPECT_LT(c.error(), 1e-7);
+  EXPECT_LT(c.asymmetry(), 1e-12);  // hyperelastic: a potential
 }
 
 // Constant strain: with the boundary nodes on a linear field, the interior nodes of a
@@ -153,7 +134,7 @@ TEST_P(ContinuumLinear, PatchTestIsExact) {
   }
   ASSERT_FALSE(interior.empty());
   // Solve K_ii u_i = -K_ib u_b for the interior dofs.
-  const Matrix K = tangent(body, Vector::Zero(body.dof_count()));
+  const Matrix K = assembled_tangent(body, Vector::Zero(body.dof_count()));
   std::vector<int> dofs;
   for (int k : interior) dofs.insert(dofs.end(), {2 * k, 2 * k + 1});
   Vector boundary = exact;
@@ -185,7 +166,7 @@ TEST_P(ContinuumFinite, HomogeneousDeformationIsExact) {
   const Mat2 F = (Mat2() << 1.15, 0.2, -0.1, 0.85).finished();
   Vector q(body.dof_count());
   for (int k = 0; k < body.node_count(); ++k) q.segment<2>(2 * k) = (F - Mat2::Identity()) * body.mesh().nodes[k];
-  const Vector f = force(body, q);
+  const Vector f = internal_force(body, q);
   for (int k = 0; k < body.node_count(); ++k) {
     const Vec2 X = body.mesh().nodes[k];
     if (X.x() > 1e-9 && X.x() < 2 - 1e-9 && X.y() > 1e-9 && X.y() < 1 - 1e-9)
@@ -205,7 +186,7 @@ TEST_P(ContinuumFinite, AgreesWithLinearForSmallStrain) {
   const ContinuumBody a = body_of(lin), b = body_of(fin);
   for (const double size : {1e-3, 1e-5}) {
     const Vector q = random_state(a, size, 5);
-    const Vector fa = force(a, q), fb = force(b, q);
+    const Vector fa = internal_force(a, q), fb = internal_force(b, q);
     // The difference is second order: relative size ~ strain.
     EXPECT_LT((fa - fb).norm(), 20 * size * fa.norm()) << size;
   }
@@ -314,7 +295,7 @@ TEST(ContinuumLocking, MeanDilatationAndNineNodesDoNotLock) {
     const PlaneMesh mesh = rectangle_mesh(spec, element_shape(element));
     ContinuumOptions options{element, ContinuumKinematics::linear, PlaneAnalysis::plane_strain, 1.0};
     const ContinuumBody body(mesh, mesh.sets.at("bottom"), {material(PlaneAnalysis::plane_strain, nu)}, options);
-    const Matrix K = tangent(body, Vector::Zero(body.dof_count()));
+    const Matrix K = assembled_tangent(body, Vector::Zero(body.dof_count()));
     // Clamp the left end; shear the right end by a parabolic traction (consistent loads).
     std::vector<char> fixed(body.dof_count(), 0);
     for (int k : mesh.sets.at("left")) fixed[2 * k] = fixed[2 * k + 1] = 1;

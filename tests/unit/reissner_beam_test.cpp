@@ -9,62 +9,37 @@
 #include <random>
 
 #include "solver/elements/reissner_beam.hpp"
+#include "tests/support/beam_section.hpp"
+#include "tests/support/tangent_check.hpp"
 
 namespace grip {
 namespace {
 
-BeamSection section(double E, double nu, double width, double depth) {
-  const double G = E / (2 * (1 + nu));
-  return {E * width * depth, E * width * depth * depth * depth / 12, 5.0 / 6.0 * G * width * depth, depth / 2, width};
-}
-
-std::vector<double> uniform(double length, int elements) {
-  std::vector<double> x;
-  for (int i = 0; i <= elements; ++i) x.push_back(length * i / elements);
-  return x;
-}
-
-Vector force(const ReissnerBeam& beam, const Vector& q) {
-  Vector f = Vector::Zero(beam.dof_count());
-  beam.internal_force(q, f, nullptr);
-  return f;
-}
-
-Matrix tangent(const ReissnerBeam& beam, const Vector& q) {
-  Vector f = Vector::Zero(beam.dof_count());
-  Triplets t;
-  beam.internal_force(q, f, &t);
-  Eigen::SparseMatrix<double> K(beam.dof_count(), beam.dof_count());
-  K.setFromTriplets(t.begin(), t.end());
-  return Matrix(K);
-}
+using testing::assembled_tangent;
+using testing::internal_force;
+using testing::rectangular_section;
+using testing::uniform_abscissae;
 
 class ReissnerBeamElements : public ::testing::TestWithParam<BeamElement> {};
 
 // At a state with rotations up to 1.5 rad and strains of a few per cent, the tangent (material
 // and geometric) is the central difference of the force to the difference's own error.
 TEST_P(ReissnerBeamElements, TangentEqualsFiniteDifferenceOfForce) {
-  const ReissnerBeam beam(uniform(10, 4), 0.3, section(2e5, 0.3, 1, 0.5), GetParam());
+  const ReissnerBeam beam(uniform_abscissae(10, 4), 0.3, rectangular_section(2e5, 0.3, 1, 0.5), GetParam());
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> small(-0.3, 0.3), angle(-1.5, 1.5);
   Vector q(beam.dof_count());
   for (int i = 0; i < q.size(); ++i) q[i] = i % 3 == 2 ? angle(rng) : small(rng);
-  const Matrix K = tangent(beam, q);
-  Matrix K_fd(q.size(), q.size());
   const double h = 1e-6;
-  for (int j = 0; j < q.size(); ++j) {
-    Vector qp = q, qm = q;
-    qp[j] += h;
-    qm[j] -= h;
-    K_fd.col(j) = (force(beam, qp) - force(beam, qm)) / (2 * h);
-  }
-  EXPECT_LT((K - K_fd).norm(), 1e-8 * K.norm());
-  EXPECT_LT((K - K.transpose()).norm(), 1e-12 * K.norm());  // a potential: symmetric
+  const testing::TangentCheck c = testing::check_tangent(beam, q, h);
+  EXPECT_LT(c.error(), 1e-8);
+  EXPECT_LT(c.asymmetry(), 1e-12);  // a potential: symmetric
+  const Matrix& K = c.K;
   // And the force is the gradient of the strain energy: a directional difference of the force
   // along a random direction is K times that direction, however far q is from the reference.
   Vector d(q.size());
   for (int i = 0; i < d.size(); ++i) d[i] = small(rng);
-  const Vector df = (force(beam, q + h * d) - force(beam, q - h * d)) / (2 * h);
+  const Vector df = (internal_force(beam, q + h * d) - internal_force(beam, q - h * d)) / (2 * h);
   EXPECT_LT((df - K * d).norm(), 1e-8 * (K * d).norm());
 }
 
@@ -72,7 +47,7 @@ TEST_P(ReissnerBeamElements, TangentEqualsFiniteDifferenceOfForce) {
 // bent state leaves its strains, so its force turned along with it; of the straight beam no force.
 TEST_P(ReissnerBeamElements, FiniteRigidMotionLeavesTheStrains) {
   const double y0 = 0.4;
-  const ReissnerBeam beam(uniform(10, 5), y0, section(2e5, 0.3, 1, 0.5), GetParam());
+  const ReissnerBeam beam(uniform_abscissae(10, 5), y0, rectangular_section(2e5, 0.3, 1, 0.5), GetParam());
   const int nodes = beam.dof_count() / 3;
   // Reference positions of every node (ends, then mid nodes).
   std::vector<double> X(nodes);
@@ -91,13 +66,13 @@ TEST_P(ReissnerBeamElements, FiniteRigidMotionLeavesTheStrains) {
     return m;
   };
   const Vector zero = Vector::Zero(beam.dof_count());
-  EXPECT_LT(force(beam, moved(zero)).norm(), 1e-9);
+  EXPECT_LT(internal_force(beam, moved(zero)).norm(), 1e-9);
   Vector bent = zero;
   for (int k = 0; k < nodes; ++k) {
     bent[3 * k + 1] = 0.02 * X[k] * X[k];
     bent[3 * k + 2] = -0.03 * X[k];
   }
-  const Vector f = force(beam, bent), g = force(beam, moved(bent));
+  const Vector f = internal_force(beam, bent), g = internal_force(beam, moved(bent));
   // The nodal forces turn with the beam; the moments stay.
   for (int k = 0; k < nodes; ++k) {
     const Vec2 fk(f[3 * k], f[3 * k + 1]), gk(g[3 * k], g[3 * k + 1]);
@@ -107,7 +82,7 @@ TEST_P(ReissnerBeamElements, FiniteRigidMotionLeavesTheStrains) {
   // Along the turn's rate at the state, the force only turns: (-f_y, f_x) at each node.
   const Vector rate = beam.own_rotation_at(bent);
   const double h = 1e-6;
-  const Vector df = (force(beam, bent + h * rate) - force(beam, bent - h * rate)) / (2 * h);
+  const Vector df = (internal_force(beam, bent + h * rate) - internal_force(beam, bent - h * rate)) / (2 * h);
   Vector turned = Vector::Zero(f.size());
   for (int k = 0; k < nodes; ++k) {
     turned[3 * k] = -f[3 * k + 1];
@@ -121,8 +96,8 @@ INSTANTIATE_TEST_SUITE_P(BothElements, ReissnerBeamElements, ::testing::Values(B
 // Linear response of a cantilever under a tip load: the tangent at the straight state solved
 // for the tip deflection, 10 elements, L/t = 1000.
 double tip_deflection(BeamElement element, int elements, double L, double t, double F) {
-  const ReissnerBeam beam(uniform(L, elements), 0.0, section(1e7, 0.3, 1, t), element);
-  const Matrix K = tangent(beam, Vector::Zero(beam.dof_count()));
+  const ReissnerBeam beam(uniform_abscissae(L, elements), 0.0, rectangular_section(1e7, 0.3, 1, t), element);
+  const Matrix K = assembled_tangent(beam, Vector::Zero(beam.dof_count()));
   Vector f = Vector::Zero(beam.dof_count());
   f[ReissnerBeam::node_dof(elements, 1)] = F;
   std::vector<int> free;

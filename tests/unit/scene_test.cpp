@@ -83,6 +83,32 @@ TEST(SceneReader, NamesTheRigidMotionThatSupportsLeaveFree) {
   EXPECT_TRUE(issues_of(sheet).empty());
 }
 
+// A beam's distributed load: a traction along the axis, not at a node; its span inside the
+// beam; a follower only on the geometrically exact beam.
+TEST(SceneReader, BeamTractionsNameTheirField) {
+  json j = example_scene("beam-on-cylinder");
+  const double length = j["body"]["mesh"]["length"];
+  j["body"]["loads"] = json::array({{{"traction", {0, -1}}, {"node", 3}},
+                                    {{"traction", {0, -1}}, {"from", length}},
+                                    {{"traction", {0, -1}}, {"follower", true}},
+                                    {{"moment", 1.0}},
+                                    {{"node", 2}, {"to", 3.0}}});
+  const auto issues = issues_of(j);
+  EXPECT_TRUE(has(issues, "/body/loads/0/node", "not at a node"));
+  EXPECT_TRUE(has(issues, "/body/loads/3", "needs \"node\""));
+  EXPECT_TRUE(has(issues, "/body/loads/4/to", "belongs to a traction"));
+  j["body"]["loads"].erase(4);
+  j["body"]["loads"].erase(3);
+  j["body"]["loads"].erase(0);
+  const auto read = issues_of(j);
+  EXPECT_TRUE(has(read, "/body/loads/0/from", "is not in"));
+  EXPECT_TRUE(has(read, "/body/loads/1/follower", "only a reissner_beam"));
+  j["body"]["model"] = "reissner_beam";
+  j["body"].erase("kinematics");
+  j["body"]["loads"].erase(0);
+  EXPECT_TRUE(issues_of(j).empty());
+}
+
 TEST(SceneReader, MembraneNeedsAStart) {
   json j = example_scene("sheet-stretching");
   j["solver"].erase("start");

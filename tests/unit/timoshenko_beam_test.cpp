@@ -7,76 +7,50 @@
 
 #include "solver/elements/timoshenko_beam.hpp"
 #include "solver/equilibrium/equilibrium.hpp"
+#include "tests/support/beam_section.hpp"
+#include "tests/support/tangent_check.hpp"
 
 namespace grip {
 namespace {
 
-BeamSection section(double E, double nu, double width, double depth) {
-  const double G = E / (2 * (1 + nu));
-  return {E * width * depth, E * width * depth * depth * depth / 12, 5.0 / 6.0 * G * width * depth, depth / 2, width};
-}
-
-std::vector<double> uniform(double length, int elements) {
-  std::vector<double> x;
-  for (int i = 0; i <= elements; ++i) x.push_back(length * i / elements);
-  return x;
-}
-
-Vector force(const TimoshenkoBeam& beam, const Vector& q) {
-  Vector f = Vector::Zero(beam.dof_count());
-  beam.internal_force(q, f, nullptr);
-  return f;
-}
-
-Matrix tangent(const TimoshenkoBeam& beam, const Vector& q) {
-  Vector f = Vector::Zero(beam.dof_count());
-  Triplets t;
-  beam.internal_force(q, f, &t);
-  Eigen::SparseMatrix<double> K(beam.dof_count(), beam.dof_count());
-  K.setFromTriplets(t.begin(), t.end());
-  return Matrix(K);
-}
+using testing::assembled_tangent;
+using testing::internal_force;
+using testing::rectangular_section;
+using testing::uniform_abscissae;
 
 class TimoshenkoBeamKinematics : public ::testing::TestWithParam<Kinematics> {};
 
 TEST_P(TimoshenkoBeamKinematics, RigidTranslationGivesNoForce) {
-  const TimoshenkoBeam beam(uniform(10, 5), 0.0, section(2e5, 0.3, 1, 0.5), GetParam());
+  const TimoshenkoBeam beam(uniform_abscissae(10, 5), 0.0, rectangular_section(2e5, 0.3, 1, 0.5), GetParam());
   Vector q = Vector::Zero(beam.dof_count());
   for (int k = 0; k < beam.node_count(); ++k) {
     q[TimoshenkoBeam::node_dof(k, 0)] = 0.7;
     q[TimoshenkoBeam::node_dof(k, 1)] = -1.3;
   }
-  EXPECT_LT(force(beam, q).norm(), 1e-9);
+  EXPECT_LT(internal_force(beam, q).norm(), 1e-9);
   // The same translation with a bending state added changes nothing.
   Vector bent = Vector::Zero(beam.dof_count());
   for (int k = 0; k < beam.node_count(); ++k) bent[TimoshenkoBeam::node_dof(k, 1)] = 0.01 * k * k;
-  EXPECT_LT((force(beam, bent + q) - force(beam, bent)).norm(), 1e-8 * force(beam, bent).norm());
+  EXPECT_LT((internal_force(beam, bent + q) - internal_force(beam, bent)).norm(),
+            1e-8 * internal_force(beam, bent).norm());
 }
 
 TEST_P(TimoshenkoBeamKinematics, TangentEqualsFiniteDifferenceOfForce) {
-  const TimoshenkoBeam beam(uniform(10, 4), 0.0, section(2e5, 0.3, 1, 0.5), GetParam());
+  const TimoshenkoBeam beam(uniform_abscissae(10, 4), 0.0, rectangular_section(2e5, 0.3, 1, 0.5), GetParam());
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> dist(-0.05, 0.05);
   Vector q(beam.dof_count());
   for (int i = 0; i < q.size(); ++i) q[i] = dist(rng);
-  const Matrix K = tangent(beam, q);
-  Matrix K_fd(q.size(), q.size());
-  const double h = 1e-6;
-  for (int j = 0; j < q.size(); ++j) {
-    Vector qp = q, qm = q;
-    qp[j] += h;
-    qm[j] -= h;
-    K_fd.col(j) = (force(beam, qp) - force(beam, qm)) / (2 * h);
-  }
-  EXPECT_LT((K - K_fd).norm(), 1e-7 * K.norm());
-  EXPECT_LT((K - K.transpose()).norm(), 1e-12 * K.norm());  // a potential: symmetric
+  const testing::TangentCheck c = testing::check_tangent(beam, q, 1e-6);
+  EXPECT_LT(c.error(), 1e-7);
+  EXPECT_LT(c.asymmetry(), 1e-12);  // a potential: symmetric
 }
 
 INSTANTIATE_TEST_SUITE_P(BothKinematics, TimoshenkoBeamKinematics,
                          ::testing::Values(Kinematics::linear, Kinematics::von_karman));
 
 TEST(TimoshenkoBeam, LinearRigidRotationGivesNoForce) {
-  const TimoshenkoBeam beam(uniform(10, 5), 0.0, section(2e5, 0.3, 1, 0.5), Kinematics::linear);
+  const TimoshenkoBeam beam(uniform_abscissae(10, 5), 0.0, rectangular_section(2e5, 0.3, 1, 0.5), Kinematics::linear);
   const double a = 1e-3;
   Vector q = Vector::Zero(beam.dof_count());
   for (int k = 0; k < beam.node_count(); ++k) {
@@ -86,7 +60,7 @@ TEST(TimoshenkoBeam, LinearRigidRotationGivesNoForce) {
   // Compare with the force of a pure bending state of the same size.
   Vector bend = Vector::Zero(beam.dof_count());
   for (int k = 0; k < beam.node_count(); ++k) bend[TimoshenkoBeam::node_dof(k, 2)] = a * k;
-  EXPECT_LT(force(beam, q).norm(), 1e-12 * force(beam, bend).norm());
+  EXPECT_LT(internal_force(beam, q).norm(), 1e-12 * internal_force(beam, bend).norm());
 }
 
 // Linear cantilever under a tip load: delta = P L^3 / (3 EI) + P L / (k'GA).
@@ -94,7 +68,8 @@ TEST(TimoshenkoBeam, CantileverTipDeflectionMatchesClosedForm) {
   for (const double depth : {0.2, 4.0}) {  // slender (bending) and stubby (shear matters)
     const double L = 10;
     Problem problem;
-    auto beam = std::make_unique<TimoshenkoBeam>(uniform(L, 10), 0.0, section(1e4, 0.3, 1, depth), Kinematics::linear);
+    auto beam = std::make_unique<TimoshenkoBeam>(uniform_abscissae(L, 10), 0.0, rectangular_section(1e4, 0.3, 1, depth),
+                                                 Kinematics::linear);
     const BeamSection s = beam->section();
     const double P = 0.03 * s.EI / (L * L);  // a bending deflection of L / 100
     problem.loads = {Vector::Zero(beam->dof_count())};

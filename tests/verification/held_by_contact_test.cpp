@@ -71,20 +71,7 @@ const Strategy kStrategies[] = {
     {"ssn", {{"method", "ssn"}}},
 };
 
-class HeldByContactStrategy : public ::testing::TestWithParam<Strategy> {
- protected:
-  json with(json j) const { return with_strategy(std::move(j), GetParam()); }
-  const char* name() const { return GetParam().name; }
-  bool runs_on(const std::string& scene) const {
-    const auto& no = GetParam().not_for;
-    return std::find(no.begin(), no.end(), scene) == no.end();
-  }
-  // Whether each linear model is solved to rounding (n = infinity), not to the tolerance.
-  bool exact_model() const {
-    const json& c = GetParam().contact;
-    return c.value("method", "cev") == "cev" && !c.contains("acceleration");
-  }
-};
+class HeldByContactStrategy : public testing::StrategyTest {};
 
 // The shipped Hertz half-disc with its diameter held in x only, pressed by a force P at the
 // centre of its diameter; or, with `prescribed`, by that node's displacement instead.

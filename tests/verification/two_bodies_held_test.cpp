@@ -107,20 +107,7 @@ const Strategy kStrategies[] = {
     {"ssn", {{"method", "ssn"}}},
 };
 
-class TwoBodiesHeld : public ::testing::TestWithParam<Strategy> {
- protected:
-  json with(json j) const { return with_strategy(std::move(j), GetParam()); }
-  const char* name() const { return GetParam().name; }
-  bool runs_on(const std::string& scene) const {
-    const auto& no = GetParam().not_for;
-    return std::find(no.begin(), no.end(), scene) == no.end();
-  }
-  // Whether each linear model is solved to rounding (n = infinity), not to the tolerance.
-  bool exact_model() const {
-    const json& c = GetParam().contact;
-    return c.value("method", "cev") == "cev" && !c.contains("acceleration");
-  }
-};
+class TwoBodiesHeld : public testing::StrategyTest {};
 
 TEST_P(TwoBodiesHeld, CylindersUnderAForceMatchHertz) {
   const double P = 5000.0;  // N / mm: a = 0.54 mm, about 11 elements of 0.05 mm
