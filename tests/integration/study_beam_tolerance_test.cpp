@@ -58,7 +58,7 @@ TEST(StudyOfThePapersBeam, ToleranceSweepReproducesGripBenchsCurve) {
   ServerProcess server(dir.path() / "grip.sqlite", {"--workers", "2"}, dir.path() / "serve.log");
   const Api api(server.port());
   json scene = json::parse(read_text(examples_dir() / "beam-on-cylinder.json"));
-  scene["solver"]["contact"] = {{"method", "cev"}};  // grip_bench's cev: the defaults
+  scene["solver"]["contact"] = {{"method", "cev"}, {"tolerance", 1e-8}};  // grip_bench's cev: the defaults
   scene["outputs"] = {{{"name", "tip_w"}, {"kind", "displacement"}, {"node", 40}, {"component", "y"}},
                       {{"name", "force_x"}, {"kind", "resultant"}, {"component", "x"}},
                       {{"name", "force_y"}, {"kind", "resultant"}, {"component", "y"}},
