@@ -1,7 +1,7 @@
 // The frictional sphere (docs/verification.md#frictional-sphere): an elastic half-space
 // pressed by a rigid sphere with friction, axisymmetric, against the ring boundary-element
 // model of the same loading (tests/support/sphere_halfspace.hpp): nu 0.3, mu 0.3, 10 steps.
-// - the model without friction gives Hertz;
+// - the model and the scene without friction give Hertz;
 // - the scene (a cylinder of radius and depth 300 mm, elements of 0.025 mm near the contact,
 //   under a rigid sphere R = 100 mm to a = 1 mm): the stick radius c/a from the solver's stick
 //   states against the model's at every step of the second half of the loading; the peak
@@ -84,6 +84,18 @@ TEST(FrictionalSphere, RingModelWithoutFrictionGivesHertz) {
   std::printf("ring model, mu 0: a %.4f (Hertz 1), peak %.4f of p0\n", m.a, m.peak);
   EXPECT_NEAR(m.a, 1.0, 1.0 / kPerA);
   EXPECT_NEAR(m.peak, 1.0, 0.005);
+}
+
+// The block's far field is a half-space's: without friction, Hertz's a (bracketed by the nodes
+// where contact ends, to half an element) and p0 (the peak nodal pressure, within 0.5 %).
+TEST(FrictionalSphere, FrictionlessBlockGivesHertz) {
+  const Solved n = solve_scene(sphere_on_block(kSize, 2, 0.0));
+  expect_every_step_sound(n);
+  ASSERT_TRUE(n.run.completed) << n.run.reason;
+  const SphereReading r = read_sphere(n, n.run.steps.back());
+  std::printf("frictionless: P %.2f N, a %.4f mm (Hertz %.4f), peak %.4f of p0\n", r.P, r.a, r.a_hertz, r.peak);
+  EXPECT_NEAR(r.a, r.a_hertz, 0.5 * kSize);
+  EXPECT_NEAR(r.peak, 1.0, 0.005);
 }
 
 TEST(FrictionalSphere, StickRadiusMatchesTheRingModel) {
