@@ -27,7 +27,7 @@
 // regularized as d_eps_bar = sqrt(phi^2 + e0^2) - e0. The element's work of the step,
 // V int_0^d_eps_bar sigma_bar(eps_bar + s) ds with V = 2 pi Rm t L its volume, is the
 // potential of its nodal forces (forces are totals over the circle); thickness t = V / (2 pi
-// rm l) = t0 exp(-(e1 + e2)). M < 2 makes the Hessian of phi singular at equal increments.
+// rm l) = t0 exp(-(e1 + e2)). M > 2 (m < 2) makes the Hessian of phi^2 unbounded at equal increments.
 #include <vector>
 
 #include "solver/model/body.hpp"
