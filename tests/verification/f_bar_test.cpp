@@ -9,14 +9,13 @@
 //   confirms to 3 %; and how far the plain q4 falls short (it locks).
 #include <gtest/gtest.h>
 
-#include <Eigen/SparseCholesky>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 
 #include "solver/elements/continuum.hpp"
 #include "solver/io/scene.hpp"
+#include "tests/support/locking_panels.hpp"
 #include "tests/support/tangent_check.hpp"
 
 namespace grip {
@@ -68,60 +67,10 @@ TEST(FBar, TangentMatchesDifferencesAndIsSymmetric) {
   }
 }
 
-// Cook's membrane on an n x n mesh of `element`: the tip's vertical displacement.
+// Cook's membrane on an n x n mesh of `element` (tests/support/locking_panels.hpp): the tip's
+// vertical displacement.
 double cook_tip(int n, ContinuumElement element, Incompressibility inc) {
-  RectangleSpec spec;
-  spec.nx = spec.ny = n;
-  PlaneMesh mesh = rectangle_mesh(spec, element_shape(element));
-  for (Vec2& x : mesh.nodes) x = Vec2(48 * x.x(), 44 * x.x() + x.y() * (44 - 28 * x.x()));
-  const std::vector<int> left = mesh.sets.at("left"), right = mesh.sets.at("right");
-  int tip = 0;
-  for (size_t k = 0; k < mesh.nodes.size(); ++k)
-    if ((mesh.nodes[k] - Vec2(48, 60)).norm() < 1e-9) tip = static_cast<int>(k);
-  // The right side's load: a uniform shear traction of 1 / 16 (total 1), consistent nodal
-  // forces along its straight sides (nodes sorted along y: 1/2, 1/2 or 1/6, 4/6, 1/6).
-  std::vector<int> side = right;
-  std::sort(side.begin(), side.end(), [&](int a, int b) { return mesh.nodes[a].y() < mesh.nodes[b].y(); });
-  const ContinuumBody body = body_of(mesh, element, inc, 0.4999);
-  Vector load = Vector::Zero(body.dof_count());
-  const bool quadratic = element == ContinuumElement::q9;
-  const int stride = quadratic ? 2 : 1;
-  for (size_t k = 0; k + stride < side.size() + 0; k += stride) {
-    const double L = (mesh.nodes[side[k + stride]] - mesh.nodes[side[k]]).norm(), f = L / 16;
-    if (quadratic) {
-      load[2 * side[k] + 1] += f / 6;
-      load[2 * side[k + 1] + 1] += 4 * f / 6;
-      load[2 * side[k + 2] + 1] += f / 6;
-    } else {
-      load[2 * side[k] + 1] += f / 2;
-      load[2 * side[k + 1] + 1] += f / 2;
-    }
-  }
-  std::vector<int> free_index(body.dof_count(), 0);
-  for (int node : left) free_index[2 * node] = free_index[2 * node + 1] = -1;
-  int free = 0;
-  for (int& i : free_index)
-    if (i == 0) i = free++;
-  Vector q = Vector::Zero(body.dof_count());
-  for (int it = 0; it < 30; ++it) {
-    Triplets t, tf;
-    Vector f = -load;
-    body.internal_force(q, f, &t);
-    Vector r(free);
-    for (int i = 0; i < q.size(); ++i)
-      if (free_index[i] >= 0) r[free_index[i]] = f[i];
-    if (r.norm() <= 1e-10) break;
-    for (const auto& e : t)
-      if (free_index[e.row()] >= 0 && free_index[e.col()] >= 0)
-        tf.emplace_back(free_index[e.row()], free_index[e.col()], e.value());
-    Eigen::SparseMatrix<double> K(free, free);
-    K.setFromTriplets(tf.begin(), tf.end());
-    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(K);
-    const Vector dq = solver.solve(-r);
-    for (int i = 0; i < q.size(); ++i)
-      if (free_index[i] >= 0) q[i] += dq[free_index[i]];
-  }
-  return q[2 * tip + 1];
+  return testing::panel_tip({testing::Panel::cook, element, inc, ContinuumKinematics::finite}, n);
 }
 
 TEST(FBar, CooksMembraneDoesNotLock) {
