@@ -51,8 +51,7 @@ inline double panel_tip(const PanelRun& run, int n) {
   std::shared_ptr<const PlaneMaterial> law;
   if (run.kinematics == ContinuumKinematics::finite)
     law = std::make_shared<NeoHookeMaterial>(250.0, run.poisson, PlaneAnalysis::plane_strain);
-  else
-    law = std::make_shared<HookeMaterial>(250.0, run.poisson, PlaneAnalysis::plane_strain);
+  else law = std::make_shared<HookeMaterial>(250.0, run.poisson, PlaneAnalysis::plane_strain);
   const ContinuumBody body(mesh, mesh.sets.at("bottom"), {law},
                            {run.element, run.kinematics, PlaneAnalysis::plane_strain, 1.0, run.incompressibility});
   // Consistent nodal forces of the uniform traction along the right side's straight pieces.

@@ -23,8 +23,9 @@ inline Extrapolated q9_reference(Panel panel, ContinuumKinematics kinematics, in
   e.order = std::log2((e.middle - e.coarse) / (e.fine - e.middle));
   e.value = e.fine + (e.fine - e.middle) / (std::pow(2.0, e.order) - 1);
   std::printf("%s, %s: q9 on %d, %d, %d: %.7f %.7f %.7f; order %.2f; extrapolated %.7f (the finest %+.2f %%)\n",
-              panel == Panel::cook ? "Cook" : "cantilever", kinematics == ContinuumKinematics::finite ? "finite" : "linear",
-              n, 2 * n, 4 * n, e.coarse, e.middle, e.fine, e.order, e.value, 100 * (e.fine / e.value - 1));
+              panel == Panel::cook ? "Cook" : "cantilever",
+              kinematics == ContinuumKinematics::finite ? "finite" : "linear", n, 2 * n, 4 * n, e.coarse, e.middle,
+              e.fine, e.order, e.value, 100 * (e.fine / e.value - 1));
   return e;
 }
 

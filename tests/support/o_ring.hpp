@@ -51,9 +51,11 @@ inline SealReading read_seal(const Solved& s) {
   const double centre = first / sum;
   r.width = 4 * std::sqrt(second / sum - centre * centre);
   r.extent = hi - lo;
-  std::printf("O-ring, %zu arc divisions: sealing force %.5f N, contact width %.5f mm (extent %.4f), walls %.4f N, %ld real solves\n",
-              s.scene.effective["body"]["mesh"]["half_disc"]["divisions"][0].get<size_t>(),
-              r.force, r.width, r.extent, r.walls, s.run.counters.solves);
+  std::printf(
+      "O-ring, %zu arc divisions: sealing force %.5f N, contact width %.5f mm (extent %.4f), walls %.4f N, %ld real "
+      "solves\n",
+      s.scene.effective["body"]["mesh"]["half_disc"]["divisions"][0].get<size_t>(), r.force, r.width, r.extent, r.walls,
+      s.run.counters.solves);
   return r;
 }
 

@@ -28,9 +28,9 @@ std::vector<Row> rows(Panel panel) {
   using E = ContinuumElement;
   using I = Incompressibility;
   using K = ContinuumKinematics;
-  return {{"q4", {panel, E::q4, I::none, K::finite}},      {"q4 f_bar", {panel, E::q4, I::f_bar, K::finite}},
+  return {{"q4", {panel, E::q4, I::none, K::finite}},           {"q4 f_bar", {panel, E::q4, I::f_bar, K::finite}},
           {"q4_bbar", {panel, E::q4_bbar, I::none, K::linear}}, {"t6", {panel, E::t6, I::none, K::finite}},
-          {"q8", {panel, E::q8, I::none, K::finite}},      {"q9", {panel, E::q9, I::none, K::finite}}};
+          {"q8", {panel, E::q8, I::none, K::finite}},           {"q9", {panel, E::q9, I::none, K::finite}}};
 }
 
 // error[row][mesh] in %, printed as the table of docs/verification.md#locking.
