@@ -11,7 +11,7 @@ punch's edge and from the top, growing geometrically beyond. grip: q4_bbar (mean
 CalculiX: CPE4 on the same quadrilaterals, and CPE8R (8-node, reduced integration, the element
 CalculiX's users take near incompressibility) on quadrilaterals of 2 h, whose nodes are as
 dense as the 4-node mesh's. Each code's whole process is timed (start, solve, writing its
-answer), one thread each, one run. The load is the sum of the punch nodes' reactions.
+answer): wall and CPU (user + system) seconds, one thread each, one run. The load is the sum of the punch nodes' reactions.
 Usage: prandtl_ccx.py [GRIP] [--h 0.05] [--steps 20]
 """
 import argparse
@@ -19,6 +19,7 @@ import json
 import math
 import os
 import re
+import resource
 import shutil
 import subprocess
 import tempfile
@@ -27,6 +28,11 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
 LIMIT = (2 + math.pi) / math.sqrt(3)  # the half model's limit load
+
+
+def children_cpu():
+    u = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return u.ru_utime + u.ru_stime
 
 
 def graded(length, h, fine, growth=1.15):
@@ -98,10 +104,10 @@ def run_grip(grip, h, steps, work):
     }
     path = work / "prandtl.json"
     path.write_text(json.dumps(scene))
-    t = time.monotonic()
+    t, cpu = time.monotonic(), children_cpu()
     done = subprocess.run([grip, "solve", str(path), "--out", str(work / "result.json"), "--threads", "1"],
                           capture_output=True, text=True)
-    seconds = time.monotonic() - t
+    seconds, cpu = time.monotonic() - t, children_cpu() - cpu
     if done.returncode:
         raise SystemExit("grip failed: " + done.stderr[-2000:])
     result = json.loads((work / "result.json").read_text())
@@ -109,7 +115,7 @@ def run_grip(grip, h, steps, work):
     last = result["steps"][-1]
     load = -sum(r["force"] for r in last["reactions"] if r["dof"] in punch_dofs)
     return {"code": "grip", "element": "q4_bbar", "nodes": len(nodes), "elements": len(elements),
-            "load": load, "seconds": seconds, "converged": last["converged"] and len(result["steps"]) == steps}
+            "load": load, "seconds": seconds, "cpu": cpu, "converged": last["converged"] and len(result["steps"]) == steps}
 
 
 def run_ccx(h, steps, order, work):
@@ -131,16 +137,16 @@ def run_ccx(h, steps, order, work):
     ]
     (work / "punch.inp").write_text("\n".join(lines) + "\n")
     env = dict(os.environ, OMP_NUM_THREADS="1", CCX_NPROC_EQUATION_SOLVER="1")
-    t = time.monotonic()
+    t, cpu = time.monotonic(), children_cpu()
     done = subprocess.run(["ccx", "-i", "punch"], cwd=work, capture_output=True, text=True, env=env)
-    seconds = time.monotonic() - t
+    seconds, cpu = time.monotonic() - t, children_cpu() - cpu
     dat = (work / "punch.dat").read_text() if (work / "punch.dat").exists() else ""
     totals = re.findall(r"total force.*?time\s+([0-9.Ee+-]+)\s*\n\s*\n\s*([-0-9.Ee+]+)\s+([-0-9.Ee+]+)", dat)
     if done.returncode or not totals:
         raise SystemExit("ccx failed: " + done.stdout[-2000:])
     time_reached, _, fy = totals[-1]
     return {"code": "CalculiX", "element": kind, "nodes": len(nodes), "elements": len(elements),
-            "load": -float(fy), "seconds": seconds, "converged": abs(float(time_reached) - 1) < 1e-9}
+            "load": -float(fy), "seconds": seconds, "cpu": cpu, "converged": abs(float(time_reached) - 1) < 1e-9}
 
 
 def main():
@@ -152,8 +158,10 @@ def main():
     if not shutil.which("ccx"):
         raise SystemExit("ccx (Debian's calculix-ccx) is not installed")
     work = Path(tempfile.mkdtemp(prefix="prandtl-"))
-    rows = [run_grip(a.grip, a.h, a.steps, work), run_ccx(a.h, a.steps, 1, work), run_ccx(a.h, a.steps, 2, work)]
-    for r in rows:
+    runs = [lambda: run_grip(a.grip, a.h, a.steps, work), lambda: run_ccx(a.h, a.steps, 1, work),
+            lambda: run_ccx(a.h, a.steps, 2, work)]
+    for run in runs:
+        r = run()
         r["error_percent"] = 100 * (r["load"] / LIMIT - 1)
         print(json.dumps(r), flush=True)
     shutil.rmtree(work)
