@@ -3,10 +3,7 @@
 //   force as the plain element;
 // - the tangent against central differences of the internal force, and its symmetry (the
 //   element's energy is sum W(F_bar) dV);
-// - Cook's membrane (the trapezoid (0, 0), (48, 44), (48, 60), (0, 44), clamped on the left, a
-//   shear load of 1 on the right side; neo-Hookean, E = 250, nu = 0.4999): the tip's deflection
-//   against Richardson's extrapolation of F-bar on 8, 16, 32 divisions, which q9 (16 x 16)
-//   confirms to 3 %; and how far the plain q4 falls short (it locks).
+// - Cook's membrane and a cantilever at nu = 0.4999: tests/verification/locking_test.cpp.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -15,7 +12,6 @@
 
 #include "solver/elements/continuum.hpp"
 #include "solver/io/scene.hpp"
-#include "tests/support/locking_panels.hpp"
 #include "tests/support/tangent_check.hpp"
 
 namespace grip {
@@ -65,37 +61,6 @@ TEST(FBar, TangentMatchesDifferencesAndIsSymmetric) {
     EXPECT_LT(c.error(), 1e-7) << "nu " << poisson;
     EXPECT_LT(c.asymmetry(), 1e-12) << "nu " << poisson;
   }
-}
-
-// Cook's membrane on an n x n mesh of `element` (tests/support/locking_panels.hpp): the tip's
-// vertical displacement.
-double cook_tip(int n, ContinuumElement element, Incompressibility inc) {
-  return testing::panel_tip({testing::Panel::cook, element, inc, ContinuumKinematics::finite}, n);
-}
-
-TEST(FBar, CooksMembraneDoesNotLock) {
-  // The reference: Richardson's extrapolation of F-bar on 8, 16 and 32 divisions, at the order
-  // they show.
-  const double f8 = cook_tip(8, ContinuumElement::q4, Incompressibility::f_bar);
-  const double f16 = cook_tip(16, ContinuumElement::q4, Incompressibility::f_bar);
-  const double f32 = cook_tip(32, ContinuumElement::q4, Incompressibility::f_bar);
-  const double order = std::log2((f16 - f8) / (f32 - f16));
-  const double reference = f32 + (f32 - f16) / (std::pow(2.0, order) - 1);
-  std::printf("Cook, nu 0.4999: F-bar tip v 8: %.6f, 16: %.6f, 32: %.6f; order %.2f, extrapolated %.6f\n", f8, f16, f32,
-              order, reference);
-  EXPECT_GT(order, 1.0);  // the clamped corners are singular: 1.4 measured
-  EXPECT_LT(order, 2.5);
-  const double q9 = cook_tip(16, ContinuumElement::q9, Incompressibility::none);
-  const double plain8 = cook_tip(8, ContinuumElement::q4, Incompressibility::none);
-  const double plain32 = cook_tip(32, ContinuumElement::q4, Incompressibility::none);
-  std::printf("errors: F-bar 8 %+.2f %%, 16 %+.2f %%, 32 %+.2f %%; plain q4 8 %+.2f %%, 32 %+.2f %%; q9 16 %+.2f %%\n",
-              100 * (f8 / reference - 1), 100 * (f16 / reference - 1), 100 * (f32 / reference - 1),
-              100 * (plain8 / reference - 1), 100 * (plain32 / reference - 1), 100 * (q9 / reference - 1));
-  EXPECT_NEAR(f16 / reference, 1.0, 0.02);
-  EXPECT_NEAR(f8 / reference, 1.0, 0.05);
-  EXPECT_NEAR(q9 / reference, 1.0, 0.03);  // q9 confirms it (and locks a little)
-  EXPECT_LT(plain8 / reference, 0.4);      // the plain q4 locks
-  EXPECT_LT(plain32 / reference, 0.4);
 }
 
 }  // namespace
