@@ -45,7 +45,8 @@ std::vector<std::vector<double>> table(Panel panel, const std::vector<int>& mesh
     std::printf("%-9s", row.name);
     for (int n : meshes) {
       // The quadratic elements on the finest mesh: as costly as the reference, not computed.
-      if (n == meshes.back() && row.run.element != ContinuumElement::q4 && row.run.element != ContinuumElement::q4_bbar) {
+      if (n == meshes.back() && row.run.element != ContinuumElement::q4 &&
+          row.run.element != ContinuumElement::q4_bbar) {
         error.back().push_back(NAN);
         std::printf(" %8s", "-");
         continue;
