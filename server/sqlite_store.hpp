@@ -19,7 +19,7 @@
 
 namespace grip::server {
 
-class SqliteStore final : public Store {
+class SqliteStore : public Store {
  public:
   // Creates the file (and its folder) and the schema when missing; upgrades an older schema.
   explicit SqliteStore(const std::string& path, int busy_timeout_ms = 5000);
