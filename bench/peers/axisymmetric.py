@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """Hertz's sphere (axisymmetric) against the same section as a cylinder in plane strain, and
-against CalculiX's CAX4 on the same nodes (issue 36, "Speed (benchmark)").
+against CalculiX's CAX4 on the same nodes and CAX8 on the same corners (issue 36, "Speed (benchmark)").
 
 grip: schemas/examples/hertz-sphere.json (the hemisphere's quarter-disc section, q8, its
 diameter lowered 0.05 mm in 2 steps onto a rigid frictionless flat) with the refine size
@@ -10,7 +10,8 @@ in x as a symmetry line), so the two differ only in the analysis. CalculiX (`ccx
 calculix-ccx: `apt-get install calculix-ccx` for this benchmark only, never in scripts/setup.sh;
 without it only the grip table is written): grip's q4 result mesh written as CAX4 on the same
 nodes, the flat a row of fixed CAX4 elements, frictionless surface-to-surface penalty contact,
-the same prescribed displacement in 2 increments.
+the same prescribed displacement in 2 increments; and CAX8 on the same corners (a mid-side node at
+each side's middle, on the arc moved onto it) against grip's q8.
 Accuracy: a and p0 of a semi-ellipse fitted about the axis (x = 0) to the nodal contact
 pressures, against the closed form at each code's own load P (the sphere: a = (3 P R /
 (4 E*))^(1/3), p0 = 3 P / (2 pi a^2); the cylinder: a = (4 P R / (pi E*))^(1/2), p0 = 2 P /
@@ -112,10 +113,33 @@ def grip_run(grip, a_over_h, analysis, tmp, repeat, element="q8"):
 
 # ---- CalculiX ---------------------------------------------------------------------------------
 
-def ccx_deck(result, k_penalty):
-    """The .inp: grip's q4 mesh as CAX4 (its reference positions), a fixed CAX4 flat below y = -R.
-    (grip's result lists each q8's corners only, and its graded rows put the mid-side nodes at
-    the sides' parametric middles, which geometry alone does not pair with their sides.)"""
+def quadratic_sides(xy, cells):
+    """CAX8 on the q4 mesh's corners: a mid-side node at each side's middle, shared by the two
+    elements that meet there; on the sphere's arc it is moved out onto the arc (grip's q8 of the
+    same divisions has the same corners and its arc sides on the circle)."""
+    mids, points = {}, [tuple(p) for p in xy]
+    out = []
+    for c in cells:
+        extra = []
+        for f in range(4):
+            key = tuple(sorted((c[f], c[(f + 1) % 4])))
+            if key not in mids:
+                m = 0.5 * (xy[key[0]] + xy[key[1]])
+                on_arc = all(abs(math.hypot(*xy[k]) - R) < 1e-6 * R for k in key)
+                if on_arc:
+                    m = m * R / math.hypot(*m)
+                mids[key] = len(points)
+                points.append(tuple(m))
+            extra.append(mids[key])
+        out.append(list(c) + extra)
+    return np.array(points), out
+
+
+def ccx_deck(result, k_penalty, quadratic=False):
+    """The .inp: grip's q4 mesh as CAX4 (its reference positions), or as CAX8 with mid-side nodes
+    added (quadratic), and a fixed CAX4 flat below y = -R. (grip's result lists each q8's corners
+    only, and its graded rows put the mid-side nodes at the sides' parametric middles, which
+    geometry alone does not pair with their sides: CAX8 gets its own.)"""
     step = result["steps"][-1]
     xy = np.array([[n["x"] - n["ux"], n["y"] - n["uy"]] for n in sorted(step["nodes"], key=lambda n: n["node"])])
     cells = []
@@ -124,6 +148,8 @@ def ccx_deck(result, k_penalty):
         area = 0.5 * sum(p[i, 0] * p[(i + 1) % 4, 1] - p[(i + 1) % 4, 0] * p[i, 1] for i in range(4))
         c = list(c) if area > 0 else list(reversed(c))  # counter-clockwise
         cells.append(c)
+    if quadratic:
+        xy, cells = quadratic_sides(xy, cells)
     n = len(xy)
     lines = ["*HEADING", "grip bench/peers/axisymmetric.py: Hertz sphere", "*NODE"]
     lines += [f"{i + 1}, {x:.15g}, {y:.15g}" for i, (x, y) in enumerate(xy)]
@@ -132,7 +158,7 @@ def ccx_deck(result, k_penalty):
     flat0 = n + 1
     lines += [f"{flat0 + i}, {width * i / cols:.15g}, {-R:.15g}" for i in range(cols + 1)]
     lines += [f"{flat0 + cols + 1 + i}, {width * i / cols:.15g}, {-R - 0.5:.15g}" for i in range(cols + 1)]
-    lines += ["*ELEMENT, TYPE=CAX4, ELSET=SPHERE"]
+    lines += [f"*ELEMENT, TYPE={'CAX8' if quadratic else 'CAX4'}, ELSET=SPHERE"]
     lines += [f"{e + 1}, " + ", ".join(str(v + 1) for v in c) for e, c in enumerate(cells)]
     e0 = len(cells) + 1
     lines += ["*ELEMENT, TYPE=CAX4, ELSET=FLAT"]
@@ -186,30 +212,31 @@ def frd_blocks(text, name):
     return {}
 
 
-def ccx_run(result, tmp, k_penalty, repeat):
-    deck, xy = ccx_deck(result, k_penalty)
-    (Path(tmp) / "sphere.inp").write_text(deck)
+def ccx_run(result, tmp, k_penalty, repeat, quadratic=False):
+    deck, xy = ccx_deck(result, k_penalty, quadratic)
+    job = "sphere8" if quadratic else "sphere"
+    (Path(tmp) / f"{job}.inp").write_text(deck)
     seconds, cpu = math.inf, math.inf
     for _ in range(repeat):
-        wall, used = timed(["ccx", "-i", "sphere"], cwd=tmp, env=dict(os.environ, OMP_NUM_THREADS="1"))
+        wall, used = timed(["ccx", "-i", job], cwd=tmp, env=dict(os.environ, OMP_NUM_THREADS="1"))
         seconds, cpu = min(seconds, wall), min(cpu, used)
     run = timed.last
     if "Job finished" not in run.stdout:
         raise RuntimeError("ccx failed:\n" + run.stdout[-3000:] + run.stderr[-2000:])
-    dat = (Path(tmp) / "sphere.dat").read_text()
+    dat = (Path(tmp) / f"{job}.dat").read_text()
     totals = re.findall(r"^\s*(-?[\d.E+-]+)\s+(-?[\d.E+-]+)\s+(-?[\d.E+-]+)\s*$",
                         dat.split("total force")[-1], re.M)
     reaction = float(totals[0][1])  # the diameter's total y force, as ccx reports it
-    contact = frd_blocks((Path(tmp) / "sphere.frd").read_text(), "CONTACT")
+    contact = frd_blocks((Path(tmp) / f"{job}.frd").read_text(), "CONTACT")
     xs, p = [], []
     for node, v in contact.items():
         if node <= len(xy) and v[3] > 0:  # CPRESS
             xs.append(xy[node - 1, 0])
             p.append(v[3])
-    iterations = sum(int(l.split()[3]) for l in (Path(tmp) / "sphere.sta").read_text().splitlines()
+    iterations = sum(int(l.split()[3]) for l in (Path(tmp) / f"{job}.sta").read_text().splitlines()
                      if re.match(r"\s+1\s+\d+\s+\d+\s+\d+\s", l))
     return {"reaction": reaction, "xs": xs, "p": p, "seconds": seconds, "cpu_seconds": cpu,
-            "iterations": iterations}
+            "iterations": iterations, "nodes": len(xy)}
 
 
 def ccx_reading(c):
@@ -228,7 +255,7 @@ def ccx_reading(c):
     return {"P": P, "pressure_integral": integral, "a_error": a_fit / a - 1, "p0_error": p0_fit / p0 - 1,
             "a_error_off_axis": a_off / a - 1, "p0_error_off_axis": p0_off / p0 - 1,
             "seconds": c["seconds"], "cpu_seconds": c["cpu_seconds"], "iterations": c["iterations"],
-            "contact_nodes": len(xs)}
+            "contact_nodes": len(xs), "nodes": c["nodes"]}
 
 
 def main():
@@ -249,11 +276,12 @@ def main():
             c = grip_run(args.grip, a_over_h, "plane_strain", tmp, args.repeat)
             q4 = grip_run(args.grip, a_over_h, "axisymmetric", tmp, args.repeat, "q4") if use_ccx else None
             x = ccx_reading(ccx_run(q4["result"], tmp, args.penalty, args.repeat)) if use_ccx else None
-        rows.append((a_over_h, s, c, q4, x))
+            x8 = ccx_reading(ccx_run(q4["result"], tmp, args.penalty, args.repeat, True)) if use_ccx else None
+        rows.append((a_over_h, s, c, q4, x, x8))
         print(f"a/h {a_over_h}: sphere {s['seconds']:.2f} s, cylinder {c['seconds']:.2f} s, ratio "
-              f"{s['seconds'] / c['seconds']:.2f}" + (f", ccx {x['seconds']:.2f} s" if x else "") +
+              f"{s['seconds'] / c['seconds']:.2f}" + (f", ccx {x['seconds']:.2f} s, CAX8 {x8['seconds']:.2f} s" if x else "") +
               f" (load {os.getloadavg()[0]:.1f})", flush=True)
-        for r in (s, c, q4, x):
+        for r in (s, c, q4, x, x8):
             if r:
                 print("  ", json.dumps({k: v for k, v in r.items() if k != "result"}), flush=True)
     write_table(args, rows, load)
@@ -265,7 +293,7 @@ def write_table(args, rows, load):
     cpu = next((l.split(":", 1)[1].strip() for l in Path("/proc/cpuinfo").read_text().splitlines()
                 if l.startswith("model name")), "?")
     ccx_version = ""
-    if any(x for *_, x in rows):
+    if any(x for *_, x, _ in rows):
         ccx_version = re.search(r"Version\s+(\S+)", subprocess.run(["ccx", "-v"], capture_output=True,
                                                                     text=True).stdout or "Version ?").group(1)
     pct = lambda v: f"{100 * v:+.2f} %"
@@ -305,12 +333,12 @@ def write_table(args, rows, load):
     counts = {(r["factorizations"], r["contact_iterations"]) for _, s, c, *_ in rows for r in (s, c)}
     lines += ["", "Factorizations and contact iterations (the whole run): " +
               ", ".join(f"{f} and {i}" for f, i in sorted(counts)) + " in every grip run above."]
-    if any(x for *_, x in rows):
+    if any(x for *_, x, _ in rows):
         lines += [
             "", "## The sphere: grip (q4) against CalculiX (CAX4) on the same nodes", "",
             f"CalculiX {ccx_version} (Debian calculix-ccx, installed for this benchmark only, one thread: "
             "OMP_NUM_THREADS=1, its default SPOOLES solver), read from grip's q4 result mesh (CAX4 on the same "
-            "nodes; grip's result lists a q8's corners only, so CAX8 on the same nodes is not written). The "
+            "nodes; CAX8 on the same corners in the next table). The "
             f"flat: a row of fixed CAX4 elements 0.05 mm wide. Contact: surface to surface, frictionless, "
             f"penalty with a linear pressure-overclosure of {args.penalty:g} MPa/mm (1e8 at a/h 10: P 0.1 % lower, "
             "the off-axis a and p0 within 0.4 %); the same prescribed displacement in 2 increments. Its pressure: CPRESS at the "
@@ -321,12 +349,27 @@ def write_table(args, rows, load):
             "| a/h | grip P N | grip a err | grip p0 err | grip s | ccx P N | ccx a err | ccx p0 err | ccx s | "
             "ccx Newton iterations | ccx / grip, wall | CPU |",
             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
-        for a_over_h, _, _, s, x in rows:
+        for a_over_h, _, _, s, x, _ in rows:
             if x:
                 lines.append(f"| {a_over_h} | {s['P']:.0f} | {both(s, 'a_error')} | {both(s, 'p0_error')} | "
                              f"{secs(s)} | {x['P']:.0f} | {both(x, 'a_error')} | {both(x, 'p0_error')} | {secs(x)} | "
                              f"{x['iterations']} | {x['seconds'] / s['seconds']:.0f}x | "
                              f"{x['cpu_seconds'] / s['cpu_seconds']:.0f}x |")
+        lines += [
+            "", "## The sphere: grip (q8) against CalculiX (CAX8) on the same corners", "",
+            "CAX8 on the q4 mesh's corners (the corners of grip's q8 mesh of the same divisions), a mid-side "
+            "node at each side's middle (on the sphere's arc moved out onto the arc); everything else as for "
+            "CAX4 above. grip: the shipped scene in q8 (the first table's sphere). Nodes: each model's.",
+            "",
+            "| a/h | grip P N | grip a err | grip p0 err | grip s | ccx nodes | ccx P N | ccx a err | "
+            "ccx p0 err | ccx s | ccx Newton iterations | ccx / grip, wall | CPU |",
+            "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+        for a_over_h, s, _, _, _, x in rows:
+            if x:
+                lines.append(f"| {a_over_h} | {s['P']:.0f} | {both(s, 'a_error')} | "
+                             f"{both(s, 'p0_error')} | {secs(s)} | {x['nodes']} | {x['P']:.0f} | {both(x, 'a_error')} | "
+                             f"{both(x, 'p0_error')} | {secs(x)} | {x['iterations']} | "
+                             f"{x['seconds'] / s['seconds']:.0f}x | {x['cpu_seconds'] / s['cpu_seconds']:.0f}x |")
     lines.append("")
     table = Path(args.table)
     if table.exists():  # the previous run moves under "Earlier runs", the notes stay on top

@@ -157,6 +157,47 @@ void RigidPlasticMembrane::internal_force(const Vector& q, Vector& force, Triple
   }
 }
 
+void RigidPlasticMembrane::follower_load(const Vector& q, const std::vector<double>& factors, Vector& force,
+                                         Triplets* tangent) const {
+  double p = 0.0;
+  for (const Pressure& pr : pressures_)
+    if (pr.load_case < static_cast<int>(factors.size())) p += factors[pr.load_case] * pr.value;
+  if (p == 0.0) return;
+  Mat2 J;  // a quarter turn: J d is the element's left normal times its length
+  J << 0, -1, 1, 0;
+  for (int e = 0; e < element_count(); ++e) {
+    const int a = node_dof(e, 0), b = node_dof(e + 1, 0);
+    const Vec2 xa = nodes_[e] + q.segment<2>(a), xb = nodes_[e + 1] + q.segment<2>(b);
+    const Vec2 n = J * (xb - xa);
+    // Each node's share of p n over the element, with the linear shape functions: width / 2
+    // each in the plane; 2 pi int N r ds about the axis, (2 ra + rb) / 6 and (ra + 2 rb) / 6.
+    double wa = 0.5 * width_, wb = wa;
+    if (axisymmetric_) {
+      wa = std::numbers::pi / 3 * (2 * xa.x() + xb.x());
+      wb = std::numbers::pi / 3 * (xa.x() + 2 * xb.x());
+    }
+    force.segment<2>(a) += p * wa * n;
+    force.segment<2>(b) += p * wb * n;
+    if (!tangent) continue;
+    // d(w n) = w J (dxb - dxa) + n dw, dw = pi / 3 (2 dra + drb) or (dra + 2 drb) about the axis.
+    Mat2 da[2] = {-p * wa * J, p * wa * J}, db[2] = {-p * wb * J, p * wb * J};  // by xa, xb
+    if (axisymmetric_) {
+      const double c = p * std::numbers::pi / 3;
+      da[0].col(0) += 2 * c * n;
+      da[1].col(0) += c * n;
+      db[0].col(0) += c * n;
+      db[1].col(0) += 2 * c * n;
+    }
+    for (int i = 0; i < 2; ++i)
+      for (int j = 0; j < 2; ++j)
+        for (int k = 0; k < 2; ++k) {
+          const int col = (k == 0 ? a : b) + j;
+          tangent->emplace_back(a + i, col, da[k](i, j));
+          tangent->emplace_back(b + i, col, db[k](i, j));
+        }
+  }
+}
+
 SurfacePoint RigidPlasticMembrane::surface_point(const VectorRef& q, int site, int /*side*/) const {
   SurfacePoint p;
   p.x = nodes_[site] + q.segment<2>(node_dof(site, 0));

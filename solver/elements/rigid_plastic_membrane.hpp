@@ -27,7 +27,7 @@
 // regularized as d_eps_bar = sqrt(phi^2 + e0^2) - e0. The element's work of the step,
 // V int_0^d_eps_bar sigma_bar(eps_bar + s) ds with V = 2 pi Rm t L its volume, is the
 // potential of its nodal forces (forces are totals over the circle); thickness t = V / (2 pi
-// rm l) = t0 exp(-(e1 + e2)). M < 2 makes the Hessian of phi singular at equal increments.
+// rm l) = t0 exp(-(e1 + e2)). M > 2 (m < 2) makes the Hessian of phi^2 unbounded at equal increments.
 #include <vector>
 
 #include "solver/model/body.hpp"
@@ -74,6 +74,13 @@ class RigidPlasticMembrane final : public Body {
   FieldTable site_fields(const Vector& q) const override;
   FieldTable element_fields(const Vector& q) const override;
   Vector start_guess(const Vector& prescribed, const std::vector<char>& is_prescribed) const override;
+  // A pressure on every element that follows the sheet (docs/algorithm.md#membrane-pressure):
+  // `value` per unit current area, at load factor 1 of `load_case`, pushing each element toward
+  // its left (+y for a sheet running along +x), on the current (swept) area.
+  void add_pressure(double value, int load_case) { pressures_.push_back({value, load_case}); }
+  bool has_follower_loads() const override { return !pressures_.empty(); }
+  void follower_load(const Vector& q, const std::vector<double>& factors, Vector& force,
+                     Triplets* tangent) const override;
   double newton_step_fraction(const Vector& q, const Vector& dq) const override;
   std::string inadmissible(const Vector& q) const override;
   void commit(const Vector& q) override;
@@ -109,6 +116,11 @@ class RigidPlasticMembrane final : public Body {
 
  private:
   double current_thickness(const VectorRef& q, int element) const;
+  struct Pressure {
+    double value;
+    int load_case;
+  };
+  std::vector<Pressure> pressures_;
   std::vector<Vec2> nodes_;
   double width_;
   HillMaterial material_;

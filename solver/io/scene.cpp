@@ -87,7 +87,8 @@ std::unique_ptr<Obstacle> read_shape(Reader& r, json& j, const std::string& ptr)
 
 // ---- solver parameters
 
-// solver.start: {"node", "component": "x" | "y", "value", "obstacle"}
+// solver.start: {"node", "component": "x" | "y", "value", "obstacle"} (the obstacle that presses
+// the node, if one does)
 // (docs/algorithm.md#load-stepping-and-cuts): the first step starts from a solve with that
 // displacement prescribed and no contact.
 void read_start(Reader& r, json& scene, Problem& problem) {
@@ -110,9 +111,10 @@ void read_start(Reader& r, json& scene, Problem& problem) {
   const std::string comp = r.choice(*st, sp, "component", {"x", "y"}, "y");
   const double value = r.number(*st, sp, "value");
   if (value == 0.0) r.error(sp + "/value", "must not be zero: the start needs a strained body");
-  int obstacle = -1;
-  if (!st->contains("obstacle") || !(*st)["obstacle"].is_string()) {
-    r.error(sp + "/obstacle", "is required: the name of the obstacle the node is pressed by");
+  int obstacle = -1;  // none (a sheet bulged by a pressure): the start is only Newton's first guess
+  if (!st->contains("obstacle")) {
+  } else if (!(*st)["obstacle"].is_string()) {
+    r.error(sp + "/obstacle", show((*st)["obstacle"]) + " is not a string: the name of the obstacle the node is pressed by");
   } else {
     for (size_t o = 0; o < problem.obstacles.size(); ++o)
       if (problem.obstacles[o].name == (*st)["obstacle"]) obstacle = static_cast<int>(o);
@@ -127,7 +129,7 @@ void read_start(Reader& r, json& scene, Problem& problem) {
   if (dof < 0) r.error(sp + "/component", "does not move node " + std::to_string(node) + " by itself");
   for (const Constraint& c : problem.constraints)
     if (c.dof == dof) r.error(sp + "/node", "that component of node " + std::to_string(node) + " is a support already");
-  if (dof >= 0 && obstacle >= 0) problem.start = StartUp{dof, value, node, obstacle};
+  if (dof >= 0 && (obstacle >= 0 || !st->contains("obstacle"))) problem.start = StartUp{dof, value, node, obstacle};
 }
 
 std::string format_point(const Vec2& p) {

@@ -6,7 +6,7 @@ namespace grip::scene_io {
 
 // body: {"model": "rigid_plastic_membrane", "material": {r, M, H, a0, n, regularization},
 //        "thickness", "width", "analysis": "plane_strain" | "axisymmetric", "mesh": {"origin", "length", "elements"} | {"nodes": [[x, y]...]},
-//        "supports": [{"node", "fix": ["x", "y"]}], "loads": [{"node", "force", "case"}]}
+//        "supports": [{"node", "fix": ["x", "y"]}], "loads": [{"node", "force", "case"} | {"pressure", "case"}]}
 void read_rigid_plastic_membrane(Reader& r, json& body, Problem& problem, const std::string& ptr) {
   json* mat = r.object(body, ptr, "material", true);
   json* mesh = r.object(body, ptr, "mesh", true);
@@ -82,6 +82,16 @@ void read_rigid_plastic_membrane(Reader& r, json& body, Problem& problem, const 
       json& l = (*loads)[i];
       if (!l.is_object()) {
         r.error(lp, "is not an object");
+        continue;
+      }
+      if (l.contains("pressure")) {  // on every element, following the sheet
+        const double p = r.number(l, lp, "pressure");
+        const int load_case = r.load_case(l, lp);
+        case_load(problem, load_case);
+        if (l.contains("node") || l.contains("force"))
+          r.error(lp, "a pressure acts on every element, following the sheet: give no \"node\" or \"force\" with it");
+        if (ptr != "/body") r.error(lp + "/pressure", "a pressure follows the sheet: for a one-body scene (body) only");
+        if (r.issues.empty()) static_cast<RigidPlasticMembrane&>(*problem.body).add_pressure(p, load_case);
         continue;
       }
       const int node = r.integer(l, lp, "node", 0, count - 1);

@@ -86,7 +86,8 @@ inline ::testing::AssertionResult step_invariants(const Problem& problem, const 
     scale += f.norm();
   }
   // Equilibrium of the whole body: a rigid translation does no internal work.
-  const Vector applied = problem.load(rec.factors);
+  Vector applied = problem.load(rec.factors);
+  problem.body->follower_load(rec.state.q, rec.factors, applied, nullptr);  // a pressure that follows the body
   double ref = scale;
   for (int axis = 0; axis < 2; ++axis) {
     const Vector mode = problem.body->rigid_translation(axis == 0 ? Vec2::UnitX() : Vec2::UnitY());
