@@ -302,8 +302,8 @@ std::pair<DismissOutcome, std::optional<JobView>> JobService::dismiss(const std:
   return {outcome, JobView{std::move(*rec), std::nullopt}};
 }
 
-EventBatch JobService::wait_events(const std::string& id, std::int64_t after, std::chrono::milliseconds wait,
-                                   int limit, std::uint64_t* seen_before) {
+EventBatch JobService::wait_events(const std::string& id, std::int64_t after, std::chrono::milliseconds wait, int limit,
+                                   std::uint64_t* seen_before) {
   const auto deadline = Clock::now() + wait;
   std::shared_ptr<Watch> watch;
   bool read_first = true;
