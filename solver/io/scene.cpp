@@ -114,7 +114,8 @@ void read_start(Reader& r, json& scene, Problem& problem) {
   int obstacle = -1;  // none (a sheet bulged by a pressure): the start is only Newton's first guess
   if (!st->contains("obstacle")) {
   } else if (!(*st)["obstacle"].is_string()) {
-    r.error(sp + "/obstacle", show((*st)["obstacle"]) + " is not a string: the name of the obstacle the node is pressed by");
+    r.error(sp + "/obstacle",
+            show((*st)["obstacle"]) + " is not a string: the name of the obstacle the node is pressed by");
   } else {
     for (size_t o = 0; o < problem.obstacles.size(); ++o)
       if (problem.obstacles[o].name == (*st)["obstacle"]) obstacle = static_cast<int>(o);

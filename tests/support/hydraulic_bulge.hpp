@@ -3,7 +3,7 @@
 // rigid-plastic membrane of Hill's 1979 material with normal anisotropy (flow theory, as in Hill
 // 1950 and Chakrabarty and Alexander 1970), computed independently of the finite elements
 // (docs/verification.md#hydraulic-bulge): the meridian in the material radius R in [0, a] on a
-// fixed grid, marched in pole heights; each height is a shooting problem from the pole to the rim.
+// fixed grid, marched in pole strains; each step is a shooting problem from the pole to the rim.
 //
 // Along the meridian, with r the current radius, z the height, phi the slope, lambda1 = ds/dR
 // and lambda2 = r / R the stretches, t = t0 / (lambda1 lambda2), T1 = t sigma1 and T2 = t sigma2:
@@ -11,12 +11,14 @@
 // (tangential equilibrium), and the equilibrium of the cap inside r under the pressure p,
 //   2 pi r T1 sin phi = pi r^2 p.
 // The stresses follow the flow rule of the yield surface |s1 + s2|^M + (1 + 2r) |s1 - s2|^M =
-// 2 (1 + r) sigma_bar^M from the strain increments of the height step, d1 = ln(lambda1 /
+// 2 (1 + r) sigma_bar^M from the strain increments of the step, d1 = ln(lambda1 /
 // lambda1_old), d2 = ln(lambda2 / lambda2_old) (backward Euler, as a rigid-plastic law is
 // integrated), with the flow stress H (a0 + eps_bar)^n at the end of the step. Given r and T1
-// at a point, lambda1 is the root of T1(lambda1) on its rising branch. Heun's method (second order) on
-// the grid's nodes, where the history lives. The march is driven by the pole strain: each step
-// is then a one-dimensional search for the pressure that brings the meridian to the rim.
+// at a point, lambda1 is the root of T1(lambda1) on its rising branch. Heun's method (second
+// order) on the grid's nodes, where the history lives. The march is driven by the pole strain:
+// each step is then a one-dimensional search for the pressure that brings the meridian to the
+// rim's radius (driven by the height, a two-unknown Newton on pole stretch and pressure met the
+// kinks of the rigid-plastic law in its trial shots and stalled).
 #include <cmath>
 #include <stdexcept>
 #include <vector>
@@ -57,8 +59,8 @@ inline Flow hill_flow(const BulgeMaterial& m, double d1, double d2) {
 struct Bulge {
   BulgeMaterial m;
   double a, t0;
-  int nodes;                           // grid nodes R_i = a i / (nodes - 1)
-  std::vector<double> l1, l2, eps;     // committed stretches and effective strain
+  int nodes;                                    // grid nodes R_i = a i / (nodes - 1)
+  std::vector<double> l1, l2, eps;              // committed stretches and effective strain
   std::vector<double> l1_new, l2_new, eps_new;  // of the last shot
 
   double R(int i) const { return a * i / (nodes - 1); }

@@ -67,9 +67,9 @@ SphereReading read_sphere(const Solved& s, const StepRecord& rec) {
   const double p0 = 3 * r.P / (2 * std::numbers::pi * r.a_hertz * r.a_hertz);
   auto nodes = contact_profile(s.scene.problem, rec);
   std::sort(nodes.begin(), nodes.end(), [](const ContactNode& x, const ContactNode& y) { return x.x < y.x; });
-  size_t k = 0;
+  size_t k = 0;  // the axis node (u_r held) starts the run whatever its state
   while (k + 1 < nodes.size() && nodes[k + 1].state == ContactState::stick) ++k;
-  if (nodes[0].state == ContactState::stick || nodes[0].x == 0.0) r.c = 0.5 * (nodes[k].x + nodes[k + 1].x);
+  if (k + 1 < nodes.size()) r.c = 0.5 * (nodes[k].x + nodes[k + 1].x);
   size_t last = 0;
   for (size_t i = 0; i < nodes.size(); ++i) {
     if (nodes[i].sigma_n < 0) last = i;

@@ -157,9 +157,11 @@ TEST(HydraulicBulge, PoleStrainAgainstHeightMatchesTheMembraneEquations) {
     const int t = static_cast<int>(std::find(el.names.begin(), el.names.end(), "thickness_strain") - el.names.begin());
     const double pole = -0.5 * el.rows[0][t];
     const testing::BulgeState expected = reference_at(ref, h);
-    std::printf("bulge: pole height %6.3f mm: pole strain %.5f, reference %.5f (%+.2f %%); p %6.3f MPa, reference %.3f (%+.2f %%)\n",
-                h, pole, expected.pole_strain, 100 * (pole / expected.pole_strain - 1), p, expected.pressure,
-                100 * (p / expected.pressure - 1));
+    std::printf(
+        "bulge: pole height %6.3f mm: pole strain %.5f, reference %.5f (%+.2f %%); p %6.3f MPa, reference %.3f (%+.2f "
+        "%%)\n",
+        h, pole, expected.pole_strain, 100 * (pole / expected.pole_strain - 1), p, expected.pressure,
+        100 * (p / expected.pressure - 1));
     EXPECT_NEAR(pole, expected.pole_strain, 0.02 * expected.pole_strain) << "step " << rec.index;
     EXPECT_NEAR(p, expected.pressure, 0.02 * expected.pressure) << "step " << rec.index;
     worst = std::max(worst, std::abs(pole / expected.pole_strain - 1));

@@ -156,7 +156,8 @@ TEST(PunchStretchingAxisymmetric, ForceAndStrainsConvergeWithTheMesh) {
     const StepRecord& rec = s.run.steps.back();
     force.push_back(-obstacle_force(s.scene.problem, rec, "punch").y());
     const FieldTable& el = rec.element_fields;
-    const int e1 = static_cast<int>(std::find(el.names.begin(), el.names.end(), "meridional_strain") - el.names.begin());
+    const int e1 =
+        static_cast<int>(std::find(el.names.begin(), el.names.end(), "meridional_strain") - el.names.begin());
     pole.push_back(el.rows[0][e1]);  // the pole element's, h / 2 from the axis
     double top = 0.0;
     for (const auto& row : el.rows) top = std::max(top, row[e1]);
