@@ -10,12 +10,13 @@ namespace grip::server {
 
 namespace {
 
-// Level 3, zstd's default, for most results: the load run's small job (87 KB) in 0.3 ms to
-// 14.7 KB (level 9: 1.1 ms, 13.2 KB, and a seventh of the server's time in a load run).
+// Level 1 for most results: the load run's small job (88.8 KB) to 14.9 KB at 400 MB/s, smaller
+// and a fifth faster than level 3, zstd's default (15.1 KB at 320-350 MB/s); level 9: 1.1 ms,
+// 13.2 KB, and a seventh of the server's time in a load run.
 // Level 16, the optimal parser, some 100 ns a byte, for large results, whose steps repeat
 // one another's numbers far apart: the sliding block's 482 KB to 39 KB (46 KB at level 9) in
 // 40 ms of its 140 ms solve.
-constexpr int kZstdLevel = 3, kZstdLargeLevel = 16;
+constexpr int kZstdLevel = 1, kZstdLargeLevel = 16;
 constexpr size_t kLargeResult = 256 * 1024;
 constexpr int kGzipWindow = 15 + 16;  // 32 KB window, gzip header and trailer
 

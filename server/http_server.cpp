@@ -919,6 +919,7 @@ void HttpServer::Impl::events(const Request& req, Response& res) {
   }
   struct State {
     std::int64_t last = 0;
+    std::uint64_t seen = 0;  // JobService::wait_events's
     std::chrono::steady_clock::time_point last_write;
     bool first = true;
   };
@@ -945,7 +946,7 @@ void HttpServer::Impl::events(const Request& req, Response& res) {
         const auto until_ping =
             std::chrono::duration_cast<std::chrono::milliseconds>(state->last_write + heartbeat - now);
         const auto wait = std::clamp(until_ping, std::chrono::milliseconds(0), std::chrono::milliseconds(500));
-        const EventBatch batch = service.wait_events(id, state->last, wait);
+        const EventBatch batch = service.wait_events(id, state->last, wait, 256, &state->seen);
         if (!batch.found) {
           sink.done();
           return true;

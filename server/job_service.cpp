@@ -134,8 +134,9 @@ void JobService::on_change(const StoreChange& change) {
     if (job) hear_dismissal(*job, "notification");
   }
   std::lock_guard lock(events_mutex_);
-  auto wake = [](Watch& w) {
-    ++w.changes;
+  ++announcements_;
+  auto wake = [this](Watch& w) {
+    w.changes = announcements_;
     w.cv.notify_all();
   };
   if (change.job_id.empty()) {
@@ -301,23 +302,36 @@ std::pair<DismissOutcome, std::optional<JobView>> JobService::dismiss(const std:
   return {outcome, JobView{std::move(*rec), std::nullopt}};
 }
 
-EventBatch JobService::wait_events(const std::string& id, std::int64_t after, std::chrono::milliseconds wait,
-                                   int limit) {
+EventBatch JobService::wait_events(const std::string& id, std::int64_t after, std::chrono::milliseconds wait, int limit,
+                                   std::uint64_t* seen_before) {
   const auto deadline = Clock::now() + wait;
   std::shared_ptr<Watch> watch;
+  bool read_first = true;
   {
     std::lock_guard lock(events_mutex_);
     auto& w = watches_[id];
-    if (!w) w = std::make_shared<Watch>();
+    if (!w) {
+      w = std::make_shared<Watch>();
+      w->changes = announcements_;
+    }
     watch = w;
     ++watch->waiters;
+    // Nothing announced since a read that found everything: wait for the next announcement.
+    read_first = !seen_before || *seen_before == 0 || watch->changes != *seen_before;
   }
+  if (seen_before) *seen_before = 0;
   const auto unwatch = [&](void*) {
     std::lock_guard lock(events_mutex_);
     const auto it = watches_.find(id);
     if (--watch->waiters == 0 && it != watches_.end() && it->second == watch) watches_.erase(it);
   };
   const std::unique_ptr<void, decltype(unwatch)> watching(watch.get(), unwatch);
+  if (!read_first) {
+    std::unique_lock lock(events_mutex_);
+    const auto seen = watch->changes;
+    const bool woke = watch->cv.wait_until(lock, deadline, [&] { return watch->changes != seen || draining_.load(); });
+    if (!woke || draining_) return {};
+  }
   while (true) {
     std::uint64_t seen = 0;
     {
@@ -329,6 +343,7 @@ EventBatch JobService::wait_events(const std::string& id, std::int64_t after, st
       batch.events = store_.events_after(id, after, limit);
       if (!batch.events.empty()) {
         batch.ended = is_terminal_event(batch.events.back().type);
+        if (seen_before && !batch.ended && static_cast<int>(batch.events.size()) < limit) *seen_before = seen;
         return batch;
       }
       const auto rec = store_.job(id);

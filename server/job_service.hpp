@@ -161,8 +161,13 @@ class JobService {
   // removes a finished one. The view is the job as dismissed or as it was before removal.
   std::pair<DismissOutcome, std::optional<JobView>> dismiss(const std::string& id);
 
-  // Stored events with seq > after, waiting up to `wait` for some to arrive.
-  EventBatch wait_events(const std::string& id, std::int64_t after, std::chrono::milliseconds wait, int limit = 256);
+  // Stored events with seq > after, waiting up to `wait` for some to arrive. `seen`, kept by a
+  // caller that reads one job's events again and again (an event stream), lets a call that
+  // follows a read which found every stored event wait for the job's next announcement rather
+  // than read again: after each batch, that read and the job's read were two reads of the store
+  // that found nothing. A wait that times out reads again (a job removed unannounced).
+  EventBatch wait_events(const std::string& id, std::int64_t after, std::chrono::milliseconds wait, int limit = 256,
+                         std::uint64_t* seen = nullptr);
   std::vector<StoredEvent> events(const std::string& id, std::int64_t after, int limit, std::string_view type = {});
   std::optional<std::string> result(const std::string& id);
 
@@ -248,11 +253,14 @@ class JobService {
   // streams of a load run at each of some 4,000 events a second; half the server's time went
   // to waking threads). Kept while a stream waits.
   struct Watch {
-    std::uint64_t changes = 0;
+    std::uint64_t changes = 0;  // announcements_ at the job's last announcement (or at the watch's start)
     int waiters = 0;
     std::condition_variable cv;
   };
   std::unordered_map<std::string, std::shared_ptr<Watch>> watches_;
+  // Announcements heard, all jobs together: a watch made again starts from here, so a reader's
+  // `seen` from an earlier watch of the job never equals it after an announcement it missed.
+  std::uint64_t announcements_ = 0;
   std::int64_t events_stored_ = 0;
   bool stop_writer_ = false;
   std::thread writer_;

@@ -20,6 +20,7 @@ Database::Database(const std::string& path, int busy_timeout_ms, const char* syn
   sqlite3_busy_timeout(db_, busy_timeout_ms);
   exec("PRAGMA journal_mode=WAL");
   exec(std::string("PRAGMA synchronous=") + synchronous);
+  full_ = std::string_view(synchronous) == "FULL";
   exec("PRAGMA foreign_keys=ON");
 }
 
@@ -147,12 +148,21 @@ std::optional<std::string> Statement::optional_text(int column) const {
 bool Statement::is_null(int column) const { return sqlite3_column_type(stmt_, column) == SQLITE_NULL; }
 
 // The few fixed texts run as kept statements: sqlite3_exec parsed them again at every use.
-Transaction::Transaction(Database& db, Sync sync) : db_(db), sync_(sync) {
-  if (sync_ == Sync::relaxed) db_.prepare("PRAGMA synchronous=NORMAL").run();
+namespace {
+
+const char* setting(Transaction::Sync sync) {
+  return sync == Transaction::Sync::full ? "PRAGMA synchronous=FULL" : "PRAGMA synchronous=NORMAL";
+}
+
+}  // namespace
+
+Transaction::Transaction(Database& db, Sync sync)
+    : db_(db), sync_(sync), switched_(db.synchronous_full() != (sync == Sync::full)) {
+  if (switched_) db_.prepare(setting(sync_)).run();
   try {
     db_.prepare("BEGIN IMMEDIATE").run();
   } catch (...) {
-    if (sync_ == Sync::relaxed) db_.prepare("PRAGMA synchronous=FULL").run();
+    if (switched_) db_.prepare(setting(sync_ == Sync::full ? Sync::relaxed : Sync::full)).run();
     throw;
   }
 }
@@ -174,15 +184,15 @@ void Transaction::commit() {
 void Transaction::end(const char* sql) {
   struct Restore {
     Database& db;
-    bool relaxed;
+    const char* back;  // the connection's own setting, if switched
     ~Restore() {
-      if (!relaxed) return;
+      if (!back) return;
       try {
-        db.prepare("PRAGMA synchronous=FULL").run();
+        db.prepare(back).run();
       } catch (...) {
       }
     }
-  } restore{db_, sync_ == Sync::relaxed};
+  } restore{db_, switched_ ? setting(sync_ == Sync::full ? Sync::relaxed : Sync::full) : nullptr};
   db_.prepare(sql).run();
 }
 

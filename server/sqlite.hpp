@@ -21,7 +21,8 @@ class Statement;
 
 class Database {
  public:
-  // Opens (creating) the file; sets WAL mode, the busy timeout and `synchronous`.
+  // Opens (creating) the file; sets WAL mode, the busy timeout and `synchronous` (FULL or
+  // NORMAL: the setting that a Transaction of the other kind switches away from and back).
   Database(const std::string& path, int busy_timeout_ms, const char* synchronous = "FULL");
   ~Database();
   Database(const Database&) = delete;
@@ -34,6 +35,7 @@ class Database {
   Statement prepare(std::string_view sql);
   std::int64_t changes() const;
   sqlite3* handle() const { return db_; }
+  bool synchronous_full() const { return full_; }
 
  private:
   struct Kept {
@@ -41,6 +43,7 @@ class Database {
     bool in_use = false;
   };
   sqlite3* db_ = nullptr;
+  bool full_ = true;
   std::unordered_map<std::string, Kept> kept_;  // node-based: a Kept stays where it is
 };
 
@@ -87,9 +90,12 @@ class Statement {
 };
 
 // BEGIN IMMEDIATE on construction; ROLLBACK on destruction unless commit() was called.
-// A relaxed transaction commits with synchronous=NORMAL (no fsync: the WAL reaches the disk at
-// the connection's next FULL commit or checkpoint), for writes that a crash may lose because
-// recovery redoes them anyway (docs/running.md#the-service); the connection is FULL again after.
+// A full transaction commits with synchronous=FULL (fsynced before commit() returns); a relaxed
+// one with NORMAL (no fsync: the WAL reaches the disk at the connection's next FULL commit or
+// checkpoint), for writes that a crash may lose because recovery redoes them anyway
+// (docs/running.md#the-service). A transaction whose kind is not the connection's setting
+// switches it for its commit and back after: each switch is a PRAGMA that SQLite parses again
+// every time it runs, so a connection is opened with the setting of its most frequent writes.
 class Transaction {
  public:
   enum class Sync { full, relaxed };
@@ -103,6 +109,7 @@ class Transaction {
   void end(const char* sql);
   Database& db_;
   Sync sync_;
+  bool switched_;  // the connection's setting is the other one
   bool done_ = false;
 };
 

@@ -149,7 +149,9 @@ void insert_event(Database& db, const std::string& id, const StoredEvent& e) {
 SqliteStore::SqliteStore(const std::string& path, int busy_timeout_ms) {
   const auto parent = std::filesystem::path(path).parent_path();
   if (!parent.empty()) std::filesystem::create_directories(parent);
-  writer_ = std::make_unique<Database>(path, busy_timeout_ms);
+  // NORMAL: claims, renewals, event batches and submissions (fsynced after) commit without
+  // fsync; a job's end and the rarer writes switch to FULL for their commit.
+  writer_ = std::make_unique<Database>(path, busy_timeout_ms, "NORMAL");
   {
     auto v = writer_->prepare("PRAGMA user_version");
     v.step();

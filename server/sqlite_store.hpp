@@ -4,7 +4,8 @@
 // with NORMAL and is then fsynced (the WAL file) outside the writer's lock, before
 // insert_job returns, so that concurrent submissions do not queue behind each other's fsync;
 // claims, lease renewals and event batches commit with NORMAL (they survive kill -9; what a
-// power cut takes of them, recovery redoes; the next fsync makes them durable). One connection writes and one reads (WAL lets reads run beside a write), each
+// power cut takes of them, recovery redoes; the next fsync makes them durable). The writer's
+// connection is NORMAL and switches to FULL for the few commits that need it. One connection writes and one reads (WAL lets reads run beside a write), each
 // under its own mutex. Since no other process shares the file, opening it releases every
 // lease: the runs of the previous process are requeued at once by requeue_expired. Changes
 // are announced to the listener right after they commit.
@@ -18,7 +19,7 @@
 
 namespace grip::server {
 
-class SqliteStore final : public Store {
+class SqliteStore : public Store {
  public:
   // Creates the file (and its folder) and the schema when missing; upgrades an older schema.
   explicit SqliteStore(const std::string& path, int busy_timeout_ms = 5000);

@@ -46,6 +46,67 @@ std::vector<server::StoredEvent> events_to_end(JobService& service, const std::s
   return all;
 }
 
+// A SQLite store that counts the event reads that found nothing.
+class CountingStore : public SqliteStore {
+ public:
+  using SqliteStore::SqliteStore;
+  std::vector<server::StoredEvent> events_after(const std::string& id, std::int64_t after, int limit,
+                                                std::string_view type) override {
+    auto events = SqliteStore::events_after(id, after, limit, type);
+    ++reads;
+    if (events.empty()) ++empty_reads;
+    return events;
+  }
+  std::atomic<int> reads{0}, empty_reads{0};
+};
+
+TEST(JobService, AStreamKeepingItsPlaceGetsEveryEventOnceAndReadsAgainOnlyAfterAnAnnouncement) {
+  TempDir dir;
+  CountingStore store((dir.path() / "grip.sqlite").string());
+  ServiceOptions options;
+  options.workers = 1;
+  // In lockstep: the run makes event k once the reader has event k - 1, so every event is
+  // stored and announced alone, and each read after the first finds one event at most.
+  std::mutex m;
+  std::condition_variable cv;
+  std::int64_t received = 0;
+  options.event_tap = [&](const std::string&, std::int64_t seq, const nlohmann::json&) {
+    std::unique_lock lock(m);
+    EXPECT_TRUE(cv.wait_for(lock, std::chrono::seconds(30), [&] { return received >= seq - 1; })) << seq;
+  };
+  JobService service(store, options);
+  service.start();
+  const std::string id = service.submit(beam_scene(10, 3)).job.record.id;
+  std::uint64_t seen = 0;
+  std::int64_t after = 0;
+  int batches = 0;
+  bool ended = false;
+  for (int calls = 0; calls < 10000 && !ended; ++calls) {
+    const EventBatch b = service.wait_events(id, after, std::chrono::milliseconds(1000), 256, &seen);
+    ASSERT_TRUE(b.found);
+    for (const auto& e : b.events) {
+      EXPECT_EQ(e.seq, after + 1) << "every event once, in order";
+      after = e.seq;
+    }
+    batches += b.events.empty() ? 0 : 1;
+    ended = b.ended;
+    {
+      std::lock_guard lock(m);
+      received = after;
+    }
+    cv.notify_all();
+  }
+  ASSERT_TRUE(ended);
+  EXPECT_GE(after, 10);
+  EXPECT_GE(batches, after - 1);  // the lockstep held: about one event a batch
+  // Reads that found nothing: the first (the job not started yet) and those woken by the claim's
+  // announcement or a timeout; not one after each batch (without `seen`, one each).
+  std::printf("[ info ] %lld events in %d batches: %d reads of the store, %d found nothing\n",
+              static_cast<long long>(after), batches, store.reads.load(), store.empty_reads.load());
+  EXPECT_LE(store.empty_reads.load(), 4);
+  EXPECT_EQ(service.job(id)->record.status, JobStatus::successful);
+}
+
 TEST(JobService, DismissalStopsARunningJobWithinOneIterationAndFreesTheWorker) {
   TempDir dir;
   SqliteStore store((dir.path() / "grip.sqlite").string());

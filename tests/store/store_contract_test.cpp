@@ -514,6 +514,45 @@ INSTANTIATE_TEST_SUITE_P(Stores, StoreContract, ::testing::Values(Kind::sqlite, 
 
 // The database going away and coming back, seen by the store: calls fail fast with
 // StoreUnavailable (no hang), and everything committed before is there afterwards.
+// The SQLite store's writer is opened with synchronous=NORMAL (its claims, renewals, event
+// batches and submissions commit without fsync); a job's end commits FULL. A transaction of
+// the other kind switches the connection for its commit and back, every time (a kept PRAGMA
+// statement acts when SQLite prepares it again, which it does at each run).
+int synchronous_setting(Database& db) {  // 1 NORMAL, 2 FULL
+  auto st = db.prepare("PRAGMA synchronous");
+  st.step();
+  return static_cast<int>(st.int64(0));
+}
+
+TEST(SqliteTransaction, CommitsWithItsOwnSyncSettingAndGivesTheConnectionsBack) {
+  TempDir dir;
+  for (const char* own : {"NORMAL", "FULL"}) {
+    Database db((dir.path() / (std::string(own) + ".sqlite")).string(), 5000, own);
+    db.exec("CREATE TABLE t (x INTEGER)");
+    const int home = std::string(own) == "FULL" ? 2 : 1;
+    ASSERT_EQ(synchronous_setting(db), home) << own;
+    for (int round = 0; round < 3; ++round)
+      for (const auto sync : {Transaction::Sync::full, Transaction::Sync::relaxed}) {
+        const int inside = sync == Transaction::Sync::full ? 2 : 1;
+        {
+          Transaction tx(db, sync);
+          db.prepare("INSERT INTO t VALUES (?)").bind(1, round).run();
+          EXPECT_EQ(synchronous_setting(db), inside) << own << " round " << round;
+          tx.commit();
+        }
+        EXPECT_EQ(synchronous_setting(db), home) << own << " after a commit, round " << round;
+        {
+          Transaction tx(db, sync);
+          EXPECT_EQ(synchronous_setting(db), inside) << own << " round " << round;
+        }  // rolled back
+        EXPECT_EQ(synchronous_setting(db), home) << own << " after a rollback, round " << round;
+      }
+    auto count = db.prepare("SELECT count(*) FROM t");
+    count.step();
+    EXPECT_EQ(count.int64(0), 6) << own;
+  }
+}
+
 TEST(PostgresStoreOutage, CallsFailFastWhileTheDatabaseIsDownAndEverythingIsBackAfter) {
   std::string why;
   PostgresCluster* cluster = grip::testing::cluster(&why);

@@ -3,13 +3,8 @@
 //   force as the plain element;
 // - the tangent against central differences of the internal force, and its symmetry (the
 //   element's energy is sum W(F_bar) dV);
-// - Cook's membrane (the trapezoid (0, 0), (48, 44), (48, 60), (0, 44), clamped on the left, a
-//   shear load of 1 on the right side; neo-Hookean, E = 250, nu = 0.4999): the tip's deflection
-//   against Richardson's extrapolation of F-bar on 8, 16, 32 divisions, which q9 (16 x 16)
-//   confirms to 3 %; and how far the plain q4 falls short (it locks).
+// - Cook's membrane and a cantilever at nu = 0.4999: tests/verification/locking_test.cpp.
 #include <gtest/gtest.h>
-
-#include <Eigen/SparseCholesky>
 
 #include <algorithm>
 #include <cmath>
@@ -66,87 +61,6 @@ TEST(FBar, TangentMatchesDifferencesAndIsSymmetric) {
     EXPECT_LT(c.error(), 1e-7) << "nu " << poisson;
     EXPECT_LT(c.asymmetry(), 1e-12) << "nu " << poisson;
   }
-}
-
-// Cook's membrane on an n x n mesh of `element`: the tip's vertical displacement.
-double cook_tip(int n, ContinuumElement element, Incompressibility inc) {
-  RectangleSpec spec;
-  spec.nx = spec.ny = n;
-  PlaneMesh mesh = rectangle_mesh(spec, element_shape(element));
-  for (Vec2& x : mesh.nodes) x = Vec2(48 * x.x(), 44 * x.x() + x.y() * (44 - 28 * x.x()));
-  const std::vector<int> left = mesh.sets.at("left"), right = mesh.sets.at("right");
-  int tip = 0;
-  for (size_t k = 0; k < mesh.nodes.size(); ++k)
-    if ((mesh.nodes[k] - Vec2(48, 60)).norm() < 1e-9) tip = static_cast<int>(k);
-  // The right side's load: a uniform shear traction of 1 / 16 (total 1), consistent nodal
-  // forces along its straight sides (nodes sorted along y: 1/2, 1/2 or 1/6, 4/6, 1/6).
-  std::vector<int> side = right;
-  std::sort(side.begin(), side.end(), [&](int a, int b) { return mesh.nodes[a].y() < mesh.nodes[b].y(); });
-  const ContinuumBody body = body_of(mesh, element, inc, 0.4999);
-  Vector load = Vector::Zero(body.dof_count());
-  const bool quadratic = element == ContinuumElement::q9;
-  const int stride = quadratic ? 2 : 1;
-  for (size_t k = 0; k + stride < side.size() + 0; k += stride) {
-    const double L = (mesh.nodes[side[k + stride]] - mesh.nodes[side[k]]).norm(), f = L / 16;
-    if (quadratic) {
-      load[2 * side[k] + 1] += f / 6;
-      load[2 * side[k + 1] + 1] += 4 * f / 6;
-      load[2 * side[k + 2] + 1] += f / 6;
-    } else {
-      load[2 * side[k] + 1] += f / 2;
-      load[2 * side[k + 1] + 1] += f / 2;
-    }
-  }
-  std::vector<int> free_index(body.dof_count(), 0);
-  for (int node : left) free_index[2 * node] = free_index[2 * node + 1] = -1;
-  int free = 0;
-  for (int& i : free_index)
-    if (i == 0) i = free++;
-  Vector q = Vector::Zero(body.dof_count());
-  for (int it = 0; it < 30; ++it) {
-    Triplets t, tf;
-    Vector f = -load;
-    body.internal_force(q, f, &t);
-    Vector r(free);
-    for (int i = 0; i < q.size(); ++i)
-      if (free_index[i] >= 0) r[free_index[i]] = f[i];
-    if (r.norm() <= 1e-10) break;
-    for (const auto& e : t)
-      if (free_index[e.row()] >= 0 && free_index[e.col()] >= 0)
-        tf.emplace_back(free_index[e.row()], free_index[e.col()], e.value());
-    Eigen::SparseMatrix<double> K(free, free);
-    K.setFromTriplets(tf.begin(), tf.end());
-    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> solver(K);
-    const Vector dq = solver.solve(-r);
-    for (int i = 0; i < q.size(); ++i)
-      if (free_index[i] >= 0) q[i] += dq[free_index[i]];
-  }
-  return q[2 * tip + 1];
-}
-
-TEST(FBar, CooksMembraneDoesNotLock) {
-  // The reference: Richardson's extrapolation of F-bar on 8, 16 and 32 divisions, at the order
-  // they show.
-  const double f8 = cook_tip(8, ContinuumElement::q4, Incompressibility::f_bar);
-  const double f16 = cook_tip(16, ContinuumElement::q4, Incompressibility::f_bar);
-  const double f32 = cook_tip(32, ContinuumElement::q4, Incompressibility::f_bar);
-  const double order = std::log2((f16 - f8) / (f32 - f16));
-  const double reference = f32 + (f32 - f16) / (std::pow(2.0, order) - 1);
-  std::printf("Cook, nu 0.4999: F-bar tip v 8: %.6f, 16: %.6f, 32: %.6f; order %.2f, extrapolated %.6f\n", f8, f16, f32,
-              order, reference);
-  EXPECT_GT(order, 1.0);  // the clamped corners are singular: 1.4 measured
-  EXPECT_LT(order, 2.5);
-  const double q9 = cook_tip(16, ContinuumElement::q9, Incompressibility::none);
-  const double plain8 = cook_tip(8, ContinuumElement::q4, Incompressibility::none);
-  const double plain32 = cook_tip(32, ContinuumElement::q4, Incompressibility::none);
-  std::printf("errors: F-bar 8 %+.2f %%, 16 %+.2f %%, 32 %+.2f %%; plain q4 8 %+.2f %%, 32 %+.2f %%; q9 16 %+.2f %%\n",
-              100 * (f8 / reference - 1), 100 * (f16 / reference - 1), 100 * (f32 / reference - 1),
-              100 * (plain8 / reference - 1), 100 * (plain32 / reference - 1), 100 * (q9 / reference - 1));
-  EXPECT_NEAR(f16 / reference, 1.0, 0.02);
-  EXPECT_NEAR(f8 / reference, 1.0, 0.05);
-  EXPECT_NEAR(q9 / reference, 1.0, 0.03);  // q9 confirms it (and locks a little)
-  EXPECT_LT(plain8 / reference, 0.4);      // the plain q4 locks
-  EXPECT_LT(plain32 / reference, 0.4);
 }
 
 }  // namespace
