@@ -15,6 +15,8 @@
 #include <numbers>
 #include <vector>
 
+#include "tests/support/coulomb_active_set.hpp"
+
 namespace grip::testing {
 
 struct HalfPlaneSpence {
@@ -48,73 +50,19 @@ inline HalfPlaneSpence spence_half_plane(double mu, double nu, int per_a, int in
   if (Rc > 0)
     for (int i = 0; i < N; ++i)
       for (int j = 0; j < N; ++j) Xp(i, j) += x[i] * (A / 2) * h / (pi * Rc);
-  VectorXd p = VectorXd::Zero(N), q = VectorXd::Zero(N), ux_prev = VectorXd::Zero(N);
-  std::vector<int> C(N, 0), S(N, 0), s(N, 0);  // contact, stick, slip sign
+  CoulombState st(N);
   for (int i = 0; i < N; ++i)
-    if (std::abs(x[i]) < h) C[i] = S[i] = 1;
+    if (std::abs(x[i]) < h) st.contact[i] = st.stick[i] = 1;
+  const HalfSpaceInfluence m{Zp, Zq, Xq, Xp};
+  const std::vector<double> weight(N, h);
   HalfPlaneSpence out;
   double P = 0;
   for (int k = 1; k <= increments; ++k) {
     P = pi / (2 * A * R) * double(k) / increments;
-    int changes = 1, it = 0;
-    for (; changes && it < 200; ++it) {
-      // unknowns: p (N), q (N), the approach delta
-      MatrixXd M = MatrixXd::Zero(2 * N + 1, 2 * N + 1);
-      VectorXd r = VectorXd::Zero(2 * N + 1);
-      for (int i = 0; i < N; ++i) {
-        if (C[i]) {  // u_z = delta - x^2 / 2R
-          M.block(i, 0, 1, N) = Zp.row(i);
-          M.block(i, N, 1, N) = Zq.row(i);
-          M(i, 2 * N) = -1;
-          r[i] = -x[i] * x[i] / (2 * R);
-          if (S[i]) {
-            M.block(N + i, N, 1, N) = Xq.row(i);
-            M.block(N + i, 0, 1, N) = Xp.row(i);
-            r[N + i] = ux_prev[i];
-          } else {
-            M(N + i, N + i) = 1;
-            M(N + i, i) = -s[i] * mu;
-          }
-        } else {
-          M(i, i) = 1;
-          M(N + i, N + i) = 1;
-        }
-      }
-      for (int j = 0; j < N; ++j) M(2 * N, j) = h;
-      r[2 * N] = P;
-      const VectorXd sol = M.partialPivLu().solve(r);
-      p = sol.head(N);
-      q = sol.segment(N, N);
-      const double delta = sol[2 * N];
-      const VectorXd uz = Zp * p + Zq * q, ux = Xq * q + Xp * p;
-      changes = 0;
-      for (int i = 0; i < N; ++i) {
-        const double pen = delta - x[i] * x[i] / (2 * R) - uz[i];
-        if (C[i] && p[i] < 0) {
-          C[i] = 0;
-          ++changes;
-          continue;
-        }
-        if (!C[i] && pen > 1e-14) {
-          C[i] = S[i] = 1;
-          ++changes;
-          continue;
-        }
-        if (!C[i]) continue;
-        const double du = ux[i] - ux_prev[i];
-        if (S[i] && std::abs(q[i]) > mu * p[i]) {
-          S[i] = 0;
-          s[i] = q[i] > 0 ? 1 : -1;
-          ++changes;
-        } else if (!S[i] && du * s[i] > 1e-15) {
-          S[i] = 1;
-          ++changes;
-        }
-      }
-    }
-    ux_prev = Xq * q + Xp * p;
-    out.iterations = it;
+    out.iterations = coulomb_increment(m, x, weight, R, P, mu, st);
   }
+  const VectorXd &p = st.p, &q = st.q;
+  const std::vector<int> &C = st.contact, &S = st.stick;
   for (int i = 0; i < N; ++i)
     if (p[i] > 0) out.a = std::max(out.a, std::abs(x[i]) + h / 2);
   const int centre = N / 2;

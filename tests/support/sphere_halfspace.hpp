@@ -21,6 +21,8 @@
 #include <numbers>
 #include <vector>
 
+#include "tests/support/coulomb_active_set.hpp"
+
 namespace grip::testing {
 
 struct HalfSpaceSphere {
@@ -99,72 +101,17 @@ inline HalfSpaceSphere sphere_half_space(double mu, double nu, int per_a, int in
       const double inside = std::clamp(r[i], lo[j], hi[j]);
       Rp(i, j) = -cross / r[i] * 0.5 * (inside * inside - lo[j] * lo[j]);
     }
-  VectorXd p = VectorXd::Zero(N), q = VectorXd::Zero(N), ur_prev = VectorXd::Zero(N);
-  std::vector<int> C(N, 0), S(N, 0), s(N, 0);  // contact, stick, slip sign
-  C[0] = S[0] = 1;
+  CoulombState st(N);
+  st.contact[0] = st.stick[0] = 1;
+  const HalfSpaceInfluence m{Zp, Zq, Rq, Rp};
   HalfSpaceSphere out;
   const double P_end = 4 * Estar / (3 * R);  // a = 1: a^3 = 3 P R / (4 E*)
   for (int k = 1; k <= increments; ++k) {
-    const double P = P_end * k / increments;
-    int changes = 1, it = 0;
-    for (; changes && it < 200; ++it) {
-      MatrixXd M = MatrixXd::Zero(2 * N + 1, 2 * N + 1);  // unknowns p, q, the approach delta
-      VectorXd rhs = VectorXd::Zero(2 * N + 1);
-      for (int i = 0; i < N; ++i) {
-        if (C[i]) {  // u_z = delta - r^2 / 2R
-          M.block(i, 0, 1, N) = Zp.row(i);
-          M.block(i, N, 1, N) = Zq.row(i);
-          M(i, 2 * N) = -1;
-          rhs[i] = -r[i] * r[i] / (2 * R);
-          if (S[i]) {
-            M.block(N + i, N, 1, N) = Rq.row(i);
-            M.block(N + i, 0, 1, N) = Rp.row(i);
-            rhs[N + i] = ur_prev[i];
-          } else {
-            M(N + i, N + i) = 1;
-            M(N + i, i) = -s[i] * mu;
-          }
-        } else {
-          M(i, i) = 1;
-          M(N + i, N + i) = 1;
-        }
-      }
-      for (int j = 0; j < N; ++j) M(2 * N, j) = area[j];
-      rhs[2 * N] = P;
-      const VectorXd sol = M.partialPivLu().solve(rhs);
-      p = sol.head(N);
-      q = sol.segment(N, N);
-      const double delta = sol[2 * N];
-      const VectorXd uz = Zp * p + Zq * q, ur = Rq * q + Rp * p;
-      changes = 0;
-      for (int i = 0; i < N; ++i) {
-        const double pen = delta - r[i] * r[i] / (2 * R) - uz[i];
-        if (C[i] && p[i] < 0) {
-          C[i] = 0;
-          ++changes;
-          continue;
-        }
-        if (!C[i] && pen > 1e-14) {
-          C[i] = S[i] = 1;
-          ++changes;
-          continue;
-        }
-        if (!C[i]) continue;
-        const double du = ur[i] - ur_prev[i];
-        if (S[i] && std::abs(q[i]) > mu * p[i]) {
-          S[i] = 0;
-          s[i] = q[i] > 0 ? 1 : -1;
-          ++changes;
-        } else if (!S[i] && du * s[i] > 1e-15) {
-          S[i] = 1;
-          ++changes;
-        }
-      }
-    }
-    ur_prev = Rq * q + Rp * p;
-    out.iterations = it;
-    out.load = P;
+    out.load = P_end * k / increments;
+    out.iterations = coulomb_increment(m, r, area, R, out.load, mu, st);
   }
+  const VectorXd& p = st.p;
+  const std::vector<int>&C = st.contact, &S = st.stick;
   for (int i = 0; i < N; ++i)
     if (p[i] > 0) out.a = std::max(out.a, hi[i]);
   int hs = 0;
