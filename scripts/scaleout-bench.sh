@@ -6,13 +6,17 @@
 # Writes bench/results/scaleout.md (or --report FILE).
 #
 #   bash scripts/scaleout-bench.sh [--jobs 400] [--clients 20] [--workers 1] [--build-dir build]
-#                                  [--no-build] [--report FILE]
+#                                  [--no-build] [--report FILE] [--study N]
+#
+# --study N: instead, one study of N jobs (the paper's beam swept over its end load) posted
+# through HAProxy to 1 and to 3 replicas: the study's wall time against its jobs' summed solve
+# times, and how many jobs each replica ran (default report bench/results/study-scaleout.md).
 #
 # Latency is the job document's `finished` - `created` (both stamped by the service; one
 # clock). Throughput: jobs / (last finished - first created).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-jobs=400 clients=20 workers=1 build_dir=build build=1 report=bench/results/scaleout.md
+jobs=400 clients=20 workers=1 build_dir=build build=1 report=bench/results/scaleout.md study=0
 while [ $# -gt 0 ]; do
   case "$1" in
     --jobs) jobs=$2; shift 2 ;;
@@ -21,6 +25,8 @@ while [ $# -gt 0 ]; do
     --build-dir) build_dir=$2; shift 2 ;;
     --no-build) build=0; shift ;;
     --report) report=$2; shift 2 ;;
+    --study) study=$2; shift 2
+      [ "$report" = bench/results/scaleout.md ] && report=bench/results/study-scaleout.md ;;
     *) echo "scaleout-bench.sh: unknown argument $1" >&2; exit 2 ;;
   esac
 done
@@ -66,8 +72,9 @@ wait_listening() { # log -> port
 }
 
 rows=()
-run() { # label replicas db
-  local label=$1 n=$2 kind=$3 ports=() run_pids=() db
+start_replicas() { # label replicas db -> ports, run_pids, lbport, lb
+  local label=$1 n=$2 kind=$3 db
+  ports=() run_pids=()
   if [ "$kind" = postgresql ]; then
     psql -d postgres -c "DROP DATABASE IF EXISTS bench" -c "CREATE DATABASE bench" >/dev/null
     db="postgresql://grip@127.0.0.1:$pgport/bench"
@@ -80,7 +87,7 @@ run() { # label replicas db
     run_pids+=($!); pids+=($!)
     ports+=("$(wait_listening "$tmp/$label-r$i.log")")
   done
-  local lbport; lbport=$(free_port)
+  lbport=$(free_port)
   {
     printf 'global\n  maxconn 4000\ndefaults\n  mode http\n  timeout connect 2s\n  timeout client 300s\n'
     printf '  timeout server 300s\nlisten grip\n  bind 127.0.0.1:%s\n  balance roundrobin\n' "$lbport"
@@ -88,8 +95,18 @@ run() { # label replicas db
     for i in "${!ports[@]}"; do printf '  server r%s 127.0.0.1:%s check inter 1s\n' "$i" "${ports[$i]}"; done
   } >"$tmp/$label.cfg"
   haproxy -db -f "$tmp/$label.cfg" >"$tmp/$label-haproxy.log" 2>&1 &
-  local lb=$!; pids+=($lb)
+  lb=$!; pids+=($lb)
   sleep 1
+}
+
+stop_replicas() {
+  kill -TERM "$lb" "${run_pids[@]}" 2>/dev/null || true
+  wait "$lb" "${run_pids[@]}" 2>/dev/null || true
+}
+
+run() { # label replicas db
+  local label=$1 n=$2 kind=$3
+  start_replicas "$label" "$n" "$kind"
   local commits0=0 rows0=0
   if [ "$kind" = postgresql ]; then
     psql -d bench -c "SELECT pg_stat_reset()" >/dev/null
@@ -127,11 +144,67 @@ print(len(jobs), "%.1f" % (len(jobs) / span), "%.2f" % q(0.5), "%.2f" % q(0.99))
     per_r=$($py -c "print('%.1f' % ($changed / $done_jobs))")
   fi
   rows+=("| $label | $n | $done_jobs | $jps | $p50 | $p99 | $per_q | $per_b | $per_c | $per_r |")
-  kill -TERM "$lb" "${run_pids[@]}" 2>/dev/null || true
-  wait "$lb" "${run_pids[@]}" 2>/dev/null || true
+  stop_replicas
+}
+
+# One study of $study variants of the paper's beam (its end load swept from 100 to 600 kgf) posted
+# through HAProxy; the study's wall time (post to successful) against its jobs' summed solve
+# times (each job's finished - started), and the jobs each replica ran.
+run_study() { # label replicas
+  local label=$1 n=$2
+  start_replicas "$label" "$n" postgresql
+  local row
+  row=$($py - "$lbport" "$study" "$n" <<'PY'
+import json, sys, time, urllib.request, datetime as d
+port, count, replicas = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
+base = "http://127.0.0.1:%s" % port
+scene = json.load(open("schemas/examples/beam-on-cylinder.json"))
+scene["outputs"] = [{"name": "tip_w", "kind": "displacement", "node": 40, "component": "y"}]
+plan = {"scene": scene, "sweep": [{"pointer": "/body/loads/0/force/1",
+                                   "range": {"from": -100, "to": -600, "count": count}}]}
+def call(path, body=None):
+    req = urllib.request.Request(base + path, data=body and json.dumps(body).encode(),
+                                 headers={"Content-Type": "application/json"})
+    return json.load(urllib.request.urlopen(req, timeout=60))
+t0 = time.monotonic()
+study = call("/v1/studies", plan)
+while study.get("status") not in ("successful", "failed"):
+    time.sleep(0.2)
+    study = call("/v1/studies/" + study["id"])
+wall = time.monotonic() - t0
+t = lambda s: d.datetime.strptime(s, "%Y-%m-%dT%H:%M:%S.%fZ").timestamp()
+jobs = [call("/v1/jobs/" + level["job"]) for level in study["levels"]]
+solve = sum(t(j["finished"]) - t(j["started"]) for j in jobs)
+per = {}
+for j in jobs:
+    per[j["replica"]] = per.get(j["replica"], 0) + 1
+print("| %d | %s | %d | %.2f | %.2f | %.2f | %s |" % (replicas, study["status"], len(jobs), wall, solve,
+      wall / solve, ", ".join("%s %d" % kv for kv in sorted(per.items()))))
+PY
+)
+  rows+=("$row")
+  stop_replicas
 }
 
 load0=$(cut -d ' ' -f 1-3 /proc/loadavg)
+if [ "$study" -gt 0 ]; then
+  run_study "study-1" 1
+  run_study "study-3" 3
+  commit=$(git rev-parse --short HEAD 2>/dev/null || echo unknown)
+  {
+    echo "# A study through HAProxy: 1 and 3 replicas (scripts/scaleout-bench.sh --study $study)"
+    echo
+    echo "$(date -u '+%Y-%m-%d %H:%M UTC'), commit $commit; $(nproc) cores; load average $load0 before,"
+    echo "$(cut -d ' ' -f 1-3 /proc/loadavg) after. $study variants of the paper's beam (end load -100 to -600 kgf),"
+    echo "one PostgreSQL database, each replica \`--workers $workers\`."
+    echo
+    echo "| replicas | status | jobs | study wall s | jobs' solve s (summed) | wall / summed | jobs per replica |"
+    echo "|---|---|---|---|---|---|---|"
+    printf '%s\n' "${rows[@]}"
+  } >"$report"
+  cat "$report"
+  exit 0
+fi
 run "postgresql, 1 replica" 1 postgresql
 run "postgresql, 2 replicas" 2 postgresql
 run "postgresql, 3 replicas" 3 postgresql
