@@ -125,6 +125,16 @@ inline Solved solve_read_scene(Scene scene) {
 inline Solved solve_scene(const nlohmann::json& j, const MeshResolver& meshes = {}) {
   return solve_read_scene(read_scene(j, meshes));
 }
+
+// A scene's first refusal as "pointer: detail", or "accepted" when it reads and runs.
+inline std::string first_refusal(const nlohmann::json& j) {
+  try {
+    solve_scene(j);
+  } catch (const SceneErrors& e) {
+    return e.issues().at(0).pointer + ": " + e.issues().at(0).detail;
+  }
+  return "accepted";
+}
 // A shipped example as a user runs it: its mesh files read beside it.
 inline Solved solve_example(const std::string& name) {
   return solve_read_scene(read_scene_file(std::string(GRIP_SOURCE_DIR) + "/schemas/examples/" + name + ".json"));
