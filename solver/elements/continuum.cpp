@@ -33,6 +33,36 @@ ElementShape element_shape(ContinuumElement element) {
   }
 }
 
+std::string incompressibility_issue(const ContinuumOptions& options) {
+  using E = ContinuumElement;
+  if (options.incompressibility == Incompressibility::none) return {};
+  const bool f_bar = options.incompressibility == Incompressibility::f_bar;
+  const std::string name = f_bar ? "\"f_bar\"" : "\"mixed\"";
+  if (options.kinematics != ContinuumKinematics::finite)
+    return name + " is for finite kinematics; with linear kinematics use element \"q4_bbar\"";
+  if (options.analysis == PlaneAnalysis::plane_stress)
+    return name + " is for plane strain and axisymmetry (plane stress does not lock)";
+  if (f_bar)
+    return options.element == E::q4
+               ? ""
+               : std::string("\"f_bar\" is implemented for element \"q4\" (") + element_name(options.element) +
+                     " has no single centre dilatation to share; for t6 and q9 use \"mixed\")";
+  switch (options.element) {
+    case E::q9:
+    case E::t6:
+      return {};
+    case E::q8:
+      return "\"mixed\" is not offered for q8: the serendipity element with a linear pressure (Bathe's 8/3) fails "
+             "the inf-sup condition; use q9 (Q2/P1, stable)";
+    case E::t3:
+      return "\"mixed\" is not offered for t3: a constant pressure on linear triangles (P1/P0) locks; use t6 (P2/P0, "
+             "stable)";
+    default:
+      return "\"mixed\" is not offered for q4: a constant pressure on q4 (Q1/P0) fails the inf-sup condition "
+             "(checkerboard pressure modes); use \"f_bar\" (the same constraint count) or q9 with \"mixed\"";
+  }
+}
+
 const char* element_name(ContinuumElement element) {
   return element == ContinuumElement::q4_bbar ? "q4_bbar" : shape_name(element_shape(element));
 }
@@ -67,10 +97,7 @@ ContinuumBody::ContinuumBody(PlaneMesh mesh, const std::vector<int>& contact_set
   if (options_.element == ContinuumElement::q4_bbar && options_.kinematics == ContinuumKinematics::finite)
     throw std::invalid_argument("q4_bbar is implemented for linear kinematics (use q9 for finite strain)");
   if (!(options_.thickness > 0)) throw std::invalid_argument("thickness must be positive");
-  if (options_.incompressibility == Incompressibility::f_bar &&
-      (options_.kinematics != ContinuumKinematics::finite || options_.element != ContinuumElement::q4 ||
-       options_.analysis != PlaneAnalysis::plane_strain))
-    throw std::invalid_argument("f_bar is implemented for finite kinematics, q4 and plane strain");
+  if (const std::string why = incompressibility_issue(options_); !why.empty()) throw std::invalid_argument(why);
   for (const auto& m : materials_) {
     has_history_ |= m->has_history();
     if (options_.kinematics == ContinuumKinematics::finite)
@@ -110,6 +137,13 @@ const ContinuumBody::Integration& ContinuumBody::integration() const {
         make_axisymmetric(in->centroids.back(), X);
       }
       if (options_.element == ContinuumElement::q4_bbar) in->mean_dN.push_back(mean_gradients(in->points.back()));
+      // The mixed: theta the projection of J onto the element's pressure space (P1 on q9, P0 on
+      // t6). F-bar in axisymmetry: the element's mean J (P0), the hoop stretch in it; J at the
+      // centre would fail the patch test there (the integral of grad N 2 pi r is not the centre's).
+      if (options_.incompressibility == Incompressibility::mixed ||
+          (options_.incompressibility == Incompressibility::f_bar && axisymmetric))
+        in->dilatation.push_back(projected_dilatation(in->points.back(), in->centroids.back(), X,
+                                                      options_.element == ContinuumElement::q9 ? 1 : 0));
     }
     if (options_.kinematics == ContinuumKinematics::linear && !has_history_) {
       for (int e = 0; e < element_count(); ++e) {
@@ -157,9 +191,13 @@ std::vector<Mat2> ContinuumBody::point_deformations(const Vector& q, int e) cons
   const Integration& in = integration();
   const ShapeGradients u = element_displacements(q, e);
   std::vector<Mat2> F;
-  for (const ElementPoint& p : in.points[e])
-    F.push_back(options_.incompressibility == Incompressibility::f_bar ? f_bar(p, in.centroids[e], u)
-                                                                       : deformation_gradient(p, u));
+  const Vector s = in.dilatation.empty() ? Vector() : dilatation_scales(in.points[e], in.dilatation[e], u);
+  for (size_t k = 0; k < in.points[e].size(); ++k) {
+    const ElementPoint& p = in.points[e][k];
+    if (!in.dilatation.empty()) F.push_back(s[k] * deformation_gradient(p, u));
+    else if (options_.incompressibility == Incompressibility::f_bar) F.push_back(f_bar(p, in.centroids[e], u));
+    else F.push_back(deformation_gradient(p, u));
+  }
   return F;
 }
 
@@ -230,7 +268,9 @@ void ContinuumBody::internal_force(const Vector& q, Vector& force, Triplets* tan
       law = [&](int k, const Mat2& E) { return material(e).finite_response(E, history_[e * np + k]).law; };
     const auto& el = mesh_.elements[e];
     for (int a = 0; a < n; ++a) u.row(a) << q[node_dof(el[a], 0)], q[node_dof(el[a], 1)];
-    if (options_.incompressibility == Incompressibility::f_bar)
+    if (!in.dilatation.empty())
+      dilatation_total_lagrangian(in.points[e], in.dilatation[e], u, material(e), fe, tangent ? &Ke : nullptr, law);
+    else if (options_.incompressibility == Incompressibility::f_bar)
       f_bar_total_lagrangian(in.points[e], in.centroids[e], u, material(e), fe, tangent ? &Ke : nullptr, law);
     else total_lagrangian(in.points[e], u, material(e), fe, tangent ? &Ke : nullptr, law);
     const int m = static_cast<int>(fe.size());
@@ -360,10 +400,13 @@ Eigen::Vector4d ContinuumBody::centroid_stress(const Vector& q, int e) const {
     const Eigen::Vector3d s = r.D * eps;
     return {s[0], s[1], s[2], r.dS33 * eps};
   }
-  const Mat2 F = deformation_gradient(c, u);
+  // With a shared dilatation the centre sees F_bar = s F (the mixed: theta of the pressure space there).
+  const auto& dilatation = integration().dilatation;
+  const double s = dilatation.empty() ? 1.0 : centre_dilatation_scale(c, dilatation[e], u);
+  const Mat2 F = s * deformation_gradient(c, u);
   const Mat2 E = 0.5 * (F.transpose() * F - Mat2::Identity());
   if (options_.analysis != PlaneAnalysis::axisymmetric) return cauchy_stress(F, material(e).response(E));
-  const double F33 = 1 + c.N.dot(u.col(0)) / c.radius;
+  const double F33 = s * (1 + c.N.dot(u.col(0)) / c.radius);
   const HoopResponse h = material(e).hoop_response(E, 0.5 * (F33 * F33 - 1));
   MaterialResponse r;
   r.S = h.S.head<3>();

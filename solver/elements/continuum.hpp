@@ -27,6 +27,7 @@
 #include <string>
 #include <vector>
 
+#include "solver/elements/dilatation.hpp"
 #include "solver/elements/plane_mesh.hpp"
 #include "solver/model/body.hpp"
 
@@ -34,9 +35,11 @@ namespace grip {
 
 enum class ContinuumElement { q4, q4_bbar, q9, t3, t6, q8 };
 enum class ContinuumKinematics { linear, finite };
-// Against volumetric locking: none, or F-bar (finite kinematics, q4, plane strain;
-// plane_element.hpp). Linear kinematics has q4_bbar.
-enum class Incompressibility { none, f_bar };
+// Against volumetric locking (finite kinematics; linear kinematics has q4_bbar): none; F-bar
+// (q4, plane strain and axisymmetric; plane_element.hpp, dilatation.hpp); mixed, the u-p-theta
+// form with the pressure discontinuous and condensed per element: q9 with a linear pressure
+// (Q2/P1), t6 with a constant one (P2/P0), the pairs that satisfy inf-sup (dilatation.hpp).
+enum class Incompressibility { none, f_bar, mixed };
 
 struct ContinuumOptions {
   ContinuumElement element = ContinuumElement::q4;
@@ -45,6 +48,10 @@ struct ContinuumOptions {
   double thickness = 1.0;  // out-of-plane depth (plane strain: the length the results are per)
   Incompressibility incompressibility = Incompressibility::none;
 };
+
+// Why `incompressibility` is not offered with the other options (empty if it is): the reason the
+// scene reader puts at /body/incompressibility (docs/algorithm.md#element-formulation-pairs).
+std::string incompressibility_issue(const ContinuumOptions& options);
 
 ElementShape element_shape(ContinuumElement element);
 // Axisymmetric (docs/algorithm.md#axisymmetric): the nodes at r = x < 0 (refused), and those on
@@ -124,7 +131,7 @@ class ContinuumBody final : public Body {
   // A law with history: the response of each integration point of element e at q.
   std::vector<PointResponse> point_responses(const Vector& q, int e) const;
   // Finite kinematics: the deformation gradient the law sees at each point of element e (F_bar
-  // with f_bar), and the responses of a law with history to them.
+  // with f_bar and mixed), and the responses of a law with history to them.
   std::vector<Mat2> point_deformations(const Vector& q, int e) const;
   std::vector<FinitePointResponse> finite_point_responses(const std::vector<Mat2>& F, int e) const;
 
@@ -135,6 +142,7 @@ class ContinuumBody final : public Body {
     std::vector<std::vector<ElementPoint>> points;  // per element, reference configuration
     std::vector<ElementPoint> centroids;
     std::vector<ShapeGradients> mean_dN;  // per element (q4_bbar)
+    std::vector<Dilatation> dilatation;   // per element: mixed, and F-bar in axisymmetry
     Triplets linear_tangent;              // linear kinematics: the constant K
     Eigen::SparseMatrix<double> linear_K;
   };

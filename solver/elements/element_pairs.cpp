@@ -23,9 +23,10 @@ std::string element_pair_issue(const ContinuumOptions& options, const PlaneMater
     return {};
   }
   std::string instead;
-  if (options.analysis == PlaneAnalysis::axisymmetric) instead = "use t6, q8 or q9";
-  else if (options.kinematics == ContinuumKinematics::linear) instead = "use q4_bbar (mean dilatation), t6, q8 or q9";
-  else instead = "use q4 with \"incompressibility\": \"f_bar\", or t6, q8, q9";
+  if (options.kinematics == ContinuumKinematics::finite)
+    instead = "use q4 with \"incompressibility\": \"f_bar\", or t6 or q9 with \"mixed\" (or plain t6, q8, q9)";
+  else if (options.analysis == PlaneAnalysis::axisymmetric) instead = "use t6, q8 or q9";
+  else instead = "use q4_bbar (mean dilatation), t6, q8 or q9";
   return "\"" + kind + "\" is refused here: " + why + "; " + instead + " (docs/algorithm.md#element-formulation-pairs)";
 }
 

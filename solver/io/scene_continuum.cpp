@@ -1,7 +1,7 @@
 // body.model "continuum": plane triangles and quadrilaterals (solver/elements/continuum.hpp).
 //   "kinematics": "finite" (default) | "linear";  "analysis": "plane_strain" | "plane_stress" | "axisymmetric"
 //   "element": "t3" | "t6" | "q4" | "q4_bbar" | "q8" | "q9";  "thickness" (default 1)
-//   "incompressibility": "none" (default) | "f_bar" (finite kinematics, q4, plane strain)
+//   "incompressibility": "none" (default) | "f_bar" (finite kinematics, q4) | "mixed" (finite, q9 and t6)
 //   "material": {"young", "poisson", "law": "neo_hookean" | "saint_venant_kirchhoff" | "j2_plasticity"} |
 //     {"law": "mooney_rivlin", "c10", "c01" (default 0), "bulk"}
 //     j2_plasticity: "yield_stress", "hardening": {"linear": H} |
@@ -496,18 +496,11 @@ void read_continuum(Reader& r, json& body, Problem& problem, const std::string& 
                              ContinuumElement::q4_bbar, ContinuumElement::q8, ContinuumElement::q9})
     if (element == element_name(e)) options.element = e;
   options.thickness = r.positive(body, ptr, "thickness", 1.0);
-  if (r.choice(body, ptr, "incompressibility", {"none", "f_bar"}, "none") == "f_bar") {
-    options.incompressibility = Incompressibility::f_bar;
-    if (options.kinematics != ContinuumKinematics::finite)
-      r.error(ptr + "/incompressibility",
-              "\"f_bar\" is for finite kinematics; with linear kinematics use element \"q4_bbar\"");
-    else if (options.element != ContinuumElement::q4)
-      r.error(ptr + "/incompressibility", "\"f_bar\" is implemented for element \"q4\" (" + element +
-                                              " has no single centre "
-                                              "dilatation to share; q9 locks little)");
-    else if (options.analysis != PlaneAnalysis::plane_strain)
-      r.error(ptr + "/incompressibility", "\"f_bar\" is implemented for plane strain (plane stress does not lock)");
-  }
+  const std::string incompressibility = r.choice(body, ptr, "incompressibility", {"none", "f_bar", "mixed"}, "none");
+  options.incompressibility = incompressibility == "f_bar"   ? Incompressibility::f_bar
+                              : incompressibility == "mixed" ? Incompressibility::mixed
+                                                             : Incompressibility::none;
+  if (const std::string why = incompressibility_issue(options); !why.empty()) r.error(ptr + "/incompressibility", why);
   if (options.element == ContinuumElement::q4_bbar) {
     if (options.kinematics == ContinuumKinematics::finite)
       r.error(ptr + "/element",

@@ -9,7 +9,7 @@
 //   the yield condition holds at every plastic state, det Fp = 1; released, C = Cp (Fe is a
 //   rotation: unloading takes back exactly the elastic part);
 // - the consistent tangent against central differences of the internal force (q4 and q8 in
-//   plane strain, q4 in plane stress, q4 with F-bar) and Newton's quadratic convergence on a
+//   plane strain, q4 in plane stress, q4 with F-bar, q9 and t6 mixed) and Newton's quadratic convergence on a
 //   plastic step;
 // - the small-strain limit: a bent block at strains of a few 1e-7 as the small-strain law, to 1e-6.
 #include <gtest/gtest.h>
@@ -235,7 +235,14 @@ const Case kCases[] = {
     {"q8 plane strain", PlaneAnalysis::plane_strain, ContinuumElement::q8, Incompressibility::none},
     {"q4 plane stress", PlaneAnalysis::plane_stress, ContinuumElement::q4, Incompressibility::none},
     {"q4 f_bar plane strain", PlaneAnalysis::plane_strain, ContinuumElement::q4, Incompressibility::f_bar},
+    {"q9 mixed plane strain", PlaneAnalysis::plane_strain, ContinuumElement::q9, Incompressibility::mixed},
+    {"t6 mixed plane strain", PlaneAnalysis::plane_strain, ContinuumElement::t6, Incompressibility::mixed},
 };
+
+// The mixed q9 overshoots with the plain Newton on the third step of 0.025 (the residual stalls
+// at 8e-2), and converges in 6 to 9 iterations with the driver's line search, which leaves full
+// steps near the solution (where the rate is read).
+bool needs_line_search(const Case& c) { return c.incompressibility == Incompressibility::mixed; }
 
 TEST(J2Finite, ConsistentTangentMatchesDifferencesOfTheForce) {
   for (const Case& c : kCases)
@@ -243,6 +250,7 @@ TEST(J2Finite, ConsistentTangentMatchesDifferencesOfTheForce) {
       SCOPED_TRACE(std::string(law.name) + " " + c.name);
       Bent b = bent_block(material(law, c.analysis), finite(c.analysis, c.element, c.incompressibility));
       Driver d(*b.body, b.held);
+      d.line_search = needs_line_search(c);
       bend_far(d, b, c.analysis, 1e-9 * kYield);  // a committed plastic history
       // A state beyond it, off equilibrium: every dof moved.
       Vector q = d.q;
@@ -265,6 +273,7 @@ TEST(J2Finite, NewtonConvergesQuadraticallyOnAPlasticStep) {
       SCOPED_TRACE(std::string(law.name) + " " + c.name);
       Bent b = bent_block(material(law, c.analysis), finite(c.analysis, c.element, c.incompressibility));
       Driver d(*b.body, b.held);
+      d.line_search = needs_line_search(c);
       bend_far(d, b, c.analysis, 1e-10 * kYield);
       const std::vector<double>& r = d.residuals;
       std::string line;
@@ -274,14 +283,16 @@ TEST(J2Finite, NewtonConvergesQuadraticallyOnAPlasticStep) {
         line += buffer;
       }
       std::printf("Newton %-6s %-22s relative residuals:%s\n", law.name, c.name, line.c_str());
-      // Near the solution (e_k < 1e-3): e_{k+1} <= 10 e_k^2 (relative to the first residual).
-      // Below 1e-11 the residual is round-off.
+      // Near the solution (e_k < 1e-3): e_{k+1} <= c e_k^2 (relative to the first residual), c = 10;
+      // 20 for t6 mixed, whose constant is 14 (1.4e-4, 2.7e-7, 1.1e-12). Below 1e-11 the
+      // residual is round-off.
+      const double c2 = c.element == ContinuumElement::t6 ? 20 : 10;
       int quadratic = 0;
       for (size_t k = 1; k + 1 < r.size(); ++k) {
         const double ek = r[k] / r[0], next = r[k + 1] / r[0];
         if (ek >= 1e-3) continue;
-        EXPECT_LE(next, std::max(10 * ek * ek, 1e-11)) << "iteration " << k;
-        quadratic += 10 * ek * ek >= 1e-11;
+        EXPECT_LE(next, std::max(c2 * ek * ek, 1e-11)) << "iteration " << k;
+        quadratic += c2 * ek * ek >= 1e-11;
       }
       EXPECT_GE(quadratic, 1);
       EXPECT_LE(r.size(), 10u);

@@ -5,6 +5,8 @@
 // in tests/hard/o_ring_slow_test.cpp.
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 #include "tests/support/o_ring.hpp"
 
 namespace grip {
@@ -21,6 +23,24 @@ TEST(ORing, ShippedSceneIsSoundAndBalanced) {
   EXPECT_NEAR(shipped.force / coarse.force, 1.0, 0.01);
   // 25 % squeeze of an incompressible ring: it widens against the groove's walls.
   EXPECT_GT(shipped.walls, 0.0);
+}
+
+// The same ring in the formulations against locking: q9 with the mixed u-p form (a linear
+// pressure per element) on the shipped mesh, and q4 with F-bar in axisymmetry on twice the
+// divisions (the same nodes), against the plain q9.
+TEST(ORing, MixedQ9AndAxisymmetricFBarAgreeWithQ9) {
+  const SealReading q9 = expect_seal(solve_o_ring(16));
+  const SealReading mixed = expect_seal(solve_o_ring(16, "q9", "mixed"));
+  const SealReading f_bar = expect_seal(solve_o_ring(32, "q4", "f_bar"));
+  std::printf(
+      "O-ring against plain q9 (16): q9 mixed (16) force %+.3f %%, width %+.3f %%; q4 f_bar (32) force %+.3f %%, "
+      "width %+.3f %%\n",
+      100 * (mixed.force / q9.force - 1), 100 * (mixed.width / q9.width - 1), 100 * (f_bar.force / q9.force - 1),
+      100 * (f_bar.width / q9.width - 1));
+  EXPECT_NEAR(mixed.force / q9.force, 1.0, 0.01);
+  EXPECT_NEAR(mixed.width / q9.width, 1.0, 0.01);
+  EXPECT_NEAR(f_bar.force / q9.force, 1.0, 0.02);
+  EXPECT_NEAR(f_bar.width / q9.width, 1.0, 0.02);
 }
 
 }  // namespace
