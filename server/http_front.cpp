@@ -145,25 +145,29 @@ class GuardedStream final : public httplib::Stream {
   // Used by a content provider (DataSink::is_writable) before each write: false once the
   // peer has closed (or shut down its side), else whether there is room within the timeout.
   bool is_writable() const override {
-    pollfd p{fd_, POLLIN | POLLRDHUP, 0};
+    pollfd p{fd_, POLLIN | POLLRDHUP | POLLOUT, 0};
     if (::poll(&p, 1, 0) > 0) {
       if (p.revents & (POLLRDHUP | POLLHUP | POLLERR)) return false;
       char c;
       if ((p.revents & POLLIN) && ::recv(fd_, &c, 1, MSG_PEEK | MSG_DONTWAIT) == 0) return false;
+      if (p.revents & POLLOUT) return true;  // room now: no second poll
     }
     return wait_for(fd_, POLLOUT, io_ms_) > 0;
   }
 
   ssize_t read(char* out, size_t size) override {
     if (pos_ == len_) {
-      const int wait_ms = std::min(io_ms_, millis_until(deadline_));
-      if (wait_for(fd_, POLLIN, wait_ms) <= 0) {
-        if (Clock::now() >= deadline_) note_.deadline_missed = true;
-        return -1;
+      // What has arrived is read at once; poll() only when nothing has (a system call less
+      // per read: the request usually arrived before the thread got to it).
+      ssize_t n = recv_now(buffer_, sizeof buffer_);
+      if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) {
+        const int wait_ms = std::min(io_ms_, millis_until(deadline_));
+        if (wait_for(fd_, POLLIN, wait_ms) <= 0) {
+          if (Clock::now() >= deadline_) note_.deadline_missed = true;
+          return -1;
+        }
+        n = recv_now(buffer_, sizeof buffer_);
       }
-      ssize_t n;
-      do n = ::recv(fd_, buffer_, sizeof buffer_, 0);
-      while (n < 0 && errno == EINTR);
       if (n <= 0) return n;
       pos_ = 0;
       len_ = static_cast<size_t>(n);
@@ -186,16 +190,28 @@ class GuardedStream final : public httplib::Stream {
     return static_cast<ssize_t>(n);
   }
 
+  // Sent at once where the socket has room; poll() for room (up to the I/O timeout) only when
+  // it has none.
   ssize_t write(const char* data, size_t size) override {
-    if (wait_for(fd_, POLLOUT, io_ms_) <= 0) return -1;
-    ssize_t n;
-    do n = ::send(fd_, data, size, MSG_NOSIGNAL);
-    while (n < 0 && errno == EINTR);
+    ssize_t n = send_now(data, size);
+    if (n < 0 && (errno == EAGAIN || errno == EWOULDBLOCK)) {
+      if (wait_for(fd_, POLLOUT, io_ms_) <= 0) return -1;
+      n = send_now(data, size);
+    }
     return n;
   }
 
-  void get_remote_ip_and_port(std::string& ip, int& port) const override { address_and_port(fd_, true, ip, port); }
-  void get_local_ip_and_port(std::string& ip, int& port) const override { address_and_port(fd_, false, ip, port); }
+  // Asked by httplib for every request: looked up once per connection.
+  void get_remote_ip_and_port(std::string& ip, int& port) const override {
+    if (remote_port_ < 0) address_and_port(fd_, true, remote_ip_, remote_port_);
+    ip = remote_ip_;
+    port = remote_port_;
+  }
+  void get_local_ip_and_port(std::string& ip, int& port) const override {
+    if (local_port_ < 0) address_and_port(fd_, false, local_ip_, local_port_);
+    ip = local_ip_;
+    port = local_port_;
+  }
   socket_t socket() const override { return fd_; }
   bool has_buffered() const { return pos_ < len_; }
 
@@ -207,6 +223,21 @@ class GuardedStream final : public httplib::Stream {
   char buffer_[4096];
   size_t pos_ = 0, len_ = 0;
   size_t head_bytes_ = 0, line_bytes_ = 0;
+  mutable std::string remote_ip_, local_ip_;
+  mutable int remote_port_ = -1, local_port_ = -1;
+
+  ssize_t recv_now(char* out, size_t size) {
+    ssize_t n;
+    do n = ::recv(fd_, out, size, MSG_DONTWAIT);
+    while (n < 0 && errno == EINTR);
+    return n;
+  }
+  ssize_t send_now(const char* data, size_t size) {
+    ssize_t n;
+    do n = ::send(fd_, data, size, MSG_NOSIGNAL | MSG_DONTWAIT);
+    while (n < 0 && errno == EINTR);
+    return n;
+  }
 };
 
 // httplib's task queue: a thread per connection, up to `max`; past them, connections go to

@@ -133,17 +133,23 @@ void JobService::on_change(const StoreChange& change) {
     }
     if (job) hear_dismissal(*job, "notification");
   }
-  std::lock_guard lock(events_mutex_);
-  ++announcements_;
-  auto wake = [this](Watch& w) {
-    w.changes = announcements_;
-    w.cv.notify_all();
-  };
-  if (change.job_id.empty()) {
-    for (auto& [id, w] : watches_) wake(*w);
-  } else if (const auto it = watches_.find(change.job_id); it != watches_.end()) {
-    wake(*it->second);
+  // The streams are woken after the lock is released: woken under it, each would block on it
+  // at once (a futex wait and wake more per stream and event).
+  std::vector<std::shared_ptr<Watch>> woken;
+  {
+    std::lock_guard lock(watch_mutex_);
+    ++announcements_;
+    auto wake = [&](const std::shared_ptr<Watch>& w) {
+      w->changes = announcements_;
+      woken.push_back(w);
+    };
+    if (change.job_id.empty()) {
+      for (auto& [id, w] : watches_) wake(w);
+    } else if (const auto it = watches_.find(change.job_id); it != watches_.end()) {
+      wake(it->second);
+    }
   }
+  for (const auto& w : woken) w->cv.notify_all();
 }
 
 void JobService::hear_dismissal(ActiveJob& job, const char* how) {
@@ -164,11 +170,12 @@ bool JobService::ready() {
 
 namespace {
 
-// read_scene with the uploaded meshes; `use` gets the ids it named. Throws SceneErrors, or
+// read_scene with the uploaded meshes (without its schema stage for a stored scene, checked
+// when it was submitted); `use` gets the ids it named. Throws SceneErrors, or
 // StoreUnavailable when a mesh could not be loaded for it.
-Scene read_with_meshes(MeshLibrary& meshes, const json& scene, MeshUse& use) {
+Scene read_with_meshes(MeshLibrary& meshes, const json& scene, MeshUse& use, bool stored = false) {
   try {
-    return read_scene(scene, meshes.resolver(use));
+    return stored ? read_checked_scene(scene, meshes.resolver(use)) : read_scene(scene, meshes.resolver(use));
   } catch (const SceneErrors&) {
     if (use.unavailable) std::rethrow_exception(use.unavailable);
     throw;
@@ -308,7 +315,7 @@ EventBatch JobService::wait_events(const std::string& id, std::int64_t after, st
   std::shared_ptr<Watch> watch;
   bool read_first = true;
   {
-    std::lock_guard lock(events_mutex_);
+    std::lock_guard lock(watch_mutex_);
     auto& w = watches_[id];
     if (!w) {
       w = std::make_shared<Watch>();
@@ -321,13 +328,13 @@ EventBatch JobService::wait_events(const std::string& id, std::int64_t after, st
   }
   if (seen_before) *seen_before = 0;
   const auto unwatch = [&](void*) {
-    std::lock_guard lock(events_mutex_);
+    std::lock_guard lock(watch_mutex_);
     const auto it = watches_.find(id);
     if (--watch->waiters == 0 && it != watches_.end() && it->second == watch) watches_.erase(it);
   };
   const std::unique_ptr<void, decltype(unwatch)> watching(watch.get(), unwatch);
   if (!read_first) {
-    std::unique_lock lock(events_mutex_);
+    std::unique_lock lock(watch_mutex_);
     const auto seen = watch->changes;
     const bool woke = watch->cv.wait_until(lock, deadline, [&] { return watch->changes != seen || draining_.load(); });
     if (!woke || draining_) return {};
@@ -335,7 +342,7 @@ EventBatch JobService::wait_events(const std::string& id, std::int64_t after, st
   while (true) {
     std::uint64_t seen = 0;
     {
-      std::lock_guard lock(events_mutex_);
+      std::lock_guard lock(watch_mutex_);
       seen = watch->changes;
     }
     try {
@@ -361,7 +368,7 @@ EventBatch JobService::wait_events(const std::string& id, std::int64_t after, st
       stored_cv_.wait_until(lock, deadline, [&] { return draining_.load(); });
       return {};
     }
-    std::unique_lock lock(events_mutex_);
+    std::unique_lock lock(watch_mutex_);
     const bool woke = watch->cv.wait_until(lock, deadline, [&] { return watch->changes != seen || draining_.load(); });
     if (!woke || draining_) return {};
   }
@@ -434,8 +441,11 @@ int JobService::retry_after_seconds() const {
 
 void JobService::begin_drain() {
   draining_ = true;
-  std::lock_guard lock(events_mutex_);
-  stored_cv_.notify_all();
+  {
+    std::lock_guard lock(events_mutex_);
+    stored_cv_.notify_all();
+  }
+  std::lock_guard lock(watch_mutex_);
   for (auto& [id, w] : watches_) w->cv.notify_all();
 }
 
@@ -518,7 +528,20 @@ void JobService::worker_loop() {
       --running_;
     }
     idle_cv_.notify_all();
+    if (claimed->idempotency_key) {
+      std::lock_guard lock(finished_hook_mutex_);
+      try {
+        if (finished_hook_) finished_hook_(*claimed->idempotency_key);
+      } catch (const std::exception& e) {
+        spdlog::warn("job {}: after its run: {}", job->id, e.what());
+      }
+    }
   }
+}
+
+void JobService::set_finished_hook(std::function<void(const std::string&)> hook) {
+  std::lock_guard lock(finished_hook_mutex_);
+  finished_hook_ = std::move(hook);
 }
 
 void JobService::emit(const std::shared_ptr<ActiveJob>& job, std::int64_t seq, const json& event) {
@@ -664,33 +687,28 @@ void JobService::finish(const std::shared_ptr<ActiveJob>& job, JobOutcome outcom
                     {{"kind", outcome.failure_kind}, {"message", outcome.message}, {"step", outcome.failure_step}}}};
     outcome.terminal = stored(last + 1, ev);
   }
-  std::optional<JobStatus> stored_status;
+  std::optional<FinishStored> stored;
   job->finishing = true;
-  if (!retry_store(job, [&] { stored_status = store_.finish_job(job->lease, outcome); })) return;
-  if (!stored_status) {
+  if (!retry_store(job, [&] { stored = store_.finish_job(job->lease, outcome); })) return;
+  if (!stored) {
     spdlog::warn("job {}: run not recorded (fenced: another run holds it)", job->id);
     return;
   }
-  // What the job stores (scene, events, result), as the store counted it.
-  std::optional<JobRecord> stored_job;
-  try {
-    stored_job = store_.job(job->id);
-  } catch (const std::exception&) {
-  }
   std::lock_guard lock(mutex_);
-  run_seconds_by_outcome_.try_emplace(std::string(to_string(*stored_status)), seconds_buckets())
+  run_seconds_by_outcome_.try_emplace(std::string(to_string(stored->status)), seconds_buckets())
       .first->second.observe(std::chrono::duration<double>(Clock::now() - job->started).count());
-  if (stored_job && stored_job->stored_bytes > 0) {
+  // What the job stores (scene, events, result), as the store counted it.
+  if (stored->stored_bytes > 0) {
     stored_bytes_counts_.resize(kStoredBytesBuckets.size());
     for (size_t b = 0; b < kStoredBytesBuckets.size(); ++b)
-      if (stored_job->stored_bytes <= kStoredBytesBuckets[b]) {
+      if (stored->stored_bytes <= kStoredBytesBuckets[b]) {
         ++stored_bytes_counts_[b];
         break;
       }
-    stored_bytes_sum_ += stored_job->stored_bytes;
+    stored_bytes_sum_ += stored->stored_bytes;
     ++stored_bytes_count_;
   }
-  if (*stored_status != JobStatus::dismissed || outcome.solve_seconds > 0) {
+  if (stored->status != JobStatus::dismissed || outcome.solve_seconds > 0) {
     solve_seconds_ += outcome.solve_seconds;
     iterations_ += outcome.iterations;
     ++finished_runs_;
@@ -715,7 +733,7 @@ void JobService::run_job(const std::shared_ptr<ActiveJob>& job, const JobRecord&
     for (int failures = 0; !scene; ++failures) {
       try {
         MeshUse use;
-        scene.emplace(read_with_meshes(meshes_, stored, use));
+        scene.emplace(read_with_meshes(meshes_, stored, use, true));
       } catch (const StoreUnavailable& e) {
         if (abort_runs_ || job->lost) throw;
         if (failures % 20 == 0) spdlog::warn("job {}: store unavailable, retrying: {}", id, e.what());

@@ -183,6 +183,11 @@ class JobService {
   // The store the jobs live in (studies keep their plans there: server/studies.hpp).
   Store& store() { return store_; }
 
+  // Called on the worker thread after each run this process finished and stored, with the
+  // job's idempotency key (an accuracy study's levels carry theirs: server/studies.hpp). Set
+  // and cleared by its owner; clearing waits for a call in progress.
+  void set_finished_hook(std::function<void(const std::string& idempotency_key)> hook);
+
   // Refuses new submissions and releases every event reader at once.
   void begin_drain();
   bool draining() const { return draining_; }
@@ -242,8 +247,10 @@ class JobService {
   std::thread lease_thread_;
   std::condition_variable lease_cv_;
 
-  // Events: pending batch, stored sequence per active run, readers' wake-up.
+  // Events: pending batch, stored sequence per active run.
   std::mutex events_mutex_;
+  std::mutex finished_hook_mutex_;  // held while the hook runs
+  std::function<void(const std::string&)> finished_hook_;
   std::condition_variable writer_cv_;
   std::condition_variable stored_cv_;  // events stored by this writer; draining
   std::condition_variable room_cv_;    // the pending buffer has room again
@@ -251,7 +258,9 @@ class JobService {
   // The jobs that event streams wait on, each with its count of announcements and a condition
   // of its own: an event wakes its own job's streams only (one condition for all woke the 100
   // streams of a load run at each of some 4,000 events a second; half the server's time went
-  // to waking threads). Kept while a stream waits.
+  // to waking threads). Kept while a stream waits. A lock of their own (not events_mutex_,
+  // which every event produced and stored takes).
+  std::mutex watch_mutex_;
   struct Watch {
     std::uint64_t changes = 0;  // announcements_ at the job's last announcement (or at the watch's start)
     int waiters = 0;

@@ -599,7 +599,7 @@ std::vector<Lease> PostgresStore::append_events(const std::vector<NewEvent>& eve
   return refused;
 }
 
-std::optional<JobStatus> PostgresStore::finish_job(const Lease& lease, const JobOutcome& o) {
+std::optional<FinishStored> PostgresStore::finish_job(const Lease& lease, const JobOutcome& o) {
   Session s(*pool_);
   // One statement: atomic, and fenced by the generation.
   const Result r = s.query(
@@ -618,20 +618,22 @@ std::optional<JobStatus> PostgresStore::finish_job(const Lease& lease, const Job
       "END + "
       "octet_length($11::text) + (SELECT coalesce(sum(octet_length(e.data)), 0) FROM grip_events e WHERE e.job_id = "
       "j.id) "
-      "FROM cur WHERE j.id = cur.id RETURNING j.id, j.status), "
+      "FROM cur WHERE j.id = cur.id RETURNING j.id, j.status, j.stored_bytes), "
       "res AS (INSERT INTO grip_results (job_id, bytes) SELECT id, $9::bytea FROM upd WHERE "
       "upd.status <> 'dismissed' AND $9::bytea IS NOT NULL ON CONFLICT (job_id) DO UPDATE SET bytes = EXCLUDED.bytes, "
       "data = NULL), "
       "ev AS (INSERT INTO grip_events (job_id, seq, type, data) SELECT id, $8::bigint, "
       "CASE WHEN upd.status = 'dismissed' THEN 'job_failed' ELSE $10::text END, "
       "CASE WHEN upd.status = 'dismissed' THEN $12::text ELSE $11::text END FROM upd) "
-      "SELECT status, pg_notify('grip', 'e' || id) FROM upd",
+      "SELECT status, stored_bytes, pg_notify('grip', 'e' || id) FROM upd",
       {lease.job_id, num(lease.generation), std::string(to_string(o.status)), o.message, o.finished,
        num(o.solve_seconds), num(o.iterations), num(o.terminal.seq), o.result ? Param(bytea(*o.result)) : Param(),
        o.terminal.type, o.terminal.data, std::string(kDismissedEvent), o.failure_kind,
        num(std::int64_t{o.failure_step}), num(std::int64_t{o.steps_completed})});
   if (r.rows() == 0) return std::nullopt;
-  return parse_job_status(r.text(0, 0));
+  const auto status = parse_job_status(r.text(0, 0));
+  if (!status) return std::nullopt;
+  return FinishStored{*status, r.int64(0, 1)};
 }
 
 bool PostgresStore::requeue_job(const Lease& lease, const std::string& updated) {

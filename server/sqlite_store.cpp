@@ -436,8 +436,8 @@ std::vector<Lease> SqliteStore::append_events(const std::vector<NewEvent>& event
   return refused;
 }
 
-std::optional<JobStatus> SqliteStore::finish_job(const Lease& lease, const JobOutcome& o) {
-  JobStatus final_status = o.status;
+std::optional<FinishStored> SqliteStore::finish_job(const Lease& lease, const JobOutcome& o) {
+  FinishStored finished{o.status};
   {
     std::lock_guard lock(write_mutex_);
     Transaction tx(*writer_);
@@ -450,7 +450,7 @@ std::optional<JobStatus> SqliteStore::finish_job(const Lease& lease, const JobOu
     }
     if (status != "running" && status != "dismissed") return std::nullopt;
     const bool dismissed = status == "dismissed" || o.status == JobStatus::dismissed;
-    if (dismissed) final_status = JobStatus::dismissed;
+    if (dismissed) finished.status = JobStatus::dismissed;
     StoredEvent terminal = o.terminal;
     if (dismissed) terminal = {o.terminal.seq, "job_failed", std::string(kDismissedEvent)};
     writer_
@@ -458,7 +458,7 @@ std::optional<JobStatus> SqliteStore::finish_job(const Lease& lease, const JobOu
             "UPDATE jobs SET status = ?1, message = ?2, finished = ?3, updated = ?3, "
             "solve_seconds = ?4, iterations = ?5, last_seq = max(last_seq, ?6), failure_kind = ?8, "
             "failure_step = ?9, steps_completed = ?10 WHERE id = ?7")
-        .bind(1, to_string(final_status))
+        .bind(1, to_string(finished.status))
         .bind(2, dismissed ? std::string("dismissed") : o.message)
         .bind(3, o.finished)
         .bind(4, o.solve_seconds)
@@ -475,17 +475,19 @@ std::optional<JobStatus> SqliteStore::finish_job(const Lease& lease, const JobOu
           .bind_blob(2, *o.result)
           .run();
     insert_event(*writer_, lease.job_id, terminal);
-    writer_
-        ->prepare(
-            "UPDATE jobs SET stored_bytes = length(CAST(scene AS BLOB)) + "
-            "coalesce((SELECT length(CAST(data AS BLOB)) FROM results WHERE job_id = ?1), 0) + "
-            "coalesce((SELECT sum(length(CAST(data AS BLOB))) FROM events WHERE job_id = ?1), 0) WHERE id = ?1")
-        .bind(1, lease.job_id)
-        .run();
+    {
+      auto st = writer_->prepare(
+          "UPDATE jobs SET stored_bytes = length(CAST(scene AS BLOB)) + "
+          "coalesce((SELECT length(CAST(data AS BLOB)) FROM results WHERE job_id = ?1), 0) + "
+          "coalesce((SELECT sum(length(CAST(data AS BLOB))) FROM events WHERE job_id = ?1), 0) WHERE id = ?1 "
+          "RETURNING stored_bytes");
+      st.bind(1, lease.job_id);
+      if (st.step()) finished.stored_bytes = st.int64(0);
+    }
     tx.commit();
   }
   announce(StoreChange::events, lease.job_id);
-  return final_status;
+  return finished;
 }
 
 bool SqliteStore::requeue_job(const Lease& lease, const std::string& updated) {

@@ -36,7 +36,7 @@ class SqliteStore : public Store {
   void release_leases(const std::string& owner) override;
   int requeue_expired(const std::string& now) override;
   std::vector<Lease> append_events(const std::vector<NewEvent>& events) override;
-  std::optional<JobStatus> finish_job(const Lease& lease, const JobOutcome& outcome) override;
+  std::optional<FinishStored> finish_job(const Lease& lease, const JobOutcome& outcome) override;
   bool requeue_job(const Lease& lease, const std::string& updated) override;
   std::pair<DismissOutcome, std::optional<JobRecord>> dismiss_job(const std::string& id,
                                                                   const std::string& now) override;

@@ -161,6 +161,12 @@ struct LeaseRenewal {
 };
 
 // A change announced to listeners.
+// What finish_job stored.
+struct FinishStored {
+  JobStatus status;
+  std::int64_t stored_bytes = 0;
+};
+
 struct StoreChange {
   enum Kind { events, job, dismissed } kind = job;  // events stored; status changed; dismissed
   std::string job_id;                               // empty: some job (a claim, a requeue)
@@ -200,8 +206,9 @@ class Store {
   virtual std::vector<Lease> append_events(const std::vector<NewEvent>& events) = 0;
   // Final status, timings, result and terminal event in one transaction, if `lease` is current
   // and the job unfinished. A job dismissed meanwhile ends dismissed (no result, the dismissed
-  // event). Returns the status stored, or none when fenced out.
-  virtual std::optional<JobStatus> finish_job(const Lease& lease, const JobOutcome& outcome) = 0;
+  // event). Returns the status stored and the job's stored bytes (scene, events, result), or
+  // none when fenced out.
+  virtual std::optional<FinishStored> finish_job(const Lease& lease, const JobOutcome& outcome) = 0;
   // Back to accepted, the run's events discarded (last_seq kept), if `lease` is current.
   virtual bool requeue_job(const Lease& lease, const std::string& updated) = 0;
   // Atomically: an accepted job is finished as dismissed (with the dismissed event), a running

@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <optional>
 #include <set>
+#include <string_view>
 
 #include "server/richardson.hpp"
 #include "server/util.hpp"
@@ -70,6 +72,15 @@ bool level_scene(const json& scene, int j, json& out, std::vector<SceneIssue>& i
 // The idempotency key of an accuracy study's level j (from 0): a level is made once, whichever
 // replica reads the study first once the level before is done.
 std::string level_key(const std::string& study, size_t j) { return "study/" + study + "/level/" + std::to_string(j); }
+
+// The study whose level this idempotency key names, if it names one.
+std::optional<std::string> study_of_level_key(const std::string& key) {
+  constexpr std::string_view prefix = "study/", level = "/level/";
+  if (key.rfind(prefix, 0) != 0) return std::nullopt;
+  const size_t end = key.find(level, prefix.size());
+  if (end == std::string::npos || end == prefix.size()) return std::nullopt;
+  return key.substr(prefix.size(), end - prefix.size());
+}
 
 // An accuracy target {"output", "relative", "levels"?, "budget_seconds"?}, normalized with its defaults.
 json plan_accuracy(const json& target, const std::vector<std::string>& names, std::vector<SceneIssue>& issues) {
@@ -435,7 +446,7 @@ json Studies::submit(const json& request, const std::string& request_id) {
       plan.levels[j].h = std::sqrt(static_cast<double>(nodes[0]) / std::max(1, nodes[j]));
   StudyRecord rec{new_job_id(), now_iso8601(), {}};
   // An accuracy study starts with three levels (the fewest that give an estimate); the
-  // others are made as it is read (advance).
+  // others one at a time, as each finishes (advance).
   const size_t first = accuracy ? 3 : plan.levels.size();
   std::vector<std::string> ids;
   try {
@@ -480,6 +491,14 @@ json Studies::submit(const json& request, const std::string& request_id) {
   spdlog::info("study {} accepted: {} levels (request {})", rec.id, ids.size(), request_id.empty() ? "-" : request_id);
   return *study(rec.id);
 }
+
+Studies::Studies(JobService& jobs) : jobs_(jobs) {
+  jobs_.set_finished_hook([this](const std::string& key) {
+    if (const auto id = study_of_level_key(key)) study(*id);
+  });
+}
+
+Studies::~Studies() { jobs_.set_finished_hook(nullptr); }
 
 std::optional<json> Studies::study(const std::string& id) {
   const auto rec = jobs_.store().study(id);

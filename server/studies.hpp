@@ -66,7 +66,13 @@ std::vector<nlohmann::json> study_rows(const nlohmann::json& study);
 
 class Studies {
  public:
-  explicit Studies(JobService& jobs) : jobs_(jobs) {}
+  // An accuracy study's next level is made as soon as the level before finishes here (the
+  // job service's finished hook), and again whenever the study is read: a replica lost
+  // between the two leaves the study to its next reader.
+  explicit Studies(JobService& jobs);
+  ~Studies();
+  Studies(const Studies&) = delete;
+  Studies& operator=(const Studies&) = delete;
   // Checks every level's scene (as a job submission would), then submits them and stores the
   // study; its document (as study() answers). Throws SceneErrors (the plan, or a level's
   // scene: pointers under /scene), QueueFull, ShuttingDown (the levels submitted are dismissed).

@@ -566,8 +566,6 @@ std::vector<LoadStep> read_load_path(Reader& r, json& scene, std::vector<Obstacl
 
 }  // namespace
 
-Scene read_checked_scene(const nlohmann::json& input, const MeshResolver& meshes);
-
 SceneErrors::SceneErrors(std::vector<SceneIssue> issues, bool more)
     : std::runtime_error(join(issues)), issues_(std::move(issues)), more_(more) {}
 

@@ -82,6 +82,10 @@ struct Scene {
 // Throws SceneErrors listing the problems found (at most kMaxSceneIssues). Without `meshes` a
 // scene that names a mesh file is refused (body.mesh.gmsh names the pointer).
 Scene read_scene(const nlohmann::json& scene, const MeshResolver& meshes = {});
+// read_scene without the schema stage, for a scene that passed read_scene before and was
+// stored unchanged (the service's workers read their job's scene again: the schema check was
+// a quarter of that read). The reader's own checks still run and throw SceneErrors.
+Scene read_checked_scene(const nlohmann::json& scene, const MeshResolver& meshes = {});
 // Mesh files are read relative to the scene file's folder.
 Scene read_scene_file(const std::string& path);
 

@@ -194,10 +194,15 @@ TEST_P(StoreContract, AnExpiredLeaseIsTakenOverAndTheOldRunIsFencedOut) {
   EXPECT_FALSE(store->requeue_job({"job-a", run1->generation}, "2025-01-01T00:00:04.000Z"));
   EXPECT_FALSE(store->finish_job({"job-a", run1->generation}, success(6)));
   // The current run finishes, exactly once.
-  EXPECT_EQ(store->finish_job({"job-a", run2->generation}, success(6)), JobStatus::successful);
+  const auto finished = store->finish_job({"job-a", run2->generation}, success(6));
+  ASSERT_TRUE(finished);
+  EXPECT_EQ(finished->status, JobStatus::successful);
   EXPECT_FALSE(store->finish_job({"job-a", run2->generation}, success(7)));
   j = store->job("job-a", false);
   EXPECT_EQ(j->status, JobStatus::successful);
+  // What finish_job says it stored is what the job reports (the scene and events at least).
+  EXPECT_EQ(finished->stored_bytes, j->stored_bytes);
+  EXPECT_GT(j->stored_bytes, 0);
   EXPECT_EQ(j->last_seq, 6);
   EXPECT_EQ(j->iterations, 7);
   EXPECT_EQ(j->owner, "alive");
@@ -235,7 +240,7 @@ TEST_P(StoreContract, RenewedLeasesHoldAndReportDismissals) {
   renewal = store->renew_leases("me", mine, 60);
   ASSERT_EQ(renewal.dismissed.size(), 1u);
   // The run ends as it was about to succeed: dismissed wins, no result.
-  EXPECT_EQ(store->finish_job({"job-b", run->generation}, success(1)), JobStatus::dismissed);
+  EXPECT_EQ(store->finish_job({"job-b", run->generation}, success(1))->status, JobStatus::dismissed);
   const auto events = store->events_after("job-b", 0, 10);
   ASSERT_EQ(events.size(), 1u);
   EXPECT_EQ(events[0].type, "job_failed");
@@ -261,7 +266,7 @@ TEST_P(StoreContract, DismissalDecidesAtomicallyByTheStoredStatus) {
   // Finished: removed with its events and result (a DELETE that races the finish sees this).
   const auto done = store->claim_job("me", "2025-01-01T00:00:02.000Z", 30);
   ASSERT_EQ(done->id, "done");
-  ASSERT_EQ(store->finish_job({"done", done->generation}, success(1)), JobStatus::successful);
+  ASSERT_EQ(store->finish_job({"done", done->generation}, success(1))->status, JobStatus::successful);
   auto [o2, d2] = store->dismiss_job("done", "2025-01-01T00:00:03.000Z");
   EXPECT_EQ(o2, DismissOutcome::removed);
   EXPECT_EQ(d2->status, JobStatus::successful);
