@@ -100,6 +100,9 @@ ContinuumBody::ContinuumBody(PlaneMesh mesh, const std::vector<int>& contact_set
   if (const std::string why = incompressibility_issue(options_); !why.empty()) throw std::invalid_argument(why);
   for (const auto& m : materials_) {
     has_history_ |= m->has_history();
+    if (m->has_history() && options_.analysis == PlaneAnalysis::axisymmetric &&
+        options_.kinematics == ContinuumKinematics::finite && options_.incompressibility != Incompressibility::none)
+      throw std::invalid_argument(kAxisymmetricHistoryIssue);
     if (options_.kinematics == ContinuumKinematics::finite)
       if (const std::string why = m->finite_strain_issue(); !why.empty()) throw std::invalid_argument(why);
   }
@@ -201,11 +204,29 @@ std::vector<Mat2> ContinuumBody::point_deformations(const Vector& q, int e) cons
   return F;
 }
 
-std::vector<FinitePointResponse> ContinuumBody::finite_point_responses(const std::vector<Mat2>& F, int e) const {
+std::vector<FinitePointResponse> ContinuumBody::finite_point_responses(const Vector& q, const std::vector<Mat2>& F,
+                                                                       int e) const {
+  const bool axisymmetric = options_.analysis == PlaneAnalysis::axisymmetric;
+  const ShapeGradients u = axisymmetric ? element_displacements(q, e) : ShapeGradients();
   std::vector<FinitePointResponse> out;
-  for (size_t k = 0; k < F.size(); ++k)
-    out.push_back(
-        material(e).finite_response(0.5 * (F[k].transpose() * F[k] - Mat2::Identity()), history_[e * F.size() + k]));
+  for (size_t k = 0; k < F.size(); ++k) {
+    const Mat2 E = 0.5 * (F[k].transpose() * F[k] - Mat2::Identity());
+    const PointHistory& h = history_[e * F.size() + k];
+    if (!axisymmetric) {
+      out.push_back(material(e).finite_response(E, h));
+      continue;
+    }
+    const ElementPoint& p = integration().points[e][k];
+    const double F33 = 1 + p.N.dot(u.col(0)) / p.radius;
+    const FiniteHoopResponse r = material(e).finite_hoop_response(E, 0.5 * (F33 * F33 - 1), h);
+    FinitePointResponse& o = out.emplace_back(FinitePointResponse{{}, r.history, r.yielding});
+    o.law.S = r.law.S.head<3>();
+    o.law.D = r.law.D.topLeftCorner<3, 3>();
+    o.law.S33 = r.law.S[3];
+    o.law.dS33 = r.law.D.block<1, 3>(3, 0);
+    o.law.dS33_dE33 = r.law.D(3, 3);
+    o.law.C33 = F33 * F33;
+  }
   return out;
 }
 
@@ -213,7 +234,7 @@ void ContinuumBody::commit(const Vector& q) {
   if (!has_history_) return;
   for (int e = 0; e < element_count(); ++e) {
     if (options_.kinematics == ContinuumKinematics::finite) {
-      const std::vector<FinitePointResponse> r = finite_point_responses(point_deformations(q, e), e);
+      const std::vector<FinitePointResponse> r = finite_point_responses(q, point_deformations(q, e), e);
       for (size_t k = 0; k < r.size(); ++k) history_[e * r.size() + k] = r[k].history;
       continue;
     }
@@ -264,7 +285,12 @@ void ContinuumBody::internal_force(const Vector& q, Vector& force, Triplets* tan
     // A law with history answers from the committed state of each point.
     const size_t np = in.points[e].size();
     PointLaw law;
-    if (has_history_)
+    HoopLaw hoop_law;
+    if (has_history_ && options_.analysis == PlaneAnalysis::axisymmetric)
+      hoop_law = [&](int k, const Mat2& E, double E33) {
+        return material(e).finite_hoop_response(E, E33, history_[e * np + k]).law;
+      };
+    else if (has_history_)
       law = [&](int k, const Mat2& E) { return material(e).finite_response(E, history_[e * np + k]).law; };
     const auto& el = mesh_.elements[e];
     for (int a = 0; a < n; ++a) u.row(a) << q[node_dof(el[a], 0)], q[node_dof(el[a], 1)];
@@ -272,7 +298,7 @@ void ContinuumBody::internal_force(const Vector& q, Vector& force, Triplets* tan
       dilatation_total_lagrangian(in.points[e], in.dilatation[e], u, material(e), fe, tangent ? &Ke : nullptr, law);
     else if (options_.incompressibility == Incompressibility::f_bar)
       f_bar_total_lagrangian(in.points[e], in.centroids[e], u, material(e), fe, tangent ? &Ke : nullptr, law);
-    else total_lagrangian(in.points[e], u, material(e), fe, tangent ? &Ke : nullptr, law);
+    else total_lagrangian(in.points[e], u, material(e), fe, tangent ? &Ke : nullptr, law, hoop_law);
     const int m = static_cast<int>(fe.size());
     for (int i = 0; i < m; ++i) {
       const int gi = node_dof(el[i / 2], i % 2);
@@ -432,7 +458,7 @@ FieldTable ContinuumBody::element_fields(const Vector& q) const {
       };
       if (finite) {
         const std::vector<Mat2> F = point_deformations(q, e);
-        const std::vector<FinitePointResponse> r = finite_point_responses(F, e);
+        const std::vector<FinitePointResponse> r = finite_point_responses(q, F, e);
         for (size_t k = 0; k < r.size(); ++k) add(k, cauchy_stress(F[k], r[k].law), r[k].history, r[k].yielding);
       } else {
         const std::vector<PointResponse> r = point_responses(q, e);

@@ -61,6 +61,12 @@ std::vector<int> axis_nodes(const PlaneMesh& mesh);
 std::string id_list(const std::vector<int>& ids);    // "3, 7, 12" (the first 20 and a count)
 const char* element_name(ContinuumElement element);  // as the scene names it: "q4_bbar", ...
 
+// Why a law with history (j2_plasticity) under finite kinematics in axisymmetry takes no shared
+// dilatation yet: the dilatation element asks the law's hoop response without history.
+inline constexpr const char* kAxisymmetricHistoryIssue =
+    "finite-strain j2_plasticity in axisymmetry runs on the displacement elements (t6, q8, q9); \"mixed\" and "
+    "\"f_bar\" in axisymmetry take elastic laws so far";
+
 class ContinuumBody final : public Body {
  public:
   // The mesh must pass check_mesh (InvalidMesh otherwise); contact_set is a node set on the
@@ -131,9 +137,10 @@ class ContinuumBody final : public Body {
   // A law with history: the response of each integration point of element e at q.
   std::vector<PointResponse> point_responses(const Vector& q, int e) const;
   // Finite kinematics: the deformation gradient the law sees at each point of element e (F_bar
-  // with f_bar and mixed), and the responses of a law with history to them.
+  // with f_bar and mixed), and the responses of a law with history to them (axisymmetric: with
+  // the hoop stretch at q; the response's C33 is its square).
   std::vector<Mat2> point_deformations(const Vector& q, int e) const;
-  std::vector<FinitePointResponse> finite_point_responses(const std::vector<Mat2>& F, int e) const;
+  std::vector<FinitePointResponse> finite_point_responses(const Vector& q, const std::vector<Mat2>& F, int e) const;
 
   // Integration points and the linear stiffness: built at the first solve, not by the
   // constructor, so that reading and validating a large scene stays cheap (the service reads

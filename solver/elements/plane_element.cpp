@@ -271,7 +271,8 @@ namespace {
 // over the upper triangle (Ke is symmetric: D is, and so is dN_a . S dN_b), mirrored once.
 template <int N, int R>
 void total_lagrangian_fixed(const std::vector<ElementPoint>& points, const ShapeGradients& u_dynamic,
-                            const PlaneMaterial& material, Vector& fe_out, Matrix* Ke_out, const PointLaw& law) {
+                            const PlaneMaterial& material, Vector& fe_out, Matrix* Ke_out, const PointLaw& law,
+                            const HoopLaw& hoop_law) {
   constexpr int M = 2 * N;
   using Nodes2 = Eigen::Matrix<double, N, 2>;
   const Nodes2 u = u_dynamic;
@@ -290,7 +291,8 @@ void total_lagrangian_fixed(const std::vector<ElementPoint>& points, const Shape
     Eigen::Matrix<double, R, R> D;
     if constexpr (R == 4) {
       F33 = 1 + p.N.dot(u.col(0)) / p.radius;
-      const HoopResponse r = material.hoop_response(E, 0.5 * (F33 * F33 - 1));
+      const double E33 = 0.5 * (F33 * F33 - 1);
+      const HoopResponse r = hoop_law ? hoop_law(static_cast<int>(k), E, E33) : material.hoop_response(E, E33);
       S_voigt = r.S.head<3>();
       S33 = r.S[3];
       D = r.D;
@@ -348,26 +350,27 @@ void total_lagrangian_fixed(const std::vector<ElementPoint>& points, const Shape
 
 template <int N>
 void total_lagrangian_nodes(const std::vector<ElementPoint>& points, const ShapeGradients& u,
-                            const PlaneMaterial& material, Vector& fe, Matrix* Ke, const PointLaw& law) {
-  if (points.front().radius > 0) total_lagrangian_fixed<N, 4>(points, u, material, fe, Ke, law);
-  else total_lagrangian_fixed<N, 3>(points, u, material, fe, Ke, law);
+                            const PlaneMaterial& material, Vector& fe, Matrix* Ke, const PointLaw& law,
+                            const HoopLaw& hoop_law) {
+  if (points.front().radius > 0) total_lagrangian_fixed<N, 4>(points, u, material, fe, Ke, law, hoop_law);
+  else total_lagrangian_fixed<N, 3>(points, u, material, fe, Ke, law, hoop_law);
 }
 
 }  // namespace
 
 void total_lagrangian(const std::vector<ElementPoint>& points, const ShapeGradients& u, const PlaneMaterial& material,
-                      Vector& fe, Matrix* Ke, const PointLaw& law) {
+                      Vector& fe, Matrix* Ke, const PointLaw& law, const HoopLaw& hoop_law) {
   switch (u.rows()) {
     case 3:
-      return total_lagrangian_nodes<3>(points, u, material, fe, Ke, law);
+      return total_lagrangian_nodes<3>(points, u, material, fe, Ke, law, hoop_law);
     case 4:
-      return total_lagrangian_nodes<4>(points, u, material, fe, Ke, law);
+      return total_lagrangian_nodes<4>(points, u, material, fe, Ke, law, hoop_law);
     case 6:
-      return total_lagrangian_nodes<6>(points, u, material, fe, Ke, law);
+      return total_lagrangian_nodes<6>(points, u, material, fe, Ke, law, hoop_law);
     case 8:
-      return total_lagrangian_nodes<8>(points, u, material, fe, Ke, law);
+      return total_lagrangian_nodes<8>(points, u, material, fe, Ke, law, hoop_law);
     case 9:
-      return total_lagrangian_nodes<9>(points, u, material, fe, Ke, law);
+      return total_lagrangian_nodes<9>(points, u, material, fe, Ke, law, hoop_law);
   }
   throw std::logic_error("total_lagrangian: no element of " + std::to_string(u.rows()) + " nodes");
 }

@@ -84,8 +84,10 @@ Mat2 deformation_gradient(const ElementPoint& point, const ShapeGradients& u);
 // `points`) from the Green-Lagrange strain E there: a law with history answers from that
 // point's committed state.
 using PointLaw = std::function<MaterialResponse(int point, const Mat2& E)>;
+// `hoop_law`, if given, answers for `material` at axisymmetric points from E and the hoop E33.
+using HoopLaw = std::function<HoopResponse(int point, const Mat2& E, double E33)>;
 void total_lagrangian(const std::vector<ElementPoint>& points, const ShapeGradients& u, const PlaneMaterial& material,
-                      Vector& fe, Matrix* Ke, const PointLaw& law = {});
+                      Vector& fe, Matrix* Ke, const PointLaw& law = {}, const HoopLaw& hoop_law = {});
 
 // F-bar in plane strain: the law sees F_bar = (J0 / J)^(1/2) F, whose in-plane determinant is
 // J0 = det F at the element's centre (`centre`), so that every point changes volume as the

@@ -6,7 +6,8 @@
 //     {"law": "mooney_rivlin", "c10", "c01" (default 0), "bulk"}
 //     j2_plasticity: "yield_stress", "hardening": {"linear": H} |
 //     {"power": {"K", "n"}} | {"table": [[eps_p, sigma_y], ...]} (default perfectly plastic),
-//     "kinematic_hardening": H_k (default 0; linear kinematics only)
+//     "kinematic_hardening": H_k (default 0; linear kinematics only),
+//     "hill48": {"r"} | {"r0", "r45" (plane stress), "r90"} (linear kinematics, isotropic hardening)
 //   "mesh": one of
 //     {"nodes": [[x, y], ...], "elements": [[n0, n1, n2(, ...9)], ...], "sets": {name: [ids]}}
 //     {"rectangle": {"origin", "size", "divisions": [nx, ny], "refine": {"towards", "size", "extent"}}}
@@ -65,13 +66,38 @@ std::shared_ptr<const PlaneMaterial> read_j2_material(Reader& r, json& mat, cons
       }
     }
   }
+  // Hill's 1948 anisotropy: a normal r, or r0, r45 (plane stress only) and r90.
+  std::optional<Hill48> hill;
+  if (json* hj = mat.contains("hill48") ? r.object(mat, mp, "hill48", true) : nullptr) {
+    const std::string hp = mp + "/hill48";
+    Hill48& v = hill.emplace();
+    if (hj->contains("r")) {
+      for (const char* key : {"r0", "r45", "r90"})
+        if (hj->contains(key)) r.error(hp + "/" + key, "give either r (normal anisotropy) or r0, r45, r90");
+      v.r0 = v.r45 = v.r90 = r.positive(*hj, hp, "r");
+    } else if (options.analysis == PlaneAnalysis::axisymmetric) {
+      r.error(hp, "axisymmetry takes a normal r only (planar anisotropy would vary round the circle)");
+    } else {
+      v.r0 = r.positive(*hj, hp, "r0");
+      v.r90 = r.positive(*hj, hp, "r90");
+      if (options.analysis == PlaneAnalysis::plane_stress) v.r45 = r.positive(*hj, hp, "r45");
+      else if (hj->contains("r45"))
+        r.error(hp + "/r45",
+                "has no role in plane strain (the section through the thickness: the sheet-plane shear "
+                "that r45 sets is zero)");
+      else v.r45 = v.r0;
+    }
+  }
   if (r.issues.size() > before) return nullptr;
-  if (const std::string why = j2_data_issue(yield_stress, h, kinematic); !why.empty()) {
+  std::string why = j2_data_issue(yield_stress, h, kinematic);
+  if (why.empty() && hill) why = hill48_data_issue(*hill, options.analysis, kinematic);
+  if (!why.empty()) {
     const size_t colon = why.find(':');
     r.error(mp + "/" + why.substr(0, colon), why.substr(colon + 2));
     return nullptr;
   }
-  auto law = std::make_shared<J2Material>(young, poisson, yield_stress, std::move(h), kinematic, options.analysis);
+  auto law =
+      std::make_shared<J2Material>(young, poisson, yield_stress, std::move(h), kinematic, options.analysis, hill);
   if (options.kinematics == ContinuumKinematics::finite)
     if (const std::string why = law->finite_strain_issue(); !why.empty()) {
       const size_t colon = why.find(':');
@@ -86,7 +112,7 @@ std::shared_ptr<const PlaneMaterial> read_j2_material(Reader& r, json& mat, cons
 std::shared_ptr<const PlaneMaterial> read_mooney_rivlin(Reader& r, json& mat, const std::string& mp,
                                                         PlaneAnalysis analysis) {
   const size_t before = r.issues.size();
-  for (const char* key : {"young", "poisson", "yield_stress", "hardening", "kinematic_hardening"})
+  for (const char* key : {"young", "poisson", "yield_stress", "hardening", "kinematic_hardening", "hill48"})
     if (mat.contains(key))
       r.error(mp + "/" + key, "is not a constant of law \"mooney_rivlin\": give c10, c01 and bulk");
   const double c10 = r.number(mat, mp, "c10");
@@ -524,7 +550,7 @@ void read_continuum(Reader& r, json& body, Problem& problem, const std::string& 
     const double poisson = r.number(mat, mp, "poisson", 0.3);
     if (!(poisson > -1 && poisson < 0.5)) r.error(mp + "/poisson", show(mat["poisson"]) + " is not in (-1, 0.5)");
     if (law == "j2_plasticity") return read_j2_material(r, mat, mp, young, poisson, options);
-    for (const char* key : {"yield_stress", "hardening", "kinematic_hardening"})
+    for (const char* key : {"yield_stress", "hardening", "kinematic_hardening", "hill48"})
       if (mat.contains(key)) r.error(mp + "/" + key, "belongs to law \"j2_plasticity\" (this law is elastic)");
     if (law == "neo_hookean") return std::make_shared<NeoHookeMaterial>(young, poisson, options.analysis);
     return std::make_shared<HookeMaterial>(young, poisson, options.analysis);
@@ -559,6 +585,12 @@ void read_continuum(Reader& r, json& body, Problem& problem, const std::string& 
     for (const PlaneMaterial* law : laws)
       if (const std::string why = law ? element_pair_issue(options, *law) : ""; !why.empty()) {
         r.error(ptr + "/element", why);
+        break;
+      }
+    for (const PlaneMaterial* law : laws)
+      if (law && law->has_history() && options.analysis == PlaneAnalysis::axisymmetric &&
+          options.kinematics == ContinuumKinematics::finite && options.incompressibility != Incompressibility::none) {
+        r.error(ptr + "/incompressibility", kAxisymmetricHistoryIssue);
         break;
       }
   }

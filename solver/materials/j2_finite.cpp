@@ -28,11 +28,10 @@ Mat2 tensor(double a11, double a22, double a12) { return (Mat2() << a11, a12, a1
 }  // namespace
 
 std::string J2Material::finite_strain_issue() const {
+  if (hill_) return "hill48: Hill's anisotropy is implemented for small strain (linear kinematics)";
   if (kinematic_ > 0)
     return "kinematic_hardening: finite kinematics takes isotropic hardening only (kinematic hardening is "
            "implemented for small strain: linear kinematics)";
-  if (analysis_ == PlaneAnalysis::axisymmetric)
-    return "law: finite-strain j2_plasticity is implemented for plane strain and plane stress";
   return {};
 }
 
@@ -73,8 +72,22 @@ FinitePointResponse J2Material::finite_point(const Mat2& E, double E33, const Po
   return out;
 }
 
+FiniteHoopResponse J2Material::finite_hoop_response(const Mat2& E, double E33, const PointHistory& committed) const {
+  if (const std::string why = finite_strain_issue(); !why.empty()) throw std::logic_error("j2_plasticity: " + why);
+  if (analysis_ != PlaneAnalysis::axisymmetric)
+    throw std::logic_error("j2_plasticity: finite_hoop_response is the axisymmetric response");
+  FiniteHoopResponse out;
+  const FinitePointResponse r = finite_point(E, E33, committed, out.law.D);
+  out.law.S << r.law.S, r.law.S33;
+  out.history = r.history;
+  out.yielding = r.yielding;
+  return out;
+}
+
 FinitePointResponse J2Material::finite_response(const Mat2& E, const PointHistory& committed) const {
   if (const std::string why = finite_strain_issue(); !why.empty()) throw std::logic_error("j2_plasticity: " + why);
+  if (analysis_ == PlaneAnalysis::axisymmetric)
+    throw std::logic_error("j2_plasticity: the axisymmetric response needs the hoop strain (finite_hoop_response)");
   Mat4 D;
   if (analysis_ == PlaneAnalysis::plane_strain) {
     FinitePointResponse out = finite_point(E, 0.0, committed, D);

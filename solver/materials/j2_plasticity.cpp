@@ -62,11 +62,16 @@ std::string j2_data_issue(double yield_stress, const IsotropicHardening& h, doub
 }
 
 J2Material::J2Material(double young, double poisson, double yield_stress, IsotropicHardening hardening,
-                       double kinematic_modulus, PlaneAnalysis analysis)
+                       double kinematic_modulus, PlaneAnalysis analysis, std::optional<Hill48> hill)
     : elastic_(young, poisson, analysis), lame_(Lame::from(young, poisson)), analysis_(analysis),
-      yield_stress_(yield_stress), hardening_(std::move(hardening)), kinematic_(kinematic_modulus) {
+      yield_stress_(yield_stress), hardening_(std::move(hardening)), kinematic_(kinematic_modulus), hill_(hill) {
   if (const std::string why = j2_data_issue(yield_stress_, hardening_, kinematic_); !why.empty())
     throw std::invalid_argument("j2_plasticity: " + why);
+  if (hill_) {
+    if (const std::string why = hill48_data_issue(*hill_, analysis_, kinematic_); !why.empty())
+      throw std::invalid_argument("j2_plasticity: " + why);
+    hill_metric_ = hill48_metric(*hill_, analysis_);
+  }
   if (hardening_.kind == IsotropicHardening::Kind::power)
     alpha0_ = std::pow(yield_stress_ / hardening_.K, 1 / hardening_.n);
 }
@@ -108,6 +113,7 @@ double J2Material::hardening_slope(double alpha) const {
 }
 
 PointResponse J2Material::return_map(const Vec4& strain, const PointHistory& h) const {
+  if (hill_) return hill_return(strain, h);
   const double G = lame_.mu, K = lame_.lambda + 2 * G / 3, Hk = kinematic_;
   const Mat4 P = deviator();
   const Vec4 ee = strain - h.plastic_strain;

@@ -11,7 +11,8 @@
 // Finite strain (j2_finite.cpp; docs/algorithm.md#finite-strain-j2-plasticity): F = Fe Fp,
 // Hooke's law on the logarithmic elastic strain, and the same radial return on it, which is
 // the exponential-map return (plastic flow exact in volume: det Fp = 1); isotropic hardening
-// only, plane strain and plane stress.
+// only; plane strain, plane stress and axisymmetric (the hoop stretch r / R the third direction).
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -33,6 +34,25 @@ struct IsotropicHardening {
   std::vector<std::pair<double, double>> table;
 };
 
+// Hill's 1948 anisotropy (docs/algorithm.md#hill-1948-anisotropy) from the Lankford
+// coefficients r = width / thickness plastic strain ratio in uniaxial tension at 0, 45 and 90
+// degrees to the rolling direction; the yield stress is that in the rolling direction. The
+// sheet's axes in the plane: plane stress, x rolling, y transverse, z the thickness (r0, r45,
+// r90); plane strain, the section through the thickness, x rolling, y the thickness, z
+// transverse (r0 and r90: the sheet-plane shear that r45 sets is zero there); axisymmetric, r
+// and theta in the sheet, z its normal: a normal r only (r0 = r45 = r90; planar anisotropy
+// would vary round the circle). The through-thickness shears, which no r fixes, keep their
+// isotropic coefficient 3/2.
+struct Hill48 {
+  double r0 = 1.0, r45 = 1.0, r90 = 1.0;
+};
+
+// Why the r-values are not usable in `analysis` with that kinematic hardening modulus (empty
+// if they are), as "field: reason" with the field relative to the material ("hill48/r0", ...).
+std::string hill48_data_issue(const Hill48& hill, PlaneAnalysis analysis, double kinematic_modulus);
+// Hill's M of sigma_bar^2 = s . M s, s = (11, 22, 12, 33) in the analysis' axes (von Mises at r = 1).
+Eigen::Matrix4d hill48_metric(const Hill48& hill, PlaneAnalysis analysis);
+
 // Why the data are not a well-posed J2 law (empty if they are), as "field: reason" with the
 // field relative to the material ("yield_stress", "hardening/table/2/1", ...).
 std::string j2_data_issue(double yield_stress, const IsotropicHardening& hardening, double kinematic_modulus);
@@ -40,22 +60,28 @@ std::string j2_data_issue(double yield_stress, const IsotropicHardening& hardeni
 class J2Material final : public PlaneMaterial {
  public:
   // Throws std::invalid_argument where j2_data_issue finds an issue.
+  // With `hill`, Hill's 1948 yield function in place of von Mises' (isotropic hardening only).
   J2Material(double young, double poisson, double yield_stress, IsotropicHardening hardening, double kinematic_modulus,
-             PlaneAnalysis analysis);
+             PlaneAnalysis analysis, std::optional<Hill48> hill = std::nullopt);
   // The elastic law (Hooke's), what the material is until it yields.
   MaterialResponse response(const Mat2& E) const override;
   bool has_history() const override { return true; }
   bool isochoric_flow() const override { return true; }
   PointResponse small_strain_response(const Eigen::Vector4d& strain, const PointHistory& committed) const override;
   FinitePointResponse finite_response(const Mat2& E, const PointHistory& committed) const override;
+  // Axisymmetric finite strain: the return of finite_response with the hoop stretch as the
+  // third principal direction (E33 = (F33^2 - 1) / 2 given, as the plane-strain one at E33 = 0).
+  FiniteHoopResponse finite_hoop_response(const Mat2& E, double E33, const PointHistory& committed) const override;
   std::string finite_strain_issue() const override;
 
   double yield_stress(double alpha) const;     // sigma_y(alpha)
   double hardening_slope(double alpha) const;  // d sigma_y / d alpha (right derivative)
 
  private:
-  // The 3D return with eps33 given.
+  // The 3D return with eps33 given (Hill's where the law has it).
   PointResponse return_map(const Eigen::Vector4d& strain, const PointHistory& committed) const;
+  // The closest-point return in Hill's metric (j2_hill48.cpp).
+  PointResponse hill_return(const Eigen::Vector4d& strain, const PointHistory& committed) const;
   // Finite strain at the in-plane E and E33: S (11, 22, 12, 33) and dS/dE (4 x 4, E as
   // (11, 22, 2 x 12, 33)) in `law.S`, `law.S33` and `D`.
   FinitePointResponse finite_point(const Mat2& E, double E33, const PointHistory& committed, Eigen::Matrix4d& D) const;
@@ -67,6 +93,10 @@ class J2Material final : public PlaneMaterial {
   IsotropicHardening hardening_;
   double kinematic_;
   double alpha0_ = 0.0;  // power law
+  // Hill: sigma_bar^2 = s . M s with s = (11, 22, 12, 33); M s is the flow direction (engineering
+  // shear). Von Mises: no M.
+  std::optional<Hill48> hill_;
+  Eigen::Matrix4d hill_metric_ = Eigen::Matrix4d::Zero();
 };
 
 }  // namespace grip

@@ -54,6 +54,14 @@ struct HoopResponse {
   Eigen::Matrix4d D = Eigen::Matrix4d::Zero();
 };
 
+// Axisymmetric finite strain of a point with history: the hoop response from the committed
+// history, and the history at (E, E33) (what a commit keeps).
+struct FiniteHoopResponse {
+  HoopResponse law;
+  PointHistory history;
+  bool yielding = false;  // the point flows plastically from its committed state
+};
+
 // Small-strain response of a point with history, in the order (11, 22, 12, 33) of the
 // axisymmetric element (rr, zz, rz, tt): strain with the engineering shear, 33 the hoop strain
 // in axisymmetry and zero in plane strain.
@@ -95,9 +103,13 @@ class PlaneMaterial {
   // Why the law cannot run under finite kinematics, as "field: reason" (empty if it can).
   virtual std::string finite_strain_issue() const { return {}; }
   // Axisymmetric finite strain: S (11, 22, 12, 33) and dS/dE (4 x 4, symmetric) for the
-  // in-plane E and the hoop E33 = (F33^2 - 1) / 2 (F33 = r / R). Laws with history: not
-  // defined (the body refuses them under finite kinematics).
+  // in-plane E and the hoop E33 = (F33^2 - 1) / 2 (F33 = r / R). Laws with history answer
+  // finite_hoop_response instead.
   virtual HoopResponse hoop_response(const Mat2& E, double E33) const;
+  // hoop_response from the committed history. Elastic laws: hoop_response(E, E33).
+  virtual FiniteHoopResponse finite_hoop_response(const Mat2& E, double E33, const PointHistory& committed) const {
+    return {hoop_response(E, E33), committed, false};
+  }
 };
 
 // Lame constants from Young's modulus and Poisson's ratio (3D values: plane stress is

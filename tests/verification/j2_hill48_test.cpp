@@ -1,0 +1,317 @@
+// Hill's 1948 anisotropy of j2_plasticity at small strain (docs/algorithm.md#hill-1948-anisotropy):
+// - uniaxial tension of a sheet (plane stress) at 0, 45 and 90 degrees to the rolling direction,
+//   one point driven along the direction with the two other stresses zero: the yield stress
+//   sigma_y / k, k^2 = F s^4 + G c^4 + H (c^2 - s^2)^2 + 2 N c^2 s^2 (Hill's formula with
+//   F, G, H, N from r0, r45, r90), the plastic branch sigma = sigma_y(alpha) / k with the strain
+//   along the direction sigma / E + k alpha (work-conjugate alpha), and the width to thickness
+//   plastic strain ratio r of each direction, linear and Swift hardening;
+// - r = 1 gives the von Mises law's numbers (a bent block, plane strain, plane stress and
+//   axisymmetric, loaded, unloaded and reversed) to 1e-10;
+// - the consistent tangent against central differences of the internal force, and Newton's
+//   quadratic convergence on a plastic step, with planar anisotropy (plane stress, plane strain)
+//   and normal anisotropy (axisymmetric);
+// - bad data refused with its pointer: r <= 0, r45 in plane strain, planar anisotropy in
+//   axisymmetry, finite kinematics, kinematic hardening.
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <Eigen/SparseCore>
+
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+
+#include "solver/elements/continuum.hpp"
+#include "solver/materials/j2_plasticity.hpp"
+#include "tests/support/newton_driver.hpp"
+#include "tests/support/scenes.hpp"
+#include "tests/support/tangent_check.hpp"
+
+namespace grip {
+namespace {
+
+using testing::Driver;
+
+constexpr double kYoung = 200e3, kPoisson = 0.3, kYield = 250.0;
+
+struct Law {
+  const char* name;
+  IsotropicHardening hardening;
+};
+
+std::vector<Law> laws() {
+  IsotropicHardening linear;
+  linear.modulus = 2000.0;
+  IsotropicHardening power;
+  power.kind = IsotropicHardening::Kind::power;
+  power.K = 600.0;
+  power.n = 0.2;
+  return {{"linear", linear}, {"power", power}};
+}
+
+// A steel-like sheet (r0 < r90, r45 the lowest) and a normal r for axisymmetry.
+const Hill48 kSheet{2.1, 1.6, 2.6};
+
+std::shared_ptr<J2Material> material(const Law& law, PlaneAnalysis analysis, std::optional<Hill48> hill) {
+  return std::make_shared<J2Material>(kYoung, kPoisson, kYield, law.hardening, 0.0, analysis, hill);
+}
+
+// Hill's factor k of uniaxial stress at angle t to the rolling direction: sigma_bar = k sigma.
+double hill_factor(const Hill48& h, double t) {
+  const double F = h.r0 / (h.r90 * (1 + h.r0)), G = 1 / (1 + h.r0), H = h.r0 / (1 + h.r0);
+  const double N = (h.r0 + h.r90) * (1 + 2 * h.r45) / (2 * h.r90 * (1 + h.r0));
+  const double c = std::cos(t), s = std::sin(t);
+  return std::sqrt(F * std::pow(s, 4) + G * std::pow(c, 4) + H * std::pow(c * c - s * s, 2) + 2 * N * c * c * s * s);
+}
+
+// Uniaxial stress at angle t of one plane-stress point, the strain along it prescribed: the
+// strain e n (x) n + b t (x) t + c sym(n (x) t) with b, c from sigma_tt = sigma_nt = 0
+// (Newton's method on the consistent tangent); commits like a body.
+struct UniaxialPoint {
+  const J2Material& m;
+  double angle;
+  PointHistory history;
+  PointResponse response;
+  double b = 0.0, c = 0.0;
+
+  Eigen::Vector2d n() const { return {std::cos(angle), std::sin(angle)}; }
+  Eigen::Vector2d t() const { return {-std::sin(angle), std::cos(angle)}; }
+  static Eigen::Vector4d voigt(const Mat2& E) { return {E(0, 0), E(1, 1), 2 * E(0, 1), 0.0}; }
+
+  // The stress along the direction at strain e along it.
+  double stretch(double e) {
+    const Mat2 nn = n() * n().transpose(), tt = t() * t().transpose();
+    const Mat2 nt = 0.5 * (n() * t().transpose() + t() * n().transpose());
+    for (int it = 0;; ++it) {
+      response = m.small_strain_response(voigt(e * nn + b * tt + c * nt), history);
+      const Eigen::Vector4d& s = response.stress;
+      const Mat2 S = (Mat2() << s[0], s[2], s[2], s[1]).finished();
+      const Eigen::Vector2d residual(t().dot(S * t()), n().dot(S * t()));
+      if (residual.norm() <= 1e-12 * kYield) break;
+      EXPECT_LT(it, 30) << "the uniaxial point did not converge";
+      if (it == 30) break;
+      // d sigma_tt and d sigma_nt per d b and d c.
+      Eigen::Matrix2d J;
+      for (int k = 0; k < 2; ++k) {
+        const Eigen::Vector4d ds = response.D * voigt(k == 0 ? tt : nt);
+        const Mat2 dS = (Mat2() << ds[0], ds[2], ds[2], ds[1]).finished();
+        J.col(k) << t().dot(dS * t()), n().dot(dS * t());
+      }
+      const Eigen::Vector2d step = J.partialPivLu().solve(-residual);
+      b += step[0];
+      c += step[1];
+    }
+    history = response.history;
+    const Eigen::Vector4d& s = response.stress;
+    return n().dot((Mat2() << s[0], s[2], s[2], s[1]).finished() * n());
+  }
+};
+
+// The closed form along the direction: sigma = E e (elastic) or E (e - k alpha) = sigma_y(alpha) / k.
+double uniaxial_closed_form(const J2Material& m, double k, double e, double* alpha) {
+  *alpha = 0.0;
+  if (kYoung * e <= m.yield_stress(0) / k) return kYoung * e;
+  double lo = 0.0, hi = e / k;
+  for (int it = 0; it < 200; ++it) {
+    const double a = 0.5 * (lo + hi);
+    (m.yield_stress(a) / k > kYoung * (e - k * a) ? hi : lo) = a;
+  }
+  *alpha = 0.5 * (lo + hi);
+  return m.yield_stress(*alpha) / k;
+}
+
+TEST(Hill48, UniaxialTensionAlongTheSheetGivesHillsYieldStressAndTheRValues) {
+  const double r_of[] = {kSheet.r0, kSheet.r45, kSheet.r90};
+  for (const Law& law : laws())
+    for (int d = 0; d < 3; ++d) {
+      const double angle = 0.25 * std::numbers::pi * d;
+      SCOPED_TRACE(std::string(law.name) + " at " + std::to_string(45 * d) + " degrees");
+      const auto m = material(law, PlaneAnalysis::plane_stress, kSheet);
+      const double k = hill_factor(kSheet, angle), first_yield = kYield / k;
+      UniaxialPoint p{*m, angle};
+      double worst = 0.0, alpha = 0.0, e = 0.0;
+      bool yielded = false;
+      // Through first yield in small steps, then on to 20 yield strains.
+      for (int s = 1; s <= 40; ++s) {
+        e = (s <= 20 ? 0.1 * s : 2.0 + 0.9 * (s - 20)) * first_yield / kYoung;
+        const double sigma = p.stretch(e);
+        const double expected = uniaxial_closed_form(*m, k, e, &alpha);
+        worst = std::max(worst, std::abs(sigma - expected) / kYield);
+        EXPECT_NEAR(p.history.equivalent_plastic_strain, alpha, 1e-12);
+        // Elastic up to sigma_y / k, flowing beyond.
+        EXPECT_EQ(p.response.yielding, kYoung * e > first_yield * (1 + 1e-12));
+        yielded |= p.response.yielding;
+      }
+      EXPECT_TRUE(yielded);
+      EXPECT_LT(worst, 1e-10);
+      // The plastic strain's width (t t) to thickness (33) ratio.
+      const Eigen::Vector4d& ep = p.history.plastic_strain;
+      const Eigen::Vector2d t = p.t();
+      const double width = t[0] * t[0] * ep[0] + t[1] * t[1] * ep[1] + t[0] * t[1] * ep[2];
+      const double r = width / ep[3];
+      EXPECT_NEAR(r, r_of[d], 1e-9 * r_of[d]);
+      // Plastic flow keeps the volume.
+      EXPECT_NEAR(ep[0] + ep[1] + ep[3], 0.0, 1e-12 * alpha);
+      std::printf(
+          "hill48 %-6s %2d deg: first yield %.3f (sigma_y / k), |sigma - closed form| / sigma_y <= %.1e, r = %.6f "
+          "(given %.2f), alpha = %.5f\n",
+          law.name, 45 * d, first_yield, worst, r, r_of[d], alpha);
+    }
+}
+
+// A 4 x 2 block of q8 held on its left side and bent by a prescribed tip displacement.
+struct Bent {
+  std::unique_ptr<ContinuumBody> body;
+  std::vector<char> held;
+  std::vector<int> tip;
+};
+
+Bent bent_block(std::shared_ptr<const PlaneMaterial> m, PlaneAnalysis analysis, ContinuumElement element) {
+  RectangleSpec spec;
+  spec.origin = {analysis == PlaneAnalysis::axisymmetric ? 1.0 : 0.0, 0.0};
+  spec.size = {4.0, 1.0};
+  spec.nx = 4;
+  spec.ny = 2;
+  PlaneMesh mesh = rectangle_mesh(spec, element_shape(element));
+  Bent b;
+  b.tip = mesh.sets.at("right");
+  const std::vector<int> left = mesh.sets.at("left");
+  b.body = std::make_unique<ContinuumBody>(mesh, mesh.sets.at("bottom"),
+                                           std::vector<std::shared_ptr<const PlaneMaterial>>{std::move(m)},
+                                           ContinuumOptions{element, ContinuumKinematics::linear, analysis, 1.0});
+  b.held.assign(b.body->dof_count(), 0);
+  for (int n : left) b.held[2 * n] = b.held[2 * n + 1] = 1;
+  for (int n : b.tip) b.held[2 * n + 1] = 1;
+  return b;
+}
+
+void bend(Driver& d, const Bent& b, double tip, double tolerance) {
+  d.solve(
+      [&](Vector& q) {
+        for (int n : b.tip) q[2 * n + 1] = tip;
+      },
+      tolerance);
+}
+
+const PlaneAnalysis kAnalyses[] = {PlaneAnalysis::plane_strain, PlaneAnalysis::plane_stress,
+                                   PlaneAnalysis::axisymmetric};
+
+const char* analysis_name(PlaneAnalysis a) {
+  return a == PlaneAnalysis::plane_strain   ? "plane strain"
+         : a == PlaneAnalysis::plane_stress ? "plane stress"
+                                            : "axisymmetric";
+}
+
+// The anisotropy each analysis takes: planar in plane stress (r0, r45, r90) and plane strain
+// (r0, r90), normal in axisymmetry.
+Hill48 anisotropy(PlaneAnalysis a) {
+  if (a == PlaneAnalysis::plane_stress) return kSheet;
+  if (a == PlaneAnalysis::plane_strain) return {kSheet.r0, kSheet.r0, kSheet.r90};
+  return {1.8, 1.8, 1.8};
+}
+
+TEST(Hill48, RValuesOfOneAreVonMises) {
+  for (PlaneAnalysis analysis : kAnalyses)
+    for (const Law& law : laws()) {
+      SCOPED_TRACE(std::string(law.name) + " " + analysis_name(analysis));
+      Bent mises = bent_block(material(law, analysis, std::nullopt), analysis, ContinuumElement::q8);
+      Bent hill = bent_block(material(law, analysis, Hill48{}), analysis, ContinuumElement::q8);
+      Driver dm(*mises.body, mises.held), dh(*hill.body, hill.held);
+      double worst = 0.0, worst_alpha = 0.0, peak_alpha = 0.0;
+      for (double tip : {0.01, 0.02, 0.03, 0.015, 0.0, -0.02}) {
+        bend(dm, mises, tip, 1e-10 * kYield);
+        bend(dh, hill, tip, 1e-10 * kYield);
+        const auto rm = mises.body->element_fields(dm.q).rows, rh = hill.body->element_fields(dh.q).rows;
+        for (size_t e = 0; e < rm.size(); ++e) {
+          for (int c = 0; c < 4; ++c) worst = std::max(worst, std::abs(rm[e][c] - rh[e][c]) / kYield);
+          worst_alpha = std::max(worst_alpha, std::abs(rm[e][4] - rh[e][4]));
+          peak_alpha = std::max(peak_alpha, rm[e][4]);
+          EXPECT_EQ(rm[e][5], rh[e][5]);
+        }
+      }
+      EXPECT_GT(peak_alpha, 2e-4);
+      EXPECT_LT(worst, 1e-10);
+      EXPECT_LT(worst_alpha, 1e-10 * peak_alpha);
+      std::printf("hill48 r = 1 %-6s %-12s: |sigma - von Mises| / sigma_y <= %.1e, alpha %.1e of %.4f\n", law.name,
+                  analysis_name(analysis), worst, worst_alpha, peak_alpha);
+    }
+}
+
+TEST(Hill48, ConsistentTangentMatchesDifferencesAndNewtonConvergesQuadratically) {
+  for (PlaneAnalysis analysis : kAnalyses)
+    for (ContinuumElement element : {ContinuumElement::q8, ContinuumElement::t6})
+      for (const Law& law : laws()) {
+        SCOPED_TRACE(std::string(law.name) + " " + element_name(element) + " " + analysis_name(analysis));
+        Bent b = bent_block(material(law, analysis, anisotropy(analysis)), analysis, element);
+        Driver d(*b.body, b.held);
+        bend(d, b, 0.01, 1e-10 * kYield);
+        bend(d, b, 0.03, 1e-10 * kYield);
+        const std::vector<double> r = d.residuals;
+        int quadratic = 0;
+        for (size_t k = 1; k + 1 < r.size(); ++k) {
+          const double ek = r[k] / r[0], next = r[k + 1] / r[0];
+          if (ek < 1e-2 && next > 1e-12) {
+            EXPECT_LE(next, 10 * ek * ek) << "iteration " << k;
+            ++quadratic;
+          }
+        }
+        EXPECT_GE(quadratic, 1);
+        EXPECT_LE(r.size(), 8u);
+        // A state beyond the committed one, off equilibrium: every dof moved.
+        Vector q = d.q;
+        for (int i = 0; i < q.size(); ++i) q[i] += 0.004 * std::sin(1.0 + 3.7 * i);
+        const auto c = testing::check_tangent(*b.body, q, 1e-7);
+        int flowing = 0;
+        const auto rows = b.body->element_fields(q).rows;
+        for (const auto& row : rows) flowing += row[5] > 0;
+        EXPECT_GT(flowing, 0);
+        EXPECT_LT(c.error(), 1e-6);
+        std::string line;
+        char buffer[32];
+        for (double v : r) {
+          std::snprintf(buffer, sizeof buffer, " %.1e", v / r[0]);
+          line += buffer;
+        }
+        std::printf("hill48 %-6s %-3s %-12s |K - K_fd| / |K| = %.1e (%d of %zu flowing); Newton:%s\n", law.name,
+                    element_name(element), analysis_name(analysis), c.error(), flowing, rows.size(), line.c_str());
+      }
+}
+
+TEST(Hill48, BadDataIsRefusedWithItsPointer) {
+  const auto scene = [](const std::string& analysis, const nlohmann::json& hill) {
+    nlohmann::json j = testing::example_scene("hertz");
+    j["body"]["element"] = "q8";
+    j["body"]["analysis"] = analysis;
+    j["body"]["material"].update(
+        {{"law", "j2_plasticity"}, {"yield_stress", 2000.0}, {"hardening", {{"linear", 20000.0}}}, {"hill48", hill}});
+    return j;
+  };
+  const auto pointer = [](const nlohmann::json& j) {
+    const std::string refusal = testing::first_refusal(j);
+    return refusal.substr(0, refusal.find(':'));
+  };
+  EXPECT_EQ(pointer(scene("plane_stress", {{"r0", 0.0}, {"r45", 1.0}, {"r90", 1.2}})), "/body/material/hill48/r0");
+  EXPECT_EQ(pointer(scene("plane_stress", {{"r0", 1.0}, {"r45", -1.0}, {"r90", 1.2}})), "/body/material/hill48/r45");
+  EXPECT_EQ(pointer(scene("plane_strain", {{"r", 0.0}})), "/body/material/hill48/r");
+  EXPECT_EQ(pointer(scene("plane_stress", {{"r0", 1.0}, {"r90", 1.2}})), "/body/material/hill48/r45");
+  EXPECT_EQ(pointer(scene("plane_strain", {{"r0", 1.0}, {"r45", 1.0}, {"r90", 1.2}})), "/body/material/hill48/r45");
+  EXPECT_EQ(pointer(scene("plane_strain", {{"r", 1.0}, {"r0", 1.2}})), "/body/material/hill48/r0");
+  nlohmann::json kinematic = scene("plane_strain", {{"r", 1.5}});
+  kinematic["body"]["material"]["kinematic_hardening"] = 1000.0;
+  EXPECT_EQ(pointer(kinematic), "/body/material/kinematic_hardening");
+  nlohmann::json finite = scene("plane_strain", {{"r", 1.5}});
+  finite["body"]["kinematics"] = "finite";
+  EXPECT_EQ(pointer(finite), "/body/material/hill48");
+  nlohmann::json elastic = scene("plane_strain", {{"r", 1.5}});
+  elastic["body"]["material"] = {{"young", 2e5}, {"poisson", 0.3}, {"hill48", {{"r", 1.5}}}};
+  EXPECT_EQ(pointer(elastic), "/body/material/hill48");
+  // The material itself refuses the same.
+  EXPECT_EQ(hill48_data_issue({1.0, 1.0, 0.0}, PlaneAnalysis::plane_stress, 0).rfind("hill48/r90:", 0), 0u);
+  EXPECT_EQ(hill48_data_issue({1.0, 1.2, 1.0}, PlaneAnalysis::axisymmetric, 0).rfind("hill48:", 0), 0u);
+  EXPECT_THROW(material(laws()[0], PlaneAnalysis::plane_stress, Hill48{-1.0, 1.0, 1.0}), std::invalid_argument);
+  // A good one reads and runs.
+  EXPECT_EQ(testing::first_refusal(scene("plane_strain", {{"r0", 2.1}, {"r90", 2.6}})), "accepted");
+}
+
+}  // namespace
+}  // namespace grip
