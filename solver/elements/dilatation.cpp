@@ -147,12 +147,7 @@ void dilatation_total_lagrangian(const std::vector<ElementPoint>& points, const 
     B0.setZero();
     for (int a = 0; a < n; ++a) {
       const double gx = p.dN(a, 0), gy = p.dN(a, 1);
-      B0(0, 2 * a) = F(0, 0) * gx;
-      B0(0, 2 * a + 1) = F(1, 0) * gx;
-      B0(1, 2 * a) = F(0, 1) * gy;
-      B0(1, 2 * a + 1) = F(1, 1) * gy;
-      B0(2, 2 * a) = F(0, 0) * gy + F(0, 1) * gx;
-      B0(2, 2 * a + 1) = F(1, 0) * gy + F(1, 1) * gx;
+      green_lagrange_rows(B0, a, F, gx, gy);
       if (hoop) B0(3, 2 * a) = F33 * p.N[a] / p.radius;
     }
     // E_bar = (beta C - I) / 2 and dE_bar = B_bar du.

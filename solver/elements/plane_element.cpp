@@ -309,12 +309,7 @@ void total_lagrangian_fixed(const std::vector<ElementPoint>& points, const Shape
       const double gx = dN(a, 0), gy = dN(a, 1);
       fe[2 * a] += p.dV * (P(0, 0) * gx + P(0, 1) * gy);
       fe[2 * a + 1] += p.dV * (P(1, 0) * gx + P(1, 1) * gy);
-      B(0, 2 * a) = F(0, 0) * gx;
-      B(0, 2 * a + 1) = F(1, 0) * gx;
-      B(1, 2 * a) = F(0, 1) * gy;
-      B(1, 2 * a + 1) = F(1, 1) * gy;
-      B(2, 2 * a) = F(0, 0) * gy + F(0, 1) * gx;
-      B(2, 2 * a + 1) = F(1, 0) * gy + F(1, 1) * gx;
+      green_lagrange_rows(B, a, F, gx, gy);
       if constexpr (R == 4) {
         B(3, 2 * a) = F33 * p.N[a] / p.radius;  // dE33 = F33 du_r / R
         B(3, 2 * a + 1) = 0.0;

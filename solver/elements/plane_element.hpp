@@ -80,6 +80,17 @@ Matrix small_strain_stiffness(const std::vector<ElementPoint>& points, const Eig
 // hoop strain E33 = (F33^2 - 1) / 2 from the law's hoop_response; f_a gains F33 S33 N_a / R in
 // r, B the row dE33 = F33 N_a / R du_r, and Ke the hoop geometric term S33 N_a N_b / R^2 (r-r).
 Mat2 deformation_gradient(const ElementPoint& point, const ShapeGradients& u);
+// Node a's column pair of the in-plane rows of dE = B du (E11, E22, 2 E12) at F, from the
+// node's shape gradient (gx, gy): the rows every total-Lagrangian kernel fills.
+template <class BMatrix>
+inline void green_lagrange_rows(BMatrix& B, int a, const Mat2& F, double gx, double gy) {
+  B(0, 2 * a) = F(0, 0) * gx;
+  B(0, 2 * a + 1) = F(1, 0) * gx;
+  B(1, 2 * a) = F(0, 1) * gy;
+  B(1, 2 * a + 1) = F(1, 1) * gy;
+  B(2, 2 * a) = F(0, 0) * gy + F(0, 1) * gx;
+  B(2, 2 * a + 1) = F(1, 0) * gy + F(1, 1) * gx;
+}
 // `law`, if given, answers for `material` in the plane at each integration point (index into
 // `points`) from the Green-Lagrange strain E there: a law with history answers from that
 // point's committed state.
