@@ -24,6 +24,7 @@
 
 #include "solver/elements/continuum.hpp"
 #include "solver/materials/j2_plasticity.hpp"
+#include "tests/support/j2_laws.hpp"
 #include "tests/support/newton_driver.hpp"
 #include "tests/support/tangent_check.hpp"
 
@@ -32,26 +33,10 @@ namespace {
 
 using testing::Driver;
 
-constexpr double kYoung = 200e3, kPoisson = 0.3, kYield = 250.0;
-
-struct Law {
-  const char* name;
-  IsotropicHardening hardening;
-};
-
-std::vector<Law> laws(double scale = 1.0) {
-  IsotropicHardening linear;
-  linear.modulus = 2000.0 * scale;
-  IsotropicHardening power;
-  power.kind = IsotropicHardening::Kind::power;
-  power.K = 600.0 * scale;
-  power.n = 0.2;
-  return {{"linear", linear}, {"power", power}};
-}
+using namespace testing::j2;
 
 std::shared_ptr<J2Material> material(const Law& law, double scale = 1.0) {
-  return std::make_shared<J2Material>(kYoung, kPoisson, kYield * scale, law.hardening, 0.0,
-                                      PlaneAnalysis::axisymmetric);
+  return testing::j2::material(law, PlaneAnalysis::axisymmetric, scale);
 }
 
 ContinuumOptions axisymmetric(ContinuumElement element, ContinuumKinematics kinematics = ContinuumKinematics::finite) {

@@ -22,6 +22,7 @@
 
 #include "solver/elements/continuum.hpp"
 #include "solver/materials/j2_plasticity.hpp"
+#include "tests/support/j2_laws.hpp"
 #include "tests/support/newton_driver.hpp"
 #include "tests/support/tangent_check.hpp"
 
@@ -30,27 +31,8 @@ namespace {
 
 using testing::Driver;
 
-constexpr double kYoung = 200e3, kPoisson = 0.3, kYield = 250.0;
-
-struct Law {
-  const char* name;
-  IsotropicHardening hardening;
-};
-
-// Isotropic hardening (finite strain takes no kinematic hardening), the yield stress scaled by `scale`.
-std::vector<Law> laws(double scale = 1.0) {
-  IsotropicHardening linear;
-  linear.modulus = 2000.0 * scale;
-  IsotropicHardening power;
-  power.kind = IsotropicHardening::Kind::power;
-  power.K = 600.0 * scale;
-  power.n = 0.2;
-  return {{"linear", linear}, {"power", power}};
-}
-
-std::shared_ptr<J2Material> material(const Law& law, PlaneAnalysis analysis, double scale = 1.0) {
-  return std::make_shared<J2Material>(kYoung, kPoisson, kYield * scale, law.hardening, 0.0, analysis);
-}
+// Isotropic hardening only: finite strain takes no kinematic hardening.
+using namespace testing::j2;
 
 // The uniaxial Kirchhoff stress at log strain eps: tau = sigma_y(eps - tau / E) on the plastic
 // branch (bisection on alpha).

@@ -23,6 +23,7 @@
 
 #include "solver/elements/continuum.hpp"
 #include "solver/materials/j2_plasticity.hpp"
+#include "tests/support/j2_laws.hpp"
 #include "tests/support/newton_driver.hpp"
 #include "tests/support/scenes.hpp"
 #include "tests/support/tangent_check.hpp"
@@ -32,28 +33,13 @@ namespace {
 
 using testing::Driver;
 
-constexpr double kYoung = 200e3, kPoisson = 0.3, kYield = 250.0;
-
-struct Law {
-  const char* name;
-  IsotropicHardening hardening;
-};
-
-std::vector<Law> laws() {
-  IsotropicHardening linear;
-  linear.modulus = 2000.0;
-  IsotropicHardening power;
-  power.kind = IsotropicHardening::Kind::power;
-  power.K = 600.0;
-  power.n = 0.2;
-  return {{"linear", linear}, {"power", power}};
-}
+using namespace testing::j2;
 
 // A steel-like sheet (r0 < r90, r45 the lowest) and a normal r for axisymmetry.
 const Hill48 kSheet{2.1, 1.6, 2.6};
 
 std::shared_ptr<J2Material> material(const Law& law, PlaneAnalysis analysis, std::optional<Hill48> hill) {
-  return std::make_shared<J2Material>(kYoung, kPoisson, kYield, law.hardening, 0.0, analysis, hill);
+  return testing::j2::material(law, analysis, 1.0, hill);
 }
 
 // Hill's factor k of uniaxial stress at angle t to the rolling direction: sigma_bar = k sigma.
