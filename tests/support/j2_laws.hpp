@@ -1,6 +1,9 @@
 #pragma once
 // The J2 tests' material: steel-like (E 200e3, nu 0.3, sigma_y 250) with linear or Swift power
 // isotropic hardening; shared by the finite-strain, axisymmetric and Hill 1948 tests.
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -31,5 +34,24 @@ inline std::shared_ptr<J2Material> material(const Law& law, PlaneAnalysis analys
                                             std::optional<Hill48> hill = std::nullopt) {
   return std::make_shared<J2Material>(kYoung, kPoisson, kYield * scale, law.hardening, 0.0, analysis, hill);
 }
+
+// The largest differences between two runs' element fields (columns 0-3 the stresses, 4 the
+// equivalent plastic strain alpha): stresses over the second run's peak stress, alpha absolute
+// (with the second run's peak alpha beside it).
+struct FieldGap {
+  double stress = 0.0, alpha = 0.0, peak_alpha = 0.0;
+
+  template <class Rows>
+  void add(const Rows& a, const Rows& b) {
+    double peak = 0.0;
+    for (const auto& row : b)
+      for (int c = 0; c < 4; ++c) peak = std::max(peak, std::abs(row[c]));
+    for (std::size_t e = 0; e < a.size(); ++e) {
+      for (int c = 0; c < 4; ++c) stress = std::max(stress, std::abs(a[e][c] - b[e][c]) / peak);
+      alpha = std::max(alpha, std::abs(a[e][4] - b[e][4]));
+      peak_alpha = std::max(peak_alpha, b[e][4]);
+    }
+  }
+};
 
 }  // namespace grip::testing::j2
