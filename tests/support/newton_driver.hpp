@@ -109,4 +109,19 @@ struct Driver {
   std::vector<double> element_row(int e) const { return body.element_fields(q).rows[e]; }
 };
 
+// Newton's quadratic rate on the residuals r of one solve, relative to the first: every
+// iterate near the solution (e_k < 1e-2) whose successor is above round-off (1e-12) is checked
+// for e_{k+1} <= 10 e_k^2. Returns how many were checked.
+inline int expect_quadratic(const std::vector<double>& r) {
+  int checked = 0;
+  for (size_t k = 1; k + 1 < r.size(); ++k) {
+    const double ek = r[k] / r[0], next = r[k + 1] / r[0];
+    if (ek < 1e-2 && next > 1e-12) {
+      EXPECT_LE(next, 10 * ek * ek) << "iteration " << k;
+      ++checked;
+    }
+  }
+  return checked;
+}
+
 }  // namespace grip::testing

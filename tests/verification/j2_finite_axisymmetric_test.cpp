@@ -256,16 +256,7 @@ TEST(J2FiniteAxisymmetric, NewtonConvergesQuadraticallyOnAPlasticStep) {
       }
       std::printf("axisymmetric Newton %-6s %-3s relative residuals:%s\n", law.name, element_name(element),
                   line.c_str());
-      // Near the solution (e_k < 1e-2) and above round-off: e_{k+1} <= 10 e_k^2.
-      int quadratic = 0;
-      for (size_t k = 1; k + 1 < r.size(); ++k) {
-        const double ek = r[k] / r[0], next = r[k + 1] / r[0];
-        if (ek < 1e-2 && next > 1e-12) {
-          EXPECT_LE(next, 10 * ek * ek) << "iteration " << k;
-          ++quadratic;
-        }
-      }
-      EXPECT_GE(quadratic, 1);
+      EXPECT_GE(testing::expect_quadratic(r), 1);
       EXPECT_LE(r.size(), 10u);
       int flowing = 0;
       for (const auto& row : b.body->element_fields(d.q).rows) flowing += row[4] > 0;
