@@ -100,9 +100,6 @@ ContinuumBody::ContinuumBody(PlaneMesh mesh, const std::vector<int>& contact_set
   if (const std::string why = incompressibility_issue(options_); !why.empty()) throw std::invalid_argument(why);
   for (const auto& m : materials_) {
     has_history_ |= m->has_history();
-    if (m->has_history() && options_.analysis == PlaneAnalysis::axisymmetric &&
-        options_.kinematics == ContinuumKinematics::finite && options_.incompressibility != Incompressibility::none)
-      throw std::invalid_argument(kAxisymmetricHistoryIssue);
     if (options_.kinematics == ContinuumKinematics::finite)
       if (const std::string why = m->finite_strain_issue(); !why.empty()) throw std::invalid_argument(why);
   }
@@ -208,6 +205,10 @@ std::vector<FinitePointResponse> ContinuumBody::finite_point_responses(const Vec
                                                                        int e) const {
   const bool axisymmetric = options_.analysis == PlaneAnalysis::axisymmetric;
   const ShapeGradients u = axisymmetric ? element_displacements(q, e) : ShapeGradients();
+  // With a shared dilatation F_bar = s F, and F33_bar = s F33 (point_deformations).
+  const auto& dilatation = integration().dilatation;
+  const Vector s = axisymmetric && !dilatation.empty() ? dilatation_scales(integration().points[e], dilatation[e], u)
+                                                       : Vector::Ones(static_cast<Eigen::Index>(F.size()));
   std::vector<FinitePointResponse> out;
   for (size_t k = 0; k < F.size(); ++k) {
     const Mat2 E = 0.5 * (F[k].transpose() * F[k] - Mat2::Identity());
@@ -217,7 +218,7 @@ std::vector<FinitePointResponse> ContinuumBody::finite_point_responses(const Vec
       continue;
     }
     const ElementPoint& p = integration().points[e][k];
-    const double F33 = 1 + p.N.dot(u.col(0)) / p.radius;
+    const double F33 = s[k] * (1 + p.N.dot(u.col(0)) / p.radius);
     const FiniteHoopResponse r = material(e).finite_hoop_response(E, 0.5 * (F33 * F33 - 1), h);
     FinitePointResponse& o = out.emplace_back(FinitePointResponse{{}, r.history, r.yielding});
     o.law.S = r.law.S.head<3>();
@@ -295,7 +296,8 @@ void ContinuumBody::internal_force(const Vector& q, Vector& force, Triplets* tan
     const auto& el = mesh_.elements[e];
     for (int a = 0; a < n; ++a) u.row(a) << q[node_dof(el[a], 0)], q[node_dof(el[a], 1)];
     if (!in.dilatation.empty())
-      dilatation_total_lagrangian(in.points[e], in.dilatation[e], u, material(e), fe, tangent ? &Ke : nullptr, law);
+      dilatation_total_lagrangian(in.points[e], in.dilatation[e], u, material(e), fe, tangent ? &Ke : nullptr, law,
+                                  hoop_law);
     else if (options_.incompressibility == Incompressibility::f_bar)
       f_bar_total_lagrangian(in.points[e], in.centroids[e], u, material(e), fe, tangent ? &Ke : nullptr, law);
     else total_lagrangian(in.points[e], u, material(e), fe, tangent ? &Ke : nullptr, law, hoop_law);

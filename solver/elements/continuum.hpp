@@ -63,10 +63,6 @@ const char* element_name(ContinuumElement element);  // as the scene names it: "
 
 // Why a law with history (j2_plasticity) under finite kinematics in axisymmetry takes no shared
 // dilatation yet: the dilatation element asks the law's hoop response without history.
-inline constexpr const char* kAxisymmetricHistoryIssue =
-    "finite-strain j2_plasticity in axisymmetry runs on the displacement elements (t6, q8, q9); \"mixed\" and "
-    "\"f_bar\" in axisymmetry take elastic laws so far";
-
 class ContinuumBody final : public Body {
  public:
   // The mesh must pass check_mesh (InvalidMesh otherwise); contact_set is a node set on the

@@ -108,7 +108,7 @@ double centre_dilatation_scale(const ElementPoint& centre, const Dilatation& dil
 
 void dilatation_total_lagrangian(const std::vector<ElementPoint>& points, const Dilatation& dilatation,
                                  const ShapeGradients& u, const PlaneMaterial& material, Vector& fe, Matrix* Ke,
-                                 const PointLaw& law) {
+                                 const PointLaw& law, const HoopLaw& hoop_law) {
   const int n = static_cast<int>(u.rows()), m = 2 * n;
   const bool hoop = points.front().radius > 0;
   const int R = hoop ? 4 : 3;
@@ -156,7 +156,7 @@ void dilatation_total_lagrangian(const std::vector<ElementPoint>& points, const 
     Mat2 E;
     E << Ebar[0], 0.5 * Ebar[2], 0.5 * Ebar[2], Ebar[1];
     if (hoop) {
-      const HoopResponse r = material.hoop_response(E, Ebar[3]);
+      const HoopResponse r = hoop_law ? hoop_law(static_cast<int>(k), E, Ebar[3]) : material.hoop_response(E, Ebar[3]);
       S = r.S;
       D = r.D;
     } else {

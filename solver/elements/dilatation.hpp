@@ -35,10 +35,10 @@ Vector dilatation_scales(const std::vector<ElementPoint>& points, const Dilatati
                          const ShapeGradients& u);
 // The same s at the element's centre.
 double centre_dilatation_scale(const ElementPoint& centre, const Dilatation& dilatation, const ShapeGradients& u);
-// Internal force fe and (if given) the tangent Ke of the element. `law` as for total_lagrangian
-// (plane strain: the law at each point's E_bar); axisymmetry asks the material's hoop_response.
+// Internal force fe and (if given) the tangent Ke of the element. `law` and `hoop_law` as for
+// total_lagrangian, asked at each point's E_bar (and E33_bar in axisymmetry).
 void dilatation_total_lagrangian(const std::vector<ElementPoint>& points, const Dilatation& dilatation,
                                  const ShapeGradients& u, const PlaneMaterial& material, Vector& fe, Matrix* Ke,
-                                 const PointLaw& law = {});
+                                 const PointLaw& law = {}, const HoopLaw& hoop_law = {});
 
 }  // namespace grip

@@ -587,12 +587,6 @@ void read_continuum(Reader& r, json& body, Problem& problem, const std::string& 
         r.error(ptr + "/element", why);
         break;
       }
-    for (const PlaneMaterial* law : laws)
-      if (law && law->has_history() && options.analysis == PlaneAnalysis::axisymmetric &&
-          options.kinematics == ContinuumKinematics::finite && options.incompressibility != Incompressibility::none) {
-        r.error(ptr + "/incompressibility", kAxisymmetricHistoryIssue);
-        break;
-      }
   }
   std::optional<PlaneMesh> mesh;
   std::string kind, default_contact;  // kind: "nodes", "rectangle" or "half_disc"

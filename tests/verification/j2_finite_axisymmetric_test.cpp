@@ -1,16 +1,19 @@
 // J2 plasticity at finite strain in axisymmetry (docs/algorithm.md#finite-strain-j2-plasticity):
 // the hoop stretch r / R is the third principal direction of the exponential-map return.
-// - a ring (one q9, R in [1, 2]) pulled along its axis, and expanded equibiaxially in r and theta
-//   (u_r = (lambda - 1) R at every node, the top free: the hoop direction loaded), loaded,
+// - a ring (R in [1, 2]: one q9, one mixed q9, two mixed t6, one q4 with F-bar) pulled along its
+//   axis, and expanded equibiaxially in r and theta (u_r = (lambda - 1) R at every node, the top
+//   free: the hoop direction loaded), loaded,
 //   unloaded and reloaded against the closed form in Kirchhoff stress against log strain: along
 //   the axis tau = E (eps - eps_p) and |tau| = sigma_y(alpha) while it flows; in the r-theta
 //   expansion the same curve in x = 2 ln lambda with E / (2 (1 - nu)) (tau_rr = tau_tt = tau,
 //   plastic log strains eps_p (1/2, 1/2, -1)); Cauchy stresses tau / J, the free log strain;
-// - the consistent tangent against central differences of the internal force (q4, q8, q9, t6)
-//   and Newton's quadratic convergence on a plastic step, on a bent annular plate;
+// - the consistent tangent against central differences of the internal force (q4, q8, q9, t6;
+//   mixed q9 and t6; q4 with F-bar) and Newton's quadratic convergence on a plastic step, on a
+//   bent annular plate;
 // - a thick-walled tube (A = 1, B = 2, u_z held) expanded to a bore radius 1.5: the bore
 //   pressure against the fully plastic large-strain closed form (2 / sqrt 3) sigma_y ln(b / a),
-//   b^2 = a^2 + B^2 - A^2 (isochoric flow), from a bore of 1.1 on (4 q9: within 2e-3, 8: 5e-4);
+//   b^2 = a^2 + B^2 - A^2 (isochoric flow), from a bore of 1.1 on: 4 q9 within 2e-3, 8 q9, 4 and 8
+//   mixed q9 within 3e-4, 8 mixed t6 8e-4, 16 q4 with F-bar 4e-4; the plain q4 locks (+4.5 %);
 //   and at a yield strain of 1.25e-8 the same tube against the small-strain axisymmetric law,
 //   loaded, unloaded and reversed.
 #include <gtest/gtest.h>
@@ -39,9 +42,29 @@ std::shared_ptr<J2Material> material(const Law& law, double scale = 1.0) {
   return testing::j2::material(law, PlaneAnalysis::axisymmetric, scale);
 }
 
-ContinuumOptions axisymmetric(ContinuumElement element, ContinuumKinematics kinematics = ContinuumKinematics::finite) {
-  return {element, kinematics, PlaneAnalysis::axisymmetric, 1.0};
+// An element and its formulation: the displacement elements, and those that share a dilatation
+// over the element (mixed q9 and t6, F-bar q4).
+struct Formulation {
+  Formulation(ContinuumElement e, Incompressibility i = Incompressibility::none) : element(e), incompressibility(i) {}
+  ContinuumElement element;
+  Incompressibility incompressibility;
+  std::string name() const {
+    const char* suffix = incompressibility == Incompressibility::mixed   ? " mixed"
+                         : incompressibility == Incompressibility::f_bar ? " f_bar"
+                                                                         : "";
+    return std::string(element_name(element)) + suffix;
+  }
+};
+
+ContinuumOptions axisymmetric(Formulation f, ContinuumKinematics kinematics = ContinuumKinematics::finite) {
+  ContinuumOptions o{f.element, kinematics, PlaneAnalysis::axisymmetric, 1.0};
+  o.incompressibility = f.incompressibility;
+  return o;
 }
+
+const Formulation kMixedQ9{ContinuumElement::q9, Incompressibility::mixed};
+const Formulation kMixedT6{ContinuumElement::t6, Incompressibility::mixed};
+const Formulation kFBarQ4{ContinuumElement::q4, Incompressibility::f_bar};
 
 // The one-dimensional return in Kirchhoff stress against log strain x with modulus M:
 // tau = M (x - eps_p), |tau| <= sigma_y(alpha); a plastic step moves eps_p and alpha by the
@@ -79,12 +102,16 @@ std::vector<double> load_unload_reload(const J2Material& m, double modulus, doub
   return x;
 }
 
-// One q9 with R in [1, 2], Z in [0, 1] (a ring of square section).
-PlaneMesh ring() {
+// One element (two for a triangle) with R in [1, 2], Z in [0, 1]: a ring of square section.
+PlaneMesh ring(ContinuumElement element = ContinuumElement::q9) {
   RectangleSpec spec;
   spec.origin = {1.0, 0.0};
-  return rectangle_mesh(spec, ElementShape::q9);
+  return rectangle_mesh(spec, element_shape(element));
 }
+
+// The homogeneous rings below on each formulation: J is the same at every point, so the shared
+// dilatation must hand every point its own F (the closed form holds to the same digits).
+const Formulation kRingFormulations[] = {ContinuumElement::q9, kMixedQ9, kMixedT6, kFBarQ4};
 
 // The largest |det Fp - 1| over the body's points.
 double worst_plastic_volume(const ContinuumBody& body) {
@@ -97,86 +124,88 @@ double worst_plastic_volume(const ContinuumBody& body) {
 }
 
 TEST(J2FiniteAxisymmetric, RingPulledAlongItsAxisFollowsTheClosedForm) {
-  for (const Law& law : laws()) {
-    SCOPED_TRACE(law.name);
-    const auto m = material(law);
-    const PlaneMesh mesh = ring();
-    ContinuumBody body(mesh, mesh.sets.at("bottom"), {m}, axisymmetric(ContinuumElement::q9));
-    std::vector<char> held(body.dof_count(), 0);
-    for (int n : mesh.sets.at("bottom")) held[2 * n + 1] = 1;
-    for (int n : mesh.sets.at("top")) held[2 * n + 1] = 1;
-    Driver d(body, held);
-    Uniaxial closed{*m, kYoung};
-    const int outer = mesh.sets.at("right").front();
-    double worst = 0.0, worst_lateral = 0.0, worst_free = 0.0;
-    for (double eps : load_unload_reload(*m, kYoung, 0.3, 0.5)) {
-      d.solve(
-          [&](Vector& q) {
-            for (int n : mesh.sets.at("top")) q[2 * n + 1] = std::exp(eps) - 1;
-          },
-          1e-9 * kYield);
-      const double tau = closed.tau(eps);
-      const double cauchy = tau * std::exp(-(1 - 2 * kPoisson) * tau / kYoung);
-      const std::vector<double> row = d.element_row(0);
-      worst = std::max(worst, std::abs(row[1] - cauchy) / kYield);
-      worst_free = std::max({worst_free, std::abs(row[0]) / kYield, std::abs(row[3]) / kYield});
-      // The radial and the hoop log strain: -nu tau / E - eps_p / 2.
-      const double lateral = -kPoisson * tau / kYoung - 0.5 * closed.eps_p;
-      worst_lateral = std::max(worst_lateral, std::abs(std::log(1 + d.q[2 * outer] / 2.0) - lateral));
-      EXPECT_NEAR(row[4], closed.alpha, 1e-9);
+  for (const Formulation& f : kRingFormulations)
+    for (const Law& law : laws()) {
+      SCOPED_TRACE(std::string(law.name) + " " + f.name());
+      const auto m = material(law);
+      const PlaneMesh mesh = ring(f.element);
+      ContinuumBody body(mesh, mesh.sets.at("bottom"), {m}, axisymmetric(f));
+      std::vector<char> held(body.dof_count(), 0);
+      for (int n : mesh.sets.at("bottom")) held[2 * n + 1] = 1;
+      for (int n : mesh.sets.at("top")) held[2 * n + 1] = 1;
+      Driver d(body, held);
+      Uniaxial closed{*m, kYoung};
+      const int outer = mesh.sets.at("right").front();
+      double worst = 0.0, worst_lateral = 0.0, worst_free = 0.0;
+      for (double eps : load_unload_reload(*m, kYoung, 0.3, 0.5)) {
+        d.solve(
+            [&](Vector& q) {
+              for (int n : mesh.sets.at("top")) q[2 * n + 1] = std::exp(eps) - 1;
+            },
+            1e-9 * kYield);
+        const double tau = closed.tau(eps);
+        const double cauchy = tau * std::exp(-(1 - 2 * kPoisson) * tau / kYoung);
+        const std::vector<double> row = d.element_row(0);
+        worst = std::max(worst, std::abs(row[1] - cauchy) / kYield);
+        worst_free = std::max({worst_free, std::abs(row[0]) / kYield, std::abs(row[3]) / kYield});
+        // The radial and the hoop log strain: -nu tau / E - eps_p / 2.
+        const double lateral = -kPoisson * tau / kYoung - 0.5 * closed.eps_p;
+        worst_lateral = std::max(worst_lateral, std::abs(std::log(1 + d.q[2 * outer] / 2.0) - lateral));
+        EXPECT_NEAR(row[4], closed.alpha, 1e-9);
+      }
+      EXPECT_GT(closed.alpha, 0.45);
+      EXPECT_LT(worst, 1e-9);
+      EXPECT_LT(worst_free, 1e-9);
+      EXPECT_LT(worst_lateral, 1e-9);
+      EXPECT_LT(worst_plastic_volume(body), 1e-12);
+      std::printf(
+          "axisymmetric ring along the axis %-6s %-8s: |sigma_zz - closed form| / sigma_y <= %.1e, |s_rr|, |s_tt| <= "
+          "%.1e, lateral log strain %.1e, alpha = %.4f\n",
+          law.name, f.name().c_str(), worst, worst_free, worst_lateral, closed.alpha);
     }
-    EXPECT_GT(closed.alpha, 0.45);
-    EXPECT_LT(worst, 1e-9);
-    EXPECT_LT(worst_free, 1e-9);
-    EXPECT_LT(worst_lateral, 1e-9);
-    EXPECT_LT(worst_plastic_volume(body), 1e-12);
-    std::printf(
-        "axisymmetric ring along the axis %-6s: |sigma_zz - closed form| / sigma_y <= %.1e, |s_rr|, |s_tt| <= %.1e, "
-        "lateral log strain %.1e, alpha = %.4f\n",
-        law.name, worst, worst_free, worst_lateral, closed.alpha);
-  }
 }
 
 TEST(J2FiniteAxisymmetric, RingExpandedInRadiusAndHoopFollowsTheClosedForm) {
-  for (const Law& law : laws()) {
-    SCOPED_TRACE(law.name);
-    const auto m = material(law);
-    const PlaneMesh mesh = ring();
-    ContinuumBody body(mesh, mesh.sets.at("bottom"), {m}, axisymmetric(ContinuumElement::q9));
-    std::vector<char> held(body.dof_count(), 0);
-    for (int n = 0; n < body.node_count(); ++n) held[2 * n] = 1;
-    for (int n : mesh.sets.at("bottom")) held[2 * n + 1] = 1;
-    Driver d(body, held);
-    const double modulus = kYoung / (2 * (1 - kPoisson));
-    Uniaxial closed{*m, modulus};
-    const int top = mesh.sets.at("top").front();
-    double worst = 0.0, worst_axial = 0.0, worst_free = 0.0;
-    for (double x : load_unload_reload(*m, modulus, 0.4, 0.6)) {
-      const double lambda = std::exp(x / 2);
-      d.solve(
-          [&](Vector& q) {
-            for (int n = 0; n < body.node_count(); ++n) q[2 * n] = (lambda - 1) * mesh.nodes[n].x();
-          },
-          1e-9 * kYield);
-      const double tau = closed.tau(x);
-      const double cauchy = tau * std::exp(-2 * (1 - 2 * kPoisson) * tau / kYoung);
-      const std::vector<double> row = d.element_row(0);
-      worst = std::max({worst, std::abs(row[0] - cauchy) / kYield, std::abs(row[3] - cauchy) / kYield});
-      worst_free = std::max({worst_free, std::abs(row[1]) / kYield, std::abs(row[2]) / kYield});
-      const double axial = -2 * kPoisson * tau / kYoung - closed.eps_p;
-      worst_axial = std::max(worst_axial, std::abs(std::log(1 + d.q[2 * top + 1]) - axial));
-      EXPECT_NEAR(row[4], closed.alpha, 1e-9);
+  for (const Formulation& f : kRingFormulations)
+    for (const Law& law : laws()) {
+      SCOPED_TRACE(std::string(law.name) + " " + f.name());
+      const auto m = material(law);
+      const PlaneMesh mesh = ring(f.element);
+      ContinuumBody body(mesh, mesh.sets.at("bottom"), {m}, axisymmetric(f));
+      std::vector<char> held(body.dof_count(), 0);
+      for (int n = 0; n < body.node_count(); ++n) held[2 * n] = 1;
+      for (int n : mesh.sets.at("bottom")) held[2 * n + 1] = 1;
+      Driver d(body, held);
+      const double modulus = kYoung / (2 * (1 - kPoisson));
+      Uniaxial closed{*m, modulus};
+      const int top = mesh.sets.at("top").front();
+      double worst = 0.0, worst_axial = 0.0, worst_free = 0.0;
+      for (double x : load_unload_reload(*m, modulus, 0.4, 0.6)) {
+        const double lambda = std::exp(x / 2);
+        d.solve(
+            [&](Vector& q) {
+              for (int n = 0; n < body.node_count(); ++n) q[2 * n] = (lambda - 1) * mesh.nodes[n].x();
+            },
+            1e-9 * kYield);
+        const double tau = closed.tau(x);
+        const double cauchy = tau * std::exp(-2 * (1 - 2 * kPoisson) * tau / kYoung);
+        const std::vector<double> row = d.element_row(0);
+        worst = std::max({worst, std::abs(row[0] - cauchy) / kYield, std::abs(row[3] - cauchy) / kYield});
+        worst_free = std::max({worst_free, std::abs(row[1]) / kYield, std::abs(row[2]) / kYield});
+        const double axial = -2 * kPoisson * tau / kYoung - closed.eps_p;
+        worst_axial = std::max(worst_axial, std::abs(std::log(1 + d.q[2 * top + 1]) - axial));
+        EXPECT_NEAR(row[4], closed.alpha, 1e-9);
+      }
+      EXPECT_GT(closed.alpha, 0.55);
+      EXPECT_LT(worst, 1e-9);
+      EXPECT_LT(worst_free, 1e-9);
+      EXPECT_LT(worst_axial, 1e-9);
+      EXPECT_LT(worst_plastic_volume(body), 1e-12);
+      std::printf(
+          "axisymmetric ring expanded in r and theta %-6s %-8s: |sigma_rr, sigma_tt - closed form| / sigma_y <= %.1e, "
+          "|s_zz|, |s_rz| <= %.1e, axial log strain %.1e, alpha = %.4f\n",
+          law.name, f.name().c_str(), worst, worst_free, worst_axial, closed.alpha);
     }
-    EXPECT_GT(closed.alpha, 0.55);
-    EXPECT_LT(worst, 1e-9);
-    EXPECT_LT(worst_free, 1e-9);
-    EXPECT_LT(worst_axial, 1e-9);
-    EXPECT_LT(worst_plastic_volume(body), 1e-12);
-    std::printf(
-        "axisymmetric ring expanded in r and theta %-6s: |sigma_rr, sigma_tt - closed form| / sigma_y <= %.1e, "
-        "|s_zz|, |s_rz| <= %.1e, axial log strain %.1e, alpha = %.4f\n",
-        law.name, worst, worst_free, worst_axial, closed.alpha);
-  }
 }
 
 // An annular plate R in [1, 5], Z in [0, 1], held at its bore and bent by a prescribed
@@ -187,19 +216,18 @@ struct Bent {
   std::vector<int> rim;
 };
 
-Bent bent_plate(std::shared_ptr<const PlaneMaterial> m, ContinuumElement element) {
+Bent bent_plate(std::shared_ptr<const PlaneMaterial> m, Formulation f) {
   RectangleSpec spec;
   spec.origin = {1.0, 0.0};
   spec.size = {4.0, 1.0};
   spec.nx = 4;
   spec.ny = 2;
-  PlaneMesh mesh = rectangle_mesh(spec, element_shape(element));
+  PlaneMesh mesh = rectangle_mesh(spec, element_shape(f.element));
   Bent b;
   b.rim = mesh.sets.at("right");
   const std::vector<int> bore = mesh.sets.at("left");
-  b.body = std::make_unique<ContinuumBody>(mesh, mesh.sets.at("bottom"),
-                                           std::vector<std::shared_ptr<const PlaneMaterial>>{std::move(m)},
-                                           axisymmetric(element));
+  b.body = std::make_unique<ContinuumBody>(
+      mesh, mesh.sets.at("bottom"), std::vector<std::shared_ptr<const PlaneMaterial>>{std::move(m)}, axisymmetric(f));
   b.held.assign(b.body->dof_count(), 0);
   for (int n : bore) b.held[2 * n] = b.held[2 * n + 1] = 1;
   for (int n : b.rim) b.held[2 * n + 1] = 1;
@@ -216,14 +244,19 @@ void bend_far(Driver& d, const Bent& b, double tolerance) {
         tolerance);
 }
 
-const ContinuumElement kElements[] = {ContinuumElement::q4, ContinuumElement::q8, ContinuumElement::q9,
-                                      ContinuumElement::t6};
+const Formulation kElements[] = {ContinuumElement::q4,
+                                 ContinuumElement::q8,
+                                 ContinuumElement::q9,
+                                 ContinuumElement::t6,
+                                 kMixedQ9,
+                                 kMixedT6,
+                                 kFBarQ4};
 
 TEST(J2FiniteAxisymmetric, ConsistentTangentMatchesDifferencesOfTheForce) {
-  for (ContinuumElement element : kElements)
+  for (const Formulation& f : kElements)
     for (const Law& law : laws()) {
-      SCOPED_TRACE(std::string(law.name) + " " + element_name(element));
-      Bent b = bent_plate(material(law), element);
+      SCOPED_TRACE(std::string(law.name) + " " + f.name());
+      Bent b = bent_plate(material(law), f);
       Driver d(*b.body, b.held);
       bend_far(d, b, 1e-9 * kYield);
       Vector q = d.q;  // a state beyond the committed one, off equilibrium: every dof moved
@@ -235,16 +268,16 @@ TEST(J2FiniteAxisymmetric, ConsistentTangentMatchesDifferencesOfTheForce) {
       EXPECT_GT(flowing, 0);
       EXPECT_LT(check.error(), 1e-6);
       EXPECT_LT(check.asymmetry(), 1e-9);
-      std::printf("axisymmetric tangent %-6s %-3s |K - K_fd| / |K| = %.1e (%d of %zu elements flowing)\n", law.name,
-                  element_name(element), check.error(), flowing, rows.size());
+      std::printf("axisymmetric tangent %-6s %-8s |K - K_fd| / |K| = %.1e (%d of %zu elements flowing)\n", law.name,
+                  f.name().c_str(), check.error(), flowing, rows.size());
     }
 }
 
 TEST(J2FiniteAxisymmetric, NewtonConvergesQuadraticallyOnAPlasticStep) {
-  for (ContinuumElement element : kElements)
+  for (const Formulation& f : kElements)
     for (const Law& law : laws()) {
-      SCOPED_TRACE(std::string(law.name) + " " + element_name(element));
-      Bent b = bent_plate(material(law), element);
+      SCOPED_TRACE(std::string(law.name) + " " + f.name());
+      Bent b = bent_plate(material(law), f);
       Driver d(*b.body, b.held);
       bend_far(d, b, 1e-10 * kYield);
       const std::vector<double>& r = d.residuals;
@@ -254,8 +287,7 @@ TEST(J2FiniteAxisymmetric, NewtonConvergesQuadraticallyOnAPlasticStep) {
         std::snprintf(buffer, sizeof buffer, " %.1e", v / r[0]);
         line += buffer;
       }
-      std::printf("axisymmetric Newton %-6s %-3s relative residuals:%s\n", law.name, element_name(element),
-                  line.c_str());
+      std::printf("axisymmetric Newton %-6s %-8s relative residuals:%s\n", law.name, f.name().c_str(), line.c_str());
       EXPECT_GE(testing::expect_quadratic(r), 1);
       EXPECT_LE(r.size(), 10u);
       int flowing = 0;
@@ -274,18 +306,19 @@ struct Tube {
   std::vector<int> bore;
 };
 
-Tube tube(std::shared_ptr<const PlaneMaterial> m, int nr, ContinuumKinematics kinematics) {
+Tube tube(std::shared_ptr<const PlaneMaterial> m, int nr, ContinuumKinematics kinematics,
+          Formulation f = ContinuumElement::q9) {
   RectangleSpec spec;
   spec.origin = {1.0, 0.0};
   spec.size = {1.0, 0.1};
   spec.nx = nr;
   spec.ny = 1;
   Tube t;
-  t.mesh = rectangle_mesh(spec, ElementShape::q9);
+  t.mesh = rectangle_mesh(spec, element_shape(f.element));
   t.bore = t.mesh.sets.at("left");
   t.body = std::make_unique<ContinuumBody>(t.mesh, t.mesh.sets.at("bottom"),
                                            std::vector<std::shared_ptr<const PlaneMaterial>>{std::move(m)},
-                                           axisymmetric(ContinuumElement::q9, kinematics));
+                                           axisymmetric(f, kinematics));
   t.held.assign(t.body->dof_count(), 0);
   for (int n = 0; n < t.body->node_count(); ++n) t.held[2 * n + 1] = 1;
   for (int n : t.bore) t.held[2 * n] = 1;
@@ -296,8 +329,23 @@ TEST(J2FiniteAxisymmetric, ThickTubeExpandedPlasticallyReachesTheLargeStrainPres
   IsotropicHardening perfect;  // linear, modulus 0
   const auto m = std::make_shared<J2Material>(kYoung, kPoisson, kYield, perfect, 0.0, PlaneAnalysis::axisymmetric);
   const double k = kYield / std::sqrt(3.0);
-  for (int nr : {4, 8}) {
-    Tube t = tube(m, nr, ContinuumKinematics::finite);
+  // The bound of each mesh: its discretization error, measured, with a margin. The plain q4 locks
+  // (isochoric flow): its pressure stays above the closed form by more than 2 %.
+  struct Case {
+    Formulation f;
+    int nr;
+    double bound;
+  };
+  const Case cases[] = {{ContinuumElement::q9, 4, 2e-3},
+                        {ContinuumElement::q9, 8, 3e-4},
+                        {kMixedQ9, 4, 3e-4},
+                        {kMixedQ9, 8, 3e-4},
+                        {kMixedT6, 8, 8e-4},
+                        {kFBarQ4, 16, 4e-4},
+                        {ContinuumElement::q4, 16, 0}};
+  for (const auto& [form, nr, bound] : cases) {
+    SCOPED_TRACE(form.name() + " " + std::to_string(nr));
+    Tube t = tube(m, nr, ContinuumKinematics::finite, form);
     Driver d(*t.body, t.held);
     double worst = 0.0;
     // The bore from 1 to 1.5 in 25 steps; fully plastic from u_a ~ k B^2 / (2 G) = 0.0075 on.
@@ -316,11 +364,13 @@ TEST(J2FiniteAxisymmetric, ThickTubeExpandedPlasticallyReachesTheLargeStrainPres
       if (s >= 5) worst = std::max(worst, std::abs(p - closed) / closed);
       if (s == 25)
         std::printf(
-            "thick tube nr = %d: bore 1 -> %.2f, outer 2 -> %.4f: p = %.3f, closed form %.3f (%.2e); worst "
+            "thick tube %-8s nr = %2d: bore 1 -> %.2f, outer 2 -> %.4f: p = %.3f, closed form %.3f (%.2e); worst "
             "from bore 1.1 on %.2e\n",
-            nr, a, 2 + d.q[2 * t.mesh.sets.at("right").front()], p, closed, (p - closed) / closed, worst);
+            form.name().c_str(), nr, a, 2 + d.q[2 * t.mesh.sets.at("right").front()], p, closed, (p - closed) / closed,
+            worst);
     }
-    EXPECT_LT(worst, nr == 4 ? 2e-3 : 5e-4);
+    if (bound > 0) EXPECT_LT(worst, bound);
+    else EXPECT_GT(worst, 2e-2);
     EXPECT_LT(worst_plastic_volume(*t.body), 1e-12);
   }
 }
@@ -353,16 +403,6 @@ TEST(J2FiniteAxisymmetric, SmallStrainLimitIsTheSmallStrainAxisymmetricLaw) {
         "axisymmetric small-strain limit %-6s: |sigma_finite - sigma_small| / peak <= %.1e, alpha %.1e of %.1e\n",
         law.name, gap.stress, gap.alpha, gap.peak_alpha);
   }
-}
-
-TEST(J2FiniteAxisymmetric, SharedDilatationIsRefusedWithALawWithHistory) {
-  // The mixed and F-bar elements ask the hoop response without history: refused, with the reason.
-  const PlaneMesh mesh = ring();
-  ContinuumOptions mixed = axisymmetric(ContinuumElement::q9);
-  mixed.incompressibility = Incompressibility::mixed;
-  EXPECT_THROW(ContinuumBody(mesh, mesh.sets.at("bottom"), {material(laws()[0])}, mixed), std::invalid_argument);
-  const auto elastic = std::make_shared<NeoHookeMaterial>(kYoung, kPoisson, PlaneAnalysis::axisymmetric);
-  EXPECT_NO_THROW(ContinuumBody(mesh, mesh.sets.at("bottom"), {elastic}, mixed));
 }
 
 }  // namespace

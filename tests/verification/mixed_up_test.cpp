@@ -5,7 +5,7 @@
 // - the tangent against central differences of the internal force, and its symmetry (the
 //   element's energy is sum W(F_bar) dV), for neo-Hookean and Mooney-Rivlin laws near
 //   incompressibility, plane strain and axisymmetric (J2 at finite strain:
-//   tests/verification/j2_finite_test.cpp);
+//   tests/verification/j2_finite_test.cpp, j2_finite_axisymmetric_test.cpp);
 // - the scene names it and refuses the pairs that fail the inf-sup condition at
 //   /body/incompressibility, with the reason;
 // - the locking table: tests/verification/locking_test.cpp; the O-ring: o_ring_test.cpp.
