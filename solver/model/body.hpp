@@ -146,6 +146,10 @@ class Body {
 
   // Bodies with history (plasticity) keep old/new state; commit after a converged step.
   virtual void commit(const Vector& /*q*/) {}
+  // Constraints held by multipliers that an augmented Lagrangian updates (Uzawa), the exactly
+  // incompressible continuum's: at a converged state q, empty where they hold; otherwise the
+  // multipliers move and the answer says how far off q is (the increment is solved again).
+  virtual std::string update_multipliers(const Vector& /*q*/) { return {}; }
 };
 
 }  // namespace grip

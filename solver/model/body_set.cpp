@@ -206,4 +206,12 @@ void BodySet::commit(const Vector& q) {
   for (int b = 0; b < part_count(); ++b) parts_[b]->commit(part_q(q, b));
 }
 
+std::string BodySet::update_multipliers(const Vector& q) {
+  std::string off;
+  for (int b = 0; b < part_count(); ++b)
+    if (const std::string why = parts_[b]->update_multipliers(part_q(q, b)); !why.empty())
+      off += (off.empty() ? "" : "; ") + names_[b] + ": " + why;
+  return off;
+}
+
 }  // namespace grip

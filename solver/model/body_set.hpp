@@ -55,6 +55,7 @@ class BodySet final : public Body {
   std::string inadmissible(const Vector& q) const override;
   std::string validity_warning(const Vector& q) const override;
   void commit(const Vector& q) override;
+  std::string update_multipliers(const Vector& q) override;
 
  private:
   // The parts' tables of `fields` one below the other, with every part's columns; a column

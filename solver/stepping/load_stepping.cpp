@@ -91,6 +91,10 @@ double distance(const LoadFactors& a, const LoadFactors& b) {
 
 using Clock = std::chrono::steady_clock;
 
+// Updates of a body's multipliers (Body::update_multipliers) one increment may take: the exact
+// incompressible continuum's shrink its volume error by about shear / bulk <= 1e-2 each.
+constexpr int kMaxMultiplierUpdates = 20;
+
 // The record of step `index` (from 1), before it is solved.
 StepRecord step_record(const LoadStep& step, int index) {
   StepRecord rec;
@@ -147,6 +151,9 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
     int depth = 0;
     bool from_previous_force = false;  // after a failure from the extrapolated force
     LoadFactors probed;                // the last target whose friction limit was decided
+    // After an update of the body's multipliers: the increment again from its converged state.
+    std::optional<std::pair<Vector, Vector>> again;
+    int updates = 0;  // of the multipliers in this increment
     while (true) {
       const double t = std::min(1.0, done + increment);
       const LoadFactors target = t == 1.0 ? target_step.factors : blend(from, target_step.factors, t);
@@ -154,16 +161,20 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
       // guess would leave a membrane without transverse stiffness.
       const double last = distance(current, before);
       const double ratio = !start_q && last > 0 ? distance(target, current) / last : 0.0;
-      const Vector guess = start_q ? *start_q : Vector(q + (q - q_before) * ratio);
+      const bool repeat = again.has_value();
+      const Vector guess = repeat ? again->first : start_q ? *start_q : Vector(q + (q - q_before) * ratio);
       // The contact forces start from the same extrapolation (the strategies bring it back
       // into the cone): a step then starts near its answer, not a whole increment away.
-      Vector p_guess = from_previous_force || !extrapolate_forces ? p : Vector(p + (p - p_before) * ratio);
-      const bool extrapolated = p_guess != p;
+      Vector p_guess = repeat                                       ? again->second
+                       : from_previous_force || !extrapolate_forces ? p
+                                                                    : Vector(p + (p - p_before) * ratio);
+      const bool extrapolated = !repeat && p_guess != p;
+      again.reset();
       // Rigid amplitudes not extrapolated follow the supports: a pin left where it was turns a
       // held body about its moving supports (two cylinders under displacement control: the upper
       // one by delta / L at the start, a turn of the pairing that the linear model leaves out;
       // cev stalled at ||v|| = 2e-3).
-      if (!extrapolated && problem.rigid.count())
+      if (!extrapolated && !repeat && problem.rigid.count())
         p_guess.segment(problem.rigid.first, problem.rigid.count()) +=
             amplitudes_following_supports(problem, current, target);
       eq->set_step(target, zeta);
@@ -252,6 +263,23 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
           out.failure = FailureKind::check_failed;
           refused = true;
         }
+        // Constraints held by multipliers (exact incompressibility): where they do not hold yet,
+        // the multipliers moved, and the increment is solved again from this state.
+        if (!refused)
+          if (std::string off = problem.body->update_multipliers(out.state.q); !off.empty()) {
+            if (updates < kMaxMultiplierUpdates) {
+              ++updates;
+              ++rec.multiplier_updates;
+              again.emplace(out.state.q, out.p);
+              continue;
+            }
+            out.converged = false;
+            out.reason = "the body's constraint does not hold after " + std::to_string(updates) +
+                         " updates of its multipliers: " + off;
+            out.failure = FailureKind::newton_diverged;
+            out.definitive = true;
+            refused = true;  // no friction limit to probe: the contact solve converged
+          }
       }
       if (!out.converged) {
         if (out.stopped) result.stopped = true;
@@ -342,6 +370,7 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
       current = target;
       done = t;
       zeta = eq->zetas(out.state);
+      updates = 0;
       problem.body->commit(q);
       if (t == 1.0) {
         rec.state = std::move(out.state);
