@@ -2,6 +2,8 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 namespace grip {
@@ -37,7 +39,9 @@ std::string incompressibility_issue(const ContinuumOptions& options) {
   using E = ContinuumElement;
   if (options.incompressibility == Incompressibility::none) return {};
   const bool f_bar = options.incompressibility == Incompressibility::f_bar;
-  const std::string name = f_bar ? "\"f_bar\"" : "\"mixed\"";
+  const std::string name = f_bar                                                   ? "\"f_bar\""
+                           : options.incompressibility == Incompressibility::exact ? "\"exact\""
+                                                                                   : "\"mixed\"";
   if (options.kinematics != ContinuumKinematics::finite)
     return name + " is for finite kinematics; with linear kinematics use element \"q4_bbar\"";
   if (options.analysis == PlaneAnalysis::plane_stress)
@@ -52,15 +56,32 @@ std::string incompressibility_issue(const ContinuumOptions& options) {
     case E::t6:
       return {};
     case E::q8:
-      return "\"mixed\" is not offered for q8: the serendipity element with a linear pressure (Bathe's 8/3) fails "
+      return name +
+             " is not offered for q8: the serendipity element with a linear pressure (Bathe's 8/3) fails "
              "the inf-sup condition; use q9 (Q2/P1, stable)";
     case E::t3:
-      return "\"mixed\" is not offered for t3: a constant pressure on linear triangles (P1/P0) locks; use t6 (P2/P0, "
+      return name +
+             " is not offered for t3: a constant pressure on linear triangles (P1/P0) locks; use t6 (P2/P0, "
              "stable)";
     default:
-      return "\"mixed\" is not offered for q4: a constant pressure on q4 (Q1/P0) fails the inf-sup condition "
+      return name +
+             " is not offered for q4: a constant pressure on q4 (Q1/P0) fails the inf-sup condition "
              "(checkerboard pressure modes); use \"f_bar\" (the same constraint count) or q9 with \"mixed\"";
   }
+}
+
+std::string exact_law_issue(const PlaneMaterial& law) {
+  if (law.has_history() || dynamic_cast<const HookeMaterial*>(&law))
+    return "law: \"exact\" incompressibility takes the elastic laws \"neo_hookean\" and \"mooney_rivlin\"";
+  if (const double ratio = law.bulk_over_shear(); ratio < kExactMinBulkOverShear) {
+    char buf[256];
+    std::snprintf(buf, sizeof buf,
+                  "bulk / shear modulus %.4g: with \"exact\" the bulk modulus is the augmented Lagrangian's penalty "
+                  "(the answer does not depend on it), at least %g x the shear modulus",
+                  ratio, kExactMinBulkOverShear);
+    return (dynamic_cast<const NeoHookeMaterial*>(&law) ? "poisson: " : "bulk: ") + std::string(buf);
+  }
+  return {};
 }
 
 const char* element_name(ContinuumElement element) {
@@ -119,6 +140,14 @@ ContinuumBody::ContinuumBody(PlaneMesh mesh, const std::vector<int>& contact_set
   }
   length_ = (hi - lo).norm();
   if (has_history_) history_.resize(mesh_.elements.size() * gauss_rule(shape_).size());
+  if (options_.incompressibility == Incompressibility::exact) {
+    for (const auto& m : materials_)
+      if (const std::string why = exact_law_issue(*m); !why.empty()) throw std::invalid_argument(why);
+    pressure_.assign(mesh_.elements.size(), Vector::Zero(static_cast<int>(gauss_rule(shape_).size())));
+    centre_pressure_.assign(mesh_.elements.size(), 0.0);
+    for (int e = 0; e < element_count(); ++e)  // K = K / G times G (D_1212) at small strain
+      penalty_.push_back(material(e).bulk_over_shear() * material(e).small_strain_D4()(2, 2));
+  }
 }
 
 const ContinuumBody::Integration& ContinuumBody::integration() const {
@@ -141,6 +170,7 @@ const ContinuumBody::Integration& ContinuumBody::integration() const {
       // t6). F-bar in axisymmetry: the element's mean J (P0), the hoop stretch in it; J at the
       // centre would fail the patch test there (the integral of grad N 2 pi r is not the centre's).
       if (options_.incompressibility == Incompressibility::mixed ||
+          options_.incompressibility == Incompressibility::exact ||
           (options_.incompressibility == Incompressibility::f_bar && axisymmetric))
         in->dilatation.push_back(projected_dilatation(in->points.back(), in->centroids.back(), X,
                                                       options_.element == ContinuumElement::q9 ? 1 : 0));
@@ -244,6 +274,43 @@ void ContinuumBody::commit(const Vector& q) {
   }
 }
 
+std::string ContinuumBody::update_multipliers(const Vector& q) {
+  if (pressure_.empty()) return {};
+  const Integration& in = integration();
+  std::vector<Vector> theta(element_count());
+  std::vector<double> centre(element_count());
+  double worst = 0.0;
+  int at = 0;
+  for (int e = 0; e < element_count(); ++e) {
+    const ShapeGradients u = element_displacements(q, e);
+    theta[e] = projected_ratios(in.dilatation[e], u);
+    centre[e] = centre_projected_ratio(in.dilatation[e], u);
+    if (const double off = (theta[e].array() - 1).abs().maxCoeff(); off > worst) {
+      worst = off;
+      at = e;
+    }
+  }
+  if (worst <= kExactVolumeTolerance) return {};
+  // theta lies in the pressure space (a projection), so the updated pressure stays in it.
+  for (int e = 0; e < element_count(); ++e) {
+    pressure_[e].array() += penalty_[e] * (theta[e].array() - 1);
+    centre_pressure_[e] += penalty_[e] * (centre[e] - 1);
+  }
+  char buf[120];
+  std::snprintf(buf, sizeof buf, "the volume ratio is off 1 by %.2e in element %d", worst, at);
+  return buf;
+}
+
+double ContinuumBody::element_volume_change(const Vector& q, int e) const {
+  const ShapeGradients u = element_displacements(q, e);
+  double before = 0.0, after = 0.0;
+  for (const ElementPoint& p : integration().points[e]) {
+    before += p.dV;
+    after += p.dV * volume_ratio(p, u);
+  }
+  return after / before - 1;
+}
+
 void ContinuumBody::internal_force(const Vector& q, Vector& force, Triplets* tangent) const {
   if (has_history_ && options_.kinematics == ContinuumKinematics::linear) {
     const Integration& in = integration();
@@ -297,7 +364,7 @@ void ContinuumBody::internal_force(const Vector& q, Vector& force, Triplets* tan
     for (int a = 0; a < n; ++a) u.row(a) << q[node_dof(el[a], 0)], q[node_dof(el[a], 1)];
     if (!in.dilatation.empty())
       dilatation_total_lagrangian(in.points[e], in.dilatation[e], u, material(e), fe, tangent ? &Ke : nullptr, law,
-                                  hoop_law);
+                                  hoop_law, pressure_.empty() ? nullptr : &pressure_[e]);
     else if (options_.incompressibility == Incompressibility::f_bar)
       f_bar_total_lagrangian(in.points[e], in.centroids[e], u, material(e), fe, tangent ? &Ke : nullptr, law);
     else total_lagrangian(in.points[e], u, material(e), fe, tangent ? &Ke : nullptr, law, hoop_law);
@@ -433,14 +500,17 @@ Eigen::Vector4d ContinuumBody::centroid_stress(const Vector& q, int e) const {
   const double s = dilatation.empty() ? 1.0 : centre_dilatation_scale(c, dilatation[e], u);
   const Mat2 F = s * deformation_gradient(c, u);
   const Mat2 E = 0.5 * (F.transpose() * F - Mat2::Identity());
-  if (options_.analysis != PlaneAnalysis::axisymmetric) return cauchy_stress(F, material(e).response(E));
+  // The exact form: the multiplier's term p (theta - 1) adds the pressure p I to the law's stress.
+  const double p = centre_pressure_.empty() ? 0.0 : centre_pressure_[e];
+  const Eigen::Vector4d pressure(p, p, 0.0, p);
+  if (options_.analysis != PlaneAnalysis::axisymmetric) return cauchy_stress(F, material(e).response(E)) + pressure;
   const double F33 = s * (1 + c.N.dot(u.col(0)) / c.radius);
   const HoopResponse h = material(e).hoop_response(E, 0.5 * (F33 * F33 - 1));
   MaterialResponse r;
   r.S = h.S.head<3>();
   r.S33 = h.S[3];
   r.C33 = F33 * F33;
-  return cauchy_stress(F, r);
+  return cauchy_stress(F, r) + pressure;
 }
 
 FieldTable ContinuumBody::element_fields(const Vector& q) const {

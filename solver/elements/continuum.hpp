@@ -38,8 +38,11 @@ enum class ContinuumKinematics { linear, finite };
 // Against volumetric locking (finite kinematics; linear kinematics has q4_bbar): none; F-bar
 // (q4, plane strain and axisymmetric; plane_element.hpp, dilatation.hpp); mixed, the u-p-theta
 // form with the pressure discontinuous and condensed per element: q9 with a linear pressure
-// (Q2/P1), t6 with a constant one (P2/P0), the pairs that satisfy inf-sup (dilatation.hpp).
-enum class Incompressibility { none, f_bar, mixed };
+// (Q2/P1), t6 with a constant one (P2/P0), the pairs that satisfy inf-sup (dilatation.hpp);
+// exact, the same elements with the volume held (theta = 1 at every point) by the pressure as a
+// Lagrange multiplier, found by an augmented Lagrangian: the law's bulk modulus is its penalty,
+// update_multipliers its Uzawa update (docs/algorithm.md#exact-incompressibility).
+enum class Incompressibility { none, f_bar, mixed, exact };
 
 struct ContinuumOptions {
   ContinuumElement element = ContinuumElement::q4;
@@ -52,6 +55,15 @@ struct ContinuumOptions {
 // Why `incompressibility` is not offered with the other options (empty if it is): the reason the
 // scene reader puts at /body/incompressibility (docs/algorithm.md#element-formulation-pairs).
 std::string incompressibility_issue(const ContinuumOptions& options);
+
+// The exact form's penalty (the law's bulk modulus) at least this many times the shear modulus:
+// each update of the multipliers shrinks the volume error by about shear / bulk.
+inline constexpr double kExactMinBulkOverShear = 100.0;
+// The exact form's volume constraint holds where |theta - 1| is below this at every point.
+inline constexpr double kExactVolumeTolerance = 1e-9;
+// Why `law` cannot be made exactly incompressible (empty if it can), as "field: reason": only
+// the elastic neo-Hookean and Mooney-Rivlin laws, with bulk / shear of kExactMinBulkOverShear.
+std::string exact_law_issue(const PlaneMaterial& law);
 
 ElementShape element_shape(ContinuumElement element);
 // Axisymmetric (docs/algorithm.md#axisymmetric): the nodes at r = x < 0 (refused), and those on
@@ -102,6 +114,12 @@ class ContinuumBody final : public Body {
   Traits traits() const override;
   // The integration points' history advances to the state at q (a law with history).
   void commit(const Vector& q) override;
+  // The exact form: the Uzawa update p += bulk (theta - 1) of every point's pressure, where some
+  // point's |theta - 1| exceeds kExactVolumeTolerance (then says where it is worst).
+  std::string update_multipliers(const Vector& q) override;
+  // The deformed volume of element e over its reference volume, minus 1 (by its integration
+  // points: exact for t6 and q9, whose J they integrate exactly).
+  double element_volume_change(const Vector& q, int e) const;
   bool axisymmetric() const override { return options_.analysis == PlaneAnalysis::axisymmetric; }
   std::optional<ElementQuality> element_quality() const override { return grip::element_quality(mesh_); }
   std::vector<std::vector<int>> cells() const override;  // element corners (node ids): 3 or 4
@@ -160,6 +178,10 @@ class ContinuumBody final : public Body {
   double length_ = 0.0;
   bool has_history_ = false;           // some element's law keeps history
   std::vector<PointHistory> history_;  // committed, per element and point (element e from e x points)
+  // The exact form: the pressure (Lagrange multiplier) at each integration point and at the
+  // centre of every element, and the element's penalty (its law's bulk modulus).
+  std::vector<Vector> pressure_;
+  std::vector<double> centre_pressure_, penalty_;
   mutable std::once_flag integration_once_;
   mutable std::unique_ptr<const Integration> integration_;
 };

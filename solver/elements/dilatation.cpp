@@ -101,6 +101,14 @@ Vector dilatation_scales(const std::vector<ElementPoint>& points, const Dilatati
   return s;
 }
 
+Vector projected_ratios(const Dilatation& dilatation, const ShapeGradients& u) {
+  return dilatation.A * ratios_at(dilatation, u);
+}
+
+double centre_projected_ratio(const Dilatation& dilatation, const ShapeGradients& u) {
+  return dilatation.centre.dot(ratios_at(dilatation, u));
+}
+
 double centre_dilatation_scale(const ElementPoint& centre, const Dilatation& dilatation, const ShapeGradients& u) {
   const double theta = dilatation.centre.dot(ratios_at(dilatation, u));
   return std::pow(theta / volume_ratio(centre, u), exponent(centre));
@@ -108,7 +116,7 @@ double centre_dilatation_scale(const ElementPoint& centre, const Dilatation& dil
 
 void dilatation_total_lagrangian(const std::vector<ElementPoint>& points, const Dilatation& dilatation,
                                  const ShapeGradients& u, const PlaneMaterial& material, Vector& fe, Matrix* Ke,
-                                 const PointLaw& law, const HoopLaw& hoop_law) {
+                                 const PointLaw& law, const HoopLaw& hoop_law, const Vector* pressure) {
   const int n = static_cast<int>(u.rows()), m = 2 * n;
   const bool hoop = points.front().radius > 0;
   const int R = hoop ? 4 : 3;
@@ -165,6 +173,10 @@ void dilatation_total_lagrangian(const std::vector<ElementPoint>& points, const 
       D = r.D;
     }
     fe.noalias() += p.dV * Bbar.transpose() * S;
+    if (pressure) {  // the multiplier's term p (theta - 1): its gradient and second derivative
+      fe.noalias() += p.dV * (*pressure)[k] * dtheta;
+      if (Ke) Ke->noalias() += p.dV * (*pressure)[k] * d2theta;
+    }
     if (!Ke) continue;
     // The second derivative of sum W(E_bar): the material part, the second derivative of beta
     // times S . C / 2, the cross terms of d beta with dC, and beta times the plain geometric part.

@@ -33,12 +33,17 @@ double volume_ratio(const ElementPoint& point, const ShapeGradients& u);
 // s_k = (theta_k / J_k)^(1/d) of each point: F_bar = s F (and F33_bar = s F33 in axisymmetry).
 Vector dilatation_scales(const std::vector<ElementPoint>& points, const Dilatation& dilatation,
                          const ShapeGradients& u);
+// theta = A J at each point, and at the centre.
+Vector projected_ratios(const Dilatation& dilatation, const ShapeGradients& u);
+double centre_projected_ratio(const Dilatation& dilatation, const ShapeGradients& u);
 // The same s at the element's centre.
 double centre_dilatation_scale(const ElementPoint& centre, const Dilatation& dilatation, const ShapeGradients& u);
 // Internal force fe and (if given) the tangent Ke of the element. `law` and `hoop_law` as for
-// total_lagrangian, asked at each point's E_bar (and E33_bar in axisymmetry).
+// total_lagrangian, asked at each point's E_bar (and E33_bar in axisymmetry). `pressure` (the
+// exact form), a multiplier per point: the energy gains sum p_k (theta_k - 1) dV.
 void dilatation_total_lagrangian(const std::vector<ElementPoint>& points, const Dilatation& dilatation,
                                  const ShapeGradients& u, const PlaneMaterial& material, Vector& fe, Matrix* Ke,
-                                 const PointLaw& law = {}, const HoopLaw& hoop_law = {});
+                                 const PointLaw& law = {}, const HoopLaw& hoop_law = {},
+                                 const Vector* pressure = nullptr);
 
 }  // namespace grip

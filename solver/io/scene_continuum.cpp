@@ -1,7 +1,8 @@
 // body.model "continuum": plane triangles and quadrilaterals (solver/elements/continuum.hpp).
 //   "kinematics": "finite" (default) | "linear";  "analysis": "plane_strain" | "plane_stress" | "axisymmetric"
 //   "element": "t3" | "t6" | "q4" | "q4_bbar" | "q8" | "q9";  "thickness" (default 1)
-//   "incompressibility": "none" (default) | "f_bar" (finite kinematics, q4) | "mixed" (finite, q9 and t6)
+//   "incompressibility": "none" (default) | "f_bar" (finite kinematics, q4) | "mixed" (finite, q9 and t6) |
+//     "exact" (as mixed; neo_hookean and mooney_rivlin with bulk >= 100 x shear, its penalty)
 //   "material": {"young", "poisson", "law": "neo_hookean" | "saint_venant_kirchhoff" | "j2_plasticity"} |
 //     {"law": "mooney_rivlin", "c10", "c01" (default 0), "bulk"}
 //     j2_plasticity: "yield_stress", "hardening": {"linear": H} |
@@ -522,9 +523,11 @@ void read_continuum(Reader& r, json& body, Problem& problem, const std::string& 
                              ContinuumElement::q4_bbar, ContinuumElement::q8, ContinuumElement::q9})
     if (element == element_name(e)) options.element = e;
   options.thickness = r.positive(body, ptr, "thickness", 1.0);
-  const std::string incompressibility = r.choice(body, ptr, "incompressibility", {"none", "f_bar", "mixed"}, "none");
+  const std::string incompressibility =
+      r.choice(body, ptr, "incompressibility", {"none", "f_bar", "mixed", "exact"}, "none");
   options.incompressibility = incompressibility == "f_bar"   ? Incompressibility::f_bar
                               : incompressibility == "mixed" ? Incompressibility::mixed
+                              : incompressibility == "exact" ? Incompressibility::exact
                                                              : Incompressibility::none;
   if (const std::string why = incompressibility_issue(options); !why.empty()) r.error(ptr + "/incompressibility", why);
   if (options.element == ContinuumElement::q4_bbar) {
@@ -539,7 +542,7 @@ void read_continuum(Reader& r, json& body, Problem& problem, const std::string& 
   }
   const ElementShape shape = element_shape(options.element);
 
-  const auto read_material = [&](json& mat, const std::string& mp) -> std::shared_ptr<const PlaneMaterial> {
+  const auto read_law = [&](json& mat, const std::string& mp) -> std::shared_ptr<const PlaneMaterial> {
     const std::string law = r.choice(
         mat, mp, "law", {"neo_hookean", "saint_venant_kirchhoff", "j2_plasticity", "mooney_rivlin"}, "neo_hookean");
     if (law == "mooney_rivlin") return read_mooney_rivlin(r, mat, mp, options.analysis);
@@ -554,6 +557,18 @@ void read_continuum(Reader& r, json& body, Problem& problem, const std::string& 
       if (mat.contains(key)) r.error(mp + "/" + key, "belongs to law \"j2_plasticity\" (this law is elastic)");
     if (law == "neo_hookean") return std::make_shared<NeoHookeMaterial>(young, poisson, options.analysis);
     return std::make_shared<HookeMaterial>(young, poisson, options.analysis);
+  };
+  // The exact form refuses the laws it cannot hold and a bulk modulus too low for its penalty.
+  const auto read_material = [&](json& mat, const std::string& mp) -> std::shared_ptr<const PlaneMaterial> {
+    const size_t before = r.issues.size();
+    std::shared_ptr<const PlaneMaterial> law = read_law(mat, mp);
+    if (law && r.issues.size() == before && options.incompressibility == Incompressibility::exact)
+      if (const std::string why = exact_law_issue(*law); !why.empty()) {
+        const size_t colon = why.find(':');
+        r.error(mp + "/" + why.substr(0, colon), why.substr(colon + 2));
+        return nullptr;
+      }
+    return law;
   };
   // `material` for every element, or `materials` by physical surface (a mesh file).
   std::vector<std::shared_ptr<const PlaneMaterial>> materials;
