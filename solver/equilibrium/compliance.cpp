@@ -8,6 +8,16 @@
 
 namespace grip {
 
+namespace {
+
+// The most surface dofs whose G comes from Newton's factorization (newton_factor_serves): G costs
+// one solve per surface dof, and such a G serves its state only, so every later update forms
+// one again. The 150 x 4 strip's few hundred: 120 real solves instead of 108 at 3 x the CPU
+// with a bound of 400 (bench/results/kernels.md).
+constexpr int kNewtonFactorRows = 128;
+
+}  // namespace
+
 Matrix Compliance::sub(const std::vector<int>& components) const {
   Matrix B(components.size(), components.size());
   for (size_t a = 0; a < components.size(); ++a)
@@ -23,7 +33,7 @@ void Equilibrium::extend_surface_compliance(const std::vector<int>& added) {
   }
   const int m = static_cast<int>(surface_free_.size());
   counters_.compliance_columns += m - m0;
-  const bool sparse_solves = m0 == 0 && body_lu_.inverse_block(surface_free_, g_);
+  const bool sparse_solves = m0 == 0 && !g_from_newton_ && body_lu_.inverse_block(surface_free_, g_);
   counters_.dissected_factorizations = body_lu_.dissected_factorizations();
   if (sparse_solves) return;  // a new G: sparse solves
   g_.conservativeResize(m, m);
@@ -34,7 +44,7 @@ void Equilibrium::extend_surface_compliance(const std::vector<int>& added) {
     const int cols = std::min(kBlock, m - start);
     rhs.setZero(free_count_, cols);
     for (int c = 0; c < cols; ++c) rhs(surface_free_[start + c], c) = 1.0;
-    const Matrix x = body_lu_.solve(rhs);
+    const Matrix x = g_factor().solve(rhs);
     for (int c = 0; c < cols; ++c)
       for (int r = 0; r < m; ++r) {
         g_(r, start + c) = x(surface_free_[r], c);
@@ -77,6 +87,24 @@ Eigen::SparseMatrix<double> contact_map(const Problem& problem, const Equilibriu
   return t;
 }
 
+// The free surface dofs of the candidates among `components`: the rows of G they need.
+int surface_dof_count(const Problem& problem, const EquilibriumState& state, const std::vector<int>& components,
+                      const std::vector<int>& free_index) {
+  std::vector<char> asked(problem.component_count, 0), counted(free_index.size(), 0);
+  for (int c : components) asked[c] = 1;
+  int count = 0;
+  for (size_t i = 0; i < problem.candidates.size(); ++i) {
+    const Candidate& c = problem.candidates[i];
+    if (!asked[c.eta] && (c.xi < 0 || !asked[c.xi])) continue;
+    for (const auto& j : state.points[i].point.jacobian)
+      if (free_index[j.dof] >= 0 && !counted[j.dof]) {
+        counted[j.dof] = 1;
+        ++count;
+      }
+  }
+  return count;
+}
+
 }  // namespace
 
 const Compliance& Equilibrium::compliance(const EquilibriumState& state, const std::vector<int>& components,
@@ -84,7 +112,7 @@ const Compliance& Equilibrium::compliance(const EquilibriumState& state, const s
   const int k = static_cast<int>(components.size());
   bool tangent_ok = false;
   if (k > 0) {
-    tangent_ok = compliance_tangent(state);
+    tangent_ok = compliance_tangent(state, surface_dof_count(problem_, state, components, free_index_));
     // The border of a body held by contact stays dense (its block is indefinite).
     if (tangent_ok && k >= sparse_from && problem_.rigid.count() == 0 && body_lu_.symmetric())
       return sparse_compliance(state, components);
@@ -146,18 +174,33 @@ const Compliance& Equilibrium::compliance(const EquilibriumState& state, const s
   return c_;
 }
 
-bool Equilibrium::compliance_tangent(const EquilibriumState& state) {
-  if (!constant_tangent_ && !compliance_reuse_) g_valid_ = false;
-  compliance_reused_ = g_valid_ && !constant_tangent_;
-  if (g_valid_) return body_lu_.ok();
+bool Equilibrium::newton_factor_serves(const EquilibriumState& state, int surface_dofs) const {
+  return !constant_tangent_ && !penalty_ && surface_dofs <= kNewtonFactorRows && newton_factor_solve_ >= 0 &&
+         newton_factor_solve_ == counters_.solves && lu_.symmetric() && state.q.size() == newton_factor_q_.size() &&
+         state.q == newton_factor_q_;
+}
+
+bool Equilibrium::compliance_tangent(const EquilibriumState& state, int surface_dofs) {
+  const bool from_newton = newton_factor_serves(state, surface_dofs);
+  // A G from Newton's factorization serves its own state only (the next real solve factorizes
+  // anew); at that state it is kept while the contact zone grows.
+  const bool same_newton_g = g_valid_ && g_from_newton_ && from_newton && g_solve_ == counters_.solves;
+  if (!constant_tangent_ && !same_newton_g && (!compliance_reuse_ || g_from_newton_)) g_valid_ = false;
+  compliance_reused_ = g_valid_ && !constant_tangent_ && !g_from_newton_;
+  if (g_valid_) return g_factor().ok();
   // A new G: from the tangent at this state.
   surface_free_.clear();
   surface_row_.assign(free_count_, -1);
   g_.resize(0, 0);
-  if (!factorize_body_tangent(state.q)) return false;
-  ++counters_.compliance_forms;
+  g_from_newton_ = from_newton;
+  if (from_newton) {
+    g_solve_ = counters_.solves;
+  } else {
+    if (!factorize_body_tangent(state.q)) return false;
+    ++counters_.compliance_forms;
+    ++tangent_version_;
+  }
   ++g_version_;
-  ++tangent_version_;
   g_valid_ = true;
   return true;
 }
@@ -233,14 +276,15 @@ Vector Equilibrium::predicted_change(const Compliance& C, const Vector& dp) cons
       if (free_index_[i] >= 0) du[i] = du_free[free_index_[i]];
     return du;
   }
-  if (C.block.rows() == 0 || t_surface_.cols() != C.block.rows() || !body_lu_.ok()) return du;
+  if (C.block.rows() == 0 || t_surface_.cols() != C.block.rows() || !g_factor().ok()) return du;
+  if (g_from_newton_ && g_solve_ != counters_.solves) return du;  // Newton has factorized since
   Vector dp_block = Vector::Zero(C.block.rows());
   for (size_t j = 0; j < C.position.size(); ++j)
     if (C.position[j] >= 0) dp_block[C.position[j]] = dp[j];
   const Vector force_surface = t_surface_ * dp_block;
   Vector force = Vector::Zero(free_count_);
   for (size_t r = 0; r < surface_free_.size(); ++r) force[surface_free_[r]] = force_surface[r];
-  const Vector du_free = body_lu_.solve(force);
+  const Vector du_free = g_factor().solve(force);
   for (size_t i = 0; i < free_index_.size(); ++i)
     if (free_index_[i] >= 0) du[i] = du_free[free_index_[i]];
   const RigidModes& rigid = problem_.rigid;

@@ -47,10 +47,12 @@ class Equilibrium {
   // C = T_s^T G T_s: G = K^-1 restricted to the surface dofs of the candidates asked for so
   // far, one solve per surface dof with one factorization of K, and T_s the rows of T at
   // those dofs (two or three non-zeros per column), so each call costs O(components^2),
-  // nothing per free dof. A constant tangent gives one G per run. A changing one gives G at state.q,
-  // or, with reuse on, the G of an earlier state, of this load step or an earlier one
-  // (refresh_compliance() renews it): the inner loop's linear model is then approximate, the
-  // real solves still decide. The reference stays valid until the next call.
+  // nothing per free dof. A constant tangent gives one G per run. A changing one gives G at state.q
+  // (from Newton's factorization there, where the real solve that reached state took one and the
+  // surface is small: newton_factor_serves), or, with reuse on, the G of an earlier state, of
+  // this load step or an earlier one (refresh_compliance() renews it): the inner loop's linear
+  // model is then approximate, the real solves still decide. The reference stays valid until
+  // the next call.
   // From `sparse_from` components on (and for a body not held by contact, whose tangent is
   // Cholesky-factorized), the sparse form instead: T on the free dofs, K's factorization and C's
   // diagonal (t_j^T K^-1 t_j by partial forward solves), no G; its reference is a separate one,
@@ -127,7 +129,7 @@ class Equilibrium {
   void extend_surface_compliance(const std::vector<int>& added);
   // The body's tangent that G (or the sparse form) comes from: kept, or factorized at state.q
   // (a changing tangent without reuse). False if it is singular.
-  bool compliance_tangent(const EquilibriumState& state);
+  bool compliance_tangent(const EquilibriumState& state, int surface_dofs);
   const Compliance& sparse_compliance(const EquilibriumState& state, const std::vector<int>& components);
 
   const Problem& problem_;
@@ -153,6 +155,18 @@ class Equilibrium {
   // whole, since a low-rank correction of the bodies' own factors would need G on the pair's
   // dofs afresh at every iterate (13 such G's cost 6x one factorization, two cylinders).
   FreeBlockSolver lu_;
+  // Where lu_ was last factorized: in the real solve of this number (counters_.solves; -1: a
+  // failed factorization), and the state that solve converged at (its last iterate but one
+  // carries the factorization). The compliance's G of a small contact zone comes from it
+  // (compliance.cpp: newton_factor_serves).
+  long newton_factor_solve_ = -1;
+  Vector newton_factor_q_;
+  bool newton_factor_serves(const EquilibriumState& state, int surface_dofs) const;
+  // The factorization G (and predicted_change) comes from: lu_ (g_from_newton_, valid during
+  // the real solve g_solve_ only) or body_lu_.
+  const FreeBlockSolver& g_factor() const { return g_from_newton_ ? lu_ : body_lu_; }
+  bool g_from_newton_ = false;
+  long g_solve_ = -1;
   // The triplets of Newton's tangent and of the body's own, kept so that their storage (megabytes
   // for a few thousand elements) is allocated once, not at every real solve.
   Triplets newton_triplets_, body_triplets_;

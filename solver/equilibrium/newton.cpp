@@ -220,6 +220,7 @@ EquilibriumState Equilibrium::newton(const Vector& q_guess, const Vector& p) {
     if (residual_met || at_floor) {
       state.at_floor = at_floor && !residual_met;
       state.noise = state.at_floor ? last_step : 0.0;
+      if (!penalty_) newton_factor_q_ = state.q;
       return penalty_ ? finish_penalty(state) : finish(state, p);
     }
     if (it > params_.max_iterations) break;
@@ -239,11 +240,13 @@ EquilibriumState Equilibrium::newton(const Vector& q_guess, const Vector& p) {
     } else {
       ++counters_.factorizations;
       ++counters_.newton_factorizations;
+      newton_factor_solve_ = -1;
       if (!lu_.factorize(triplets, free_index_, free_count_, 1e-4)) {
         state.reason = "singular tangent stiffness in Newton iteration " + std::to_string(it);
         state.failure = FailureKind::newton_diverged;
         return state;
       }
+      newton_factor_solve_ = counters_.solves;
     }
     Vector r_free(free_count_);
     for (int i = 0; i < r.size(); ++i)
@@ -271,6 +274,7 @@ EquilibriumState Equilibrium::newton(const Vector& q_guess, const Vector& p) {
     if (step <= params_.displacement_tolerance && stick_branch_.empty()) {
       state.q += dq;
       pair(state.q, state);
+      if (!penalty_) newton_factor_q_ = state.q;
       return penalty_ ? finish_penalty(state) : finish(state, p);
     }
     state.q += line_search(state.q, dq, p, reuse ? body_lu_ : lu_) * dq;

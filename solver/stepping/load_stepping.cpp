@@ -89,6 +89,13 @@ double distance(const LoadFactors& a, const LoadFactors& b) {
   return std::sqrt(d);
 }
 
+// -1 where the increment b -> c turns back on a -> b (a load reversed: unloading), else 1.
+double turn(const LoadFactors& a, const LoadFactors& b, const LoadFactors& c) {
+  double dot = 0.0;
+  for (size_t k = 0; k < a.size() && k < b.size() && k < c.size(); ++k) dot += (b[k] - a[k]) * (c[k] - b[k]);
+  return dot < 0 ? -1.0 : 1.0;
+}
+
 using Clock = std::chrono::steady_clock;
 
 // Updates of a body's multipliers (Body::update_multipliers) one increment may take: the exact
@@ -160,7 +167,8 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
       // Newton starts from the previous increment scaled to this one (section 9): a zero
       // guess would leave a membrane without transverse stiffness.
       const double last = distance(current, before);
-      const double ratio = !start_q && last > 0 ? distance(target, current) / last : 0.0;
+      const double ratio =
+          !start_q && last > 0 ? turn(before, current, target) * distance(target, current) / last : 0.0;
       const bool repeat = again.has_value();
       const Vector guess = repeat ? again->first : start_q ? *start_q : Vector(q + (q - q_before) * ratio);
       // The contact forces start from the same extrapolation (the strategies bring it back
