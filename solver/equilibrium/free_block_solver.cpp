@@ -21,76 +21,98 @@ void factorize_dissected(CholmodFactor& dissected, const Eigen::SparseMatrix<dou
 
 }  // namespace
 
-bool FreeBlockSolver::factorize(const Triplets& triplets, const std::vector<int>& free_index, int free_count,
-                                double near_symmetric_tolerance) {
-  bool same = triplets.size() == rows_.size();
-  for (size_t k = 0; same && k < triplets.size(); ++k)
-    same = triplets[k].row() == rows_[k] && triplets[k].col() == cols_[k];
-  if (!same) {
-    // New pattern: build it, remember where every triplet lands, analyse it once.
-    rows_.resize(triplets.size());
-    cols_.resize(triplets.size());
-    Triplets pattern;
-    for (size_t k = 0; k < triplets.size(); ++k) {
-      rows_[k] = triplets[k].row();
-      cols_[k] = triplets[k].col();
-      const int i = free_index[rows_[k]], j = free_index[cols_[k]];
-      if (i >= 0 && j >= 0) pattern.emplace_back(i, j, 1.0);
-    }
-    matrix_.resize(free_count, free_count);
-    matrix_.setFromTriplets(pattern.begin(), pattern.end());
-    matrix_.makeCompressed();
-    slot_.assign(triplets.size(), -1);
-    for (size_t k = 0; k < triplets.size(); ++k) {
-      const int i = free_index[rows_[k]], j = free_index[cols_[k]];
-      if (i >= 0 && j >= 0) slot_[k] = static_cast<int>(&matrix_.coeffRef(i, j) - matrix_.valuePtr());
-    }
-    // Where each entry's transpose lives (the pattern of a tangent is symmetric).
-    mirror_.assign(matrix_.nonZeros(), -1);
-    for (int col = 0; col < matrix_.outerSize(); ++col)
-      for (Eigen::SparseMatrix<double>::InnerIterator it(matrix_, col); it; ++it) {
-        const double* t = &matrix_.coeffRef(it.col(), it.row());
-        mirror_[&it.valueRef() - matrix_.valuePtr()] = static_cast<int>(t - matrix_.valuePtr());
-      }
-    lu_analysed_ = llt_analysed_ = dissected_analysed_ = llt_dissected_ = false;
-    dissected_fails_at_ = 0;
-    coupled_ = starts_.size() < 3;  // one body
-    for (int col = 0; !coupled_ && col < matrix_.outerSize(); ++col)
-      for (Eigen::SparseMatrix<double>::InnerIterator it(matrix_, col); it; ++it)
-        if (block_of(static_cast<int>(it.row())) != block_of(col)) coupled_ = true;
+bool FreeBlockSolver::scatter(const Triplets& triplets) {
+  if (triplets.size() != rows_.size()) return false;
+  double* v = matrix_.valuePtr();
+  std::fill(v, v + matrix_.nonZeros(), 0.0);
+  // One pass: the sequence checked against the pattern's as the values are summed.
+  for (size_t k = 0; k < triplets.size(); ++k) {
+    if (triplets[k].row() != rows_[k] || triplets[k].col() != cols_[k]) return false;
+    if (slot_[k] >= 0) v[slot_[k]] += triplets[k].value();
   }
-  ++factorizations_;
-  std::fill(matrix_.valuePtr(), matrix_.valuePtr() + matrix_.nonZeros(), 0.0);
-  for (size_t k = 0; k < triplets.size(); ++k)
-    if (slot_[k] >= 0) matrix_.valuePtr()[slot_[k]] += triplets[k].value();
-  const double* v = matrix_.valuePtr();
+  return true;
+}
+
+void FreeBlockSolver::build_pattern(const Triplets& triplets, const std::vector<int>& free_index, int free_count) {
+  rows_.resize(triplets.size());
+  cols_.resize(triplets.size());
+  Triplets pattern;
+  for (size_t k = 0; k < triplets.size(); ++k) {
+    rows_[k] = triplets[k].row();
+    cols_[k] = triplets[k].col();
+    const int i = free_index[rows_[k]], j = free_index[cols_[k]];
+    if (i >= 0 && j >= 0) pattern.emplace_back(i, j, 1.0);
+  }
+  matrix_.resize(free_count, free_count);
+  matrix_.setFromTriplets(pattern.begin(), pattern.end());
+  matrix_.makeCompressed();
+  slot_.assign(triplets.size(), -1);
+  for (size_t k = 0; k < triplets.size(); ++k) {
+    const int i = free_index[rows_[k]], j = free_index[cols_[k]];
+    if (i >= 0 && j >= 0) slot_[k] = static_cast<int>(&matrix_.coeffRef(i, j) - matrix_.valuePtr());
+  }
+  // Where each entry's transpose lives (the pattern of a tangent is symmetric).
+  mirror_.assign(matrix_.nonZeros(), -1);
+  for (int col = 0; col < matrix_.outerSize(); ++col)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(matrix_, col); it; ++it) {
+      const double* t = &matrix_.coeffRef(it.col(), it.row());
+      mirror_[&it.valueRef() - matrix_.valuePtr()] = static_cast<int>(t - matrix_.valuePtr());
+    }
+  lu_analysed_ = llt_analysed_ = dissected_analysed_ = llt_dissected_ = false;
+  dissected_fails_at_ = 0;
+  coupled_ = starts_.size() < 3;  // one body
+  for (int col = 0; !coupled_ && col < matrix_.outerSize(); ++col)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(matrix_, col); it; ++it)
+      if (block_of(static_cast<int>(it.row())) != block_of(col)) coupled_ = true;
+}
+
+void FreeBlockSolver::check_symmetry(double near_symmetric_tolerance) {
+  double* v = matrix_.valuePtr();
   double scale = 0.0, skew = 0.0;
   for (int k = 0; k < matrix_.nonZeros(); ++k) {
     scale = std::max(scale, std::abs(v[k]));
     skew = std::max(skew, std::abs(v[k] - v[mirror_[k]]));
   }
   symmetric_ = skew <= std::max(1e-13, near_symmetric_tolerance) * scale;
-  if (symmetric_ && skew > 0) {
-    double* w = matrix_.valuePtr();
+  if (symmetric_ && skew > 0)
     for (int k = 0; k < matrix_.nonZeros(); ++k)
-      if (mirror_[k] > k) w[k] = w[mirror_[k]] = 0.5 * (w[k] + w[mirror_[k]]);
+      if (mirror_[k] > k) v[k] = v[mirror_[k]] = 0.5 * (v[k] + v[mirror_[k]]);
+}
+
+bool FreeBlockSolver::factorize(const Triplets& triplets, const std::vector<int>& free_index, int free_count,
+                                double near_symmetric_tolerance) {
+  if (!scatter(triplets)) {
+    // New pattern: build it, remember where every triplet lands, analyse it once.
+    build_pattern(triplets, free_index, free_count);
+    scatter(triplets);
   }
+  ++factorizations_;
   split_ = !coupled_;
-  if (split_) return factorize_parts(near_symmetric_tolerance);
+  if (split_) {
+    check_symmetry(near_symmetric_tolerance);
+    return factorize_parts(near_symmetric_tolerance);
+  }
+  if (!llt_analysed_) analyse_ordered();  // the ordering: once per pattern
+  llt_analysed_ = true;
+  // The ordered triangle's values, and the symmetry check on the way: each pair of entries is
+  // one entry of the triangle and its transpose.
+  double* w = ordered_.valuePtr();
+  const double* v = matrix_.valuePtr();
+  double scale = 0.0, skew = 0.0;
+  for (size_t k = 0; k < gather_.size(); ++k) {
+    const double a = v[gather_[k]], b = v[transposed_[k]];
+    scale = std::max(scale, std::max(std::abs(a), std::abs(b)));
+    skew = std::max(skew, std::abs(a - b));
+    w[k] = a;
+  }
+  symmetric_ = skew <= std::max(1e-13, near_symmetric_tolerance) * scale;
+  if (symmetric_ && skew > 0) {  // matrix_ too: LU's fallback and the dissected factor read it
+    double* m = matrix_.valuePtr();
+    for (size_t k = 0; k < gather_.size(); ++k)
+      w[k] = m[gather_[k]] = m[transposed_[k]] = 0.5 * (w[k] + m[transposed_[k]]);
+  }
   if (symmetric_) {
-    if (!llt_analysed_) {  // the ordering: once per pattern
-      // CHOLMOD's own choice: supernodal where dense blocks pay (2D continua), simplicial for
-      // banded blocks (beams, membranes), where the supernodal BLAS calls on tiny blocks cost
-      // more than the arithmetic (the beam's compliance: 30 % of its time in dtrsm). L L^T
-      // either way (inverse_block reads L).
-      llt_.cholmod().supernodal = CHOLMOD_AUTO;
-      llt_.cholmod().final_ll = 1;
-      llt_.cholmod().nmethods = 0;  // CHOLMOD's default choice of ordering
-      if (llt_dissected_) order_by_nested_dissection(llt_);
-      llt_.analyzePattern(matrix_);
-    }
-    llt_analysed_ = true;
-    llt_.factorize(matrix_);
+    llt_.factorize_ordered(ordered_, ordered_stype_);
     // Not positive definite, or a pivot at round-off (the supports do not hold the body):
     // (min/max diag L)^2 is the min/max of LDL^T's D.
     ok_ = llt_.info() == Eigen::Success && llt_.rcond() > 1e-14;
@@ -102,6 +124,107 @@ bool FreeBlockSolver::factorize(const Triplets& triplets, const std::vector<int>
   lu_.factorize(matrix_);
   ok_ = lu_.info() == Eigen::Success;
   return ok_;
+}
+
+void FreeBlockSolver::analyse_ordered() {
+  // CHOLMOD's own choice: supernodal where dense blocks pay (2D continua), simplicial for banded
+  // blocks (beams, membranes), where the supernodal BLAS calls on tiny blocks cost more than the
+  // arithmetic (the beam's compliance: 30 % of its time in dtrsm). L L^T either way
+  // (inverse_block reads L). The probe's order includes CHOLMOD's postordering.
+  CholmodFactor probe;
+  probe.cholmod().supernodal = CHOLMOD_AUTO;
+  probe.cholmod().nmethods = 0;  // CHOLMOD's default choice of ordering
+  if (llt_dissected_) order_by_nested_dissection(probe);
+  probe.analyzePattern(matrix_);
+  const cholmod_factor* L = probe.factor();
+  const int n = static_cast<int>(matrix_.rows());
+  order_.resize(n);
+  const int* perm = L ? static_cast<const int*>(L->Perm) : nullptr;
+  for (int k = 0; k < n; ++k) order_.indices()[perm ? perm[k] : k] = k;
+  ordered_stype_ = L && L->is_super ? -1 : 1;
+  // The triangle, each entry's value taken from matrix_'s lower one (gather_). Simplicial: the
+  // upper triangle with its columns in the order cholmod_transpose_sym gives them (CHOLMOD's
+  // row factorization sums in that order: the same factor, bit for bit, as with the permuted
+  // lower triangle CHOLMOD transposed itself). Supernodal: the lower, columns sorted.
+  const int* ap = matrix_.outerIndexPtr();
+  const int* ai = matrix_.innerIndexPtr();
+  const auto& position = order_.indices();
+  std::vector<int> start(n + 1, 0), inner;
+  gather_.clear();
+  if (ordered_stype_ > 0) {
+    const auto each_lower = [&](const auto& use) {  // (column of the triangle, row, source)
+      for (int j = 0; j < n; ++j) {
+        const int jold = perm ? perm[j] : j;
+        for (int p = ap[jold]; p < ap[jold + 1]; ++p)
+          if (ai[p] >= jold) {
+            const int i = position[ai[p]];
+            use(std::max(i, j), std::min(i, j), p);
+          }
+      }
+    };
+    each_lower([&](int col, int, int) { ++start[col + 1]; });
+    for (int j = 0; j < n; ++j) start[j + 1] += start[j];
+    std::vector<int> next(start.begin(), start.end() - 1);
+    inner.resize(start[n]);
+    gather_.resize(start[n]);
+    each_lower([&](int col, int row, int p) {
+      inner[next[col]] = row;
+      gather_[next[col]++] = p;
+    });
+  } else {
+    for (int jold = 0; jold < n; ++jold)  // count, then fill by increasing row
+      for (int p = ap[jold]; p < ap[jold + 1]; ++p)
+        if (ai[p] >= jold) ++start[std::min(position[ai[p]], position[jold]) + 1];
+    for (int j = 0; j < n; ++j) start[j + 1] += start[j];
+    std::vector<std::vector<std::pair<int, int>>> columns(n);  // (row, source)
+    for (int jold = 0; jold < n; ++jold)
+      for (int p = ap[jold]; p < ap[jold + 1]; ++p)
+        if (ai[p] >= jold) {
+          const int i = position[ai[p]], j = position[jold];
+          columns[std::min(i, j)].emplace_back(std::max(i, j), p);
+        }
+    for (auto& column : columns) {
+      std::sort(column.begin(), column.end());
+      for (const auto& [row, p] : column) {
+        inner.push_back(row);
+        gather_.push_back(p);
+      }
+    }
+  }
+  ordered_ = Eigen::SparseMatrix<double>(n, n);  // compressed; filled through its arrays
+  ordered_.resizeNonZeros(static_cast<Eigen::Index>(inner.size()));
+  std::copy(start.begin(), start.end(), ordered_.outerIndexPtr());
+  std::copy(inner.begin(), inner.end(), ordered_.innerIndexPtr());
+  transposed_.resize(gather_.size());
+  for (size_t k = 0; k < gather_.size(); ++k) transposed_[k] = mirror_[gather_[k]];
+  llt_.cholmod().supernodal = CHOLMOD_AUTO;
+  llt_.cholmod().final_ll = 1;
+  llt_.analyze_ordered(ordered_, ordered_stype_);
+}
+
+void CholmodFactor::analyze_ordered(const Eigen::SparseMatrix<double>& triangle, int stype) {
+  if (m_cholmodFactor) cholmod_free_factor(&m_cholmodFactor, &cholmod());
+  cholmod().nmethods = 1;
+  cholmod().method[0].ordering = CHOLMOD_NATURAL;
+  cholmod().postorder = 0;  // the order is final: CHOLMOD then neither permutes nor transposes
+  cholmod_sparse A = Eigen::viewAsCholmod(triangle);
+  A.stype = stype;
+  A.sorted = 0;  // the upper triangle's columns in cholmod_transpose_sym's order
+  m_cholmodFactor = cholmod_analyze(&A, &cholmod());
+  m_isInitialized = true;
+  m_info = m_cholmodFactor ? Eigen::Success : Eigen::InvalidInput;
+  m_analysisIsOk = m_cholmodFactor != nullptr;
+  m_factorizationIsOk = false;
+}
+
+void CholmodFactor::factorize_ordered(const Eigen::SparseMatrix<double>& triangle, int stype) {
+  if (!m_cholmodFactor) return;
+  cholmod_sparse A = Eigen::viewAsCholmod(triangle);
+  A.stype = stype;
+  A.sorted = 0;
+  cholmod_factorize_p(&A, m_shiftOffset, nullptr, 0, m_cholmodFactor, &cholmod());
+  m_info = m_cholmodFactor->minor == m_cholmodFactor->n ? Eigen::Success : Eigen::NumericalIssue;
+  m_factorizationIsOk = true;
 }
 
 // A simplicial factor tells beforehand whether the partial solves pay: the solve from row k
@@ -153,7 +276,9 @@ bool FreeBlockSolver::inverse_block(const std::vector<int>& rows, Matrix& G) {
         for (size_t j = 0; j < at[b].size(); ++j) G(at[b][i], at[b][j]) = blocks[b](i, j);
     return true;
   }
-  if (llt_.inverse_block(rows, G)) return true;
+  std::vector<int> ordered_rows(rows.size());
+  for (size_t a = 0; a < rows.size(); ++a) ordered_rows[a] = order_.indices()[rows[a]];
+  if (llt_.inverse_block(ordered_rows, G)) return true;
   // More rows only lengthen the partial solves against the same factor's pattern.
   if (dissected_fails_at_ && rows.size() >= dissected_fails_at_) return false;
   if (!dissected_analysed_) {
@@ -303,7 +428,8 @@ Vector FreeBlockSolver::quadratic_forms(const Eigen::SparseMatrix<double>& t) {
     return out;
   }
   // A path through more than 1/32 of the rows on average: the nested-dissection order instead.
-  if (llt_.quadratic_forms(t, out, matrix_.rows() / 32.0)) return out;
+  const Eigen::SparseMatrix<double> ordered_t = order_ * t;
+  if (llt_.quadratic_forms(ordered_t, out, matrix_.rows() / 32.0)) return out;
   CholmodFactor dissected;
   ++dissected_factorizations_;
   factorize_dissected(dissected, matrix_);
@@ -357,7 +483,8 @@ bool FreeBlockSolver::factorize_parts(double near_symmetric_tolerance) {
 }
 
 Vector FreeBlockSolver::solve(const Vector& b) const {
-  if (!split_) return symmetric_ ? Vector(llt_.solve(b)) : Vector(lu_.solve(b));
+  if (!split_)
+    return symmetric_ ? Vector(order_.transpose() * Vector(llt_.solve(Vector(order_ * b)))) : Vector(lu_.solve(b));
   Vector x(b.size());
   for_each_part([&](int k) {
     const int s = starts_[k], n = starts_[k + 1] - s;
@@ -367,7 +494,8 @@ Vector FreeBlockSolver::solve(const Vector& b) const {
 }
 
 Matrix FreeBlockSolver::solve(const Matrix& b) const {
-  if (!split_) return symmetric_ ? Matrix(llt_.solve(b)) : Matrix(lu_.solve(b));
+  if (!split_)
+    return symmetric_ ? Matrix(order_.transpose() * Matrix(llt_.solve(Matrix(order_ * b)))) : Matrix(lu_.solve(b));
   Matrix x(b.rows(), b.cols());
   for_each_part([&](int k) {
     const int s = starts_[k], n = starts_[k + 1] - s;

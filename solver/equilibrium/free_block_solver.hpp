@@ -3,8 +3,9 @@
 // and the symbolic analysis while the triplet sequence repeats (it does from one Newton
 // iterate to the next: the assembly loops are fixed and contact terms are always emitted).
 // A symmetric positive definite block (the body's own tangent; Newton's without friction on
-// curved tools) is factorized by CHOLMOD's supernodal Cholesky with a fill-reducing ordering,
-// many times cheaper than the LU that an unsymmetric (or indefinite) one needs.
+// curved tools) is factorized by CHOLMOD's Cholesky (simplicial or supernodal, as CHOLMOD
+// chooses) in a fill-reducing order fixed once per pattern, many times cheaper than the LU that
+// an unsymmetric (or indefinite) one needs.
 #include <Eigen/CholmodSupport>
 #include <Eigen/SparseCore>
 #include <Eigen/SparseLU>
@@ -22,6 +23,13 @@ class CholmodFactor : public Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<dou
  public:
   CholmodFactor() { cholmod().print = 0; }  // a non-SPD block is a result, not a message
   double rcond() { return m_cholmodFactor ? cholmod_rcond(m_cholmodFactor, &cholmod()) : 0.0; }
+  const cholmod_factor* factor() const { return m_cholmodFactor; }
+  // A block already in its fill-reducing order, given as the one triangle (stype +1: upper,
+  // -1: lower, in column form) that CHOLMOD's numeric factorization reads as it is: the upper
+  // for the simplicial one, the lower for the supernodal one. In any other form CHOLMOD
+  // permutes and transposes the block at every factorization (cholmod_transpose_sym).
+  void analyze_ordered(const Eigen::SparseMatrix<double>& triangle, int stype);
+  void factorize_ordered(const Eigen::SparseMatrix<double>& triangle, int stype);
   // K^-1 on the given rows, |rows|^2, as W^T W with W = L^-1 P E: each column of W is a sparse
   // forward solve that touches only the elimination-tree path of its row (CHOLMOD's partial
   // solve, on a simplicial copy of the factor), where a dense solve costs 2 nnz(L) flops per
@@ -95,7 +103,19 @@ class FreeBlockSolver {
   // The bodies' blocks: factorizes each diagonal block of matrix_ on its own (split_), or
   // leaves split_ false where an entry couples two bodies.
   bool factorize_parts(double near_symmetric_tolerance);
+  // Sums the triplets into matrix_ through the slots; false where their sequence is not the
+  // pattern's (then matrix_ is left part-filled).
+  bool scatter(const Triplets& triplets);
+  // matrix_'s new pattern from the triplets, the slots and mirrors, and what depends on them.
+  void build_pattern(const Triplets& triplets, const std::vector<int>& free_index, int free_count);
+  // symmetric_ from the skew part of matrix_ against its largest entry; a near-symmetric
+  // matrix_ averaged with its transpose.
+  void check_symmetry(double near_symmetric_tolerance);
   int block_of(int row) const;
+  // Once per pattern: the fill-reducing order of matrix_ (CHOLMOD's choice, or nested
+  // dissection once it paid for G), the triangle of the ordered block that llt_ factorizes and
+  // where each of its entries comes from in matrix_; then llt_'s analysis of it.
+  void analyse_ordered();
   // The bodies' tasks: through parallel_ where a thread's start (tens of microseconds) is
   // small beside the work (kParallelRows free rows or more), else one after another.
   void for_each_part(const std::function<void(int)>& task) const;
@@ -111,7 +131,14 @@ class FreeBlockSolver {
   std::vector<int> slot_;         // triplet k -> index in matrix_.valuePtr(), -1 if dropped
   std::vector<int> mirror_;       // value index -> index of its transpose entry
   Eigen::SparseLU<Eigen::SparseMatrix<double>> lu_;
-  CholmodFactor llt_;
+  CholmodFactor llt_;  // of ordered_: rows and columns in order_
+  // Free row i is row order_.indices()[i] of the ordered block; ordered_ holds the triangle
+  // (ordered_stype_) that llt_ reads, its k-th value matrix_'s value gather_[k], whose
+  // transpose is matrix_'s value transposed_[k].
+  Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> order_;
+  Eigen::SparseMatrix<double> ordered_;
+  std::vector<int> gather_, transposed_;
+  int ordered_stype_ = 1;
   CholmodFactor dissected_;  // nested-dissection order, for inverse_block only
   bool lu_analysed_ = false, llt_analysed_ = false, dissected_analysed_ = false;
   long factorizations_ = 0, dissected_factorizations_ = 0;

@@ -4,11 +4,15 @@
 // body's internal force with its tangent (the element kernels and the triplets) and of one
 // numeric factorization of the free block (FreeBlockSolver::factorize, pattern and ordering
 // already analysed: the scatter of the triplets and CHOLMOD's numeric factorization).
+// With --orderings, the same block's factorization under each fill-reducing order (CHOLMOD's
+// AMD, METIS, its nested dissection; a band order by reverse Cuthill-McKee), simplicial and
+// supernodal: nnz(L), flops and the median CPU time of CHOLMOD's numeric factorization.
 // CPU time of this process (one thread), which the load of other work inflates least.
-//   build/tests/bench/grip_kernels_bench SCENE.json [repeats, default 20]
+//   build/tests/bench/grip_kernels_bench SCENE.json [repeats, default 20] [--orderings]
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <ctime>
 #include <string>
 #include <vector>
@@ -33,11 +37,86 @@ double median_cpu_ms(int repeats, F&& f) {
   return ms[ms.size() / 2];
 }
 
+// Reverse Cuthill-McKee on the pattern of a symmetric matrix: breadth first from a far end
+// (the last node reached from a node of least degree), neighbours by increasing degree; a
+// band order, the natural one for a thin strip. Returns new -> old.
+std::vector<int> reverse_cuthill_mckee(const Eigen::SparseMatrix<double>& a) {
+  const int n = static_cast<int>(a.rows());
+  const auto degree = [&](int j) { return a.outerIndexPtr()[j + 1] - a.outerIndexPtr()[j]; };
+  const auto breadth_first = [&](int start) {
+    std::vector<int> order, seen(n, 0), next;
+    order.push_back(start);
+    seen[start] = 1;
+    for (size_t k = 0; k < order.size(); ++k) {
+      next.clear();
+      for (Eigen::SparseMatrix<double>::InnerIterator it(a, order[k]); it; ++it)
+        if (!seen[it.row()]) {
+          seen[it.row()] = 1;
+          next.push_back(static_cast<int>(it.row()));
+        }
+      std::sort(next.begin(), next.end(), [&](int x, int y) { return degree(x) < degree(y); });
+      order.insert(order.end(), next.begin(), next.end());
+    }
+    return order;
+  };
+  int start = 0;
+  for (int j = 1; j < n; ++j)
+    if (degree(j) < degree(start)) start = j;
+  std::vector<int> order = breadth_first(breadth_first(start).back());
+  std::reverse(order.begin(), order.end());
+  return order;
+}
+
+// Each order's factorization as FreeBlockSolver does it: the block permuted beforehand, CHOLMOD
+// handed the triangle it reads as it is (no transpose at each factorization).
+void report_orderings(const Eigen::SparseMatrix<double>& block, int repeats) {
+  const int n = static_cast<int>(block.rows());
+  using Permutation = Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int>;
+  const auto cholmod_order = [&](int ordering) {
+    grip::CholmodFactor probe;
+    probe.cholmod().nmethods = 1;
+    probe.cholmod().method[0].ordering = ordering;
+    probe.analyzePattern(block);
+    const int* perm = static_cast<const int*>(probe.factor()->Perm);
+    Permutation p(n);
+    for (int k = 0; k < n; ++k) p.indices()[perm[k]] = k;
+    return p;
+  };
+  Permutation band(n);
+  const std::vector<int> rcm = reverse_cuthill_mckee(block);
+  for (int k = 0; k < n; ++k) band.indices()[rcm[k]] = k;
+  const std::pair<const char*, Permutation> orders[] = {{"amd", cholmod_order(CHOLMOD_AMD)},
+                                                        {"metis", cholmod_order(CHOLMOD_METIS)},
+                                                        {"nesdis", cholmod_order(CHOLMOD_NESDIS)},
+                                                        {"rcm band", band}};
+  for (const auto& [name, order] : orders) {
+    Eigen::SparseMatrix<double> permuted;
+    permuted = block.twistedBy(order);
+    for (const int supernodal : {CHOLMOD_SIMPLICIAL, CHOLMOD_SUPERNODAL}) {
+      const int stype = supernodal == CHOLMOD_SUPERNODAL ? -1 : 1;  // the triangle each reads as it is
+      Eigen::SparseMatrix<double> triangle;
+      if (stype > 0) triangle = permuted.triangularView<Eigen::Upper>();
+      else triangle = permuted.triangularView<Eigen::Lower>();
+      grip::CholmodFactor f;
+      f.cholmod().supernodal = supernodal;
+      f.cholmod().final_ll = 1;
+      f.analyze_ordered(triangle, stype);
+      const double lnz = f.cholmod().lnz, flops = f.cholmod().fl;
+      const double ms = median_cpu_ms(repeats, [&] { f.factorize_ordered(triangle, stype); });
+      std::printf(
+          "{\"ordering\": \"%s\", \"supernodal\": %s, \"ok\": %s, \"nnz_l\": %.0f, \"flops\": %.4g, "
+          "\"factorize_ms\": %.4f}\n",
+          name, supernodal == CHOLMOD_SUPERNODAL ? "true" : "false", f.info() == Eigen::Success ? "true" : "false", lnz,
+          flops, ms);
+    }
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   if (argc < 2) {
-    std::fprintf(stderr, "usage: grip_kernels_bench SCENE.json [repeats]\n");
+    std::fprintf(stderr, "usage: grip_kernels_bench SCENE.json [repeats] [--orderings]\n");
     return 2;
   }
   const int repeats = argc > 2 ? std::max(1, std::atoi(argv[2])) : 20;
@@ -63,6 +142,7 @@ int main(int argc, char** argv) {
   grip::FreeBlockSolver solver;
   if (!solver.factorize(triplets, free_index, free_count)) std::fprintf(stderr, "singular reference stiffness\n");
   const double factorize_ms = median_cpu_ms(repeats, [&] { solver.factorize(triplets, free_index, free_count); });
+  if (argc > 3 && std::strcmp(argv[3], "--orderings") == 0) report_orderings(solver.matrix(), repeats);
   const double start = cpu_seconds();
   const grip::RunResult run = grip::run_load_steps(scene.problem, scene.steps, scene.params);
   const double run_s = cpu_seconds() - start;
