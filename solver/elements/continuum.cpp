@@ -119,11 +119,7 @@ ContinuumBody::ContinuumBody(PlaneMesh mesh, const std::vector<int>& contact_set
     throw std::invalid_argument("q4_bbar is implemented for linear kinematics (use q9 for finite strain)");
   if (!(options_.thickness > 0)) throw std::invalid_argument("thickness must be positive");
   if (const std::string why = incompressibility_issue(options_); !why.empty()) throw std::invalid_argument(why);
-  for (const auto& m : materials_) {
-    has_history_ |= m->has_history();
-    if (options_.kinematics == ContinuumKinematics::finite)
-      if (const std::string why = m->finite_strain_issue(); !why.empty()) throw std::invalid_argument(why);
-  }
+  for (const auto& m : materials_) has_history_ |= m->has_history();
   if (options_.analysis == PlaneAnalysis::axisymmetric) {
     if (options_.element == ContinuumElement::q4_bbar)
       throw std::invalid_argument("axisymmetric is implemented for t3, t6, q4, q8, q9");

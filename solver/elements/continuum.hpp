@@ -78,9 +78,8 @@ const char* element_name(ContinuumElement element);  // as the scene names it: "
 class ContinuumBody final : public Body {
  public:
   // The mesh must pass check_mesh (InvalidMesh otherwise); contact_set is a node set on the
-  // boundary (boundary_part). Throws std::invalid_argument otherwise, for q4_bbar with
-  // finite kinematics, or for a law that cannot run under finite kinematics (its
-  // finite_strain_issue).
+  // boundary (boundary_part). Throws std::invalid_argument otherwise, or for q4_bbar with
+  // finite kinematics.
   // `materials`: one for every element, or one per element (a body of several materials: the
   // physical surfaces of a mesh file).
   ContinuumBody(PlaneMesh mesh, const std::vector<int>& contact_set,

@@ -97,15 +97,7 @@ std::shared_ptr<const PlaneMaterial> read_j2_material(Reader& r, json& mat, cons
     r.error(mp + "/" + why.substr(0, colon), why.substr(colon + 2));
     return nullptr;
   }
-  auto law =
-      std::make_shared<J2Material>(young, poisson, yield_stress, std::move(h), kinematic, options.analysis, hill);
-  if (options.kinematics == ContinuumKinematics::finite)
-    if (const std::string why = law->finite_strain_issue(); !why.empty()) {
-      const size_t colon = why.find(':');
-      r.error(mp + "/" + why.substr(0, colon), why.substr(colon + 2));
-      return nullptr;
-    }
-  return law;
+  return std::make_shared<J2Material>(young, poisson, yield_stress, std::move(h), kinematic, options.analysis, hill);
 }
 
 // The Mooney-Rivlin law of material `mp` (c10, c01, bulk; no young or poisson); nullptr after

@@ -27,15 +27,8 @@ Mat2 tensor(double a11, double a22, double a12) { return (Mat2() << a11, a12, a1
 
 }  // namespace
 
-std::string J2Material::finite_strain_issue() const {
-  if (hill_) return "hill48: Hill's anisotropy is implemented for small strain (linear kinematics)";
-  if (kinematic_ > 0)
-    return "kinematic_hardening: finite kinematics takes isotropic hardening only (kinematic hardening is "
-           "implemented for small strain: linear kinematics)";
-  return {};
-}
-
 FinitePointResponse J2Material::finite_point(const Mat2& E, double E33, const PointHistory& h, Mat4& D) const {
+  if (kinematic_ > 0 || hill_) return log_strain_point(E, E33, h, D);
   const Vec4& c = h.plastic_metric_inverse;
   const Mat2 U = sqrt_spd(tensor(c[0], c[1], c[2]));
   const double cpi33 = c[3];
@@ -72,8 +65,42 @@ FinitePointResponse J2Material::finite_point(const Mat2& E, double E33, const Po
   return out;
 }
 
+// Kinematic hardening and Hill's anisotropy: the small-strain return on the Lagrangian log strain
+// eps = log(C) / 2 (eps33 = log(C33) / 2), eps_p, the back stress and alpha its history; T the
+// stress conjugate to eps, S = P^T T with P = d eps / dE, and
+// dS/dE = P^T (dT / d eps) P + T : d^2 eps / dE^2.
+FinitePointResponse J2Material::log_strain_point(const Mat2& E, double E33, const PointHistory& h, Mat4& D) const {
+  const Mat2 C = Mat2::Identity() + 2 * E;
+  const double C33 = 1 + 2 * E33;
+  const Mat2 eps = 0.5 * log_spd(C);
+  const PointResponse r = return_map(Vec4(eps(0, 0), eps(1, 1), 2 * eps(0, 1), 0.5 * std::log(C33)), h);
+  // d eps = dlog(C)[dE]: columns E11, E22, 2 E12 (strains with the engineering shear), and E33.
+  const Mat2 directions[3] = {tensor(1, 0, 0), tensor(0, 1, 0), tensor(0, 0, 0.5)};
+  Mat4 P = Mat4::Zero();
+  for (int k = 0; k < 3; ++k) {
+    const Mat2 d = log_spd_derivative(C, directions[k]);
+    P.col(k) << d(0, 0), d(1, 1), 2 * d(0, 1), 0.0;
+  }
+  P(3, 3) = 1 / C33;
+  const Vec4 S = P.transpose() * r.stress;
+  D = P.transpose() * r.D * P;
+  const Vec4& T = r.stress;  // (11, 22, 12, 33)
+  for (int k = 0; k < 3; ++k)
+    for (int l = 0; l < 3; ++l) {
+      const Mat2 d2 = 2 * log_spd_second_derivative(C, directions[k], directions[l]);
+      D(k, l) += T[0] * d2(0, 0) + T[1] * d2(1, 1) + 2 * T[2] * d2(0, 1);
+    }
+  D(3, 3) -= 2 * T[3] / (C33 * C33);
+  D = 0.5 * (D + D.transpose());
+  FinitePointResponse out;
+  out.law.S = S.head<3>();
+  out.law.S33 = S[3];
+  out.history = r.history;
+  out.yielding = r.yielding;
+  return out;
+}
+
 FiniteHoopResponse J2Material::finite_hoop_response(const Mat2& E, double E33, const PointHistory& committed) const {
-  if (const std::string why = finite_strain_issue(); !why.empty()) throw std::logic_error("j2_plasticity: " + why);
   if (analysis_ != PlaneAnalysis::axisymmetric)
     throw std::logic_error("j2_plasticity: finite_hoop_response is the axisymmetric response");
   FiniteHoopResponse out;
@@ -85,7 +112,6 @@ FiniteHoopResponse J2Material::finite_hoop_response(const Mat2& E, double E33, c
 }
 
 FinitePointResponse J2Material::finite_response(const Mat2& E, const PointHistory& committed) const {
-  if (const std::string why = finite_strain_issue(); !why.empty()) throw std::logic_error("j2_plasticity: " + why);
   if (analysis_ == PlaneAnalysis::axisymmetric)
     throw std::logic_error("j2_plasticity: the axisymmetric response needs the hoop strain (finite_hoop_response)");
   Mat4 D;

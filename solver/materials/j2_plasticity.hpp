@@ -10,8 +10,10 @@
 // that return (and condenses the tangent), so that the plane-stress state is exact.
 // Finite strain (j2_finite.cpp; docs/algorithm.md#finite-strain-j2-plasticity): F = Fe Fp,
 // Hooke's law on the logarithmic elastic strain, and the same radial return on it, which is
-// the exponential-map return (plastic flow exact in volume: det Fp = 1); isotropic hardening
-// only; plane strain, plane stress and axisymmetric (the hoop stretch r / R the third direction).
+// the exponential-map return (plastic flow exact in volume: det Fp = 1); plane strain, plane
+// stress and axisymmetric (the hoop stretch r / R the third direction). With kinematic hardening
+// or Hill's anisotropy, whose back stress and axes the principal-space return cannot carry: the
+// small-strain return on the Lagrangian log strain log(C) / 2 (additive, also exact in volume).
 #include <optional>
 #include <string>
 #include <utility>
@@ -72,7 +74,6 @@ class J2Material final : public PlaneMaterial {
   // Axisymmetric finite strain: the return of finite_response with the hoop stretch as the
   // third principal direction (E33 = (F33^2 - 1) / 2 given, as the plane-strain one at E33 = 0).
   FiniteHoopResponse finite_hoop_response(const Mat2& E, double E33, const PointHistory& committed) const override;
-  std::string finite_strain_issue() const override;
 
   double yield_stress(double alpha) const;     // sigma_y(alpha)
   double hardening_slope(double alpha) const;  // d sigma_y / d alpha (right derivative)
@@ -85,6 +86,10 @@ class J2Material final : public PlaneMaterial {
   // Finite strain at the in-plane E and E33: S (11, 22, 12, 33) and dS/dE (4 x 4, E as
   // (11, 22, 2 x 12, 33)) in `law.S`, `law.S33` and `D`.
   FinitePointResponse finite_point(const Mat2& E, double E33, const PointHistory& committed, Eigen::Matrix4d& D) const;
+  // The same with kinematic hardening or Hill's anisotropy: additive plasticity in the Lagrangian
+  // logarithmic strain (j2_finite.cpp).
+  FinitePointResponse log_strain_point(const Mat2& E, double E33, const PointHistory& committed,
+                                       Eigen::Matrix4d& D) const;
 
   HookeMaterial elastic_;
   Lame lame_;

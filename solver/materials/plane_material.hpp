@@ -100,8 +100,6 @@ class PlaneMaterial {
   // Whether plastic flow keeps the volume (J2): in the plastic range the body is then
   // incompressible whatever K / G (docs/algorithm.md#element-formulation-pairs).
   virtual bool isochoric_flow() const { return false; }
-  // Why the law cannot run under finite kinematics, as "field: reason" (empty if it can).
-  virtual std::string finite_strain_issue() const { return {}; }
   // Axisymmetric finite strain: S (11, 22, 12, 33) and dS/dE (4 x 4, symmetric) for the
   // in-plane E and the hoop E33 = (F33^2 - 1) / 2 (F33 = r / R). Laws with history answer
   // finite_hoop_response instead.

@@ -11,6 +11,9 @@ namespace grip {
 Mat2 log_spd(const Mat2& A);
 // The derivative of log A in the direction dA (symmetric): d/dt log(A + t dA) at t = 0.
 Mat2 log_spd_derivative(const Mat2& A, const Mat2& dA);
+// The second derivative of log A in the directions dA and dB (symmetric):
+// d^2/(ds dt) log(A + s dA + t dB) at 0, symmetric in dA and dB.
+Mat2 log_spd_second_derivative(const Mat2& A, const Mat2& dA, const Mat2& dB);
 // exp M of a symmetric M.
 Mat2 exp_symmetric(const Mat2& M);
 // The symmetric positive definite square root of a symmetric positive definite A.

@@ -1,4 +1,4 @@
-// solver/materials/symmetric_2x2.hpp: log, its derivative, exp and sqrt of symmetric 2 x 2
+// solver/materials/symmetric_2x2.hpp: log, its first and second derivatives, exp and sqrt of symmetric 2 x 2
 // tensors against the eigen-decomposition and central differences, at distinct, close and
 // equal eigenvalues (where the closed forms switch to their series).
 #include <gtest/gtest.h>
@@ -40,6 +40,22 @@ TEST(Symmetric2x2, LogDerivativeMatchesDifferences) {
       const Mat2 exact = log_spd_derivative(A, dA);
       EXPECT_LT((exact - fd).norm(), 1e-7 * exact.norm()) << A << "\n" << dA;
     }
+}
+
+TEST(Symmetric2x2, LogSecondDerivativeMatchesDifferencesOfTheDerivative) {
+  const Mat2 directions[] = {sym(1, 0, 0), sym(0, 1, 0), sym(0, 0, 1), sym(0.3, -0.2, 0.5)};
+  for (const Mat2& A : kCases)
+    for (const Mat2& dA : directions)
+      for (const Mat2& dB : directions) {
+        const double h = 1e-5 * Eigen::SelfAdjointEigenSolver<Mat2>(A).eigenvalues()[0];
+        const Mat2 fd = (log_spd_derivative(A + h * dB, dA) - log_spd_derivative(A - h * dB, dA)) / (2 * h);
+        const Mat2 exact = log_spd_second_derivative(A, dA, dB);
+        EXPECT_LT((exact - fd).norm(), 1e-6 * (exact.norm() + log_spd_derivative(A, dA).norm() / A.norm()))
+            << A << "\n"
+            << dA << "\n"
+            << dB;
+        EXPECT_LT((exact - log_spd_second_derivative(A, dB, dA)).norm(), 1e-13 * (1 + exact.norm()));
+      }
 }
 
 }  // namespace

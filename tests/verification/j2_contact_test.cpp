@@ -214,11 +214,13 @@ TEST(J2Contact, BadMaterialDataIsRefusedWithItsPointer) {
             "/body/material/hardening/power/n");
   EXPECT_EQ(refusal(plastic({{"hardening", {{"linear", 1.0}, {"table", {{0, 2000}}}}}})).first,
             "/body/material/hardening");
-  // Finite strain takes isotropic hardening only.
+  // Finite strain takes kinematic hardening (on the log strain), and the plain q4 is refused.
   nlohmann::json finite = plastic({{"kinematic_hardening", 1000.0}});
   finite["body"]["kinematics"] = "finite";
+  finite["body"]["element"] = "q8";
+  EXPECT_EQ(refusal(finite).first, "(read)");
   finite["body"]["element"] = "q4";
-  EXPECT_EQ(refusal(finite).first, "/body/material/kinematic_hardening");
+  EXPECT_EQ(refusal(finite).first, "/body/element");
   nlohmann::json elastic = pressed_and_released(false, "cev");
   elastic["body"]["material"]["yield_stress"] = 100.0;
   EXPECT_EQ(refusal(elastic).first, "/body/material/yield_stress");

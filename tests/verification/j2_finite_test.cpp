@@ -31,7 +31,7 @@ namespace {
 
 using testing::Driver;
 
-// Isotropic hardening only: finite strain takes no kinematic hardening.
+// Isotropic hardening (kinematic hardening and Hill: j2_finite_log_strain_test.cpp).
 using namespace testing::j2;
 
 // The uniaxial Kirchhoff stress at log strain eps: tau = sigma_y(eps - tau / E) on the plastic
@@ -312,13 +312,6 @@ TEST(J2Finite, SmallStrainLimitIsTheSmallStrainLaw) {
                   law.name, analysis == PlaneAnalysis::plane_strain ? "plane strain" : "plane stress", gap.stress,
                   gap.alpha, gap.peak_alpha);
     }
-}
-
-TEST(J2Finite, KinematicHardeningIsRefusedUnderFiniteKinematics) {
-  const auto m =
-      std::make_shared<J2Material>(kYoung, kPoisson, kYield, IsotropicHardening{}, 1000.0, PlaneAnalysis::plane_strain);
-  EXPECT_EQ(m->finite_strain_issue().rfind("kinematic_hardening:", 0), 0u);
-  EXPECT_THROW(ContinuumBody(unit_square(), {0, 1}, {m}, finite(PlaneAnalysis::plane_strain)), std::invalid_argument);
 }
 
 }  // namespace

@@ -1,4 +1,5 @@
-// Hill's 1948 anisotropy of j2_plasticity at small strain (docs/algorithm.md#hill-1948-anisotropy):
+// Hill's 1948 anisotropy of j2_plasticity at small strain (docs/algorithm.md#hill-1948-anisotropy;
+// at finite strain: j2_finite_log_strain_test.cpp):
 // - uniaxial tension of a sheet (plane stress) at 0, 45 and 90 degrees to the rolling direction,
 //   one point driven along the direction with the two other stresses zero: the yield stress
 //   sigma_y / k, k^2 = F s^4 + G c^4 + H (c^2 - s^2)^2 + 2 N c^2 s^2 (Hill's formula with
@@ -11,7 +12,7 @@
 //   quadratic convergence on a plastic step, with planar anisotropy (plane stress, plane strain)
 //   and normal anisotropy (axisymmetric);
 // - bad data refused with its pointer: r <= 0, r45 in plane strain, planar anisotropy in
-//   axisymmetry, finite kinematics, kinematic hardening.
+//   axisymmetry, kinematic hardening.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -277,9 +278,6 @@ TEST(Hill48, BadDataIsRefusedWithItsPointer) {
   nlohmann::json kinematic = scene("plane_strain", {{"r", 1.5}});
   kinematic["body"]["material"]["kinematic_hardening"] = 1000.0;
   EXPECT_EQ(pointer(kinematic), "/body/material/kinematic_hardening");
-  nlohmann::json finite = scene("plane_strain", {{"r", 1.5}});
-  finite["body"]["kinematics"] = "finite";
-  EXPECT_EQ(pointer(finite), "/body/material/hill48");
   nlohmann::json elastic = scene("plane_strain", {{"r", 1.5}});
   elastic["body"]["material"] = {{"young", 2e5}, {"poisson", 0.3}, {"hill48", {{"r", 1.5}}}};
   EXPECT_EQ(pointer(elastic), "/body/material/hill48");
