@@ -8,8 +8,10 @@
 #include <Eigen/SparseCore>
 
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <limits>
+#include <string>
 #include <vector>
 
 #include "solver/model/body.hpp"
@@ -122,6 +124,17 @@ inline int expect_quadratic(const std::vector<double>& r) {
     }
   }
   return checked;
+}
+
+// The residuals relative to the first, as printed beside each test's line (" 1.0e+00 8.6e-02 ...").
+inline std::string relative_residuals(const std::vector<double>& r) {
+  std::string line;
+  char buffer[32];
+  for (double v : r) {
+    std::snprintf(buffer, sizeof buffer, " %.1e", v / r[0]);
+    line += buffer;
+  }
+  return line;
 }
 
 }  // namespace grip::testing

@@ -281,12 +281,7 @@ TEST(J2FiniteAxisymmetric, NewtonConvergesQuadraticallyOnAPlasticStep) {
       Driver d(*b.body, b.held);
       bend_far(d, b, 1e-10 * kYield);
       const std::vector<double>& r = d.residuals;
-      std::string line;
-      char buffer[32];
-      for (double v : r) {
-        std::snprintf(buffer, sizeof buffer, " %.1e", v / r[0]);
-        line += buffer;
-      }
+      const std::string line = testing::relative_residuals(r);
       std::printf("axisymmetric Newton %-6s %-8s relative residuals:%s\n", law.name, f.name().c_str(), line.c_str());
       EXPECT_GE(testing::expect_quadratic(r), 1);
       EXPECT_LE(r.size(), 10u);

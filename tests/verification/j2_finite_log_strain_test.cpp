@@ -276,12 +276,7 @@ TEST(J2FiniteLogStrain, TangentMatchesDifferencesAndNewtonConvergesQuadratically
       EXPECT_GT(flowing, 0);
       EXPECT_LT(check.error(), 1e-6);
       EXPECT_LT(check.asymmetry(), 1e-9);
-      std::string line;
-      char buffer[32];
-      for (double v : r) {
-        std::snprintf(buffer, sizeof buffer, " %.1e", v / r[0]);
-        line += buffer;
-      }
+      const std::string line = testing::relative_residuals(r);
       std::printf("%-6s %-32s |K - K_fd| / |K| = %.1e (%d of %zu flowing); Newton:%s\n", law.name, c.name,
                   check.error(), flowing, rows.size(), line.c_str());
     }

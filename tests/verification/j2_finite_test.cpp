@@ -258,12 +258,7 @@ TEST(J2Finite, NewtonConvergesQuadraticallyOnAPlasticStep) {
       d.line_search = needs_line_search(c);
       bend_far(d, b, c.analysis, 1e-10 * kYield);
       const std::vector<double>& r = d.residuals;
-      std::string line;
-      char buffer[32];
-      for (double v : r) {
-        std::snprintf(buffer, sizeof buffer, " %.1e", v / r[0]);
-        line += buffer;
-      }
+      const std::string line = testing::relative_residuals(r);
       std::printf("Newton %-6s %-22s relative residuals:%s\n", law.name, c.name, line.c_str());
       // Near the solution (e_k < 1e-3): e_{k+1} <= c e_k^2 (relative to the first residual), c = 10;
       // 20 for t6 mixed, whose constant is 14 (1.4e-4, 2.7e-7, 1.1e-12). Below 1e-11 the

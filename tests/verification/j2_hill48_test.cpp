@@ -245,12 +245,7 @@ TEST(Hill48, ConsistentTangentMatchesDifferencesAndNewtonConvergesQuadratically)
         for (const auto& row : rows) flowing += row[5] > 0;
         EXPECT_GT(flowing, 0);
         EXPECT_LT(c.error(), 1e-6);
-        std::string line;
-        char buffer[32];
-        for (double v : r) {
-          std::snprintf(buffer, sizeof buffer, " %.1e", v / r[0]);
-          line += buffer;
-        }
+        const std::string line = testing::relative_residuals(r);
         std::printf("hill48 %-6s %-3s %-12s |K - K_fd| / |K| = %.1e (%d of %zu flowing); Newton:%s\n", law.name,
                     element_name(element), analysis_name(analysis), c.error(), flowing, rows.size(), line.c_str());
       }
