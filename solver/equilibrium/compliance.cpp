@@ -105,6 +105,21 @@ int surface_dof_count(const Problem& problem, const EquilibriumState& state, con
   return count;
 }
 
+// Newton's tangent is the body's own at `state` plus the stiffness of the contact forces that
+// follow the surface (a curved obstacle's or a pair's) and of follower loads. Where those terms
+// are not zero its factorization is no compliance of the body: on a membrane wrapped over a
+// punch they nearly cancel the tension's transverse stiffness, and a G from it sent the sheet's
+// first real solve to a correction of 6e11.
+bool only_body_in_newton_tangent(const Problem& problem, const EquilibriumState& state, bool has_pairs) {
+  if (has_pairs || problem.body->has_follower_loads() || state.p.size() != problem.component_count) return false;
+  for (size_t i = 0; i < problem.candidates.size(); ++i) {
+    const Candidate& c = problem.candidates[i];
+    const bool loaded = state.p[c.eta] != 0.0 || (c.xi >= 0 && state.p[c.xi] != 0.0);
+    if (loaded && !state.points[i].projection.dnormal_dx.isZero(0.0)) return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 const Compliance& Equilibrium::compliance(const EquilibriumState& state, const std::vector<int>& components,
@@ -176,8 +191,8 @@ const Compliance& Equilibrium::compliance(const EquilibriumState& state, const s
 
 bool Equilibrium::newton_factor_serves(const EquilibriumState& state, int surface_dofs) const {
   return !constant_tangent_ && !penalty_ && surface_dofs <= kNewtonFactorRows && newton_factor_solve_ >= 0 &&
-         newton_factor_solve_ == counters_.solves && lu_.symmetric() && state.q.size() == newton_factor_q_.size() &&
-         state.q == newton_factor_q_;
+         only_body_in_newton_tangent(problem_, state, has_pairs_) && newton_factor_solve_ == counters_.solves &&
+         lu_.symmetric() && state.q.size() == newton_factor_q_.size() && state.q == newton_factor_q_;
 }
 
 bool Equilibrium::compliance_tangent(const EquilibriumState& state, int surface_dofs) {
