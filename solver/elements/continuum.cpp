@@ -307,7 +307,7 @@ double ContinuumBody::element_volume_change(const Vector& q, int e) const {
   return after / before - 1;
 }
 
-void ContinuumBody::internal_force(const Vector& q, Vector& force, Triplets* tangent) const {
+void ContinuumBody::internal_force(const Vector& q, Vector& force, TangentSink* tangent) const {
   if (has_history_ && options_.kinematics == ContinuumKinematics::linear) {
     const Integration& in = integration();
     for (int e = 0; e < element_count(); ++e) {
@@ -322,29 +322,29 @@ void ContinuumBody::internal_force(const Vector& q, Vector& force, Triplets* tan
         fe.noalias() += p.dV * B.transpose() * r[k].stress;
         if (tangent) Ke.noalias() += p.dV * B.transpose() * r[k].D * B;
       }
+      std::vector<int> dofs(m);
       for (int i = 0; i < m; ++i) {
-        const int gi = node_dof(el[i / 2], i % 2);
-        force[gi] += fe[i];
-        if (tangent)
-          for (int j = 0; j < m; ++j)
-            tangent->emplace_back(gi, node_dof(el[j / 2], j % 2), 0.5 * (Ke(i, j) + Ke(j, i)));
+        dofs[i] = node_dof(el[i / 2], i % 2);
+        force[dofs[i]] += fe[i];
       }
+      if (tangent) tangent->add_block(dofs.data(), Matrix(0.5 * (Ke + Ke.transpose())));
     }
     return;
   }
   if (options_.kinematics == ContinuumKinematics::linear) {
     const Integration& in = integration();
     force += in.linear_K * q;
-    if (tangent) tangent->insert(tangent->end(), in.linear_tangent.begin(), in.linear_tangent.end());
+    if (tangent)
+      for (const auto& t : in.linear_tangent) tangent->add(t.row(), t.col(), t.value());
     return;
   }
   const Integration& in = integration();
-  // Work storage kept across elements: the loop allocates nothing but the triplets, reserved once.
+  // Work storage kept across elements: the loop allocates nothing.
   Vector fe;
   Matrix Ke;
   const int n = element_node_count(shape_);
   ShapeGradients u(n, 2);
-  if (tangent) tangent->reserve(tangent->size() + static_cast<size_t>(element_count()) * 4 * n * n);
+  std::vector<int> dofs;
   for (int e = 0; e < element_count(); ++e) {
     // A law with history answers from the committed state of each point.
     const size_t np = in.points[e].size();
@@ -365,12 +365,12 @@ void ContinuumBody::internal_force(const Vector& q, Vector& force, Triplets* tan
       f_bar_total_lagrangian(in.points[e], in.centroids[e], u, material(e), fe, tangent ? &Ke : nullptr, law);
     else total_lagrangian(in.points[e], u, material(e), fe, tangent ? &Ke : nullptr, law, hoop_law);
     const int m = static_cast<int>(fe.size());
+    dofs.resize(m);
     for (int i = 0; i < m; ++i) {
-      const int gi = node_dof(el[i / 2], i % 2);
-      force[gi] += fe[i];
-      if (tangent)
-        for (int j = 0; j < m; ++j) tangent->emplace_back(gi, node_dof(el[j / 2], j % 2), Ke(i, j));
+      dofs[i] = node_dof(el[i / 2], i % 2);
+      force[dofs[i]] += fe[i];
     }
+    if (tangent) tangent->add_block(dofs.data(), Ke);
   }
 }
 

@@ -87,7 +87,7 @@ class ContinuumBody final : public Body {
 
   int dof_count() const override { return 2 * node_count(); }
   Vector dof_length_scales() const override { return Vector::Ones(dof_count()); }
-  void internal_force(const Vector& q, Vector& force, Triplets* tangent) const override;
+  void internal_force(const Vector& q, Vector& force, TangentSink* tangent) const override;
 
   int site_count() const override { return static_cast<int>(contact_.nodes.size()); }
   int site_node(int site) const override { return contact_.nodes[site]; }

@@ -93,7 +93,7 @@ void element_force(const Eigen::Matrix<double, 3 * n, 1>& q, double length, cons
 
 template <int n>
 void add_element(const Vector& q, const int* nodes, double length, const BeamSection& sec, Vector& force,
-                 Triplets* tangent) {
+                 TangentSink* tangent) {
   constexpr int m = 3 * n;
   Eigen::Matrix<double, m, 1> ql, f;
   Eigen::Matrix<double, m, m> K;
@@ -105,7 +105,7 @@ void add_element(const Vector& q, const int* nodes, double length, const BeamSec
   for (int i = 0; i < m; ++i) {
     force[dofs[i]] += f[i];
     if (tangent)
-      for (int j = 0; j < m; ++j) tangent->emplace_back(dofs[i], dofs[j], K(i, j));
+      for (int j = 0; j < m; ++j) tangent->add(dofs[i], dofs[j], K(i, j));
   }
 }
 
@@ -134,8 +134,7 @@ int ReissnerBeam::element_nodes(int e, int* nodes, double* x) const {
   return 3;
 }
 
-void ReissnerBeam::internal_force(const Vector& q, Vector& force, Triplets* tangent) const {
-  if (tangent) tangent->reserve(tangent->size() + element_count() * (element_ == BeamElement::b2 ? 36 : 81));
+void ReissnerBeam::internal_force(const Vector& q, Vector& force, TangentSink* tangent) const {
   for (int e = 0; e < element_count(); ++e) {
     int nodes[3];
     double x[3];

@@ -23,7 +23,7 @@ class ReissnerBeam final : public StraightBeam {
   ReissnerBeam(std::vector<double> node_x, double y0, BeamSection section, BeamElement element);
 
   int dof_count() const override { return 3 * (node_count() + mid_node_count()); }
-  void internal_force(const Vector& q, Vector& force, Triplets* tangent) const override;
+  void internal_force(const Vector& q, Vector& force, TangentSink* tangent) const override;
   SurfacePoint surface_point(const VectorRef& q, int site, int side) const override;
 
   Vector rigid_translation(const Vec2& d) const override;

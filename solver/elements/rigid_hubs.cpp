@@ -73,11 +73,12 @@ Vector RigidHubs::reduce_force(const Vector& inner_force) const {
   return f;
 }
 
-void RigidHubs::internal_force(const Vector& q, Vector& force, Triplets* tangent) const {
+void RigidHubs::internal_force(const Vector& q, Vector& force, TangentSink* tangent) const {
   const Vector full = expand(q);
   Vector f = Vector::Zero(full.size());
-  Triplets inner_tangent;
-  inner_->internal_force(full, f, tangent ? &inner_tangent : nullptr);
+  Triplets inner_tangent;  // mapped through the links below, entry by entry
+  TripletSink inner_sink(inner_tangent);
+  inner_->internal_force(full, f, tangent ? &inner_sink : nullptr);
   Link l[2];
   for (int d = 0; d < f.size(); ++d)
     for (int k = 0, m = links(d, q, l); k < m; ++k) force[l[k].dof] += l[k].weight * f[d];
@@ -88,7 +89,7 @@ void RigidHubs::internal_force(const Vector& q, Vector& force, Triplets* tangent
   for (const auto& t : inner_tangent) {
     const int ma = links(t.row(), q, a), mb = links(t.col(), q, b);
     for (int i = 0; i < ma; ++i)
-      for (int j = 0; j < mb; ++j) tangent->emplace_back(a[i].dof, b[j].dof, a[i].weight * b[j].weight * t.value());
+      for (int j = 0; j < mb; ++j) tangent->add(a[i].dof, b[j].dof, a[i].weight * b[j].weight * t.value());
   }
   // The turn's own curvature with finite kinematics: d2x_i/dtheta2 = -R(theta) a_i, so the
   // hub's force does work at second order: sum_i f_i . (-R(theta) a_i) on (theta, theta).
@@ -99,7 +100,7 @@ void RigidHubs::internal_force(const Vector& q, Vector& force, Triplets* tangent
       for (int node : hubs_[h].nodes)
         curvature -= f.segment<2>(2 * node).dot(turned(arm_[node], std::cos(theta), std::sin(theta)));
     const int t = hub_dof(static_cast<int>(h), 2);
-    tangent->emplace_back(t, t, curvature);
+    tangent->add(t, t, curvature);
   }
 }
 

@@ -40,7 +40,7 @@ class RigidHubs final : public Body {
 
   int dof_count() const override { return free_count_ + 3 * static_cast<int>(hubs_.size()); }
   Vector dof_length_scales() const override;
-  void internal_force(const Vector& q, Vector& force, Triplets* tangent) const override;
+  void internal_force(const Vector& q, Vector& force, TangentSink* tangent) const override;
   int site_count() const override { return inner_->site_count(); }
   int node_count() const override { return inner_->node_count(); }
   Vec2 site_reference(int site) const override { return inner_->site_reference(site); }

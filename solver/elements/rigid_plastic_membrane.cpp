@@ -126,7 +126,7 @@ RigidPlasticMembrane::ElementState RigidPlasticMembrane::element_state(const Vec
   return s;
 }
 
-void RigidPlasticMembrane::internal_force(const Vector& q, Vector& force, Triplets* tangent) const {
+void RigidPlasticMembrane::internal_force(const Vector& q, Vector& force, TangentSink* tangent) const {
   if (axisymmetric_) {
     Eigen::Matrix4d K;
     for (int e = 0; e < element_count(); ++e) {
@@ -134,7 +134,7 @@ void RigidPlasticMembrane::internal_force(const Vector& q, Vector& force, Triple
       force.segment<4>(node_dof(e, 0)) += s.force;
       if (tangent)
         for (int i = 0; i < 4; ++i)
-          for (int j = 0; j < 4; ++j) tangent->emplace_back(node_dof(e, 0) + i, node_dof(e, 0) + j, K(i, j));
+          for (int j = 0; j < 4; ++j) tangent->add(node_dof(e, 0) + i, node_dof(e, 0) + j, K(i, j));
     }
     return;
   }
@@ -149,10 +149,10 @@ void RigidPlasticMembrane::internal_force(const Vector& q, Vector& force, Triple
     const Mat2 k = width_ * (s.dtension_dl * ee + s.tension / s.l * (Mat2::Identity() - ee));
     for (int i = 0; i < 2; ++i)
       for (int j = 0; j < 2; ++j) {
-        tangent->emplace_back(node_dof(e, i), node_dof(e, j), k(i, j));
-        tangent->emplace_back(node_dof(e + 1, i), node_dof(e + 1, j), k(i, j));
-        tangent->emplace_back(node_dof(e, i), node_dof(e + 1, j), -k(i, j));
-        tangent->emplace_back(node_dof(e + 1, i), node_dof(e, j), -k(i, j));
+        tangent->add(node_dof(e, i), node_dof(e, j), k(i, j));
+        tangent->add(node_dof(e + 1, i), node_dof(e + 1, j), k(i, j));
+        tangent->add(node_dof(e, i), node_dof(e + 1, j), -k(i, j));
+        tangent->add(node_dof(e + 1, i), node_dof(e, j), -k(i, j));
       }
   }
 }

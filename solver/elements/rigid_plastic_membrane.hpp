@@ -59,7 +59,7 @@ class RigidPlasticMembrane final : public Body {
 
   int dof_count() const override { return 2 * node_count(); }
   Vector dof_length_scales() const override { return Vector::Ones(dof_count()); }
-  void internal_force(const Vector& q, Vector& force, Triplets* tangent) const override;
+  void internal_force(const Vector& q, Vector& force, TangentSink* tangent) const override;
   int site_count() const override { return node_count(); }
   Vec2 site_reference(int site) const override { return nodes_[site]; }
   SurfacePoint surface_point(const VectorRef& q, int site, int side) const override;

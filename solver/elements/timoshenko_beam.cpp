@@ -32,7 +32,7 @@ TimoshenkoBeam::TimoshenkoBeam(std::vector<double> node_x, double y0, BeamSectio
     throw std::invalid_argument("the beam supports linear and von_karman kinematics");
 }
 
-void TimoshenkoBeam::internal_force(const Vector& q, Vector& force, Triplets* tangent) const {
+void TimoshenkoBeam::internal_force(const Vector& q, Vector& force, TangentSink* tangent) const {
   const bool nonlinear = kinematics_ == Kinematics::von_karman;
   const auto& s = section_;
   for (int e = 0; e < element_count(); ++e) {
@@ -82,7 +82,7 @@ void TimoshenkoBeam::internal_force(const Vector& q, Vector& force, Triplets* ta
     for (int i = 0; i < 9; ++i) {
       force[dofs[i]] += f[i];
       if (tangent)
-        for (int j = 0; j < 9; ++j) tangent->emplace_back(dofs[i], dofs[j], K(i, j));
+        for (int j = 0; j < 9; ++j) tangent->add(dofs[i], dofs[j], K(i, j));
     }
   }
 }

@@ -47,16 +47,17 @@ void Equilibrium::set_step(LoadFactors factors, std::vector<double> zeta_previou
 
 double Equilibrium::stiffness_scale(const Vector& q) const {
   Triplets t;
+  TripletSink sink(t);
   Vector f = Vector::Zero(q.size());
-  problem_.body->internal_force(q, f, &t);
+  problem_.body->internal_force(q, f, &sink);
   Vector diagonal = Vector::Zero(q.size());
   for (const auto& e : t)
     if (e.row() == e.col()) diagonal[e.row()] += e.value();
   return diagonal.cwiseAbs().maxCoeff();
 }
 
-Vector Equilibrium::residual(const Vector& q, const EquilibriumState& paired, const Vector& p_given, Triplets* tangent,
-                             double* force_scale, bool body_tangent) const {
+Vector Equilibrium::residual(const Vector& q, const EquilibriumState& paired, const Vector& p_given,
+                             TangentSink* tangent, double* force_scale, bool body_tangent) const {
   const Vector p = penalty_ ? penalty_forces(q, paired, tangent) : p_given;
   Vector r = Vector::Zero(q.size());
   problem_.body->internal_force(q, r, body_tangent ? tangent : nullptr);
@@ -64,9 +65,10 @@ Vector Equilibrium::residual(const Vector& q, const EquilibriumState& paired, co
   if (problem_.body->has_follower_loads()) {
     Triplets follow;  // r = A - F(q): the follower load's derivative enters with a minus
     problem_.body->follower_load(q, factors_, external, body_tangent && tangent ? &follow : nullptr);
-    for (const auto& e : follow) tangent->emplace_back(e.row(), e.col(), -e.value());
+    for (const auto& e : follow) tangent->add(e.row(), e.col(), -e.value());
   }
   Vector contact = Vector::Zero(q.size());
+  Triplets pair_terms;
   for (size_t i = 0; i < problem_.candidates.size(); ++i) {
     const Candidate& c = problem_.candidates[i];
     const PairedPoint& pp = paired.points[i];
@@ -83,7 +85,7 @@ Vector Equilibrium::residual(const Vector& q, const EquilibriumState& paired, co
     R << 0, -1, 1, 0;
     const Mat2 df_dx = (-p_eta * Mat2::Identity() + p_xi * R) * pp.projection.dnormal_dx;
     for (const auto& a : pp.point.jacobian)
-      for (const auto& b : pp.point.jacobian) tangent->emplace_back(a.dof, b.dof, -a.dx.dot(df_dx * b.dx));
+      for (const auto& b : pp.point.jacobian) tangent->add(a.dof, b.dof, -a.dx.dot(df_dx * b.dx));
     // The pair's stiffness at the iterate's forces, both bodies (the penalty law's change of p
     // with the positions, the gradients of the gap and zeta, is in penalty_forces): the whole
     // consistent tangent, given forces or the law's. These terms scale with p (p / element size):
@@ -91,10 +93,9 @@ Vector Equilibrium::residual(const Vector& q, const EquilibriumState& paired, co
     // own stiffness and the tangent is indefinite; the penalty strategy then starts its law soft
     // (penalty.cpp) rather than leaving them out, which cost a linear rate at the answer.
     if (const auto& master = paired.masters[c.obstacle]) {
-      const size_t first = tangent->size();
-      master->force_derivative(problem_.body->surface_point(q, c.site, c.side), c.site, p_eta, p_xi, *tangent);
-      for (size_t k = first; k < tangent->size(); ++k)
-        (*tangent)[k] = {(*tangent)[k].row(), (*tangent)[k].col(), -(*tangent)[k].value()};
+      pair_terms.clear();
+      master->force_derivative(problem_.body->surface_point(q, c.site, c.side), c.site, p_eta, p_xi, pair_terms);
+      for (const auto& e : pair_terms) tangent->add(e.row(), e.col(), -e.value());
     }
   }
   if (force_scale) {
@@ -105,13 +106,15 @@ Vector Equilibrium::residual(const Vector& q, const EquilibriumState& paired, co
   if (pins_free_)
     for (int pin : problem_.rigid.pins) {
       r[pin] += penalty_->pin_spring * q[pin];
-      if (tangent) tangent->emplace_back(pin, pin, penalty_->pin_spring);
+      if (tangent) tangent->add(pin, pin, penalty_->pin_spring);
     }
   return r;
 }
 
 Vector Equilibrium::residual(const Vector& q, const Vector& p, Triplets* tangent) const {
-  return residual(q, evaluate(q), p, tangent);
+  if (!tangent) return residual(q, evaluate(q), p, nullptr);
+  TripletSink sink(*tangent);
+  return residual(q, evaluate(q), p, &sink);
 }
 
 Vector Equilibrium::applied_forces(const EquilibriumState& paired, const Vector& p) const {

@@ -94,7 +94,7 @@ class Equilibrium {
   // force_scale (if asked): the largest of |A(q)|, |lambda F| and |T p| over all dofs, in
   // force units (the scale Newton's residual test is relative to). Without body_tangent, the
   // tangent's contact terms only.
-  Vector residual(const Vector& q, const EquilibriumState& paired, const Vector& p, Triplets* tangent,
+  Vector residual(const Vector& q, const EquilibriumState& paired, const Vector& p, TangentSink* tangent,
                   double* force_scale = nullptr, bool body_tangent = true) const;
   // Newton's step K_t^-1 rhs for the constant body tangent plus the pair's stiffness (the
   // `contact` triplets): the body's factorization and a Krylov solve on the pair's dofs.
@@ -103,9 +103,9 @@ class Equilibrium {
   // Newton's tests decide, as for any approximate tangent).
   static constexpr double kLowRankTolerance = 1e-13;
   static constexpr int kLowRankIterations = 60;
-  // p(q) of the penalty law at a paired state of q, and (if asked) its stiffness triplets. With an
+  // p(q) of the penalty law at a paired state of q, and (if asked) its stiffness entries. With an
   // increment dq (all dofs), p(q) + (dp/dq) dq: the law linearized at q.
-  Vector penalty_forces(const Vector& q, const EquilibriumState& paired, Triplets* tangent,
+  Vector penalty_forces(const Vector& q, const EquilibriumState& paired, TangentSink* tangent,
                         const Vector* increment = nullptr) const;
   // The penalty law's answer at a converged iterate q (paired): one more Newton correction dq,
   // and the forces p(q) + (dp/dq) dq at q + dq.
@@ -167,9 +167,9 @@ class Equilibrium {
   const FreeBlockSolver& g_factor() const { return g_from_newton_ ? lu_ : body_lu_; }
   bool g_from_newton_ = false;
   long g_solve_ = -1;
-  // The triplets of Newton's tangent and of the body's own, kept so that their storage (megabytes
-  // for a few thousand elements) is allocated once, not at every real solve.
-  Triplets newton_triplets_, body_triplets_;
+  // The contact terms of Newton's tangent for the low-rank step, kept so that their storage is
+  // allocated once, not at every real solve (the factorized tangents are assembled in place).
+  Triplets newton_triplets_;
   double body_tangent_norm_ = 0.0;  // |K|_inf of the constant body tangent (round-off scale)
   std::vector<int> surface_free_;   // surface row of G -> free index
   std::vector<int> surface_row_;    // free index -> surface row of G, -1 off the surface

@@ -21,36 +21,190 @@ void factorize_dissected(CholmodFactor& dissected, const Eigen::SparseMatrix<dou
 
 }  // namespace
 
-bool FreeBlockSolver::scatter(const Triplets& triplets) {
-  if (triplets.size() != rows_.size()) return false;
-  double* v = matrix_.valuePtr();
-  std::fill(v, v + matrix_.nonZeros(), 0.0);
-  // One pass: the sequence checked against the pattern's as the values are summed.
-  for (size_t k = 0; k < triplets.size(); ++k) {
-    if (triplets[k].row() != rows_[k] || triplets[k].col() != cols_[k]) return false;
-    if (slot_[k] >= 0) v[slot_[k]] += triplets[k].value();
-  }
-  return true;
+TangentSink& FreeBlockSolver::assemble(const std::vector<int>& free_index, int free_count,
+                                       const Vector* length_scales) {
+  free_index_ = &free_index;
+  free_count_ = free_count;
+  length_scales_ = length_scales;
+  unit_scales_ = !length_scales || (length_scales->array() == 1.0).all();
+  row_sums_.setZero(length_scales ? free_count : 0);
+  next_piece_ = matched_ = 0;
+  following_ = !pieces_.empty();  // no pattern yet: every piece is recorded
+  finished_ = false;
+  recorded_.clear();
+  recorded_dofs_.clear();
+  recorded_values_.clear();
+  if (following_) std::fill(matrix_.valuePtr(), matrix_.valuePtr() + matrix_.nonZeros(), 0.0);
+  return assembly_;
 }
 
-void FreeBlockSolver::build_pattern(const Triplets& triplets, const std::vector<int>& free_index, int free_count) {
-  rows_.resize(triplets.size());
-  cols_.resize(triplets.size());
-  Triplets pattern;
-  for (size_t k = 0; k < triplets.size(); ++k) {
-    rows_[k] = triplets[k].row();
-    cols_[k] = triplets[k].col();
-    const int i = free_index[rows_[k]], j = free_index[cols_[k]];
-    if (i >= 0 && j >= 0) pattern.emplace_back(i, j, 1.0);
+void FreeBlockSolver::Assembly::add(int row, int col, double value) {
+  FreeBlockSolver& o = owner_;
+  const int dofs[2] = {row, col};
+  if (o.following_ && o.next_piece_ < o.pieces_.size()) {
+    const Piece& p = o.pieces_[o.next_piece_];
+    if (p.size == 0 && o.dofs_[p.dofs] == row && o.dofs_[p.dofs + 1] == col) {
+      ++o.next_piece_;
+      if (const int slot = o.slots_[p.slots]; slot >= 0) o.matrix_.valuePtr()[slot] += value;
+      if (o.length_scales_) o.add_magnitudes(0, dofs, &value);
+      return;
+    }
   }
-  matrix_.resize(free_count, free_count);
+  o.depart();
+  o.record(0, dofs, &value);
+}
+
+void FreeBlockSolver::Assembly::add_block(const int* dofs, const Matrix& block) {
+  FreeBlockSolver& o = owner_;
+  const int m = static_cast<int>(block.rows());
+  if (o.following_ && o.next_piece_ < o.pieces_.size()) {
+    const Piece& p = o.pieces_[o.next_piece_];
+    if (p.size == m && std::equal(dofs, dofs + m, o.dofs_.data() + p.dofs)) {
+      ++o.next_piece_;
+      double* v = o.matrix_.valuePtr();
+      const int* slot = o.slots_.data() + p.slots;
+      if (!o.length_scales_) {
+        for (int i = 0; i < m; ++i)  // row by row, as the pattern was built
+          for (int j = 0; j < m; ++j, ++slot)
+            if (*slot >= 0) v[*slot] += block(i, j);
+        return;
+      }
+      // The magnitudes on the way (a slot: a free row and column), as add_magnitudes sums them.
+      const std::vector<int>& free = *o.free_index_;
+      const Vector& scale = *o.length_scales_;
+      for (int i = 0; i < m; ++i) {
+        const int row = free[dofs[i]];
+        double sum = row >= 0 ? o.row_sums_[row] : 0.0;
+        for (int j = 0; j < m; ++j, ++slot)
+          if (*slot >= 0) {
+            const double x = block(i, j);
+            v[*slot] += x;
+            sum += o.unit_scales_ ? std::abs(x) : std::abs(x) / (scale[dofs[i]] * scale[dofs[j]]);
+          }
+        if (row >= 0) o.row_sums_[row] = sum;
+      }
+      return;
+    }
+  }
+  o.depart();
+  const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> rows = block;
+  o.record(m, dofs, rows.data());
+}
+
+void FreeBlockSolver::depart() {
+  if (following_) matched_ = next_piece_;
+  following_ = false;
+}
+
+void FreeBlockSolver::record(int size, const int* dofs, const double* values) {
+  const int count = size ? size : 2, entries = size ? size * size : 1;
+  recorded_.push_back({size, static_cast<int>(recorded_dofs_.size()), static_cast<int>(recorded_values_.size())});
+  recorded_dofs_.insert(recorded_dofs_.end(), dofs, dofs + count);
+  recorded_values_.insert(recorded_values_.end(), values, values + entries);
+  if (length_scales_) {
+    if (size == 0) add_magnitudes(0, dofs, values);
+    else {  // add_magnitudes reads a block column by column
+      Matrix block(size, size);
+      for (int i = 0; i < size; ++i)
+        for (int j = 0; j < size; ++j) block(i, j) = values[i * size + j];
+      add_magnitudes(size, dofs, block.data());
+    }
+  }
+}
+
+void FreeBlockSolver::add_magnitudes(int size, const int* dofs, const double* values) {
+  const std::vector<int>& free = *free_index_;
+  const Vector& scale = *length_scales_;
+  if (size == 0) {
+    const int i = free[dofs[0]], j = free[dofs[1]];
+    if (i >= 0 && j >= 0) row_sums_[i] += std::abs(values[0]) / (scale[dofs[0]] * scale[dofs[1]]);
+    return;
+  }
+  for (int a = 0; a < size; ++a) {  // values: column-major, size x size
+    const int i = free[dofs[a]];
+    if (i < 0) continue;
+    double sum = row_sums_[i];
+    for (int b = 0; b < size; ++b)
+      if (free[dofs[b]] >= 0)
+        sum += unit_scales_ ? std::abs(values[a + b * size])
+                            : std::abs(values[a + b * size]) / (scale[dofs[a]] * scale[dofs[b]]);
+    row_sums_[i] = sum;
+  }
+}
+
+double FreeBlockSolver::row_sum_norm() {
+  finish_assembly();
+  return row_sums_.size() ? row_sums_.maxCoeff() : 0.0;
+}
+
+void FreeBlockSolver::finish_assembly() {
+  if (finished_) return;
+  finished_ = true;
+  if (following_ && next_piece_ == pieces_.size()) return;  // the pattern's sequence: values in place
+  depart();
+  // The pieces that followed the pattern keep their sums (each entry's whole sum so far sits at
+  // its slot), the recorded ones are added after them: the order they were emitted in.
+  const std::vector<Piece> before(pieces_.begin(), pieces_.begin() + static_cast<long>(matched_));
+  const std::vector<int> old_slots(slots_);
+  const std::vector<double> old_values(matrix_.valuePtr(),
+                                       matrix_.valuePtr() + (pieces_.empty() ? 0 : matrix_.nonZeros()));
+  std::vector<int> dofs;
+  std::vector<Piece> pieces;
+  int slots = 0;
+  const auto append = [&](const Piece& p, const int* piece_dofs) {
+    pieces.push_back({p.size, static_cast<int>(dofs.size()), slots});
+    dofs.insert(dofs.end(), piece_dofs, piece_dofs + (p.size ? p.size : 2));
+    slots += p.size ? p.size * p.size : 1;
+  };
+  for (const Piece& p : before) append(p, dofs_.data() + p.dofs);
+  for (const Piece& p : recorded_) append(p, recorded_dofs_.data() + p.dofs);
+  pieces_ = std::move(pieces);
+  dofs_ = std::move(dofs);
+  build_pattern();
+  double* v = matrix_.valuePtr();
+  std::fill(v, v + matrix_.nonZeros(), 0.0);
+  for (size_t k = 0; k < before.size(); ++k) {
+    const int entries = before[k].size ? before[k].size * before[k].size : 1;
+    for (int e = 0; e < entries; ++e)
+      if (const int old = old_slots[before[k].slots + e]; old >= 0) v[slots_[pieces_[k].slots + e]] = old_values[old];
+  }
+  for (size_t k = 0; k < recorded_.size(); ++k) {
+    const Piece& p = pieces_[before.size() + k];
+    const int entries = p.size ? p.size * p.size : 1;
+    for (int e = 0; e < entries; ++e)
+      if (const int slot = slots_[p.slots + e]; slot >= 0) v[slot] += recorded_values_[recorded_[k].slots + e];
+  }
+  recorded_.clear();
+  recorded_dofs_.clear();
+  recorded_values_.clear();
+}
+
+void FreeBlockSolver::build_pattern() {
+  const std::vector<int>& free = *free_index_;
+  const auto each_entry = [&](const auto& use) {  // (index in slots_, row, column) of every entry
+    for (const Piece& p : pieces_) {
+      if (p.size == 0) {
+        use(p.slots, dofs_[p.dofs], dofs_[p.dofs + 1]);
+        continue;
+      }
+      for (int i = 0; i < p.size; ++i)
+        for (int j = 0; j < p.size; ++j) use(p.slots + i * p.size + j, dofs_[p.dofs + i], dofs_[p.dofs + j]);
+    }
+  };
+  Triplets pattern;
+  each_entry([&](int, int row, int col) {
+    if (free[row] >= 0 && free[col] >= 0) pattern.emplace_back(free[row], free[col], 1.0);
+  });
+  matrix_.resize(free_count_, free_count_);
   matrix_.setFromTriplets(pattern.begin(), pattern.end());
   matrix_.makeCompressed();
-  slot_.assign(triplets.size(), -1);
-  for (size_t k = 0; k < triplets.size(); ++k) {
-    const int i = free_index[rows_[k]], j = free_index[cols_[k]];
-    if (i >= 0 && j >= 0) slot_[k] = static_cast<int>(&matrix_.coeffRef(i, j) - matrix_.valuePtr());
-  }
+  int count = 0;
+  for (const Piece& p : pieces_) count += p.size ? p.size * p.size : 1;
+  slots_.assign(count, -1);
+  each_entry([&](int k, int row, int col) {
+    if (free[row] >= 0 && free[col] >= 0)
+      slots_[k] = static_cast<int>(&matrix_.coeffRef(free[row], free[col]) - matrix_.valuePtr());
+  });
   // Where each entry's transpose lives (the pattern of a tangent is symmetric).
   mirror_.assign(matrix_.nonZeros(), -1);
   for (int col = 0; col < matrix_.outerSize(); ++col)
@@ -81,11 +235,13 @@ void FreeBlockSolver::check_symmetry(double near_symmetric_tolerance) {
 
 bool FreeBlockSolver::factorize(const Triplets& triplets, const std::vector<int>& free_index, int free_count,
                                 double near_symmetric_tolerance) {
-  if (!scatter(triplets)) {
-    // New pattern: build it, remember where every triplet lands, analyse it once.
-    build_pattern(triplets, free_index, free_count);
-    scatter(triplets);
-  }
+  TangentSink& sink = assemble(free_index, free_count);
+  for (const auto& t : triplets) sink.add(t.row(), t.col(), t.value());
+  return factorize(near_symmetric_tolerance);
+}
+
+bool FreeBlockSolver::factorize(double near_symmetric_tolerance) {
+  finish_assembly();
   ++factorizations_;
   split_ = !coupled_;
   if (split_) {
@@ -461,20 +617,18 @@ void FreeBlockSolver::for_each_part(const std::function<void(int)>& task) const 
 }
 
 bool FreeBlockSolver::factorize_parts(double near_symmetric_tolerance) {
-  std::vector<Triplets> local(parts_.size());
-  for (int col = 0; col < matrix_.outerSize(); ++col) {
-    const int b = block_of(col);
-    for (Eigen::SparseMatrix<double>::InnerIterator it(matrix_, col); it; ++it)
-      local[b].emplace_back(static_cast<int>(it.row()) - starts_[b], col - starts_[b], it.value());
-  }
   const int largest = static_cast<int>(matrix_.rows());
   if (static_cast<int>(identity_.size()) < largest) {
     identity_.resize(largest);
     for (int k = 0; k < largest; ++k) identity_[k] = k;
   }
   std::vector<char> ok(parts_.size(), 0);
-  for_each_part([&](int b) {
-    ok[b] = parts_[b]->factorize(local[b], identity_, starts_[b + 1] - starts_[b], near_symmetric_tolerance);
+  for_each_part([&](int b) {  // each body's block, column by column (no entry lies outside them)
+    TangentSink& part = parts_[b]->assemble(identity_, starts_[b + 1] - starts_[b]);
+    for (int col = starts_[b]; col < starts_[b + 1]; ++col)
+      for (Eigen::SparseMatrix<double>::InnerIterator it(matrix_, col); it; ++it)
+        part.add(static_cast<int>(it.row()) - starts_[b], col - starts_[b], it.value());
+    ok[b] = parts_[b]->factorize(near_symmetric_tolerance);
   });
   ok_ = std::all_of(ok.begin(), ok.end(), [](char c) { return c != 0; });
   symmetric_ = ok_;

@@ -1,7 +1,10 @@
 #pragma once
-// Factorizes the free-dof block of a tangent given as triplets, reusing the sparsity pattern
-// and the symbolic analysis while the triplet sequence repeats (it does from one Newton
-// iterate to the next: the assembly loops are fixed and contact terms are always emitted).
+// Assembles and factorizes the free-dof block of a tangent. The assembly loops emit the same
+// entries in the same order at every call (contact terms are emitted even when zero), so the
+// block's pattern, where each emitted entry lands in its values and the symbolic analysis are
+// computed once, and each assembly adds the entries straight into the values: no triplets, no
+// sort. A sequence that departs from the pattern's (a contact candidate added, the free set
+// changed) is recorded from there and the pattern built afresh.
 // A symmetric positive definite block (the body's own tangent; Newton's without friction on
 // curved tools) is factorized by CHOLMOD's Cholesky (simplicial or supernodal, as CHOLMOD
 // chooses) in a fill-reducing order fixed once per pattern, many times cheaper than the LU that
@@ -15,6 +18,7 @@
 
 #include "solver/model/body.hpp"
 #include "solver/model/parallel.hpp"
+#include "solver/model/tangent_sink.hpp"
 
 namespace grip {
 
@@ -49,13 +53,22 @@ class CholmodFactor : public Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<dou
 
 class FreeBlockSolver {
  public:
-  // free_index: dof -> row of the free block, -1 for a prescribed dof.
-  // Returns false if the block is singular.
+  // Starts an assembly of the block: the sink takes the tangent's entries by dof (free_index:
+  // dof -> row of the free block, -1 for a prescribed dof, whose entries are dropped). With
+  // `length_scales` (by dof), row_sum_norm() measures what was assembled.
+  TangentSink& assemble(const std::vector<int>& free_index, int free_count, const Vector* length_scales = nullptr);
+  // Factorizes what was assembled. Returns false if the block is singular.
   // near_symmetric_tolerance > 0: a block whose skew part is below that fraction of its
   // largest entry is symmetrized (Newton's tangent with friction on a curved tool: the
   // residual stays exact, so Newton still converges, and LDL^T serves).
+  bool factorize(double near_symmetric_tolerance = 0.0);
+  // The triplets assembled, then factorized.
   bool factorize(const Triplets& triplets, const std::vector<int>& free_index, int free_count,
                  double near_symmetric_tolerance = 0.0);
+  // |K|_inf of the last assembly in force / length units (each entry over the length scales of
+  // its row's and column's dofs), the entries' magnitudes summed as they were emitted (the
+  // element by element sums that round-off in the residual comes from); 0 without length_scales.
+  double row_sum_norm();
   // Several bodies: free rows [starts[b], starts[b + 1]) are body b's (starts ends with the free
   // count). Where the block has no entry between two bodies (the bodies' own tangent; Newton's
   // where bodies meet rigid tools only, or where a pair's stiffness enters as a low-rank
@@ -90,8 +103,9 @@ class FreeBlockSolver {
   const Eigen::SparseMatrix<double>& matrix() const { return matrix_; }
   // The next factorize() builds its pattern afresh (the free set changed).
   void forget_pattern() {
-    rows_.clear();
-    cols_.clear();
+    pieces_.clear();
+    dofs_.clear();
+    slots_.clear();
     ok_ = false;
     dissected_analysed_ = false;
     dissected_fails_at_ = 0;
@@ -103,11 +117,33 @@ class FreeBlockSolver {
   // The bodies' blocks: factorizes each diagonal block of matrix_ on its own (split_), or
   // leaves split_ false where an entry couples two bodies.
   bool factorize_parts(double near_symmetric_tolerance);
-  // Sums the triplets into matrix_ through the slots; false where their sequence is not the
-  // pattern's (then matrix_ is left part-filled).
-  bool scatter(const Triplets& triplets);
-  // matrix_'s new pattern from the triplets, the slots and mirrors, and what depends on them.
-  void build_pattern(const Triplets& triplets, const std::vector<int>& free_index, int free_count);
+  // The assembly's sink: entries into matrix_'s values through slots_ while they follow the
+  // pattern's pieces, recorded from the first that does not.
+  class Assembly final : public TangentSink {
+   public:
+    explicit Assembly(FreeBlockSolver& owner) : owner_(owner) {}
+    void add(int row, int col, double value) override;
+    void add_block(const int* dofs, const Matrix& block) override;
+
+   private:
+    FreeBlockSolver& owner_;
+  };
+  friend class Assembly;
+  // An element's block (size m: m dofs, m x m slots row by row) or one entry (size 0: its row
+  // and column in dofs_, one slot), in the order emitted.
+  struct Piece {
+    int size, dofs, slots;
+  };
+  // Where the assembly departs from the pattern: the pieces matched so far stay, the rest is
+  // recorded.
+  void depart();
+  void record(int size, const int* dofs, const double* values);
+  // |entries| over their length scales into row_sums_ (entries at free rows and columns).
+  void add_magnitudes(int size, const int* dofs, const double* values);
+  // Completes the assembly: a departed one gets its new pattern (build_pattern) and values.
+  void finish_assembly();
+  // matrix_'s new pattern from the pieces, slots_, the mirrors, and what depends on them.
+  void build_pattern();
   // symmetric_ from the skew part of matrix_ against its largest entry; a near-symmetric
   // matrix_ averaged with its transpose.
   void check_symmetry(double near_symmetric_tolerance);
@@ -127,9 +163,24 @@ class FreeBlockSolver {
   bool coupled_ = true;        // the pattern has entries between bodies
   bool split_ = false;
   Eigen::SparseMatrix<double> matrix_;
-  std::vector<int> rows_, cols_;  // the triplet sequence the pattern was built from
-  std::vector<int> slot_;         // triplet k -> index in matrix_.valuePtr(), -1 if dropped
-  std::vector<int> mirror_;       // value index -> index of its transpose entry
+  // The pattern's sequence of pieces, their dofs, and each entry's index in matrix_'s values
+  // (-1: dropped, a prescribed row or column).
+  std::vector<Piece> pieces_;
+  std::vector<int> dofs_, slots_;
+  // The assembly under way: the next piece expected, whether every one so far followed the
+  // pattern, and from where not, the pieces recorded (slots: index in recorded_values_).
+  Assembly assembly_{*this};
+  size_t next_piece_ = 0, matched_ = 0;
+  bool following_ = false, finished_ = true;
+  std::vector<Piece> recorded_;
+  std::vector<int> recorded_dofs_;
+  std::vector<double> recorded_values_;
+  const std::vector<int>* free_index_ = nullptr;
+  int free_count_ = 0;
+  const Vector* length_scales_ = nullptr;
+  bool unit_scales_ = true;  // every length scale 1: no division
+  Vector row_sums_;
+  std::vector<int> mirror_;  // value index -> index of its transpose entry
   Eigen::SparseLU<Eigen::SparseMatrix<double>> lu_;
   CholmodFactor llt_;  // of ordered_: rows and columns in order_
   // Free row i is row order_.indices()[i] of the ordered block; ordered_ holds the triangle

@@ -34,17 +34,6 @@ double Equilibrium::free_length_norm(const Vector& dq) const {
 
 namespace {
 
-// |K|_inf over the free block in force / length units (moments over the length scale of
-// their dof, rotations times it), from the tangent's triplets.
-double free_row_sum_norm(const Triplets& triplets, const std::vector<int>& free_index, int free_count,
-                         const Vector& length_scales) {
-  Vector rows = Vector::Zero(free_count);
-  for (const auto& t : triplets)
-    if (free_index[t.row()] >= 0 && free_index[t.col()] >= 0)
-      rows[free_index[t.row()]] += std::abs(t.value()) / (length_scales[t.row()] * length_scales[t.col()]);
-  return free_count ? rows.maxCoeff() : 0.0;
-}
-
 // y solving (I + B) y = c by GMRES (Arnoldi with modified Gram-Schmidt, Givens rotations, no
 // restart), `apply` giving B v: stops where the residual is below `tolerance` |c|, or after
 // `most` iterations (then the least-residual iterate of that space).
@@ -174,12 +163,20 @@ EquilibriumState Equilibrium::newton(const Vector& q_guess, const Vector& p) {
   // A pair of bodies adds its stiffness, which moves with the pairing, on a few surface dofs:
   // kept as a low-rank correction of the constant body tangent (low_rank_step).
   const bool low_rank = reuse && has_pairs_;
-  Triplets& triplets = newton_triplets_;  // kept from solve to solve: no allocation once grown
+  // The tangent: assembled in place into the factorization's block, or (low_rank) its contact
+  // terms recorded, kept from solve to solve (no allocation once grown).
+  Triplets& triplets = newton_triplets_;
+  TripletSink contact_terms(triplets);
+  const auto tangent = [&]() -> TangentSink* {
+    if (reuse && !low_rank) return nullptr;
+    triplets.clear();
+    return low_rank ? static_cast<TangentSink*>(&contact_terms)
+                    : &lu_.assemble(free_index_, free_count_, &length_scales_);
+  };
   double last_step = 0.0;
   std::vector<signed char> signs;  // the penalty law's trial signs at the last iterate
   for (int it = 1; it <= params_.max_iterations + 1; ++it) {
     pair(state.q, state);
-    triplets.clear();
     // A penalty point whose trial tangential force changed sign since the last iterate has
     // crossed the cone's interior, its stick band (width 2 mu |p_eta| / k_t, a few 1e-6 of the
     // body when k_t is 1e3 x its stiffness): Newton from either slip branch predicts the other
@@ -199,7 +196,7 @@ EquilibriumState Equilibrium::newton(const Vector& q_guess, const Vector& p) {
     }
     double force_scale = 0.0;
     // low_rank: the contact terms only (the body's are in its kept factorization).
-    const Vector r = residual(state.q, state, p, reuse && !low_rank ? nullptr : &triplets, &force_scale, !low_rank);
+    const Vector r = residual(state.q, state, p, tangent(), &force_scale, !low_rank);
     const double r_max = scaled_free_max(r);
     state.relative_residual = force_scale > 0 ? r_max / force_scale : 0.0;
     if (!std::isfinite(r_max)) {
@@ -209,11 +206,11 @@ EquilibriumState Equilibrium::newton(const Vector& q_guess, const Vector& p) {
     }
     const bool residual_met = r_max <= params_.residual_tolerance * force_scale;
     // The round-off floor only matters where the residual test fails (|K| costs a pass over
-    // the triplets: 6 % of the beam's time when taken at every iterate).
+    // assembled entries: 6 % of the beam's time when taken at every iterate).
     bool at_floor = false;
     if (!residual_met && it > 1) {
       double k_norm = body_tangent_norm_;
-      if (!reuse) k_norm = free_row_sum_norm(triplets, free_index_, free_count_, length_scales_);
+      if (!reuse) k_norm = lu_.row_sum_norm();
       const double q_size = (state.q.array() * length_scales_.array()).abs().maxCoeff();
       at_floor = r_max <= params_.floor_factor * kEpsilon * (k_norm * q_size + force_scale);
     }
@@ -227,8 +224,7 @@ EquilibriumState Equilibrium::newton(const Vector& q_guess, const Vector& p) {
     Vector r_step;
     if (!branch.empty()) {
       stick_branch_ = std::move(branch);
-      triplets.clear();
-      r_step = residual(state.q, state, p, reuse && !low_rank ? nullptr : &triplets, nullptr, !low_rank);
+      r_step = residual(state.q, state, p, tangent(), nullptr, !low_rank);
     }
     const Vector& r_newton = stick_branch_.empty() ? r : r_step;
     if (reuse) {
@@ -241,7 +237,7 @@ EquilibriumState Equilibrium::newton(const Vector& q_guess, const Vector& p) {
       ++counters_.factorizations;
       ++counters_.newton_factorizations;
       newton_factor_solve_ = -1;
-      if (!lu_.factorize(triplets, free_index_, free_count_, 1e-4)) {
+      if (!lu_.factorize(1e-4)) {
         state.reason = "singular tangent stiffness in Newton iteration " + std::to_string(it);
         state.failure = FailureKind::newton_diverged;
         return state;
@@ -331,16 +327,14 @@ double Equilibrium::line_search(const Vector& q, const Vector& dq, const Vector&
 
 bool Equilibrium::factorize_body_tangent(const Vector& q) {
   if (constant_tangent_ && body_factorized_) return body_lu_.ok();
-  Triplets& triplets = body_triplets_;
-  triplets.clear();
   Vector force = Vector::Zero(q.size());
-  problem_.body->internal_force(q, force, &triplets);
+  problem_.body->internal_force(q, force, &body_lu_.assemble(free_index_, free_count_, &length_scales_));
   ++counters_.factorizations;
   ++counters_.body_factorizations;
   body_factorized_ = true;
-  // Read by Newton only for a constant tangent (a changing one has its own triplets).
-  if (constant_tangent_) body_tangent_norm_ = free_row_sum_norm(triplets, free_index_, free_count_, length_scales_);
-  return body_lu_.factorize(triplets, free_index_, free_count_);
+  // Read by Newton only for a constant tangent (a changing one has its own).
+  if (constant_tangent_) body_tangent_norm_ = body_lu_.row_sum_norm();
+  return body_lu_.factorize();
 }
 
 }  // namespace grip

@@ -20,7 +20,7 @@ void Equilibrium::set_penalty(std::optional<PenaltyLaw> law) {
   surface_free_.clear();
 }
 
-Vector Equilibrium::penalty_forces(const Vector& q, const EquilibriumState& paired, Triplets* tangent,
+Vector Equilibrium::penalty_forces(const Vector& q, const EquilibriumState& paired, TangentSink* tangent,
                                    const Vector* increment) const {
   const PenaltyLaw& law = *penalty_;
   Vector p = Vector::Zero(problem_.component_count);
@@ -31,7 +31,7 @@ Vector Equilibrium::penalty_forces(const Vector& q, const EquilibriumState& pair
     if (!paired.enabled[c.eta] || paired.s[c.eta] <= 0) {
       if (tangent)  // zeros keep the tangent's pattern fixed
         for (const auto& a : pp.point.jacobian)
-          for (const auto& b : pp.point.jacobian) tangent->emplace_back(a.dof, b.dof, 0.0);
+          for (const auto& b : pp.point.jacobian) tangent->add(a.dof, b.dof, 0.0);
       continue;
     }
     p[c.eta] = -law.normal * paired.s[c.eta];
@@ -82,8 +82,8 @@ Vector Equilibrium::penalty_forces(const Vector& q, const EquilibriumState& pair
     for (const auto& a : pp.point.jacobian) {
       const double on_eta = a.dx.dot(pp.eta), on_xi = a.dx.dot(pp.xi);
       for (const auto& [dof, dpn, dpt] : dp) {
-        tangent->emplace_back(a.dof, dof, -(on_eta * dpn + on_xi * dpt));
-        if (master) tangent->emplace_back(dof, a.dof, 0.0);  // a tangent's pattern is symmetric
+        tangent->add(a.dof, dof, -(on_eta * dpn + on_xi * dpt));
+        if (master) tangent->add(dof, a.dof, 0.0);  // a tangent's pattern is symmetric
       }
     }
   }
@@ -110,12 +110,10 @@ std::vector<signed char> Equilibrium::trial_signs(const EquilibriumState& paired
 // differs from the law at q + dq by its rounding there, and by the law's second-order change over
 // dq, a correction already below Newton's tests.
 EquilibriumState& Equilibrium::finish_penalty(EquilibriumState& state) {
-  Triplets tangent;
-  const Vector r = residual(state.q, state, state.p, &tangent);
+  const Vector r = residual(state.q, state, state.p, &lu_.assemble(free_index_, free_count_));
   ++counters_.factorizations;
   ++counters_.newton_factorizations;
-  if (!lu_.factorize(tangent, free_index_, free_count_, 1e-4))
-    return finish(state, penalty_forces(state.q, state, nullptr));
+  if (!lu_.factorize(1e-4)) return finish(state, penalty_forces(state.q, state, nullptr));
   Vector r_free(free_count_);
   for (int i = 0; i < r.size(); ++i)
     if (free_index_[i] >= 0) r_free[free_index_[i]] = -r[i];

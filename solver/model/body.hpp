@@ -7,11 +7,10 @@
 #include <string>
 #include <vector>
 
+#include "solver/model/tangent_sink.hpp"
 #include "solver/model/types.hpp"
 
 namespace grip {
-
-using Triplets = std::vector<Eigen::Triplet<double>>;
 
 // Named columns of per-site or per-element output values.
 struct FieldTable {
@@ -44,8 +43,8 @@ class Body {
   // rotations): makes Newton's displacement test unit-consistent.
   virtual Vector dof_length_scales() const = 0;
   // Adds the internal force A(q) into `force` (sized dof_count) and, if `tangent` is given,
-  // the triplets of dA/dq.
-  virtual void internal_force(const Vector& q, Vector& force, Triplets* tangent) const = 0;
+  // the entries of dA/dq, the same ones in the same order at every call.
+  virtual void internal_force(const Vector& q, Vector& force, TangentSink* tangent) const = 0;
 
   // Sites that can carry a contact candidate (beam and membrane: the element end nodes).
   virtual int site_count() const = 0;

@@ -32,15 +32,34 @@ Vector BodySet::dof_length_scales() const {
   return s;
 }
 
-void BodySet::internal_force(const Vector& q, Vector& force, Triplets* tangent) const {
+namespace {
+
+// A part's entries, passed on at its rows in the set.
+class OffsetSink final : public TangentSink {
+ public:
+  OffsetSink(TangentSink* out, int offset) : out_(out), offset_(offset) {}
+  void add(int row, int col, double value) override { out_->add(row + offset_, col + offset_, value); }
+  void add_block(const int* dofs, const Matrix& block) override {
+    shifted_.resize(block.rows());
+    for (size_t i = 0; i < shifted_.size(); ++i) shifted_[i] = dofs[i] + offset_;
+    out_->add_block(shifted_.data(), block);
+  }
+
+ private:
+  TangentSink* out_;
+  int offset_;
+  std::vector<int> shifted_;
+};
+
+}  // namespace
+
+void BodySet::internal_force(const Vector& q, Vector& force, TangentSink* tangent) const {
   for (int b = 0; b < part_count(); ++b) {
     const int n = parts_[b]->dof_count(), o = dof_offset_[b];
     Vector f = Vector::Zero(n);
-    Triplets t;
-    parts_[b]->internal_force(part_q(q, b), f, tangent ? &t : nullptr);
+    OffsetSink part_tangent(tangent, o);
+    parts_[b]->internal_force(part_q(q, b), f, tangent ? &part_tangent : nullptr);
     force.segment(o, n) += f;
-    if (tangent)
-      for (const auto& e : t) tangent->emplace_back(e.row() + o, e.col() + o, e.value());
   }
 }
 

@@ -29,7 +29,7 @@ class BodySet final : public Body {
 
   int dof_count() const override { return dof_offset_.back(); }
   Vector dof_length_scales() const override;
-  void internal_force(const Vector& q, Vector& force, Triplets* tangent) const override;
+  void internal_force(const Vector& q, Vector& force, TangentSink* tangent) const override;
   int site_count() const override { return site_offset_.back(); }
   int node_count() const override { return node_offset_.back(); }
   Vec2 site_reference(int site) const override;

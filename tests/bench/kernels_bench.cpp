@@ -1,9 +1,10 @@
 // grip_kernels_bench: what a Newton iteration costs beside one numeric factorization of the
 // stiffness (issue 39; bench/results/kernels.md). For a scene file: the whole solve's CPU
 // seconds over its Newton iterations, and, at the reference state, the median CPU time of the
-// body's internal force with its tangent (the element kernels and the triplets) and of one
-// numeric factorization of the free block (FreeBlockSolver::factorize, pattern and ordering
-// already analysed: the scatter of the triplets and CHOLMOD's numeric factorization).
+// body's internal force with its tangent assembled into the free block as Newton does it (the
+// element kernels and the entries added into the block's values) and of one numeric
+// factorization of the assembled block (FreeBlockSolver::factorize, pattern and ordering already
+// analysed: the ordered triangle's gather, the symmetry check and CHOLMOD's numeric factorization).
 // With --orderings, the same block's factorization under each fill-reducing order (CHOLMOD's
 // AMD, METIS, its nested dissection; a band order by reverse Cuthill-McKee), simplicial and
 // supernodal: nnz(L), flops and the median CPU time of CHOLMOD's numeric factorization.
@@ -130,29 +131,29 @@ int main(int argc, char** argv) {
   for (int& f : free_index)
     if (f == 0) f = free_count++;
   const grip::Vector q = grip::Vector::Zero(n);
+  const grip::Vector scales = body.dof_length_scales();
   grip::Vector force(n);
-  grip::Triplets triplets;
-  const auto assemble = [&] {
-    triplets.clear();
-    force.setZero();
-    body.internal_force(q, force, &triplets);
-  };
-  assemble();  // integration points, first allocation of the triplets
-  const double assemble_ms = median_cpu_ms(repeats, assemble);
   grip::FreeBlockSolver solver;
-  if (!solver.factorize(triplets, free_index, free_count)) std::fprintf(stderr, "singular reference stiffness\n");
-  const double factorize_ms = median_cpu_ms(repeats, [&] { solver.factorize(triplets, free_index, free_count); });
+  const auto assemble = [&] {
+    force.setZero();
+    body.internal_force(q, force, &solver.assemble(free_index, free_count, &scales));
+    solver.row_sum_norm();  // Newton's round-off scale, taken at most iterations
+  };
+  assemble();  // integration points; the pattern
+  if (!solver.factorize()) std::fprintf(stderr, "singular reference stiffness\n");
+  const double assemble_ms = median_cpu_ms(repeats, assemble);
+  const double factorize_ms = median_cpu_ms(repeats, [&] { solver.factorize(); });
   if (argc > 3 && std::strcmp(argv[3], "--orderings") == 0) report_orderings(solver.matrix(), repeats);
   const double start = cpu_seconds();
   const grip::RunResult run = grip::run_load_steps(scene.problem, scene.steps, scene.params);
   const double run_s = cpu_seconds() - start;
   const grip::EquilibriumCounters& c = run.counters;
   std::printf(
-      "{\"dofs\": %d, \"free\": %d, \"triplets\": %zu, \"assemble_ms\": %.4f, \"factorize_ms\": %.4f, "
+      "{\"dofs\": %d, \"free\": %d, \"block_entries\": %ld, \"assemble_ms\": %.4f, \"factorize_ms\": %.4f, "
       "\"solve_cpu_s\": %.4f, \"completed\": %s, \"real_solves\": %ld, \"newton_iterations\": %ld, "
       "\"factorizations\": %ld, \"newton_factorizations\": %ld, \"body_factorizations\": %ld, "
       "\"dissected_factorizations\": %ld, \"ms_per_newton_iteration\": %.4f}\n",
-      n, free_count, triplets.size(), assemble_ms, factorize_ms, run_s, run.completed ? "true" : "false", c.solves,
-      c.newton_iterations, c.factorizations, c.newton_factorizations, c.body_factorizations, c.dissected_factorizations,
-      c.newton_iterations ? 1e3 * run_s / c.newton_iterations : 0.0);
+      n, free_count, static_cast<long>(solver.matrix().nonZeros()), assemble_ms, factorize_ms, run_s,
+      run.completed ? "true" : "false", c.solves, c.newton_iterations, c.factorizations, c.newton_factorizations,
+      c.body_factorizations, c.dissected_factorizations, c.newton_iterations ? 1e3 * run_s / c.newton_iterations : 0.0);
 }

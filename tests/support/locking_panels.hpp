@@ -80,7 +80,8 @@ inline double panel_tip(const PanelRun& run, int n) {
   for (int it = 0; it < 30; ++it) {
     Triplets t, tf;
     Vector f = -f_ext;
-    body.internal_force(q, f, &t);
+    TripletSink sink(t);
+    body.internal_force(q, f, &sink);
     Vector r(free);
     for (int i = 0; i < q.size(); ++i)
       if (free_index[i] >= 0) r[free_index[i]] = f[i];

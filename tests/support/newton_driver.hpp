@@ -33,7 +33,12 @@ struct Driver {
 
   Vector force(Triplets* t) const {
     Vector f = Vector::Zero(body.dof_count());
-    body.internal_force(q, f, t);
+    if (!t) {
+      body.internal_force(q, f, nullptr);
+      return f;
+    }
+    TripletSink sink(*t);
+    body.internal_force(q, f, &sink);
     return f;
   }
 

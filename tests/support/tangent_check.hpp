@@ -27,7 +27,8 @@ inline Vector internal_force(const Body& body, const Vector& q) {
 inline Matrix assembled_tangent(const Body& body, const Vector& q, Vector& f) {
   f = Vector::Zero(q.size());
   Triplets t;
-  body.internal_force(q, f, &t);
+  TripletSink sink(t);
+  body.internal_force(q, f, &sink);
   Eigen::SparseMatrix<double> K(q.size(), q.size());
   K.setFromTriplets(t.begin(), t.end());
   return Matrix(K);

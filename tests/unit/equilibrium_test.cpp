@@ -78,7 +78,8 @@ Matrix dense_compliance(const Problem& problem, const Equilibrium& eq, const Equ
     if (eq.is_free(i)) free_index[i] = free_count++;
   Triplets t;
   Vector force = Vector::Zero(n);
-  problem.body->internal_force(state.q, force, &t);
+  TripletSink sink(t);
+  problem.body->internal_force(state.q, force, &sink);
   Matrix K = Matrix::Zero(free_count, free_count);
   for (const auto& e : t)
     if (free_index[e.row()] >= 0 && free_index[e.col()] >= 0) K(free_index[e.row()], free_index[e.col()]) += e.value();

@@ -104,7 +104,8 @@ void expect_stiffness_is_the_derivative(json scene) {
   Triplets triplets, internal;  // the residual's tangent holds -d(T p)/dq beside the body's
   eq.residual(q, p, &triplets);
   Vector ignored = Vector::Zero(n);
-  all.internal_force(q, ignored, &internal);
+  TripletSink sink(internal);
+  all.internal_force(q, ignored, &sink);
   Eigen::SparseMatrix<double> tangent(n, n), body(n, n);
   tangent.setFromTriplets(triplets.begin(), triplets.end());
   body.setFromTriplets(internal.begin(), internal.end());

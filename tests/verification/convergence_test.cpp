@@ -71,7 +71,8 @@ Solution solve(ContinuumElement element, int n) {
   const int dofs = body.dof_count();
   Vector f = Vector::Zero(dofs);
   Triplets triplets;
-  body.internal_force(Vector::Zero(dofs), f, &triplets);
+  TripletSink sink(triplets);
+  body.internal_force(Vector::Zero(dofs), f, &sink);
   // The consistent body force, by the element's own rule.
   const int nodes = element_node_count(shape);
   auto coordinates = [&](const std::vector<int>& el) {
