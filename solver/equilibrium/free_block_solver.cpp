@@ -142,38 +142,30 @@ void FreeBlockSolver::finish_assembly() {
   finished_ = true;
   if (following_ && next_piece_ == pieces_.size()) return;  // the pattern's sequence: values in place
   depart();
-  // The pieces that followed the pattern keep their sums (each entry's whole sum so far sits at
-  // its slot), the recorded ones are added after them: the order they were emitted in.
-  const std::vector<Piece> before(pieces_.begin(), pieces_.begin() + static_cast<long>(matched_));
-  const std::vector<int> old_slots(slots_);
-  const std::vector<double> old_values(matrix_.valuePtr(),
-                                       matrix_.valuePtr() + (pieces_.empty() ? 0 : matrix_.nonZeros()));
-  std::vector<int> dofs;
-  std::vector<Piece> pieces;
-  int slots = 0;
-  const auto append = [&](const Piece& p, const int* piece_dofs) {
-    pieces.push_back({p.size, static_cast<int>(dofs.size()), slots});
-    dofs.insert(dofs.end(), piece_dofs, piece_dofs + (p.size ? p.size : 2));
-    slots += p.size ? p.size * p.size : 1;
-  };
-  for (const Piece& p : before) append(p, dofs_.data() + p.dofs);
-  for (const Piece& p : recorded_) append(p, recorded_dofs_.data() + p.dofs);
-  pieces_ = std::move(pieces);
-  dofs_ = std::move(dofs);
+  // The first matched_ pieces followed the pattern: they stay, with their sums (each entry's
+  // whole sum so far sits at its slot); the recorded ones follow them, in the order emitted.
+  const bool rest = matched_ < pieces_.size();
+  const int prefix_dofs = rest ? pieces_[matched_].dofs : static_cast<int>(dofs_.size());
+  const int prefix_slots = rest ? pieces_[matched_].slots : static_cast<int>(slots_.size());
+  const std::vector<int> old_slots(slots_.begin(), slots_.begin() + prefix_slots);
+  std::vector<double> old_values;
+  if (matched_) old_values.assign(matrix_.valuePtr(), matrix_.valuePtr() + matrix_.nonZeros());
+  if (matched_ == 0) {  // all recorded: their offsets are the pattern's
+    pieces_.swap(recorded_);
+    dofs_.swap(recorded_dofs_);
+  } else {
+    pieces_.resize(matched_);
+    dofs_.resize(prefix_dofs);
+    for (const Piece& p : recorded_) pieces_.push_back({p.size, prefix_dofs + p.dofs, prefix_slots + p.slots});
+    dofs_.insert(dofs_.end(), recorded_dofs_.begin(), recorded_dofs_.end());
+  }
   build_pattern();
   double* v = matrix_.valuePtr();
   std::fill(v, v + matrix_.nonZeros(), 0.0);
-  for (size_t k = 0; k < before.size(); ++k) {
-    const int entries = before[k].size ? before[k].size * before[k].size : 1;
-    for (int e = 0; e < entries; ++e)
-      if (const int old = old_slots[before[k].slots + e]; old >= 0) v[slots_[pieces_[k].slots + e]] = old_values[old];
-  }
-  for (size_t k = 0; k < recorded_.size(); ++k) {
-    const Piece& p = pieces_[before.size() + k];
-    const int entries = p.size ? p.size * p.size : 1;
-    for (int e = 0; e < entries; ++e)
-      if (const int slot = slots_[p.slots + e]; slot >= 0) v[slot] += recorded_values_[recorded_[k].slots + e];
-  }
+  for (int e = 0; e < prefix_slots; ++e)
+    if (old_slots[e] >= 0 && slots_[e] >= 0) v[slots_[e]] = old_values[old_slots[e]];
+  for (size_t e = 0; e < recorded_values_.size(); ++e)
+    if (const int slot = slots_[prefix_slots + e]; slot >= 0) v[slot] += recorded_values_[e];
   recorded_.clear();
   recorded_dofs_.clear();
   recorded_values_.clear();
@@ -191,15 +183,16 @@ void FreeBlockSolver::build_pattern() {
         for (int j = 0; j < p.size; ++j) use(p.slots + i * p.size + j, dofs_[p.dofs + i], dofs_[p.dofs + j]);
     }
   };
+  int count = 0;
+  for (const Piece& p : pieces_) count += p.size ? p.size * p.size : 1;
   Triplets pattern;
+  pattern.reserve(count);
   each_entry([&](int, int row, int col) {
     if (free[row] >= 0 && free[col] >= 0) pattern.emplace_back(free[row], free[col], 1.0);
   });
   matrix_.resize(free_count_, free_count_);
   matrix_.setFromTriplets(pattern.begin(), pattern.end());
   matrix_.makeCompressed();
-  int count = 0;
-  for (const Piece& p : pieces_) count += p.size ? p.size * p.size : 1;
   slots_.assign(count, -1);
   each_entry([&](int k, int row, int col) {
     if (free[row] >= 0 && free[col] >= 0)
