@@ -7,8 +7,8 @@
 //     {"law": "mooney_rivlin", "c10", "c01" (default 0), "bulk"}
 //     j2_plasticity: "yield_stress", "hardening": {"linear": H} |
 //     {"power": {"K", "n"}} | {"table": [[eps_p, sigma_y], ...]} (default perfectly plastic),
-//     "kinematic_hardening": H_k (default 0; linear kinematics only),
-//     "hill48": {"r"} | {"r0", "r45" (plane stress), "r90"} (linear kinematics, isotropic hardening)
+//     "kinematic_hardening": H_k (default 0),
+//     "hill48": {"r"} | {"r0", "r45" (plane stress), "r90"}
 //   "mesh": one of
 //     {"nodes": [[x, y], ...], "elements": [[n0, n1, n2(, ...9)], ...], "sets": {name: [ids]}}
 //     {"rectangle": {"origin", "size", "divisions": [nx, ny], "refine": {"towards", "size", "extent"}}}
@@ -91,7 +91,7 @@ std::shared_ptr<const PlaneMaterial> read_j2_material(Reader& r, json& mat, cons
   }
   if (r.issues.size() > before) return nullptr;
   std::string why = j2_data_issue(yield_stress, h, kinematic);
-  if (why.empty() && hill) why = hill48_data_issue(*hill, options.analysis, kinematic);
+  if (why.empty() && hill) why = hill48_data_issue(*hill, options.analysis);
   if (!why.empty()) {
     const size_t colon = why.find(':');
     r.error(mp + "/" + why.substr(0, colon), why.substr(colon + 2));

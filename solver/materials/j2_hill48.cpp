@@ -1,12 +1,18 @@
 // Hill's 1948 anisotropy for j2_plasticity (docs/algorithm.md#hill-1948-anisotropy): the yield
-// function sigma_bar(s) - sigma_y(alpha) with sigma_bar^2 = s . M s, associative flow
-// d eps_p = d gamma M s and the work-conjugate equivalent plastic strain d alpha = d gamma
-// sigma_bar (s . d eps_p = sigma_bar d alpha). The backward-Euler return (Simo and Hughes,
-// Computational Inelasticity, sec. 3.4, there for plane stress) is the closest point in the
-// metric of the compliance: s = Xi(dg) (eps - eps_p), Xi = (C^-1 + dg M)^-1, with dg the root
-// of g(dg) = sigma_bar(s(dg)) - sigma_y(alpha + dg sigma_bar); its consistent tangent is
-//   D = Xi - beta (Xi n)(Xi n)^T / (H' sigma_bar^2 + beta n . Xi n),  n = M s, beta = 1 - H' dg.
-// At r = 1, M is von Mises' and the return the radial one.
+// function sigma_bar(s - b) - sigma_y(alpha) with sigma_bar^2 = s . M s and b the back stress,
+// associative flow d eps_p = d gamma M (s - b), the equivalent plastic strain d alpha = d gamma
+// sigma_bar (work-conjugate: (s - b) . d eps_p = sigma_bar d alpha) and Ziegler's rule
+// d b = H_k d gamma dev(s - b) (at r = 1 Prager's 2/3 H_k d eps_p, the von Mises law's; Prager's
+// rule itself would turn the flow away from M u in uniaxial tension u and drift the r-values).
+// As d b = Kb d eps_p with the kinematic modulus Kb = H_k M^+ (M^+ M the deviatoric projector),
+// the backward-Euler return (Simo and Hughes, Computational Inelasticity, sec. 3.4) is the
+// closest point in the metric A = (C + Kb)^-1:
+//   xi = s - b = Xi(dg) y,  Xi = (A + dg M)^-1,  y = A (C (eps - eps_p) - b),
+// with dg the root of g(dg) = sigma_bar(xi(dg)) - sigma_y(alpha + dg sigma_bar); its consistent
+// tangent, symmetric,
+//   D = Kb - Kb A Kb + Q Xi Q^T - beta (Q Xi n)(Q Xi n)^T / (H' sigma_bar^2 + beta n . Xi n),
+// n = M xi, beta = 1 - H' dg, Q = C A = I - Kb A. Without kinematic hardening A = C^-1, Q = I and
+// this is s = Xi (eps - eps_p), D = Xi - ...; at r = 1, M is von Mises' and the return the radial one.
 #include <Eigen/Dense>
 #include <cmath>
 #include <stdexcept>
@@ -33,13 +39,10 @@ Coefficients coefficients(const Hill48& h) {
 
 }  // namespace
 
-std::string hill48_data_issue(const Hill48& h, PlaneAnalysis analysis, double kinematic_modulus) {
+std::string hill48_data_issue(const Hill48& h, PlaneAnalysis analysis) {
   for (const auto& [name, r] : {std::pair{"r0", h.r0}, std::pair{"r45", h.r45}, std::pair{"r90", h.r90}})
     if (!(r > 0 && std::isfinite(r)))
       return std::string("hill48/") + name + ": must be positive (the width to thickness plastic strain ratio)";
-  if (kinematic_modulus > 0)
-    return "kinematic_hardening: hill48 takes isotropic hardening only (kinematic hardening is implemented for von "
-           "Mises)";
   if (analysis == PlaneAnalysis::plane_strain && h.r45 != h.r0)
     return "hill48/r45: has no role in plane strain (the section through the thickness: the sheet-plane shear that "
            "r45 sets is zero); give r0 and r90, or a normal r";
@@ -82,8 +85,16 @@ PointResponse J2Material::hill_return(const Vec4& strain, const PointHistory& h)
   Mat4 P;  // the deviatoric projector, strain (engineering shear) to tensor
   P << 2, -1, 0, -1, -1, 2, 0, -1, 0, 0, 1.5, 0, -1, -1, 0, 2;
   const Mat4 C = K * one * one.transpose() + 2 * G * P / 3;
-  const Mat4 compliance = C.inverse();
   const Mat4& M = hill_metric_;
+  // The kinematic modulus H_k M^+ (zero without kinematic hardening): M^+ M is the deviatoric
+  // projector, so a plastic strain d eps_p = dg M xi moves the back stress by H_k dg dev(xi).
+  Mat4 Kb = Mat4::Zero();
+  if (kinematic_ > 0) {
+    const Mat4 hydrostatic = one * one.transpose() / 3;
+    Kb = kinematic_ * ((M + hydrostatic).inverse() - hydrostatic);
+    Kb = 0.5 * (Kb + Kb.transpose());
+  }
+  const Mat4 A = (C + Kb).inverse();
   const Vec4 ee = strain - h.plastic_strain;
   const double a0 = h.equivalent_plastic_strain;
   const auto equivalent = [&M](const Vec4& s) { return std::sqrt(std::max(0.0, s.dot(M * s))); };
@@ -91,17 +102,19 @@ PointResponse J2Material::hill_return(const Vec4& strain, const PointHistory& h)
   r.history = h;
   r.stress = C * ee;
   r.D = C;
-  const double trial = equivalent(r.stress);
+  const double trial = equivalent(r.stress - h.back_stress);
   if (trial - yield_stress(a0) <= 1e-12 * yield_stress_) return r;
-  // g(dg) decreases from g(0) > 0 (sigma_bar falls, alpha grows); a bracket [lo, hi] found by
-  // doubling from the von Mises estimate, then Newton's method kept inside it.
+  // xi = s - b = Xi(dg) y with y = A (C ee - b0) (= ee without a back stress). g(dg) decreases
+  // from g(0) > 0 (sigma_bar falls, alpha grows); a bracket [lo, hi] found by doubling from the
+  // von Mises estimate, then Newton's method kept inside it.
+  const Vec4 y = ee - A * (Kb * ee + h.back_stress);
   Mat4 Xi;
-  Vec4 s;
+  Vec4 xi;
   double bar = trial;
   const auto evaluate = [&](double dg) {
-    Xi = (compliance + dg * M).inverse();
-    s = Xi * ee;
-    bar = equivalent(s);
+    Xi = (A + dg * M).inverse();
+    xi = Xi * y;
+    bar = equivalent(xi);
     return bar - yield_stress(a0 + dg * bar);
   };
   double lo = 0.0, hi = (trial - yield_stress(a0)) / (3 * G * yield_stress(a0));
@@ -115,7 +128,7 @@ PointResponse J2Material::hill_return(const Vec4& strain, const PointHistory& h)
     const double g = evaluate(dg);
     if (std::abs(g) <= 1e-14 * trial) break;
     (g > 0 ? lo : hi) = dg;
-    const Vec4 n = M * s;
+    const Vec4 n = M * xi;
     const double dbar = -n.dot(Xi * n) / bar;
     const double slope = dbar - hardening_slope(a0 + dg * bar) * (bar + dg * dbar);
     double next = dg - g / slope;
@@ -124,14 +137,17 @@ PointResponse J2Material::hill_return(const Vec4& strain, const PointHistory& h)
     dg = next;
   }
   evaluate(dg);
-  const Vec4 n = M * s;
+  const Vec4 n = M * xi;
   const double alpha = a0 + dg * bar, slope = hardening_slope(alpha), beta = 1 - slope * dg;
-  const Vec4 Xin = Xi * n;
+  const Mat4 Q = Mat4::Identity() - Kb * A;  // C A
+  const Vec4 Xin = Q * (Xi * n);
   r.yielding = true;
-  r.stress = s;
   r.history.plastic_strain += dg * n;
+  r.history.back_stress += Kb * (dg * n);
   r.history.equivalent_plastic_strain = alpha;
-  r.D = Xi - beta * Xin * Xin.transpose() / (slope * bar * bar + beta * n.dot(Xin));
+  r.stress = xi + r.history.back_stress;
+  r.D = (Kb - Kb * A * Kb) + Q * Xi * Q.transpose() -
+        beta * Xin * Xin.transpose() / (slope * bar * bar + beta * n.dot(Xi * n));
   return r;
 }
 

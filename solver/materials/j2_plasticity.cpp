@@ -68,7 +68,7 @@ J2Material::J2Material(double young, double poisson, double yield_stress, Isotro
   if (const std::string why = j2_data_issue(yield_stress_, hardening_, kinematic_); !why.empty())
     throw std::invalid_argument("j2_plasticity: " + why);
   if (hill_) {
-    if (const std::string why = hill48_data_issue(*hill_, analysis_, kinematic_); !why.empty())
+    if (const std::string why = hill48_data_issue(*hill_, analysis_); !why.empty())
       throw std::invalid_argument("j2_plasticity: " + why);
     hill_metric_ = hill48_metric(*hill_, analysis_);
   }

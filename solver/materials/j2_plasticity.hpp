@@ -49,9 +49,9 @@ struct Hill48 {
   double r0 = 1.0, r45 = 1.0, r90 = 1.0;
 };
 
-// Why the r-values are not usable in `analysis` with that kinematic hardening modulus (empty
-// if they are), as "field: reason" with the field relative to the material ("hill48/r0", ...).
-std::string hill48_data_issue(const Hill48& hill, PlaneAnalysis analysis, double kinematic_modulus);
+// Why the r-values are not usable in `analysis` (empty if they are), as "field: reason" with the
+// field relative to the material ("hill48/r0", ...).
+std::string hill48_data_issue(const Hill48& hill, PlaneAnalysis analysis);
 // Hill's M of sigma_bar^2 = s . M s, s = (11, 22, 12, 33) in the analysis' axes (von Mises at r = 1).
 Eigen::Matrix4d hill48_metric(const Hill48& hill, PlaneAnalysis analysis);
 
@@ -62,7 +62,7 @@ std::string j2_data_issue(double yield_stress, const IsotropicHardening& hardeni
 class J2Material final : public PlaneMaterial {
  public:
   // Throws std::invalid_argument where j2_data_issue finds an issue.
-  // With `hill`, Hill's 1948 yield function in place of von Mises' (isotropic hardening only).
+  // With `hill`, Hill's 1948 yield function in place of von Mises' (j2_hill48.cpp).
   J2Material(double young, double poisson, double yield_stress, IsotropicHardening hardening, double kinematic_modulus,
              PlaneAnalysis analysis, std::optional<Hill48> hill = std::nullopt);
   // The elastic law (Hooke's), what the material is until it yields.

@@ -1,6 +1,6 @@
 #pragma once
 // The J2 tests' material: steel-like (E 200e3, nu 0.3, sigma_y 250) with linear or Swift power
-// isotropic hardening; shared by the finite-strain, axisymmetric and Hill 1948 tests.
+// isotropic hardening (and kinematic hardening); shared by the finite-strain, axisymmetric and Hill 1948 tests.
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -30,9 +30,12 @@ inline std::vector<Law> laws(double scale = 1.0) {
   return {{"linear", linear}, {"power", power}};
 }
 
+// The law with Hill's anisotropy `hill` (von Mises without) and the kinematic hardening modulus
+// `kinematic` (scaled with the yield stress too).
 inline std::shared_ptr<J2Material> material(const Law& law, PlaneAnalysis analysis, double scale = 1.0,
-                                            std::optional<Hill48> hill = std::nullopt) {
-  return std::make_shared<J2Material>(kYoung, kPoisson, kYield * scale, law.hardening, 0.0, analysis, hill);
+                                            std::optional<Hill48> hill = std::nullopt, double kinematic = 0.0) {
+  return std::make_shared<J2Material>(kYoung, kPoisson, kYield * scale, law.hardening, kinematic * scale, analysis,
+                                      hill);
 }
 
 // The largest differences between two runs' element fields (columns 0-3 the stresses, 4 the

@@ -8,7 +8,8 @@
 //   tau = sigma_y(alpha) / k with alpha = k eps_p (k Hill's factor), and the r-value of the
 //   plastic log strains, width over thickness, the given r at every step;
 // - the consistent tangent against central differences and Newton's quadratic convergence on a
-//   plastic step, plane strain, plane stress and axisymmetric, plain, mixed and F-bar elements;
+//   plastic step, plane strain, plane stress and axisymmetric, plain, mixed and F-bar elements,
+//   kinematic hardening, Hill's anisotropy and the two together;
 // - at a tiny yield strain the small-strain law's answer (the finite measures at small strain).
 #include <gtest/gtest.h>
 
@@ -21,6 +22,7 @@
 
 #include "solver/elements/continuum.hpp"
 #include "solver/materials/j2_plasticity.hpp"
+#include "tests/support/hill48_uniaxial.hpp"
 #include "tests/support/j2_laws.hpp"
 #include "tests/support/newton_driver.hpp"
 #include "tests/support/tangent_check.hpp"
@@ -35,10 +37,6 @@ constexpr double kKinematic = 10000.0;  // H_k: 5 % of E
 const Hill48 kSheet{2.1, 1.6, 2.6};     // a steel-like sheet
 const Hill48 kSection{2.1, 2.1, 2.6};   // plane strain: r0 and r90
 const Hill48 kNormal{1.8, 1.8, 1.8};    // axisymmetric: a normal r
-
-std::shared_ptr<J2Material> kinematic(const Law& law, PlaneAnalysis analysis, double scale = 1.0) {
-  return std::make_shared<J2Material>(kYoung, kPoisson, kYield * scale, law.hardening, kKinematic * scale, analysis);
-}
 
 // The one-dimensional return in Kirchhoff stress against log strain x: tau = E (x - eps_p),
 // |tau - b| <= sigma_y(alpha), b = H_k eps_p; a plastic step moves eps_p by d and alpha by |d|
@@ -110,7 +108,7 @@ struct Pulled {
 TEST(J2FiniteLogStrain, KinematicHardeningCycleFollowsTheClosedForm) {
   for (const Law& law : laws()) {
     SCOPED_TRACE(law.name);
-    const auto m = kinematic(law, PlaneAnalysis::plane_stress);
+    const auto m = material(law, PlaneAnalysis::plane_stress, 1.0, std::nullopt, kKinematic);
     Pulled p(m, false);
     Uniaxial closed{*m, kKinematic};
     std::vector<double> path;
@@ -147,17 +145,13 @@ TEST(J2FiniteLogStrain, KinematicHardeningCycleFollowsTheClosedForm) {
   }
 }
 
-// Hill's factor k of uniaxial stress at 0 and 90 degrees to the rolling direction: sigma_bar = k sigma.
-double hill_factor(const Hill48& h, bool across) {
-  return across ? std::sqrt(h.r0 * (1 + h.r90) / (h.r90 * (1 + h.r0))) : 1.0;
-}
-
 TEST(J2FiniteLogStrain, HillUniaxialTensionKeepsTheRValuesToLargeStrain) {
   for (const Law& law : laws())
     for (bool across : {false, true}) {
       SCOPED_TRACE(std::string(law.name) + (across ? " at 90 degrees" : " at 0 degrees"));
       const auto m = material(law, PlaneAnalysis::plane_stress, 1.0, kSheet);
-      const double k = hill_factor(kSheet, across), r_given = across ? kSheet.r90 : kSheet.r0;
+      const double k = testing::hill_factor(kSheet, across ? 0.5 * std::numbers::pi : 0.0),
+                   r_given = across ? kSheet.r90 : kSheet.r0;
       Pulled p(m, across);
       double worst = 0.0, worst_r = 0.0, alpha = 0.0;
       for (int s = 1; s <= 15; ++s) {
@@ -225,31 +219,32 @@ void bend(Driver& d, const Bent& b, double tip, double tolerance) {
 struct Case {
   const char* name;
   ContinuumOptions options;
-  bool hill;
+  bool hill, kinematic;
 };
 
 std::shared_ptr<J2Material> law_of(const Case& c, const Law& law, double scale = 1.0) {
   const PlaneAnalysis a = c.options.analysis;
-  if (!c.hill) return kinematic(law, a, scale);
-  return material(law, a, scale,
-                  a == PlaneAnalysis::plane_stress   ? kSheet
-                  : a == PlaneAnalysis::plane_strain ? kSection
-                                                     : kNormal);
+  std::optional<Hill48> hill;
+  if (c.hill) hill = a == PlaneAnalysis::plane_stress ? kSheet : a == PlaneAnalysis::plane_strain ? kSection : kNormal;
+  return material(law, a, scale, hill, c.kinematic ? kKinematic : 0.0);
 }
 
 const Case kCases[] = {
-    {"kinematic q8 plane strain", finite(PlaneAnalysis::plane_strain, ContinuumElement::q8), false},
-    {"kinematic q4 plane stress", finite(PlaneAnalysis::plane_stress), false},
+    {"kinematic q8 plane strain", finite(PlaneAnalysis::plane_strain, ContinuumElement::q8), false, true},
+    {"kinematic q4 plane stress", finite(PlaneAnalysis::plane_stress), false, true},
     {"kinematic q9 mixed plane strain",
-     finite(PlaneAnalysis::plane_strain, ContinuumElement::q9, Incompressibility::mixed), false},
-    {"kinematic q9 axisymmetric", finite(PlaneAnalysis::axisymmetric, ContinuumElement::q9), false},
+     finite(PlaneAnalysis::plane_strain, ContinuumElement::q9, Incompressibility::mixed), false, true},
+    {"kinematic q9 axisymmetric", finite(PlaneAnalysis::axisymmetric, ContinuumElement::q9), false, true},
     {"kinematic q4 f_bar axisymmetric",
-     finite(PlaneAnalysis::axisymmetric, ContinuumElement::q4, Incompressibility::f_bar), false},
-    {"hill q8 plane strain", finite(PlaneAnalysis::plane_strain, ContinuumElement::q8), true},
-    {"hill q8 plane stress", finite(PlaneAnalysis::plane_stress, ContinuumElement::q8), true},
+     finite(PlaneAnalysis::axisymmetric, ContinuumElement::q4, Incompressibility::f_bar), false, true},
+    {"hill q8 plane strain", finite(PlaneAnalysis::plane_strain, ContinuumElement::q8), true, false},
+    {"hill q8 plane stress", finite(PlaneAnalysis::plane_stress, ContinuumElement::q8), true, false},
     {"hill t6 mixed plane strain", finite(PlaneAnalysis::plane_strain, ContinuumElement::t6, Incompressibility::mixed),
-     true},
-    {"hill q9 axisymmetric", finite(PlaneAnalysis::axisymmetric, ContinuumElement::q9), true},
+     true, false},
+    {"hill q9 axisymmetric", finite(PlaneAnalysis::axisymmetric, ContinuumElement::q9), true, false},
+    {"hill+kinematic q8 plane strain", finite(PlaneAnalysis::plane_strain, ContinuumElement::q8), true, true},
+    {"hill+kinematic q8 plane stress", finite(PlaneAnalysis::plane_stress, ContinuumElement::q8), true, true},
+    {"hill+kinematic q9 axisymmetric", finite(PlaneAnalysis::axisymmetric, ContinuumElement::q9), true, true},
 };
 
 TEST(J2FiniteLogStrain, TangentMatchesDifferencesAndNewtonConvergesQuadratically) {
