@@ -13,6 +13,23 @@
 
 namespace grip::testing {
 
+// The Hill tests' anisotropy: a steel-like sheet (r0 < r90, r45 the lowest) in plane stress, its
+// r0 and r90 in plane strain, a normal r in axisymmetry.
+inline const Hill48 kSheet{2.1, 1.6, 2.6};
+inline const Hill48 kSection{2.1, 2.1, 2.6};
+inline const Hill48 kNormal{1.8, 1.8, 1.8};
+inline Hill48 anisotropy(PlaneAnalysis a) {
+  return a == PlaneAnalysis::plane_stress ? kSheet : a == PlaneAnalysis::plane_strain ? kSection : kNormal;
+}
+
+inline const PlaneAnalysis kAnalyses[] = {PlaneAnalysis::plane_strain, PlaneAnalysis::plane_stress,
+                                          PlaneAnalysis::axisymmetric};
+inline const char* analysis_name(PlaneAnalysis a) {
+  return a == PlaneAnalysis::plane_strain   ? "plane strain"
+         : a == PlaneAnalysis::plane_stress ? "plane stress"
+                                            : "axisymmetric";
+}
+
 // Hill's factor k of uniaxial stress at angle t to the rolling direction: sigma_bar = k sigma,
 // k^2 = F s^4 + G c^4 + H (c^2 - s^2)^2 + 2 N c^2 s^2 (1 at t = 0).
 inline double hill_factor(const Hill48& h, double t) {

@@ -31,12 +31,10 @@ namespace grip {
 namespace {
 
 using testing::Driver;
+using testing::kSheet;
 using namespace testing::j2;
 
 constexpr double kKinematic = 10000.0;  // H_k: 5 % of E
-const Hill48 kSheet{2.1, 1.6, 2.6};     // a steel-like sheet
-const Hill48 kSection{2.1, 2.1, 2.6};   // plane strain: r0 and r90
-const Hill48 kNormal{1.8, 1.8, 1.8};    // axisymmetric: a normal r
 
 // The one-dimensional return in Kirchhoff stress against log strain x: tau = E (x - eps_p),
 // |tau - b| <= sigma_y(alpha), b = H_k eps_p; a plastic step moves eps_p by d and alpha by |d|
@@ -225,7 +223,7 @@ struct Case {
 std::shared_ptr<J2Material> law_of(const Case& c, const Law& law, double scale = 1.0) {
   const PlaneAnalysis a = c.options.analysis;
   std::optional<Hill48> hill;
-  if (c.hill) hill = a == PlaneAnalysis::plane_stress ? kSheet : a == PlaneAnalysis::plane_strain ? kSection : kNormal;
+  if (c.hill) hill = testing::anisotropy(a);
   return material(law, a, scale, hill, c.kinematic ? kKinematic : 0.0);
 }
 

@@ -45,25 +45,12 @@ namespace {
 using namespace testing::j2;
 using testing::hill_factor;
 using testing::UniaxialPoint;
+using testing::analysis_name;
+using testing::anisotropy;
+using testing::kAnalyses;
+using testing::kSheet;
 
 constexpr double kKinematic = 10000.0;  // H_k: 5 % of E
-const Hill48 kSheet{2.1, 1.6, 2.6};     // plane stress: a steel-like sheet
-const Hill48 kSection{2.1, 2.1, 2.6};   // plane strain: r0 and r90
-const Hill48 kNormal{1.8, 1.8, 1.8};    // axisymmetric: a normal r
-
-const PlaneAnalysis kAnalyses[] = {PlaneAnalysis::plane_strain, PlaneAnalysis::plane_stress,
-                                   PlaneAnalysis::axisymmetric};
-
-const char* analysis_name(PlaneAnalysis a) {
-  return a == PlaneAnalysis::plane_strain   ? "plane strain"
-         : a == PlaneAnalysis::plane_stress ? "plane stress"
-                                            : "axisymmetric";
-}
-
-Hill48 anisotropy(PlaneAnalysis a) {
-  return a == PlaneAnalysis::plane_stress ? kSheet : a == PlaneAnalysis::plane_strain ? kSection : kNormal;
-}
-
 // Laws with isotropic hardening and one with kinematic hardening alone.
 std::vector<Law> kinematic_laws() {
   std::vector<Law> all = laws();

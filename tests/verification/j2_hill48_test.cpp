@@ -39,11 +39,12 @@ namespace {
 using testing::Driver;
 using testing::hill_factor;
 using testing::UniaxialPoint;
+using testing::analysis_name;
+using testing::anisotropy;
+using testing::kAnalyses;
+using testing::kSheet;
 
 using namespace testing::j2;
-
-// A steel-like sheet (r0 < r90, r45 the lowest) and a normal r for axisymmetry.
-const Hill48 kSheet{2.1, 1.6, 2.6};
 
 std::shared_ptr<J2Material> material(const Law& law, PlaneAnalysis analysis, std::optional<Hill48> hill,
                                      double kinematic = 0.0) {
@@ -131,23 +132,6 @@ void bend(Driver& d, const Bent& b, double tip, double tolerance) {
         for (int n : b.tip) q[2 * n + 1] = tip;
       },
       tolerance);
-}
-
-const PlaneAnalysis kAnalyses[] = {PlaneAnalysis::plane_strain, PlaneAnalysis::plane_stress,
-                                   PlaneAnalysis::axisymmetric};
-
-const char* analysis_name(PlaneAnalysis a) {
-  return a == PlaneAnalysis::plane_strain   ? "plane strain"
-         : a == PlaneAnalysis::plane_stress ? "plane stress"
-                                            : "axisymmetric";
-}
-
-// The anisotropy each analysis takes: planar in plane stress (r0, r45, r90) and plane strain
-// (r0, r90), normal in axisymmetry.
-Hill48 anisotropy(PlaneAnalysis a) {
-  if (a == PlaneAnalysis::plane_stress) return kSheet;
-  if (a == PlaneAnalysis::plane_strain) return {kSheet.r0, kSheet.r0, kSheet.r90};
-  return {1.8, 1.8, 1.8};
 }
 
 TEST(Hill48, RValuesOfOneAreVonMises) {
