@@ -3,6 +3,7 @@
 // element and law test makes (a wrong tangent costs Newton its quadratic convergence silently).
 #include <Eigen/Dense>
 #include <Eigen/SparseCore>
+#include <cmath>
 
 #include "solver/model/body.hpp"
 
@@ -51,6 +52,23 @@ inline TangentCheck check_tangent(const Body& body, const Vector& q, double h) {
     body.internal_force(qm, fm, nullptr);
     c.K_fd.col(j) = (fp - fm) / (2 * h);
   }
+  return c;
+}
+
+// The tangent of a body with history at a state beyond its committed one and off equilibrium
+// (every dof of q moved by amplitude x sin(1 + 3.7 i)), where the J2 tests check it, and how many
+// of its elements flow there (element field 5).
+struct PlasticTangentCheck : TangentCheck {
+  int flowing = 0;
+  size_t elements = 0;
+};
+
+inline PlasticTangentCheck check_tangent_beyond(const Body& body, Vector q, double amplitude) {
+  for (int i = 0; i < q.size(); ++i) q[i] += amplitude * std::sin(1.0 + 3.7 * i);
+  PlasticTangentCheck c{check_tangent(body, q, 1e-7)};
+  const auto rows = body.element_fields(q).rows;
+  c.elements = rows.size();
+  for (const auto& row : rows) c.flowing += row[5] > 0;
   return c;
 }
 
