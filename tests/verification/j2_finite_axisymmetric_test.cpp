@@ -27,6 +27,7 @@
 
 #include "solver/elements/continuum.hpp"
 #include "solver/materials/j2_plasticity.hpp"
+#include "tests/support/continuum_blocks.hpp"
 #include "tests/support/j2_laws.hpp"
 #include "tests/support/newton_driver.hpp"
 #include "tests/support/tangent_check.hpp"
@@ -34,6 +35,9 @@
 namespace grip {
 namespace {
 
+using testing::Bent;
+using testing::bend;
+using testing::bent_block;
 using testing::Driver;
 
 using namespace testing::j2;
@@ -208,40 +212,10 @@ TEST(J2FiniteAxisymmetric, RingExpandedInRadiusAndHoopFollowsTheClosedForm) {
     }
 }
 
-// An annular plate R in [1, 5], Z in [0, 1], held at its bore and bent by a prescribed
-// deflection of its rim.
-struct Bent {
-  std::unique_ptr<ContinuumBody> body;
-  std::vector<char> held;
-  std::vector<int> rim;
-};
-
-Bent bent_plate(std::shared_ptr<const PlaneMaterial> m, Formulation f) {
-  RectangleSpec spec;
-  spec.origin = {1.0, 0.0};
-  spec.size = {4.0, 1.0};
-  spec.nx = 4;
-  spec.ny = 2;
-  PlaneMesh mesh = rectangle_mesh(spec, element_shape(f.element));
-  Bent b;
-  b.rim = mesh.sets.at("right");
-  const std::vector<int> bore = mesh.sets.at("left");
-  b.body = std::make_unique<ContinuumBody>(
-      mesh, mesh.sets.at("bottom"), std::vector<std::shared_ptr<const PlaneMaterial>>{std::move(m)}, axisymmetric(f));
-  b.held.assign(b.body->dof_count(), 0);
-  for (int n : bore) b.held[2 * n] = b.held[2 * n + 1] = 1;
-  for (int n : b.rim) b.held[2 * n + 1] = 1;
-  return b;
-}
-
-// Bent in steps of 0.025 to 0.2 (strains of a few %, ten times the yield strain).
+// An annular plate R in [1, 5], Z in [0, 1] (testing::bent_block), held at its bore and bent in
+// steps of 0.025 to a deflection of its rim of 0.2 (strains of a few %, ten times the yield strain).
 void bend_far(Driver& d, const Bent& b, double tolerance) {
-  for (int k = 1; k <= 8; ++k)
-    d.solve(
-        [&](Vector& q) {
-          for (int n : b.rim) q[2 * n + 1] = 0.025 * k;
-        },
-        tolerance);
+  for (int k = 1; k <= 8; ++k) bend(d, b, 0.025 * k, tolerance);
 }
 
 const Formulation kElements[] = {ContinuumElement::q4,
@@ -256,7 +230,7 @@ TEST(J2FiniteAxisymmetric, ConsistentTangentMatchesDifferencesOfTheForce) {
   for (const Formulation& f : kElements)
     for (const Law& law : laws()) {
       SCOPED_TRACE(std::string(law.name) + " " + f.name());
-      Bent b = bent_plate(material(law), f);
+      Bent b = bent_block(material(law), axisymmetric(f));
       Driver d(*b.body, b.held);
       bend_far(d, b, 1e-9 * kYield);
       const auto check = testing::check_tangent_beyond(*b.body, d.q, 0.01);
@@ -272,7 +246,7 @@ TEST(J2FiniteAxisymmetric, NewtonConvergesQuadraticallyOnAPlasticStep) {
   for (const Formulation& f : kElements)
     for (const Law& law : laws()) {
       SCOPED_TRACE(std::string(law.name) + " " + f.name());
-      Bent b = bent_plate(material(law), f);
+      Bent b = bent_block(material(law), axisymmetric(f));
       Driver d(*b.body, b.held);
       bend_far(d, b, 1e-10 * kYield);
       const std::vector<double>& r = d.residuals;

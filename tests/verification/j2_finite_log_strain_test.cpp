@@ -22,6 +22,7 @@
 
 #include "solver/elements/continuum.hpp"
 #include "solver/materials/j2_plasticity.hpp"
+#include "tests/support/continuum_blocks.hpp"
 #include "tests/support/hill48_uniaxial.hpp"
 #include "tests/support/j2_laws.hpp"
 #include "tests/support/newton_driver.hpp"
@@ -30,7 +31,12 @@
 namespace grip {
 namespace {
 
+using testing::Bent;
+using testing::bend;
+using testing::bent_block;
 using testing::Driver;
+using testing::finite;
+using testing::unit_square;
 using testing::kSheet;
 using namespace testing::j2;
 
@@ -58,19 +64,6 @@ struct Uniaxial {
     return kYoung * (x - eps_p);
   }
 };
-
-PlaneMesh unit_square() {
-  PlaneMesh m;
-  m.nodes = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
-  m.elements = {{0, 1, 2, 3}};
-  m.sets["bottom"] = {0, 1};
-  return m;
-}
-
-ContinuumOptions finite(PlaneAnalysis analysis, ContinuumElement element = ContinuumElement::q4,
-                        Incompressibility incompressibility = Incompressibility::none) {
-  return {element, ContinuumKinematics::finite, analysis, 1.0, incompressibility};
-}
 
 // The square's dofs: x held on the left (nodes 0, 3), y at the bottom (nodes 0, 1); pulled along
 // x (the right side, dofs 2 and 4) or along y (the top, dofs 5 and 7).
@@ -179,41 +172,6 @@ TEST(J2FiniteLogStrain, HillUniaxialTensionKeepsTheRValuesToLargeStrain) {
     }
 }
 
-// A 4 x 1 block of 4 x 2 elements (R from 1 in axisymmetry) held on its left side and bent by
-// a prescribed tip displacement.
-struct Bent {
-  std::unique_ptr<ContinuumBody> body;
-  std::vector<char> held;
-  std::vector<int> tip;
-};
-
-Bent bent_block(std::shared_ptr<const PlaneMaterial> m, ContinuumOptions options,
-                ContinuumKinematics kinematics = ContinuumKinematics::finite) {
-  options.kinematics = kinematics;
-  RectangleSpec spec;
-  spec.origin = {options.analysis == PlaneAnalysis::axisymmetric ? 1.0 : 0.0, 0.0};
-  spec.size = {4.0, 1.0};
-  spec.nx = 4;
-  spec.ny = 2;
-  PlaneMesh mesh = rectangle_mesh(spec, element_shape(options.element));
-  Bent b;
-  b.tip = mesh.sets.at("right");
-  b.body = std::make_unique<ContinuumBody>(mesh, mesh.sets.at("bottom"),
-                                           std::vector<std::shared_ptr<const PlaneMaterial>>{std::move(m)}, options);
-  b.held.assign(b.body->dof_count(), 0);
-  for (int n : mesh.sets.at("left")) b.held[2 * n] = b.held[2 * n + 1] = 1;
-  for (int n : b.tip) b.held[2 * n + 1] = 1;
-  return b;
-}
-
-void bend(Driver& d, const Bent& b, double tip, double tolerance) {
-  d.solve(
-      [&](Vector& q) {
-        for (int n : b.tip) q[2 * n + 1] = tip;
-      },
-      tolerance);
-}
-
 struct Case {
   const char* name;
   ContinuumOptions options;
@@ -276,7 +234,9 @@ TEST(J2FiniteLogStrain, SmallStrainLimitIsTheSmallStrainLaw) {
     for (const Law& law : laws(scale)) {
       SCOPED_TRACE(std::string(law.name) + " " + c.name);
       const auto m = law_of(c, law, scale);
-      Bent fin = bent_block(m, c.options), lin = bent_block(m, c.options, ContinuumKinematics::linear);
+      ContinuumOptions linear = c.options;
+      linear.kinematics = ContinuumKinematics::linear;
+      Bent fin = bent_block(m, c.options), lin = bent_block(m, linear);
       Driver df(*fin.body, fin.held), dl(*lin.body, lin.held);
       FieldGap gap;
       // Out to 12 steps of 5e-8, back and reversed (kinematic hardening's reverse flow).

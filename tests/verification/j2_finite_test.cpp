@@ -22,6 +22,7 @@
 
 #include "solver/elements/continuum.hpp"
 #include "solver/materials/j2_plasticity.hpp"
+#include "tests/support/continuum_blocks.hpp"
 #include "tests/support/j2_laws.hpp"
 #include "tests/support/newton_driver.hpp"
 #include "tests/support/tangent_check.hpp"
@@ -29,7 +30,13 @@
 namespace grip {
 namespace {
 
+using testing::Bent;
+using testing::bend;
+using testing::bent_block;
 using testing::Driver;
+using testing::finite;
+using testing::small_strain;
+using testing::unit_square;
 
 // Isotropic hardening (kinematic hardening and Hill: j2_finite_log_strain_test.cpp).
 using namespace testing::j2;
@@ -44,19 +51,6 @@ double uniaxial_kirchhoff(const J2Material& m, double eps) {
     (m.yield_stress(a) > kYoung * (eps - a) ? hi : lo) = a;
   }
   return kYoung * (eps - 0.5 * (lo + hi));
-}
-
-PlaneMesh unit_square() {
-  PlaneMesh m;
-  m.nodes = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
-  m.elements = {{0, 1, 2, 3}};
-  m.sets["bottom"] = {0, 1};
-  return m;
-}
-
-ContinuumOptions finite(PlaneAnalysis analysis, ContinuumElement element = ContinuumElement::q4,
-                        Incompressibility incompressibility = Incompressibility::none) {
-  return {element, ContinuumKinematics::finite, analysis, 1.0, incompressibility};
 }
 
 Mat2 tensor(const Eigen::Vector4d& v) { return (Mat2() << v[0], v[2], v[2], v[1]).finished(); }
@@ -162,39 +156,6 @@ TEST(J2Finite, SimpleShearKeepsTheVolumeAndReleasesTheElasticPart) {
   }
 }
 
-// A 4 x 2 block held on its left side and bent by a prescribed tip displacement.
-struct Bent {
-  std::unique_ptr<ContinuumBody> body;
-  std::vector<char> held;
-  std::vector<int> tip;
-};
-
-Bent bent_block(std::shared_ptr<const PlaneMaterial> m, ContinuumOptions options) {
-  RectangleSpec spec;
-  spec.origin = {0.0, 0.0};
-  spec.size = {4.0, 1.0};
-  spec.nx = 4;
-  spec.ny = 2;
-  PlaneMesh mesh = rectangle_mesh(spec, element_shape(options.element));
-  Bent b;
-  b.tip = mesh.sets.at("right");
-  const std::vector<int> left = mesh.sets.at("left");
-  b.body = std::make_unique<ContinuumBody>(mesh, mesh.sets.at("bottom"),
-                                           std::vector<std::shared_ptr<const PlaneMaterial>>{std::move(m)}, options);
-  b.held.assign(b.body->dof_count(), 0);
-  for (int n : left) b.held[2 * n] = b.held[2 * n + 1] = 1;
-  for (int n : b.tip) b.held[2 * n + 1] = 1;
-  return b;
-}
-
-void bend(Driver& d, const Bent& b, double tip, double tolerance) {
-  d.solve(
-      [&](Vector& q) {
-        for (int n : b.tip) q[2 * n + 1] = tip;
-      },
-      tolerance);
-}
-
 // Bent in steps of 0.025 to 0.4 (plane strain: strains of ~4 %, 30 times the yield strain) or
 // 0.2 (plane stress). The driver's plain Newton (no line search, a predictor on the last
 // tangent) fails on q8 with steps of 0.05, as it does with the small-strain law; in plane
@@ -282,7 +243,7 @@ TEST(J2Finite, SmallStrainLimitIsTheSmallStrainLaw) {
                    (analysis == PlaneAnalysis::plane_strain ? " plane strain" : " plane stress"));
       const auto m = material(law, analysis, scale);
       Bent fin = bent_block(m, finite(analysis, ContinuumElement::q8));
-      Bent lin = bent_block(m, {ContinuumElement::q8, ContinuumKinematics::linear, analysis, 1.0});
+      Bent lin = bent_block(m, small_strain(analysis, ContinuumElement::q8));
       Driver df(*fin.body, fin.held), dl(*lin.body, lin.held);
       FieldGap gap;
       // Loading to 6e-7 (4.5 times the tip deflection at first yield), unloading and reversing to -4e-7.

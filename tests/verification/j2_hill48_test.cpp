@@ -27,6 +27,7 @@
 
 #include "solver/elements/continuum.hpp"
 #include "solver/materials/j2_plasticity.hpp"
+#include "tests/support/continuum_blocks.hpp"
 #include "tests/support/hill48_uniaxial.hpp"
 #include "tests/support/j2_laws.hpp"
 #include "tests/support/newton_driver.hpp"
@@ -36,7 +37,11 @@
 namespace grip {
 namespace {
 
+using testing::Bent;
+using testing::bend;
+using testing::bent_block;
 using testing::Driver;
+using testing::small_strain;
 using testing::hill_factor;
 using testing::UniaxialPoint;
 using testing::analysis_name;
@@ -100,46 +105,12 @@ TEST(Hill48, UniaxialTensionAlongTheSheetGivesHillsYieldStressAndTheRValues) {
     }
 }
 
-// A 4 x 2 block of q8 held on its left side and bent by a prescribed tip displacement.
-struct Bent {
-  std::unique_ptr<ContinuumBody> body;
-  std::vector<char> held;
-  std::vector<int> tip;
-};
-
-Bent bent_block(std::shared_ptr<const PlaneMaterial> m, PlaneAnalysis analysis, ContinuumElement element) {
-  RectangleSpec spec;
-  spec.origin = {analysis == PlaneAnalysis::axisymmetric ? 1.0 : 0.0, 0.0};
-  spec.size = {4.0, 1.0};
-  spec.nx = 4;
-  spec.ny = 2;
-  PlaneMesh mesh = rectangle_mesh(spec, element_shape(element));
-  Bent b;
-  b.tip = mesh.sets.at("right");
-  const std::vector<int> left = mesh.sets.at("left");
-  b.body = std::make_unique<ContinuumBody>(mesh, mesh.sets.at("bottom"),
-                                           std::vector<std::shared_ptr<const PlaneMaterial>>{std::move(m)},
-                                           ContinuumOptions{element, ContinuumKinematics::linear, analysis, 1.0});
-  b.held.assign(b.body->dof_count(), 0);
-  for (int n : left) b.held[2 * n] = b.held[2 * n + 1] = 1;
-  for (int n : b.tip) b.held[2 * n + 1] = 1;
-  return b;
-}
-
-void bend(Driver& d, const Bent& b, double tip, double tolerance) {
-  d.solve(
-      [&](Vector& q) {
-        for (int n : b.tip) q[2 * n + 1] = tip;
-      },
-      tolerance);
-}
-
 TEST(Hill48, RValuesOfOneAreVonMises) {
   for (PlaneAnalysis analysis : kAnalyses)
     for (const Law& law : laws()) {
       SCOPED_TRACE(std::string(law.name) + " " + analysis_name(analysis));
-      Bent mises = bent_block(material(law, analysis, std::nullopt), analysis, ContinuumElement::q8);
-      Bent hill = bent_block(material(law, analysis, Hill48{}), analysis, ContinuumElement::q8);
+      Bent mises = bent_block(material(law, analysis, std::nullopt), small_strain(analysis, ContinuumElement::q8));
+      Bent hill = bent_block(material(law, analysis, Hill48{}), small_strain(analysis, ContinuumElement::q8));
       Driver dm(*mises.body, mises.held), dh(*hill.body, hill.held);
       double worst = 0.0, worst_alpha = 0.0, peak_alpha = 0.0;
       for (double tip : {0.01, 0.02, 0.03, 0.015, 0.0, -0.02}) {
@@ -170,7 +141,7 @@ TEST(Hill48, ConsistentTangentMatchesDifferencesAndNewtonConvergesQuadratically)
       for (const Law& law : laws()) {
         const std::string name = std::string(element_name(element)) + (kinematic > 0 ? "+Hk" : "");
         SCOPED_TRACE(std::string(law.name) + " " + name + " " + analysis_name(analysis));
-        Bent b = bent_block(material(law, analysis, anisotropy(analysis), kinematic), analysis, element);
+        Bent b = bent_block(material(law, analysis, anisotropy(analysis), kinematic), small_strain(analysis, element));
         Driver d(*b.body, b.held);
         bend(d, b, 0.01, 1e-10 * kYield);
         // With kinematic hardening a longer step: from 0.03 Newton reaches round-off from 6e-6 in

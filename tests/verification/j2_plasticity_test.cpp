@@ -19,13 +19,18 @@
 
 #include "solver/elements/continuum.hpp"
 #include "solver/materials/j2_plasticity.hpp"
+#include "tests/support/continuum_blocks.hpp"
 #include "tests/support/newton_driver.hpp"
 #include "tests/support/tangent_check.hpp"
 
 namespace grip {
 namespace {
 
+using testing::Bent;
+using testing::bend;
+using testing::bent_block;
 using testing::Driver;
+using testing::small_strain;
 
 constexpr double kYoung = 200e3, kPoisson = 0.3, kYield = 250.0;
 
@@ -167,46 +172,15 @@ TEST(J2Plasticity, SimpleShearFollowsTheClosedFormOfEachLaw) {
   }
 }
 
-// A 4 x 2 block of q8 held on its left side and bent by a prescribed tip displacement.
-struct Bent {
-  std::unique_ptr<ContinuumBody> body;
-  std::vector<char> held;
-  std::vector<int> tip;
-};
-
-Bent bent_block(const Law& law, PlaneAnalysis analysis, ContinuumElement element) {
-  RectangleSpec spec;
-  spec.origin = {analysis == PlaneAnalysis::axisymmetric ? 1.0 : 0.0, 0.0};
-  spec.size = {4.0, 1.0};
-  spec.nx = 4;
-  spec.ny = 2;
-  PlaneMesh mesh = rectangle_mesh(spec, element_shape(element));
-  Bent b;
-  b.tip = mesh.sets.at("right");
-  const std::vector<int> left = mesh.sets.at("left");
-  b.body = std::make_unique<ContinuumBody>(mesh, mesh.sets.at("bottom"),
-                                           std::vector<std::shared_ptr<const PlaneMaterial>>{material(law, analysis)},
-                                           ContinuumOptions{element, ContinuumKinematics::linear, analysis, 1.0});
-  b.held.assign(b.body->dof_count(), 0);
-  for (int n : left) b.held[2 * n] = b.held[2 * n + 1] = 1;
-  for (int n : b.tip) b.held[2 * n + 1] = 1;
-  return b;
-}
-
 TEST(J2Plasticity, ConsistentTangentMatchesDifferencesOfTheForce) {
   for (PlaneAnalysis analysis : {PlaneAnalysis::plane_strain, PlaneAnalysis::plane_stress, PlaneAnalysis::axisymmetric})
     for (ContinuumElement element : {ContinuumElement::q4, ContinuumElement::q8, ContinuumElement::t6})
       for (const Law& law : laws()) {
         SCOPED_TRACE(std::string(law.name) + " " + element_name(element) + " analysis " +
                      std::to_string(static_cast<int>(analysis)));
-        Bent b = bent_block(law, analysis, element);
+        Bent b = bent_block(material(law, analysis), small_strain(analysis, element));
         Driver d(*b.body, b.held);
-        for (double tip : {0.01, 0.03})  // a committed plastic history
-          d.solve(
-              [&](Vector& q) {
-                for (int n : b.tip) q[2 * n + 1] = tip;
-              },
-              1e-9 * kYield);
+        for (double tip : {0.01, 0.03}) bend(d, b, tip, 1e-9 * kYield);  // a committed plastic history
         const auto c = testing::check_tangent_beyond(*b.body, d.q, 0.004);
         EXPECT_GT(c.flowing, 0);
         const double error = c.error();
@@ -218,18 +192,11 @@ TEST(J2Plasticity, ConsistentTangentMatchesDifferencesOfTheForce) {
 TEST(J2Plasticity, NewtonConvergesQuadraticallyOnAPlasticStep) {
   for (const Law& law : laws()) {
     SCOPED_TRACE(law.name);
-    Bent b = bent_block(law, PlaneAnalysis::plane_strain, ContinuumElement::q8);
+    Bent b = bent_block(material(law, PlaneAnalysis::plane_strain),
+                        small_strain(PlaneAnalysis::plane_strain, ContinuumElement::q8));
     Driver d(*b.body, b.held);
-    d.solve(
-        [&](Vector& q) {
-          for (int n : b.tip) q[2 * n + 1] = 0.01;
-        },
-        1e-10 * kYield);
-    d.solve(
-        [&](Vector& q) {
-          for (int n : b.tip) q[2 * n + 1] = 0.03;
-        },
-        1e-10 * kYield);
+    bend(d, b, 0.01, 1e-10 * kYield);
+    bend(d, b, 0.03, 1e-10 * kYield);
     const std::vector<double>& r = d.residuals;
     const std::string line = testing::relative_residuals(r);
     std::printf("Newton %-9s relative residuals:%s\n", law.name, line.c_str());
@@ -240,13 +207,9 @@ TEST(J2Plasticity, NewtonConvergesQuadraticallyOnAPlasticStep) {
 
 TEST(J2Plasticity, OnlyCommitMovesTheHistory) {
   const Law law = laws()[0];
-  Bent b = bent_block(law, PlaneAnalysis::plane_strain, ContinuumElement::q4);
+  Bent b = bent_block(material(law, PlaneAnalysis::plane_strain), small_strain(PlaneAnalysis::plane_strain));
   Driver d(*b.body, b.held);
-  d.solve(
-      [&](Vector& q) {
-        for (int n : b.tip) q[2 * n + 1] = 0.01;
-      },
-      1e-9 * kYield);
+  bend(d, b, 0.01, 1e-9 * kYield);
   const Vector at_first = d.force(nullptr);
   // An attempt further on (a cut or refused increment evaluates such states) leaves it unchanged.
   Vector further = d.q;

@@ -18,6 +18,7 @@
 
 #include "solver/elements/continuum.hpp"
 #include "solver/materials/mooney_rivlin.hpp"
+#include "tests/support/continuum_blocks.hpp"
 #include "tests/support/newton_driver.hpp"
 #include "tests/support/tangent_check.hpp"
 
@@ -25,6 +26,7 @@ namespace grip {
 namespace {
 
 using testing::Driver;
+using testing::unit_square;
 
 constexpr double kC10 = 0.4, kC01 = 0.1, kShear = 2 * (kC10 + kC01), kBulk = 1e4 * kShear;
 
@@ -45,14 +47,6 @@ double free_stretch(const std::function<std::array<double, 3>(double)>& with, in
     (principal_stress(with(x), free) > 0 ? hi : lo) = x;
   }
   return 0.5 * (lo + hi);
-}
-
-PlaneMesh unit_square() {
-  PlaneMesh m;
-  m.nodes = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
-  m.elements = {{0, 1, 2, 3}};
-  m.sets["bottom"] = {0, 1};
-  return m;
 }
 
 std::shared_ptr<const PlaneMaterial> rubber(PlaneAnalysis analysis) {
