@@ -33,6 +33,7 @@
 #include "apps/process_tuning.hpp"
 #include "apps/result_writer.hpp"
 #include "apps/thread_team.hpp"
+#include "solver/elements/continuum.hpp"
 #include "solver/io/gmsh_mesh.hpp"
 #include "solver/io/result.hpp"
 #include "solver/io/schema_validation.hpp"
@@ -126,6 +127,7 @@ int solve(int argc, char** argv) {
     std::fflush(stdout);
   };
   scene.params.newton.parallel = on_threads(threads);
+  grip::assemble_on(*scene.problem.body, scene.params.newton.parallel);  // the continua's element kernels
   const auto read = now();
   const grip::RunResult run = grip::run_load_steps(scene.problem, scene.steps, scene.params, observer);
   const auto solved = now();

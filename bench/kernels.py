@@ -36,13 +36,13 @@ def strip_scene(nx, ny):
     return scene
 
 
-def run_grip(grip, scene):
+def run_grip(grip, scene, threads=1):
     """CPU and wall seconds of the whole process, and the result's counters."""
     with tempfile.TemporaryDirectory() as tmp:
         path, out, times = Path(tmp) / "scene.json", Path(tmp) / "out.json", Path(tmp) / "times"
         path.write_text(json.dumps(scene))
         proc = subprocess.run(["/usr/bin/time", "-f", "%e %U %S", "-o", str(times), grip, "solve", str(path),
-                               "--out", str(out), "--threads", "1"], capture_output=True, text=True)
+                               "--out", str(out), "--threads", str(threads)], capture_output=True, text=True)
         if proc.returncode != 0:
             raise RuntimeError(proc.stderr[-500:])
         wall, user, system = (float(x) for x in times.read_text().split()[-3:])

@@ -2,12 +2,20 @@
 
 #include <Eigen/Dense>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
 
+#include "solver/model/body_set.hpp"
+
 namespace grip {
 namespace {
+
+// The element kernels take the threads from this many integration points of a mesh on: below
+// it a team call's wake-up (tens of microseconds) eats what the second thread saves
+// (bench/results/kernels.md, parallel assembly).
+constexpr long kParallelPoints = 2000;
 
 // The small strain (11, 22, 2 x 12, 33) = B u (4 x 2n): 33 the hoop strain u_r / r in
 // axisymmetry, zero in plane strain and plane stress (where the law finds it).
@@ -338,40 +346,85 @@ void ContinuumBody::internal_force(const Vector& q, Vector& force, TangentSink* 
       for (const auto& t : in.linear_tangent) tangent->add(t.row(), t.col(), t.value());
     return;
   }
-  const Integration& in = integration();
+  if (parallel_ && element_count() * static_cast<long>(integration().points.front().size()) >= kParallelPoints) {
+    const std::unique_lock<std::mutex> lock(blocks_mutex_, std::try_to_lock);
+    if (lock.owns_lock()) return parallel_internal_force(q, force, tangent);
+  }
   // Work storage kept across elements: the loop allocates nothing.
   Vector fe;
   Matrix Ke;
-  const int n = element_node_count(shape_);
-  ShapeGradients u(n, 2);
-  std::vector<int> dofs;
+  ShapeGradients u(element_node_count(shape_), 2);
   for (int e = 0; e < element_count(); ++e) {
-    // A law with history answers from the committed state of each point.
-    const size_t np = in.points[e].size();
-    PointLaw law;
-    HoopLaw hoop_law;
-    if (has_history_ && options_.analysis == PlaneAnalysis::axisymmetric)
-      hoop_law = [&](int k, const Mat2& E, double E33) {
-        return material(e).finite_hoop_response(E, E33, history_[e * np + k]).law;
-      };
-    else if (has_history_)
-      law = [&](int k, const Mat2& E) { return material(e).finite_response(E, history_[e * np + k]).law; };
-    const auto& el = mesh_.elements[e];
-    for (int a = 0; a < n; ++a) u.row(a) << q[node_dof(el[a], 0)], q[node_dof(el[a], 1)];
-    if (!in.dilatation.empty())
-      dilatation_total_lagrangian(in.points[e], in.dilatation[e], u, material(e), fe, tangent ? &Ke : nullptr, law,
-                                  hoop_law, pressure_.empty() ? nullptr : &pressure_[e]);
-    else if (options_.incompressibility == Incompressibility::f_bar)
-      f_bar_total_lagrangian(in.points[e], in.centroids[e], u, material(e), fe, tangent ? &Ke : nullptr, law);
-    else total_lagrangian(in.points[e], u, material(e), fe, tangent ? &Ke : nullptr, law, hoop_law);
-    const int m = static_cast<int>(fe.size());
-    dofs.resize(m);
-    for (int i = 0; i < m; ++i) {
-      dofs[i] = node_dof(el[i / 2], i % 2);
-      force[dofs[i]] += fe[i];
-    }
-    if (tangent) tangent->add_block(dofs.data(), Ke);
+    element_kernel(q, e, u, fe, tangent ? &Ke : nullptr);
+    add_element(e, fe, Ke, force, tangent);
   }
+}
+
+void ContinuumBody::element_kernel(const Vector& q, int e, ShapeGradients& u, Vector& fe, Matrix* Ke) const {
+  const Integration& in = integration();
+  // A law with history answers from the committed state of each point (read only here).
+  const size_t np = in.points[e].size();
+  PointLaw law;
+  HoopLaw hoop_law;
+  if (has_history_ && options_.analysis == PlaneAnalysis::axisymmetric)
+    hoop_law = [&](int k, const Mat2& E, double E33) {
+      return material(e).finite_hoop_response(E, E33, history_[e * np + k]).law;
+    };
+  else if (has_history_)
+    law = [&](int k, const Mat2& E) { return material(e).finite_response(E, history_[e * np + k]).law; };
+  const auto& el = mesh_.elements[e];
+  for (int a = 0; a < u.rows(); ++a) u.row(a) << q[node_dof(el[a], 0)], q[node_dof(el[a], 1)];
+  if (!in.dilatation.empty())
+    dilatation_total_lagrangian(in.points[e], in.dilatation[e], u, material(e), fe, Ke, law, hoop_law,
+                                pressure_.empty() ? nullptr : &pressure_[e]);
+  else if (options_.incompressibility == Incompressibility::f_bar)
+    f_bar_total_lagrangian(in.points[e], in.centroids[e], u, material(e), fe, Ke, law);
+  else total_lagrangian(in.points[e], u, material(e), fe, Ke, law, hoop_law);
+}
+
+void ContinuumBody::add_element(int e, const Vector& fe, const Matrix& Ke, Vector& force, TangentSink* tangent) const {
+  const auto& el = mesh_.elements[e];
+  std::array<int, 18> dofs;  // 9 nodes at most (q9)
+  const int m = static_cast<int>(fe.size());
+  for (int i = 0; i < m; ++i) {
+    dofs[i] = node_dof(el[i / 2], i % 2);
+    force[dofs[i]] += fe[i];
+  }
+  if (tangent) tangent->add_block(dofs.data(), Ke);
+}
+
+void ContinuumBody::parallel_internal_force(const Vector& q, Vector& force, TangentSink* tangent) const {
+  // With the tangent, rounds of kRound elements: their blocks (q9: 2.6 kB each) are summed while
+  // still in cache. The force alone keeps every element's in one round (one wake-up a call).
+  // A task is kTask elements, what a thread takes at a time.
+  constexpr int kRound = 512, kTask = 16;
+  const int count = element_count();
+  const int round = tangent ? std::min(kRound, count) : count;
+  ElementBlocks& b = blocks_;
+  if (static_cast<int>(b.fe.size()) < round) b.fe.resize(round);
+  if (tangent && static_cast<int>(b.Ke.size()) < round) b.Ke.resize(round);
+  // Per element, not per task: a thread writes only its own elements' storage.
+  if (static_cast<int>(b.u.size()) < round) b.u.resize(round, ShapeGradients(element_node_count(shape_), 2));
+  static const Matrix none;
+  for (int first = 0; first < count; first += round) {
+    const int last = std::min(first + round, count);
+    parallel_((last - first + kTask - 1) / kTask, [&](int task) {
+      const int from = first + task * kTask, to = std::min(from + kTask, last);
+      for (int e = from, s = from - first; e < to; ++e, ++s)
+        element_kernel(q, e, b.u[s], b.fe[s], tangent ? &b.Ke[s] : nullptr);
+    });
+    // The sums on this thread in element order: the serial loop's, bit for bit.
+    for (int e = first; e < last; ++e)
+      add_element(e, b.fe[e - first], tangent ? b.Ke[e - first] : none, force, tangent);
+  }
+}
+
+void assemble_on(Body& body, const ParallelFor& parallel) {
+  if (auto* set = dynamic_cast<BodySet*>(&body)) {
+    for (int b = 0; b < set->part_count(); ++b) assemble_on(set->mutable_part(b), parallel);
+    return;
+  }
+  if (auto* continuum = dynamic_cast<ContinuumBody*>(&body)) continuum->set_parallel(parallel);
 }
 
 SurfacePoint ContinuumBody::surface_point(const VectorRef& q, int site, int /*side*/) const {

@@ -30,6 +30,7 @@
 #include "solver/elements/dilatation.hpp"
 #include "solver/elements/plane_mesh.hpp"
 #include "solver/model/body.hpp"
+#include "solver/model/parallel.hpp"
 
 namespace grip {
 
@@ -87,7 +88,14 @@ class ContinuumBody final : public Body {
 
   int dof_count() const override { return 2 * node_count(); }
   Vector dof_length_scales() const override { return Vector::Ones(dof_count()); }
+  // Finite kinematics: the element kernels run through the ParallelFor given to set_parallel
+  // where the mesh is large enough to pay for the threads' wake-up (continuum.cpp,
+  // kParallelPoints); their sums stay on the calling thread, in element order, so the answer is
+  // the serial one to the last bit.
   void internal_force(const Vector& q, Vector& force, TangentSink* tangent) const override;
+  // The threads the element kernels may use (empty: the calling thread alone). The solver starts
+  // none: `grip solve` passes its team (assemble_on below).
+  void set_parallel(ParallelFor parallel) { parallel_ = std::move(parallel); }
 
   int site_count() const override { return static_cast<int>(contact_.nodes.size()); }
   int site_node(int site) const override { return contact_.nodes[site]; }
@@ -146,6 +154,12 @@ class ContinuumBody final : public Body {
 
  private:
   ShapeGradients element_displacements(const Vector& q, int e) const;
+  // Finite kinematics: element e's force fe and tangent Ke (if asked) at q, u its work storage.
+  void element_kernel(const Vector& q, int e, ShapeGradients& u, Vector& fe, Matrix* Ke) const;
+  // Adds fe into `force` at element e's dofs and hands Ke to the sink.
+  void add_element(int e, const Vector& fe, const Matrix& Ke, Vector& force, TangentSink* tangent) const;
+  // internal_force's finite kinematics with the kernels over parallel_ (storage in blocks_).
+  void parallel_internal_force(const Vector& q, Vector& force, TangentSink* tangent) const;
   const ShapeGradients* mean_gradient(int e) const;
   // A law with history: the response of each integration point of element e at q.
   std::vector<PointResponse> point_responses(const Vector& q, int e) const;
@@ -183,6 +197,22 @@ class ContinuumBody final : public Body {
   std::vector<double> centre_pressure_, penalty_;
   mutable std::once_flag integration_once_;
   mutable std::unique_ptr<const Integration> integration_;
+
+  ParallelFor parallel_;
+  // The kernels' answers of one round of elements, computed on the threads before the calling
+  // thread sums them; kept from call to call (nothing allocated once sized). The mutex keeps
+  // two callers at once from sharing it: the second one runs serially.
+  struct ElementBlocks {
+    std::vector<Vector> fe;
+    std::vector<Matrix> Ke;
+    std::vector<ShapeGradients> u;  // the element's displacements
+  };
+  mutable std::mutex blocks_mutex_;
+  mutable ElementBlocks blocks_;
 };
+
+// Every continuum body in `body` (itself, or a BodySet's parts) runs its kernels through
+// `parallel` (ContinuumBody::set_parallel); other bodies are left as they are.
+void assemble_on(Body& body, const ParallelFor& parallel);
 
 }  // namespace grip

@@ -17,6 +17,7 @@ class BodySet final : public Body {
 
   int part_count() const override { return static_cast<int>(parts_.size()); }
   const Body& part(int b) const override { return *parts_[b]; }
+  Body& mutable_part(int b) { return *parts_[b]; }  // to set a part up before the solve
   const std::string& name(int b) const { return names_[b]; }
   int dof_offset(int b) const override { return dof_offset_[b]; }
   int site_offset(int b) const override { return site_offset_[b]; }

@@ -8,16 +8,23 @@
 // With --orderings, the same block's factorization under each fill-reducing order (CHOLMOD's
 // AMD, METIS, its nested dissection; a band order by reverse Cuthill-McKee), simplicial and
 // supernodal: nnz(L), flops and the median CPU time of CHOLMOD's numeric factorization.
-// CPU time of this process (one thread), which the load of other work inflates least.
-//   build/tests/bench/grip_kernels_bench SCENE.json [repeats, default 20] [--orderings]
+// CPU time of this process (one thread), which the load of other work inflates least. With
+// --threads N (N > 1) the element kernels and the solve run on a team of N threads as `grip
+// solve --threads N` runs them, and the wall medians of the assembly (with the tangent, and the
+// force alone: the line search's residual) are what to compare with one thread.
+// --no-solve leaves the whole solve out (the per-call medians only).
+//   build/tests/bench/grip_kernels_bench SCENE.json [repeats, default 20] [--orderings] [--threads N] [--no-solve]
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <ctime>
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "apps/thread_team.hpp"
+#include "solver/elements/continuum.hpp"
 #include "solver/equilibrium/free_block_solver.hpp"
 #include "solver/io/scene.hpp"
 #include "solver/stepping/load_stepping.hpp"
@@ -26,16 +33,39 @@ namespace {
 
 double cpu_seconds() { return static_cast<double>(std::clock()) / CLOCKS_PER_SEC; }
 
+double wall_seconds() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+// The median and the least of `repeats` timings: under other sessions' load the least is when
+// every thread had a core.
 template <class F>
-double median_cpu_ms(int repeats, F&& f) {
+std::pair<double, double> median_min_ms(int repeats, double (*clock)(), F&& f) {
   std::vector<double> ms;
   for (int k = 0; k < repeats; ++k) {
-    const double start = cpu_seconds();
+    const double start = clock();
     f();
-    ms.push_back(1e3 * (cpu_seconds() - start));
+    ms.push_back(1e3 * (clock() - start));
   }
   std::sort(ms.begin(), ms.end());
-  return ms[ms.size() / 2];
+  return {ms[ms.size() / 2], ms.front()};
+}
+
+template <class F>
+double median_ms(int repeats, double (*clock)(), F&& f) {
+  return median_min_ms(repeats, clock, f).first;
+}
+
+// The element kernels alone: their tangent blocks handed to nothing.
+class DiscardSink final : public grip::TangentSink {
+ public:
+  void add(int, int, double) override {}
+  void add_block(const int*, const grip::Matrix&) override {}
+};
+
+template <class F>
+double median_cpu_ms(int repeats, F&& f) {
+  return median_ms(repeats, cpu_seconds, f);
 }
 
 // Reverse Cuthill-McKee on the pattern of a symmetric matrix: breadth first from a far end
@@ -116,12 +146,29 @@ void report_orderings(const Eigen::SparseMatrix<double>& block, int repeats) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc < 2) {
-    std::fprintf(stderr, "usage: grip_kernels_bench SCENE.json [repeats] [--orderings]\n");
+  std::vector<std::string> args(argv + 1, argv + argc);
+  int threads = 1;
+  bool orderings = false, no_solve = false;
+  for (size_t k = 0; k < args.size(); ++k)
+    if (args[k] == "--threads" && k + 1 < args.size()) {
+      threads = std::max(1, std::atoi(args[k + 1].c_str()));
+      args.erase(args.begin() + static_cast<long>(k), args.begin() + static_cast<long>(k) + 2);
+      --k;
+    } else if (args[k] == "--orderings" || args[k] == "--no-solve") {
+      (args[k] == "--orderings" ? orderings : no_solve) = true;
+      args.erase(args.begin() + static_cast<long>(k--));
+    }
+  if (args.empty()) {
+    std::fprintf(stderr, "usage: grip_kernels_bench SCENE.json [repeats] [--orderings] [--threads N] [--no-solve]\n");
     return 2;
   }
-  const int repeats = argc > 2 ? std::max(1, std::atoi(argv[2])) : 20;
-  grip::Scene scene = grip::read_scene_file(argv[1]);
+  const int repeats = args.size() > 1 ? std::max(1, std::atoi(args[1].c_str())) : 20;
+  grip::Scene scene = grip::read_scene_file(args[0]);
+  if (threads > 1) {  // as grip solve --threads N
+    auto team = std::make_shared<grip::ThreadTeam>(threads);
+    scene.params.newton.parallel = [team](int count, const std::function<void(int)>& task) { team->run(count, task); };
+    grip::assemble_on(*scene.problem.body, scene.params.newton.parallel);
+  }
   const grip::Problem& problem = scene.problem;
   const grip::Body& body = *problem.body;
   const int n = body.dof_count();
@@ -142,18 +189,42 @@ int main(int argc, char** argv) {
   assemble();  // integration points; the pattern
   if (!solver.factorize()) std::fprintf(stderr, "singular reference stiffness\n");
   const double assemble_ms = median_cpu_ms(repeats, assemble);
+  const auto [assemble_wall_ms, assemble_wall_min_ms] = median_min_ms(repeats, wall_seconds, assemble);
+  DiscardSink discard;
+  const auto kernels = [&] {
+    force.setZero();
+    body.internal_force(q, force, &discard);
+  };
+  const auto [kernels_wall_ms, kernels_wall_min_ms] = median_min_ms(repeats, wall_seconds, kernels);
+  const auto force_only = [&] {
+    force.setZero();
+    body.internal_force(q, force, nullptr);
+  };
+  const double force_ms = median_cpu_ms(repeats, force_only);
+  const auto [force_wall_ms, force_wall_min_ms] = median_min_ms(repeats, wall_seconds, force_only);
   const double factorize_ms = median_cpu_ms(repeats, [&] { solver.factorize(); });
-  if (argc > 3 && std::strcmp(argv[3], "--orderings") == 0) report_orderings(solver.matrix(), repeats);
-  const double start = cpu_seconds();
+  if (orderings) report_orderings(solver.matrix(), repeats);
+  std::printf(
+      "{\"threads\": %d, \"dofs\": %d, \"free\": %d, \"block_entries\": %ld, \"assemble_ms\": %.4f, "
+      "\"assemble_wall_ms\": %.4f, \"assemble_wall_min_ms\": %.4f, \"kernels_wall_ms\": %.4f, "
+      "\"kernels_wall_min_ms\": %.4f, \"force_ms\": %.4f, \"force_wall_ms\": %.4f, \"force_wall_min_ms\": %.4f, "
+      "\"factorize_ms\": %.4f",
+      threads, n, free_count, static_cast<long>(solver.matrix().nonZeros()), assemble_ms, assemble_wall_ms,
+      assemble_wall_min_ms, kernels_wall_ms, kernels_wall_min_ms, force_ms, force_wall_ms, force_wall_min_ms,
+      factorize_ms);
+  if (no_solve) {
+    std::printf("}\n");
+    return 0;
+  }
+  const double start = cpu_seconds(), wall_start = wall_seconds();
   const grip::RunResult run = grip::run_load_steps(scene.problem, scene.steps, scene.params);
-  const double run_s = cpu_seconds() - start;
+  const double run_s = cpu_seconds() - start, run_wall_s = wall_seconds() - wall_start;
   const grip::EquilibriumCounters& c = run.counters;
   std::printf(
-      "{\"dofs\": %d, \"free\": %d, \"block_entries\": %ld, \"assemble_ms\": %.4f, \"factorize_ms\": %.4f, "
-      "\"solve_cpu_s\": %.4f, \"completed\": %s, \"real_solves\": %ld, \"newton_iterations\": %ld, "
-      "\"factorizations\": %ld, \"newton_factorizations\": %ld, \"body_factorizations\": %ld, "
-      "\"dissected_factorizations\": %ld, \"ms_per_newton_iteration\": %.4f}\n",
-      n, free_count, static_cast<long>(solver.matrix().nonZeros()), assemble_ms, factorize_ms, run_s,
-      run.completed ? "true" : "false", c.solves, c.newton_iterations, c.factorizations, c.newton_factorizations,
-      c.body_factorizations, c.dissected_factorizations, c.newton_iterations ? 1e3 * run_s / c.newton_iterations : 0.0);
+      ", \"solve_cpu_s\": %.4f, \"solve_wall_s\": %.4f, \"completed\": %s, \"real_solves\": %ld, "
+      "\"newton_iterations\": %ld, \"factorizations\": %ld, \"newton_factorizations\": %ld, "
+      "\"body_factorizations\": %ld, \"dissected_factorizations\": %ld, \"ms_per_newton_iteration\": %.4f}\n",
+      run_s, run_wall_s, run.completed ? "true" : "false", c.solves, c.newton_iterations, c.factorizations,
+      c.newton_factorizations, c.body_factorizations, c.dissected_factorizations,
+      c.newton_iterations ? 1e3 * run_s / c.newton_iterations : 0.0);
 }
