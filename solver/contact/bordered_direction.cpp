@@ -19,6 +19,23 @@
 
 namespace grip {
 
+// What of the bordered block depends on the compliance and the active set only.
+struct StepSolver::BorderedFactors {
+  std::vector<int> contact, amplitude;
+  Matrix Cc, G, Z;
+  Compliance reduced;  // Z^T C Z, symmetrized, all rows active: its factor is kept with it
+  int rank = 0;
+  Eigen::CompleteOrthogonalDecomposition<Matrix> cod_g, cod_gt;
+  Eigen::LLT<Matrix> llt;  // of reduced, where the bordered block is regular
+  bool regular = false;
+};
+
+namespace {
+
+constexpr double kRankThreshold = 1e-9;  // relative to G's largest pivot
+
+}  // namespace
+
 Direction StepSolver::bordered_direction(const Compliance& C, const ContactError& err, int level, double alpha_fixed) {
   Direction dir;
   dir.d = Vector::Zero(err.v.size());
@@ -26,22 +43,42 @@ Direction StepSolver::bordered_direction(const Compliance& C, const ContactError
   for (int j : active_indices(err)) (problem_.rigid.is_amplitude(j) ? amplitude : contact).push_back(j);
   const int m = static_cast<int>(contact.size()), k = static_cast<int>(amplitude.size());
   if (m == 0) return dir;
-  const Matrix Cc = C.sub(contact);
-  Matrix G(m, k);
-  Vector vc(m), va(k);
-  for (int a = 0; a < m; ++a) {
-    vc[a] = err.v[contact[a]];
-    for (int b = 0; b < k; ++b) G(a, b) = C(contact[a], amplitude[b]);
+  if (!keep_bordered_ || !bordered_ || bordered_->contact != contact || bordered_->amplitude != amplitude) {
+    auto f = std::make_shared<BorderedFactors>();
+    f->contact = contact;
+    f->amplitude = amplitude;
+    f->Cc = C.sub(contact);
+    f->G.resize(m, k);
+    for (int a = 0; a < m; ++a)
+      for (int b = 0; b < k; ++b) f->G(a, b) = C(contact[a], amplitude[b]);
+    Eigen::ColPivHouseholderQR<Matrix> qr(f->G);
+    qr.setThreshold(kRankThreshold);
+    f->rank = static_cast<int>(qr.rank());
+    f->Z = (qr.householderQ() * Matrix::Identity(m, m)).rightCols(m - f->rank);
+    f->cod_g.setThreshold(kRankThreshold);
+    f->cod_gt.setThreshold(kRankThreshold);
+    f->cod_g.compute(f->G);
+    f->cod_gt.compute(f->G.transpose());
+    if (m > f->rank) {
+      Matrix& block = f->reduced.block;
+      block = f->Z.transpose() * f->Cc * f->Z;
+      block = (0.5 * (block + block.transpose())).eval();
+      f->reduced.position.resize(m - f->rank);
+      for (int a = 0; a < m - f->rank; ++a) f->reduced.position[a] = a;
+    }
+    if (k && f->rank == k && m > f->rank) {
+      f->llt.compute(f->reduced.block);
+      f->regular = f->llt.info() == Eigen::Success;
+    }
+    bordered_ = std::move(f);
   }
+  const BorderedFactors& f = *bordered_;
+  const Matrix& Cc = f.Cc;
+  const Matrix& Z = f.Z;
+  const int r = f.rank;
+  Vector vc(m), va(k);
+  for (int a = 0; a < m; ++a) vc[a] = err.v[contact[a]];
   for (int b = 0; b < k; ++b) va[b] = err.v[amplitude[b]];
-  constexpr double kRankThreshold = 1e-9;  // relative to G's largest pivot
-  Eigen::ColPivHouseholderQR<Matrix> qr(G);
-  qr.setThreshold(kRankThreshold);
-  const int r = static_cast<int>(qr.rank());
-  const Matrix Z = (qr.householderQ() * Matrix::Identity(m, m)).rightCols(m - r);
-  Eigen::CompleteOrthogonalDecomposition<Matrix> cod_g(G), cod_gt(G.transpose());
-  cod_g.setThreshold(kRankThreshold);
-  cod_gt.setThreshold(kRankThreshold);
   // dp0 from the bordered system with no contact error, [C G; G^T 0] [dp0; c] = [0; -v_a]: its
   // displacement C dp0 = -G c is a rigid motion, which da takes up, so restoring the equilibrium
   // leaves the rest of the contact error as it was (FETI's natural coarse problem; C alone may be
@@ -51,39 +88,27 @@ Direction StepSolver::bordered_direction(const Compliance& C, const ContactError
   // Solved in the null space of G^T: dp0 = d + Z y with G^T d = -v_a and (Z^T C Z) y = -Z^T C d,
   // the reduced block that eq. 13 needs below anyway. A full-pivoting LU of the whole bordered
   // block cost O(m^3) at every inner iteration: with 401 points mostly slipping, 100 s a step.
-  const Vector least = k ? Vector(-cod_gt.solve(va)) : Vector::Zero(m);
-  Matrix reduced_block;
-  if (m > r) {
-    reduced_block = Z.transpose() * Cc * Z;
-    reduced_block = (0.5 * (reduced_block + reduced_block.transpose())).eval();
-  }
+  const Vector least = k ? Vector(-f.cod_gt.solve(va)) : Vector::Zero(m);
   Vector dp0 = least;
-  if (k && r == k && m > r) {
-    const Eigen::LLT<Matrix> llt(reduced_block);
-    if (llt.info() == Eigen::Success) {
-      const Vector bordered = least - Z * llt.solve(Vector(Z.transpose() * (Cc * least)));
-      if (bordered.allFinite()) dp0 = bordered;
-    }
+  if (f.regular) {
+    const Vector bordered = least - Z * f.llt.solve(Vector(Z.transpose() * (Cc * least)));
+    if (bordered.allFinite()) dp0 = bordered;
   }
   const Vector w = vc + Cc * dp0;
   Vector dp = dp0;
   dir.ok = true;
   if (m > r) {
     // eq. 13 on the reduced block, through the ordinary direction (all its rows active).
-    Compliance reduced;
-    reduced.block = std::move(reduced_block);
-    reduced.position.resize(m - r);
     ContactError re;
     re.v = Z.transpose() * w;
     re.active.assign(m - r, 1);
-    for (int a = 0; a < m - r; ++a) reduced.position[a] = a;
-    const Direction inner = direction(reduced, re, level, alpha_fixed);
+    const Direction inner = direction(f.reduced, re, level, alpha_fixed);
     dir.ok = inner.ok;
     dir.n = inner.n;
     dir.alpha = inner.alpha;
     dp -= Z * inner.d;
   }
-  const Vector da = k ? Vector(-cod_g.solve(Vector(w + Cc * (dp - dp0)))) : Vector();
+  const Vector da = k ? Vector(-f.cod_g.solve(Vector(w + Cc * (dp - dp0)))) : Vector();
   for (int a = 0; a < m; ++a) dir.d[contact[a]] = -dp[a];
   for (int b = 0; b < k; ++b) dir.d[amplitude[b]] = -da[b];
   dir.ok = dir.ok && dir.d.allFinite();

@@ -168,6 +168,7 @@ class CevStep : public StepSolver {
                  int& n_used, double& alpha_used) {
     Vector pl = p0, sl = s0;
     const double target = model_target();
+    keep_bordered_factors(true);  // C stays the same through these iterations
     for (inner = 0; inner < params_.max_inner_iterations; ++inner) {
       const ContactError e = contact_error(problem_, pl, sl, tau, out_.state.enabled);
       if (e.norm2 <= target) break;
@@ -194,6 +195,7 @@ class CevStep : public StepSolver {
       pl += dp;
       sl += model_change(C, dp);  // dp is zero off the active set
     }
+    keep_bordered_factors(false);
     return pl;
   }
 

@@ -8,6 +8,7 @@
 // below, load stepping above.
 #include <chrono>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -97,6 +98,13 @@ class StepSolver {
   // The same on the bordered block of a body held by contact (bordered_direction.cpp): the
   // amplitudes eliminated, eq. 13 on the positive definite block of the null space of G^T.
   Direction bordered_direction(const Compliance& C, const ContactError& err, int level, double alpha_fixed);
+  // While on, bordered_direction keeps the factors of one active set's bordered block (Z, Z^T C Z
+  // and its Cholesky: O(m^3)) from call to call: for the inner iterations on one linear model,
+  // whose compliance does not change meanwhile. Turning it on or off drops them.
+  void keep_bordered_factors(bool on) {
+    keep_bordered_ = on;
+    bordered_.reset();
+  }
   // eq. 13's projection of pbar (project_forces), keeping a held body's equilibrium rows met.
   // `asked` (if given): the forces the direction's step assumed, where they differ from pbar
   // (held_direction's forces put on their bound): the rows are kept against those.
@@ -191,6 +199,11 @@ class StepSolver {
   std::string friction_limit_;  // why, once shown: budget_left ends the step with it
   ContactError error_;
   StepOutcome out_;
+
+ private:
+  struct BorderedFactors;  // bordered_direction.cpp
+  bool keep_bordered_ = false;
+  std::shared_ptr<const BorderedFactors> bordered_;
 };
 
 // One entry per strategy file.
