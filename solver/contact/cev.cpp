@@ -5,6 +5,8 @@
 // eq. 14 around the same inner loop with eq. 13 on the model (`friction_loop: passes`,
 // docs/algorithm.md#friction_loop-passes-the-tau-passes), or around the paper's literal loop
 // (`loop: paper`).
+#include <optional>
+
 #include "solver/contact/acceleration.hpp"
 #include "solver/contact/coulomb_model.hpp"
 #include "solver/contact/step.hpp"
@@ -42,13 +44,18 @@ class CevStep : public StepSolver {
     if (!fresh_solve(q_guess, v_previous_) || !approach_contact()) return;
     while (!error_met(error_)) {
       if (!budget_left()) return;
+      // Held solves leave no factorization of the body's own tangent (their springs are in
+      // Newton's): its G is formed afresh at each update, where a solve under given forces hands
+      // over its own (J2Contact: 46 real solves with the kept G, 24 fresh).
+      if (held()) eq_.refresh_compliance();
       const Compliance& C = eq_.compliance(out_.state, relevant_components(), params_.sparse_compliance_from);
       int inner = 0, halvings = 0;
       const Vector pl = predict_coulomb(C, inner, halvings);
       out_.inner_iterations += inner;
       const Vector du = eq_.predicted_change(C, pl - out_.p);
       int trials = 0;
-      const Update u = real_update(pl, du, trials);
+      const std::optional<HeldPlan> held = held_plan(C, pl);
+      const Update u = real_update(pl, du, trials, held ? &*held : nullptr);
       if (u == Update::failed) return;
       if (u == Update::retry) continue;
       ++m_;
@@ -93,10 +100,10 @@ class CevStep : public StepSolver {
   // made again from a fresh one when no trial was accepted (retry), and the next update gets
   // a fresh one when only a shortened step was, or the error fell too little.
   enum class Update { accepted, retry, failed };
-  Update real_update(const Vector& pl, const Vector& du, int& trials) {
+  Update real_update(const Vector& pl, const Vector& du, int& trials, const HeldPlan* held = nullptr) {
     const double v_before = error_.norm2;
     const bool stale = eq_.compliance_reused();
-    if (!line_search(pl, du, trials)) {
+    if (!line_search(pl, du, trials, held)) {
       if (!stale || !budget_left()) return Update::failed;
       out_.reason.clear();
       out_.failure = FailureKind::none;
@@ -105,6 +112,41 @@ class CevStep : public StepSolver {
     }
     if (stale && (trials > 1 || error_.norm2 > kStaleContraction * v_before)) eq_.refresh_compliance();
     return Update::accepted;
+  }
+
+  bool held() const { return params_.real_solve == RealSolve::held && problem_.rigid.count() == 0; }
+
+  // real_solve held (docs/algorithm.md#the-held-real-solve): the line search's solves hold the
+  // points that the prediction pl presses across their obstacle and those it sticks along it, by
+  // springs of stiffness held_stiffness / C_jj (each component's own contact stiffness times that
+  // factor) toward the model's s along p -> pl; a point that pl slips carries mu times the normal
+  // force it carries. Not for a body held by contact (its amplitudes stay given forces).
+  std::optional<HeldPlan> held_plan(const Compliance& C, const Vector& pl) const {
+    if (!held() || C.bordered) return std::nullopt;
+    const int n = static_cast<int>(pl.size());
+    Vector z = Vector::Zero(C.size());
+    for (int j = 0; j < n; ++j)
+      if (C.position[j] >= 0) z[C.position[j]] = pl[j] - out_.p[j];
+    const Vector cz = C.apply(z);
+    HeldPlan plan{HeldContact{}, out_.state.s, Vector::Zero(n)};
+    for (int j = 0; j < n; ++j)
+      if (C.position[j] >= 0) plan.ds[j] = cz[C.position[j]];
+    HeldContact& law = plan.law;
+    law.stiffness = Vector::Zero(n);
+    law.slip.assign(problem_.candidates.size(), 0);
+    const auto spring = [&](int j) {
+      const double cjj = C.position[j] >= 0 ? C.diagonal(C.position[j]) : 0.0;
+      return cjj > 0 ? params_.held_stiffness / cjj : 0.0;
+    };
+    for (size_t i = 0; i < problem_.candidates.size(); ++i) {
+      const Candidate& c = problem_.candidates[i];
+      if (!(pl[c.eta] < 0) || (law.stiffness[c.eta] = spring(c.eta)) == 0.0) continue;
+      const double mu = problem_.obstacles[c.obstacle].friction;
+      if (c.xi < 0 || C.position[c.xi] < 0 || mu <= 0) continue;
+      if (std::abs(pl[c.xi]) < mu * -pl[c.eta] * (1 - 1e-10)) law.stiffness[c.xi] = spring(c.xi);
+      else law.slip[i] = pl[c.xi] > 0 ? 1 : -1;
+    }
+    return plan;
   }
 
   // The inner loop's target on the model: well below the step's tolerance and the error now.

@@ -362,7 +362,7 @@ bool StepSolver::budget_left() {
   return fail(FailureKind::contact_budget, why);
 }
 
-bool StepSolver::line_search(const Vector& pl, const Vector& du, int& trials) {
+bool StepSolver::line_search(const Vector& pl, const Vector& du, int& trials, const HeldPlan* held) {
   const Vector p0 = out_.p;
   const double v0 = error_.norm2;
   for (int h = 0; h <= params_.line_search_steps; ++h) {
@@ -370,26 +370,48 @@ bool StepSolver::line_search(const Vector& pl, const Vector& du, int& trials) {
     const double f = std::ldexp(1.0, -h);
     const Vector pt = h == 0 ? pl : Vector(p0 + f * (pl - p0));
     ++trials;
+    if (held) {
+      HeldContact law = held->law;
+      law.target = held->s + f * held->ds;
+      eq_.set_held(std::move(law));
+    }
+    // The forces the trial carried: pt, or the held law's at its state.
+    const auto sound = [&](const EquilibriumState& t) {
+      return t.converged && (!held || held_admissible(held->law, t.p));
+    };
     const bool loose = loosen_newton(v0);
     EquilibriumState trial = eq_.solve(out_.state.q + f * du, pt);
     tighten_newton();
-    if (!trial.converged) continue;  // a diverging trial is a failed trial: halve
-    ContactError e = error_at(pt, trial.s, trial.enabled);
+    bool ok = sound(trial);  // a diverging trial is a failed trial: halve
+    ContactError e;
+    if (ok) e = error_at(held ? trial.p : pt, trial.s, trial.enabled);
     // A loose trial that ends the step is finished at the full precision (no solve counted:
     // the same solve continued), and judged there.
-    if (loose && improves(e, v0) && e.norm2 <= tol_) {
+    if (ok && loose && improves(e, v0) && e.norm2 <= tol_) {
       eq_.continue_solve(trial, pt);
-      if (!trial.converged) continue;
-      e = error_at(pt, trial.s, trial.enabled);
+      ok = sound(trial);
+      if (ok) e = error_at(held ? trial.p : pt, trial.s, trial.enabled);
     }
-    if (improves(e, v0)) {
-      accept(std::move(trial), pt);
+    if (held) eq_.set_held(std::nullopt);
+    if (ok && improves(e, v0)) {
+      const Vector carried = held ? trial.p : pt;
+      accept(std::move(trial), carried);
       return true;
     }
   }
   if (reached_precision()) return true;
   return fail(FailureKind::contact_stalled,
               "no decrease of the contact error along the predicted force change (||v|| = " + number_text(v0) + ")");
+}
+
+bool StepSolver::held_admissible(const HeldContact& law, const Vector& p) const {
+  for (const Candidate& c : problem_.candidates) {
+    if (law.stiffness[c.eta] > 0 && p[c.eta] > 0) return false;
+    if (c.xi >= 0 && law.stiffness[c.xi] > 0 &&
+        std::abs(p[c.xi]) > problem_.obstacles[c.obstacle].friction * -p[c.eta] * (1 + 1e-9))
+      return false;
+  }
+  return true;
 }
 
 bool StepSolver::reached_precision() {

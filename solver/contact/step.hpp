@@ -28,6 +28,13 @@ struct Direction {
 
 std::vector<int> active_indices(const ContactError& e);
 
+// cev's held real solves (ContactParams::real_solve): the law of the line search's trials, its
+// springs' target at the trial p + f (pl - p) the model's s + f ds, ds = C (pl - p).
+struct HeldPlan {
+  HeldContact law;
+  Vector s, ds;
+};
+
 class StepSolver {
  public:
   StepSolver(Equilibrium& eq, const ContactParams& params, int step, const IterationObserver& obs,
@@ -79,7 +86,12 @@ class StepSolver {
   // Real solves along p -> pl: the first trial is pl itself, then p + 2^-h (pl - p); the first
   // with a smaller ||v|| is accepted. du is the linear model's displacement change for pl - p
   // (Newton starts from it). `trials` counts the real solves.
-  bool line_search(const Vector& pl, const Vector& du, int& trials);
+  // With `held`, each trial is a held real solve, judged (and accepted) at the forces the body
+  // carried; a trial whose carried forces leave the cone where it held them is rejected.
+  bool line_search(const Vector& pl, const Vector& du, int& trials, const HeldPlan* held = nullptr);
+  // The carried forces p meet the cone where the law held them: no tension, a sticking force
+  // within mu |p_eta| (to 1e-9).
+  bool held_admissible(const HeldContact& law, const Vector& p) const;
   // No real solve lowers ||v|| any more (the line search, or alpha's halvings) where it is
   // within tolerance x L, the bound before it moved with D: the precision the real solves allow
   // is reached (their round-off: the mortar pairs of two bodies). The step converges there with

@@ -19,6 +19,7 @@ enum class ContactLoop { inner, paper };  // inner: section 5's default; paper: 
 // inner: Coulomb's bound mu |p_eta| moves with p_eta inside the inner loop (cev's default);
 // passes: the tau passes of eq. 14, each a Tresca problem (the paper's loop always uses them).
 enum class FrictionLoop { inner, passes };
+enum class RealSolve { given, held };
 enum class EpsilonSource { exact, warmup };
 
 // Acceleration level n: kInfinity = a Cholesky solve with the active block (default);
@@ -74,6 +75,11 @@ struct ContactParams {
   // 2000 unknowns 1.53-2.06 / 1.35-1.38. The paper's beam and sheet and Hertz up to a/h 40 (242)
   // stay dense.
   int sparse_compliance_from = 1200;
+  // cev's default loop: the real solves of its line search under the given forces (given), or
+  // held by the obstacles where the linear model presses or sticks (held: springs of stiffness
+  // held_stiffness / C_jj toward the model's kinematics; docs/algorithm.md#the-held-real-solve).
+  RealSolve real_solve = RealSolve::given;
+  double held_stiffness = 30.0;
   // penalty: k_n and k_t (force / length); 0 means penalty_factor times the largest diagonal
   // entry of the body's stiffness (k_t defaults to k_n).
   double penalty_normal = 0.0;

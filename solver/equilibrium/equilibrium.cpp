@@ -58,7 +58,9 @@ double Equilibrium::stiffness_scale(const Vector& q) const {
 
 Vector Equilibrium::residual(const Vector& q, const EquilibriumState& paired, const Vector& p_given,
                              TangentSink* tangent, double* force_scale, bool body_tangent) const {
-  const Vector p = penalty_ ? penalty_forces(q, paired, tangent) : p_given;
+  const Vector p = penalty_ ? penalty_forces(q, paired, tangent)
+                   : held_  ? held_forces(q, paired, p_given, tangent)
+                            : p_given;
   Vector r = Vector::Zero(q.size());
   problem_.body->internal_force(q, r, body_tangent ? tangent : nullptr);
   Vector external = problem_.load(factors_);

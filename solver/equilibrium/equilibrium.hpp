@@ -13,6 +13,7 @@
 #include "solver/equilibrium/compliance.hpp"
 #include "solver/equilibrium/equilibrium_state.hpp"
 #include "solver/equilibrium/free_block_solver.hpp"
+#include "solver/equilibrium/held_contact.hpp"
 #include "solver/equilibrium/newton_params.hpp"
 #include "solver/equilibrium/penalty_law.hpp"
 #include "solver/model/parallel.hpp"
@@ -39,6 +40,9 @@ class Equilibrium {
   // With a penalty law set, solve() ignores its p and finds p(q) from the law.
   // A body held by contact then has its pins free (PenaltyLaw::pin_spring).
   void set_penalty(std::optional<PenaltyLaw> law);
+  // With a held law set, solve(q, p) carries p + k (target - s(q)) at the held components
+  // (HeldContact), and the state's p is what the body carried.
+  void set_held(std::optional<HeldContact> held) { held_ = std::move(held); }
   // The largest diagonal entry of the body's stiffness at q: a scale for penalty stiffnesses.
   double stiffness_scale(const Vector& q) const;
   // The pairing and s at q, without solving (e.g. the reference configuration).
@@ -107,6 +111,22 @@ class Equilibrium {
   // increment dq (all dofs), p(q) + (dp/dq) dq: the law linearized at q.
   Vector penalty_forces(const Vector& q, const EquilibriumState& paired, TangentSink* tangent,
                         const Vector* increment = nullptr) const;
+  // The held law's forces at a paired state of q (p_given elsewhere), and (if asked) their
+  // stiffness entries (held_contact.cpp).
+  Vector held_forces(const Vector& q, const EquilibriumState& paired, const Vector& p_given,
+                     TangentSink* tangent) const;
+  // A contact law's (penalty, held) shared parts: the gradients of candidate i's gap and (if
+  // asked) zeta at q, as (dof, derivative); and d(T p)/dq into the tangent, from the law's change
+  // of p_eta and p_xi per dof.
+  using LawGradient = std::vector<std::pair<int, double>>;
+  struct LawChange {
+    int dof;
+    double normal, tangential;
+  };
+  void law_gradients(const Vector& q, const EquilibriumState& paired, size_t i, bool with_zeta, LawGradient& gap,
+                     LawGradient& zeta) const;
+  void add_law_tangent(const EquilibriumState& paired, size_t i, const std::vector<LawChange>& dp,
+                       TangentSink& tangent) const;
   // The penalty law's answer at a converged iterate q (paired): one more Newton correction dq,
   // and the forces p(q) + (dp/dq) dq at q + dq.
   EquilibriumState& finish_penalty(EquilibriumState& state);
@@ -138,6 +158,7 @@ class Equilibrium {
   std::vector<double> zeta_previous_;
   std::vector<Constraint> extra_;
   std::optional<PenaltyLaw> penalty_;
+  std::optional<HeldContact> held_;
   std::vector<int> free_index_;  // dof -> free index, -1 if prescribed
   std::vector<char> is_pin_;     // dof holds a rigid amplitude (problem.rigid.pins)
   int free_count_ = 0;

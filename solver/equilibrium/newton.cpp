@@ -158,8 +158,9 @@ EquilibriumState Equilibrium::newton(const Vector& q_guess, const Vector& p) {
     for (int k = 0; k < rigid.count(); ++k) state.q[rigid.pins[k]] = rigid.scale * p[rigid.first + k];
   const double body_length = problem_.body->characteristic_length();
   constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
-  // The penalty law adds stiffness that changes with the contact state: no reuse then.
-  const bool reuse = constant_tangent_ && !penalty_;
+  // The penalty law (or the held one) adds stiffness that changes with the contact state: no
+  // reuse then.
+  const bool reuse = constant_tangent_ && !penalty_ && !held_;
   // A pair of bodies adds its stiffness, which moves with the pairing, on a few surface dofs:
   // kept as a low-rank correction of the constant body tangent (low_rank_step).
   const bool low_rank = reuse && has_pairs_;
@@ -218,7 +219,7 @@ EquilibriumState Equilibrium::newton(const Vector& q_guess, const Vector& p) {
       state.at_floor = at_floor && !residual_met;
       state.noise = state.at_floor ? last_step : 0.0;
       if (!penalty_) newton_factor_q_ = state.q;
-      return penalty_ ? finish_penalty(state) : finish(state, p);
+      return penalty_ ? finish_penalty(state) : finish(state, held_ ? held_forces(state.q, state, p, nullptr) : p);
     }
     if (it > params_.max_iterations) break;
     Vector r_step;
@@ -242,7 +243,8 @@ EquilibriumState Equilibrium::newton(const Vector& q_guess, const Vector& p) {
         state.failure = FailureKind::newton_diverged;
         return state;
       }
-      newton_factor_solve_ = counters_.solves;
+      // The held law's springs are in it: no compliance of the body (compliance.cpp).
+      newton_factor_solve_ = held_ ? -1 : counters_.solves;
     }
     Vector r_free(free_count_);
     for (int i = 0; i < r.size(); ++i)
@@ -271,7 +273,7 @@ EquilibriumState Equilibrium::newton(const Vector& q_guess, const Vector& p) {
       state.q += dq;
       pair(state.q, state);
       if (!penalty_) newton_factor_q_ = state.q;
-      return penalty_ ? finish_penalty(state) : finish(state, p);
+      return penalty_ ? finish_penalty(state) : finish(state, held_ ? held_forces(state.q, state, p, nullptr) : p);
     }
     state.q += line_search(state.q, dq, p, reuse ? body_lu_ : lu_) * dq;
     stick_branch_.clear();

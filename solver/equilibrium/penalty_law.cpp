@@ -2,7 +2,6 @@
 #include "solver/equilibrium/equilibrium.hpp"
 
 #include <cmath>
-#include <tuple>
 
 namespace grip {
 
@@ -24,7 +23,8 @@ Vector Equilibrium::penalty_forces(const Vector& q, const EquilibriumState& pair
                                    const Vector* increment) const {
   const PenaltyLaw& law = *penalty_;
   Vector p = Vector::Zero(problem_.component_count);
-  std::vector<std::pair<int, double>> gap, zeta;  // d(gap)/dq, d(zeta)/dq: (dof, derivative)
+  LawGradient gap, zeta;
+  std::vector<LawChange> dp;
   for (size_t i = 0; i < problem_.candidates.size(); ++i) {
     const Candidate& c = problem_.candidates[i];
     const PairedPoint& pp = paired.points[i];
@@ -53,41 +53,53 @@ Vector Equilibrium::penalty_forces(const Vector& q, const EquilibriumState& pair
       }
     }
     if (!tangent && !increment) continue;
-    // The gradients of the gap and of zeta: against a rigid obstacle n . J and zeta_rate xi . J
-    // (its closest point); against a deformable master also the normal's turn and the mortar
-    // weights' shift with both bodies (DeformedMaster::gradients): one consistent tangent.
-    gap.clear();
-    zeta.clear();
-    const auto& master = paired.masters[c.obstacle];
-    if (master) {
-      master->gradients(problem_.body->surface_point(q, c.site, c.side), c.site, gap, zeta);
-    } else {
-      for (const auto& j : pp.point.jacobian) {
-        gap.emplace_back(j.dof, -pp.eta.dot(j.dx));
-        if (frictional) zeta.emplace_back(j.dof, pp.projection.zeta_rate * pp.xi.dot(j.dx));
-      }
-    }
-    // dp_eta = k_n d(gap), dp_xi = stick d(zeta) + slip dp_eta, as (dof, dp_eta, dp_xi).
-    std::vector<std::tuple<int, double, double>> dp;
-    for (const auto& [dof, g] : gap) dp.emplace_back(dof, law.normal * g, slip * law.normal * g);
-    if (frictional)
-      for (const auto& [dof, z] : zeta) dp.emplace_back(dof, 0.0, stick * z);
+    law_gradients(q, paired, i, frictional, gap, zeta);
+    // dp_eta = k_n d(gap), dp_xi = stick d(zeta) + slip dp_eta.
+    dp.clear();
+    for (const auto& [dof, g] : gap) dp.push_back({dof, law.normal * g, slip * law.normal * g});
+    for (const auto& [dof, z] : zeta) dp.push_back({dof, 0.0, stick * z});
     if (increment)  // the law's linear change over the increment, from the increment itself
-      for (const auto& [dof, dpn, dpt] : dp) {
-        p[c.eta] += dpn * (*increment)[dof];
-        if (frictional) p[c.xi] += dpt * (*increment)[dof];
+      for (const LawChange& d : dp) {
+        p[c.eta] += d.normal * (*increment)[d.dof];
+        if (frictional) p[c.xi] += d.tangential * (*increment)[d.dof];
       }
-    if (!tangent) continue;
-    // d(T p)/dq from p's dependence on q; the residual carries it with a minus sign.
-    for (const auto& a : pp.point.jacobian) {
-      const double on_eta = a.dx.dot(pp.eta), on_xi = a.dx.dot(pp.xi);
-      for (const auto& [dof, dpn, dpt] : dp) {
-        tangent->add(a.dof, dof, -(on_eta * dpn + on_xi * dpt));
-        if (master) tangent->add(dof, a.dof, 0.0);  // a tangent's pattern is symmetric
-      }
-    }
+    if (tangent) add_law_tangent(paired, i, dp, *tangent);
   }
   return p;
+}
+
+void Equilibrium::law_gradients(const Vector& q, const EquilibriumState& paired, size_t i, bool with_zeta,
+                                LawGradient& gap, LawGradient& zeta) const {
+  // Against a rigid obstacle n . J and zeta_rate xi . J (its closest point); against a deformable
+  // master also the normal's turn and the mortar weights' shift with both bodies
+  // (DeformedMaster::gradients): one consistent tangent.
+  const Candidate& c = problem_.candidates[i];
+  const PairedPoint& pp = paired.points[i];
+  gap.clear();
+  zeta.clear();
+  if (const auto& master = paired.masters[c.obstacle]) {
+    master->gradients(problem_.body->surface_point(q, c.site, c.side), c.site, gap, zeta);
+    if (!with_zeta) zeta.clear();
+    return;
+  }
+  for (const auto& j : pp.point.jacobian) {
+    gap.emplace_back(j.dof, -pp.eta.dot(j.dx));
+    if (with_zeta) zeta.emplace_back(j.dof, pp.projection.zeta_rate * pp.xi.dot(j.dx));
+  }
+}
+
+void Equilibrium::add_law_tangent(const EquilibriumState& paired, size_t i, const std::vector<LawChange>& dp,
+                                  TangentSink& tangent) const {
+  // d(T p)/dq from p's dependence on q; the residual carries it with a minus sign.
+  const PairedPoint& pp = paired.points[i];
+  const bool master = paired.masters[problem_.candidates[i].obstacle] != nullptr;
+  for (const auto& a : pp.point.jacobian) {
+    const double on_eta = a.dx.dot(pp.eta), on_xi = a.dx.dot(pp.xi);
+    for (const LawChange& d : dp) {
+      tangent.add(a.dof, d.dof, -(on_eta * d.normal + on_xi * d.tangential));
+      if (master) tangent.add(d.dof, a.dof, 0.0);  // a tangent's pattern is symmetric
+    }
+  }
 }
 
 std::vector<signed char> Equilibrium::trial_signs(const EquilibriumState& paired) const {

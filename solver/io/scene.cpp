@@ -395,6 +395,9 @@ void read_solver(Reader& r, json& scene, SteppingParams& params) {
     c.loop = loop == "paper" ? ContactLoop::paper : ContactLoop::inner;
     const std::string friction_loop = r.choice(*contact, cp, "friction_loop", {"inner", "passes"}, "inner");
     c.friction_loop = friction_loop == "passes" ? FrictionLoop::passes : FrictionLoop::inner;
+    c.real_solve =
+        r.choice(*contact, cp, "real_solve", {"given", "held"}, "given") == "held" ? RealSolve::held : RealSolve::given;
+    c.held_stiffness = r.positive(*contact, cp, "held_stiffness", c.held_stiffness);
     c.augmentation = r.positive(*contact, cp, "augmentation", c.augmentation);
     c.max_iterations = r.integer(*contact, cp, "max_iterations", 1, 1000000, c.max_iterations);
     c.max_tau_passes = r.integer(*contact, cp, "max_tau_passes", 1, 1000, c.max_tau_passes);
