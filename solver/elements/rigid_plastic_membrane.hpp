@@ -68,7 +68,7 @@ class RigidPlasticMembrane final : public Body {
   // No rigid_rotation: a membrane has no bending stiffness, so every transverse motion of a
   // flat sheet is free until tension stiffens it; solver.start handles that state.
   Vector rigid_translation(const Vec2& d) const override;
-  Traits traits() const override { return {true, true, false}; }
+  Traits traits() const override { return {true, true, false, false}; }
   bool axisymmetric() const override { return axisymmetric_; }
   std::vector<std::vector<int>> cells() const override;
   FieldTable site_fields(const Vector& q) const override;

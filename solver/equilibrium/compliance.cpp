@@ -197,21 +197,26 @@ bool Equilibrium::newton_factor_serves(const EquilibriumState& state, int surfac
 
 bool Equilibrium::compliance_tangent(const EquilibriumState& state, int surface_dofs) {
   const bool from_newton = newton_factor_serves(state, surface_dofs);
-  // A G from Newton's factorization serves its own state only (the next real solve factorizes
-  // anew); at that state it is kept while the contact zone grows.
-  const bool same_newton_g = g_valid_ && g_from_newton_ && from_newton && g_solve_ == counters_.solves;
-  if (!constant_tangent_ && !same_newton_g && (!compliance_reuse_ || g_from_newton_)) g_valid_ = false;
-  compliance_reused_ = g_valid_ && !constant_tangent_ && !g_from_newton_;
+  // A G from Newton's factorization, or one with the turning contact forces' stiffness (the
+  // exact linearization at its state, and only there), serves its own state only (the next
+  // real solve factorizes anew); at that state it is kept while the contact zone grows.
+  const bool own_state = g_from_newton_ || g_turns_;
+  const bool same_state_g = g_valid_ && own_state && from_newton == g_from_newton_ && g_solve_ == counters_.solves &&
+                            (!g_turns_ || g_turns_q_ == state.q);
+  if (!constant_tangent_ && !same_state_g && (!compliance_reuse_ || own_state)) g_valid_ = false;
+  compliance_reused_ = g_valid_ && !constant_tangent_ && !own_state;
   if (g_valid_) return g_factor().ok();
   // A new G: from the tangent at this state.
   surface_free_.clear();
   surface_row_.assign(free_count_, -1);
   g_.resize(0, 0);
   g_from_newton_ = from_newton;
-  if (from_newton) {
-    g_solve_ = counters_.solves;
-  } else {
-    if (!factorize_body_tangent(state.q)) return false;
+  g_turns_ = false;
+  g_solve_ = counters_.solves;
+  if (!from_newton) {
+    const bool turning = turning_ && !problem_.body->has_follower_loads() && state.p.size() == problem_.component_count;
+    if (!factorize_body_tangent(state.q, turning ? &state : nullptr)) return false;
+    if (g_turns_) g_turns_q_ = state.q;
     ++counters_.compliance_forms;
     ++tangent_version_;
   }

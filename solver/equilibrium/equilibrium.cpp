@@ -13,6 +13,7 @@ Equilibrium::Equilibrium(const Problem& problem, NewtonParams params, std::vecto
   length_scales_ = problem.body->dof_length_scales();
   constant_tangent_ = problem.body->traits().constant_tangent;
   for (const ObstacleInstance& o : problem.obstacles) has_pairs_ = has_pairs_ || o.master.has_value();
+  turning_ = !constant_tangent_ && problem.body->traits().reference_stiffness && !has_pairs_;
   zeta_previous_.assign(problem.candidates.size(), 0.0);
 }
 

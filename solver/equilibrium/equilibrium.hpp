@@ -69,6 +69,10 @@ class Equilibrium {
   void refresh_compliance() { g_valid_ = constant_tangent_ && g_valid_; }
   // The last compliance() used a G formed at an earlier state (a changing tangent only).
   bool compliance_reused() const { return compliance_reused_; }
+  // The last compliance() carries the stiffness of contact forces that turn with a curved
+  // obstacle (a body stiff in its reference state): the exact linearization at its state, so
+  // formed afresh at every update (docs/algorithm.md#the-contact-compliance).
+  bool compliance_turns() const { return g_turns_; }
   // The linear model's displacement change K^-1 T dp for a force change dp, from the last
   // compliance (its components only, with the tangent its G came from): where the next
   // solve should start. One sparse solve.
@@ -165,8 +169,16 @@ class Equilibrium {
   Vector length_scales_;
   EquilibriumCounters counters_;
   // The body's own tangent, factorized once when it is constant (linear kinematics): then
-  // Newton is a modified Newton on it and the compliance reuses it.
-  bool factorize_body_tangent(const Vector& q);
+  // Newton is a modified Newton on it and the compliance reuses it. With `turning` (a changing
+  // tangent of a body stiff in its reference state), plus the symmetrized stiffness of that
+  // state's contact forces turning with curved obstacles, where it stays positive definite.
+  bool factorize_body_tangent(const Vector& q, const EquilibriumState* turning = nullptr);
+  // Adds scale x the symmetrized turning stiffness -J^T sym(df/dx) J of every candidate of
+  // `state` (emitted even where zero: the pattern stays); true if some term is not zero.
+  bool add_turning_stiffness(const EquilibriumState& state, TangentSink& sink, double scale) const;
+  bool turning_ = false;  // the compliance may carry the turning stiffness (factorize_body_tangent)
+  bool g_turns_ = false;  // G does (its state's: real solve g_solve_ at g_turns_q_)
+  Vector g_turns_q_;
   bool constant_tangent_ = false;
   bool has_pairs_ = false;  // a contact pair of two bodies (a deformable master)
   bool body_factorized_ = false;

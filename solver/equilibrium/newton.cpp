@@ -327,16 +327,46 @@ double Equilibrium::line_search(const Vector& q, const Vector& dq, const Vector&
   return a;
 }
 
-bool Equilibrium::factorize_body_tangent(const Vector& q) {
+bool Equilibrium::factorize_body_tangent(const Vector& q, const EquilibriumState* turning) {
   if (constant_tangent_ && body_factorized_) return body_lu_.ok();
-  Vector force = Vector::Zero(q.size());
-  problem_.body->internal_force(q, force, &body_lu_.assemble(free_index_, free_count_, &length_scales_));
-  ++counters_.factorizations;
-  ++counters_.body_factorizations;
-  body_factorized_ = true;
-  // Read by Newton only for a constant tangent (a changing one has its own).
-  if (constant_tangent_) body_tangent_norm_ = body_lu_.row_sum_norm();
-  return body_lu_.factorize();
+  g_turns_ = false;
+  // The turning terms, then (not positive definite with them) the same pattern with zeros.
+  for (const double scale : {1.0, 0.0}) {
+    Vector force = Vector::Zero(q.size());
+    TangentSink& sink = body_lu_.assemble(free_index_, free_count_, &length_scales_);
+    problem_.body->internal_force(q, force, &sink);
+    const bool turns = turning && add_turning_stiffness(*turning, sink, scale);
+    ++counters_.factorizations;
+    ++counters_.body_factorizations;
+    body_factorized_ = true;
+    // Read by Newton only for a constant tangent (a changing one has its own).
+    if (constant_tangent_) body_tangent_norm_ = body_lu_.row_sum_norm();
+    const bool ok = body_lu_.factorize();
+    if (!turns || (ok && body_lu_.symmetric())) {
+      g_turns_ = turns;
+      return ok;
+    }
+  }
+  return body_lu_.ok();
+}
+
+bool Equilibrium::add_turning_stiffness(const EquilibriumState& state, TangentSink& sink, double scale) const {
+  Mat2 R;
+  R << 0, -1, 1, 0;
+  bool any = false;
+  for (size_t i = 0; i < problem_.candidates.size(); ++i) {
+    const Candidate& c = problem_.candidates[i];
+    const PairedPoint& pp = state.points[i];
+    const double p_eta = state.p[c.eta], p_xi = c.xi >= 0 ? state.p[c.xi] : 0.0;
+    // Newton's df/dx (residual()), symmetrized: C must be symmetric for the Coulomb model's
+    // Cholesky factors; the friction force's part p_xi R dn/dx is not.
+    const Mat2 df_dx = scale * (-p_eta * Mat2::Identity() + p_xi * R) * pp.projection.dnormal_dx;
+    const Mat2 sym = 0.5 * (df_dx + df_dx.transpose());
+    any = any || !sym.isZero(0.0);
+    for (const auto& a : pp.point.jacobian)
+      for (const auto& b : pp.point.jacobian) sink.add(a.dof, b.dof, -a.dx.dot(sym * b.dx));
+  }
+  return any;
 }
 
 }  // namespace grip

@@ -104,6 +104,10 @@ class Body {
     bool geometric_nonlinearity = true;
     bool plasticity = false;
     bool constant_tangent = false;
+    // Stiff in its reference state (a continuum, a beam). A membrane is not: its transverse
+    // stiffness is its tension's, which the stiffness of contact forces turning with a curved
+    // obstacle may nearly cancel (docs/algorithm.md#the-contact-compliance).
+    bool reference_stiffness = true;
   };
   virtual Traits traits() const { return {}; }
   // A section of a body of revolution (x = r, y = z: the axis): of its rigid motions only the

@@ -131,12 +131,13 @@ Vector BodySet::rigid_rotation() const {
 }
 
 Body::Traits BodySet::traits() const {
-  Traits t{false, false, true};
+  Traits t{false, false, true, true};
   for (const auto& p : parts_) {
     const Traits pt = p->traits();
     t.geometric_nonlinearity |= pt.geometric_nonlinearity;
     t.plasticity |= pt.plasticity;
     t.constant_tangent &= pt.constant_tangent;
+    t.reference_stiffness &= pt.reference_stiffness;
   }
   return t;
 }

@@ -130,8 +130,9 @@ void expect_one_story(const Story& s, const std::string& what) {
 }
 
 // A scene whose solve cuts an increment, for each method (the cuts are asserted below, so a
-// scene that stops cutting fails the test): cev on the paper's beam with 4 real solves a step
-// (5 cuts, 155 solves), uzawa on the block held by friction with a budget it can finish in
+// scene that stops cutting fails the test): cev on the paper's beam with 3 real solves a step
+// (16 cuts, 239 solves; with 4 it no longer cuts since its compliance holds the turning contact
+// forces' stiffness: 53 solves), uzawa on the block held by friction with a budget it can finish in
 // (1 cut, 11,366 solves), penalty on the strip wrapped on a cylinder (1 cut, 63 solves).
 json cut_scene(const std::string& method) {
   const char* name = method == "cev"     ? "beam-on-cylinder"
@@ -139,7 +140,7 @@ json cut_scene(const std::string& method) {
                                          : "strip-on-cylinder";
   json scene = json::parse(read_text(examples_dir() / (std::string(name) + ".json")));
   scene["solver"]["contact"]["method"] = method;
-  if (method == "cev") scene["solver"]["contact"]["max_iterations"] = 4;
+  if (method == "cev") scene["solver"]["contact"]["max_iterations"] = 3;
   if (method == "uzawa") scene["solver"]["contact"]["max_iterations"] = 20000;
   return scene;
 }

@@ -139,7 +139,10 @@ TEST(SlenderStrip, WrapsOntoACylinder) {
 }
 
 // With friction 0.3 (the shipped strip-on-cylinder scene): every step converges, Coulomb
-// holds at every point, and the contact error falls monotonically.
+// holds at every point, and the contact error falls monotonically. Its compliance holds the
+// stiffness of the contact forces that turn with the cylinder (docs/algorithm.md, the contact
+// compliance): 56 real solves and 190 Newton iterations measured (86 and 259 with the body's
+// own compliance); the bounds leave room for a path that round-off moves by a solve or two.
 TEST(SlenderStrip, WrapsOntoACylinderWithFriction) {
   const auto s = solve_scene(testing::example_scene("strip-on-cylinder"));
   expect_every_step_sound(s);
@@ -147,6 +150,9 @@ TEST(SlenderStrip, WrapsOntoACylinderWithFriction) {
   int slipping = 0;
   for (const auto& p : s.scene.problem.candidates) slipping += std::abs(s.run.steps.back().p[p.xi]) > 0;
   EXPECT_GE(slipping, 1);
+  std::printf("%ld real solves, %ld Newton iterations\n", s.run.counters.solves, s.run.counters.newton_iterations);
+  EXPECT_LE(s.run.counters.solves, 60);
+  EXPECT_LE(s.run.counters.newton_iterations, 200);
   // The counters are honest: a step's iteration events add up to its real solves and its
   // Newton iterations (rejected line-search trials included); a failed attempt (a cut, a
   // restart from the last force) ends without an event for its last trials.
