@@ -157,7 +157,11 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
     double done = 0.0, increment = 1.0;
     int depth = 0;
     bool from_previous_force = false;  // after a failure from the extrapolated force
-    LoadFactors probed;                // the last target whose friction limit was decided
+    // The fallback: where the increment's every attempt failed from the extrapolated state, its
+    // attempts again with Newton from the last converged state (`chain`: where they began).
+    bool from_converged = false;
+    std::tuple<double, int, bool> chain{increment, depth, from_previous_force};
+    LoadFactors probed;  // the last target whose friction limit was decided
     // After an update of the body's multipliers: the increment again from its converged state.
     std::optional<std::pair<Vector, Vector>> again;
     int updates = 0;  // of the multipliers in this increment
@@ -170,7 +174,10 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
       const double ratio =
           !start_q && last > 0 ? turn(before, current, target) * distance(target, current) / last : 0.0;
       const bool repeat = again.has_value();
-      const Vector guess = repeat ? again->first : start_q ? *start_q : Vector(q + (q - q_before) * ratio);
+      const Vector guess = repeat           ? again->first
+                           : start_q        ? *start_q
+                           : from_converged ? q
+                                            : Vector(q + (q - q_before) * ratio);
       // The contact forces start from the same extrapolation (the strategies bring it back
       // into the cone): a step then starts near its answer, not a whole increment away.
       Vector p_guess = repeat                                       ? again->second
@@ -338,12 +345,27 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
           ++rec.restarts;
           continue;
         }
+        // Every attempt of the increment failed from the extrapolated state: they run again from
+        // the last converged state, an equilibrium under the previous forces. The extrapolation
+        // can fall on the near side of a limit point of the body under given contact forces,
+        // where Newton falls away (the bulging block, docs/verification.md#bulging-block). Not
+        // for a body without reference stiffness (a start-up): at a zero increment its tangent
+        // is singular (the rigid-plastic sheet).
+        if (depth >= params.max_cuts && !out.stopped && !out.definitive && !spent && !from_converged &&
+            !problem.start && ratio != 0) {
+          rec.notes.push_back("every attempt from the extrapolated state failed (" + out.reason +
+                              "): the increment again from the last converged state");
+          from_converged = true;
+          std::tie(increment, depth, from_previous_force) = chain;
+          continue;
+        }
         if (depth >= params.max_cuts || out.stopped || out.definitive || spent) {
           rec.failure = out.failure;
           rec.reason = out.reason;
           // A stop names its cause where the caller gives one (the service: a job limit, a dismissal).
           if (out.stopped && observer.stop_reason) std::tie(rec.failure, rec.reason) = observer.stop_reason();
           if (depth) rec.reason += " (after " + std::to_string(depth) + " cuts of the increment)";
+          if (from_converged) rec.reason += ", from the last converged state as well";
           rec.p = out.p;
           rec.tau = out.tau;
           rec.state = std::move(out.state);
@@ -379,6 +401,8 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
       done = t;
       zeta = eq->zetas(out.state);
       updates = 0;
+      from_converged = false;
+      chain = {increment, depth, from_previous_force};
       problem.body->commit(q);
       if (t == 1.0) {
         rec.state = std::move(out.state);
