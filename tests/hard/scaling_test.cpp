@@ -1,8 +1,9 @@
 // Issue 9, units: the beam bent round the cylinder with Young's modulus and the load scaled
 // together by 1e6 up and down, and with every length in a unit a thousand times larger and a
 // thousand times smaller (E rescaled to match). A consistent change of units changes no
-// decision of the solver: displacements and forces scale exactly (to rounding, 1e-9
-// relative), and every step takes the same real solves and Newton iterations.
+// decision of the solver: displacements and forces scale exactly (to rounding: 1e-9 relative,
+// the forces of the scaled modulus 1e-7), and every step takes the same real solves and Newton
+// iterations.
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -70,7 +71,11 @@ TEST(Scaling, YoungsModulusAndLoadsTogether) {
     for (size_t k = 0; k < ref.run.steps.size(); ++k)
       worst_p = std::max(worst_p, relative(s.run.steps[k].p, ref.run.steps[k].p, f));
     std::printf("E and loads x %g: displacements differ by %.3g, forces by %.3g\n", f, worst, worst_p);
-    EXPECT_LT(worst_p, 1e-9) << "E and loads x " << f;
+    // The forces are the gaps' image through the compliance's inverse, formed afresh at each
+    // update on the cylinder (the turning contact forces' stiffness): each factorization's
+    // rounding, 1e6 being no power of two, reaches them amplified by the beam's stiffness
+    // (measured 1.6e-8 at E x 1e6 and 5.9e-11 at 1e-6, with every decision the same above).
+    EXPECT_LT(worst_p, 1e-7) << "E and loads x " << f;
   }
 }
 

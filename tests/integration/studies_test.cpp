@@ -441,7 +441,10 @@ TEST(Studies, AnAccuracyStudyRefinesUntilTheEstimateIsBelowTheTarget) {
   const json accepted =
       post_study(api, {{"scene", cylinder()}, {"accuracy", {{"output", "u_inner"}, {"relative", 1e-3}}}}, 201);
   EXPECT_EQ(accepted["kind"], "accuracy");
-  EXPECT_EQ(accepted["levels"].size(), 3u);  // three to begin with
+  // Three to begin with; a fourth already where all three finished before the answer was
+  // written (the answer is the study as read then, and that read makes the next level).
+  EXPECT_GE(accepted["levels"].size(), 3u);
+  EXPECT_LE(accepted["levels"].size(), 4u);
   // Nobody reads the study while it runs: its levels are made as the ones before finish. The
   // jobs list is watched instead, until four jobs have finished and none is left running.
   EXPECT_EQ(jobs_when_finished(api, 4), 4u);
