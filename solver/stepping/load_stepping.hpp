@@ -35,7 +35,7 @@ struct StepRecord {
   std::string reason;
   FailureKind failure = FailureKind::none;  // the kind of the reason
   std::string warning;                      // the converged state lies beyond the model's accurate range
-  std::vector<std::string> notes;           // what the step changed in the problem (candidates added)
+  std::vector<std::string> notes;           // candidates added; a start from the last converged state
   StepChecks checks;                        // the step checks' worst values (step_checks.hpp)
   int cuts = 0;                             // sub-increments this step needed beyond one
   int restarts = 0;                         // attempts from the extrapolated force retried from the last one
