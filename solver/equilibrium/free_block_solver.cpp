@@ -452,7 +452,10 @@ bool CholmodFactor::forward_solves(const Eigen::SparseMatrix<double>& columns,
                                    const std::function<bool(int, const int*, const double*, int)>& use) {
   if (!m_cholmodFactor) return false;
   cholmod_common* cc = &cholmod();
-  cholmod_factor* L = cholmod_copy_factor(m_cholmodFactor, cc);  // the partial solve makes it simplicial
+  // The partial solve makes a supernodal factor simplicial: on a copy. A simplicial one it only
+  // reads (no copy of L, megabytes of fresh pages, at every G).
+  cholmod_factor* copy = m_cholmodFactor->is_super ? cholmod_copy_factor(m_cholmodFactor, cc) : nullptr;
+  cholmod_factor* L = m_cholmodFactor->is_super ? copy : m_cholmodFactor;
   if (!L) return false;
   const int n = static_cast<int>(L->n);
   std::vector<int> position(n);  // row of P b that b's entry f lands in
@@ -493,7 +496,7 @@ bool CholmodFactor::forward_solves(const Eigen::SparseMatrix<double>& columns,
   cholmod_free_dense(&E, cc);
   cholmod_free_sparse(&bset, cc);
   cholmod_free_sparse(&xset, cc);
-  cholmod_free_factor(&L, cc);
+  if (copy) cholmod_free_factor(&copy, cc);
   return ok;
 }
 
@@ -505,7 +508,11 @@ bool CholmodFactor::inverse_block(const std::vector<int>& rows, Matrix& G) {
   std::vector<Eigen::Triplet<double>> ones;
   for (int a = 0; a < s; ++a) ones.emplace_back(rows[a], a, 1.0);
   units.setFromTriplets(ones.begin(), ones.end());
-  std::vector<std::vector<std::pair<int, double>>> by_row(n);  // W's rows: (column, value)
+  // W's columns as the solves give them, then its rows (the storage kept from G to G).
+  w_.column_start.assign(1, 0);
+  w_.column_rows.clear();
+  w_.column_values.clear();
+  w_.row_start.assign(n + 1, 0);  // the count of row k at k + 1 until the sums below
   // W^T W costs sum |row|^2 <= s^2 x (mean column length) multiply-adds; dense solves would
   // cost 4 nnz(L) per row. Where W is not sparse enough (thin strips: long elimination-tree
   // paths), give up after a few columns.
@@ -520,20 +527,43 @@ bool CholmodFactor::inverse_block(const std::vector<int>& rows, Matrix& G) {
     reach += count;
     if (a + 1 == std::min(s, kSample) && static_cast<double>(s) * s * reach / (a + 1) > budget) return false;
     for (int t = 0; t < count; ++t)
-      if (xv[xi[t]] != 0.0) {
-        auto& row = by_row[xi[t]];
-        pairs += 2.0 * row.size() + 1.0;
-        row.emplace_back(a, xv[xi[t]]);
+      if (const int k = xi[t]; xv[k] != 0.0) {
+        pairs += 2.0 * w_.row_start[k + 1] + 1.0;
+        ++w_.row_start[k + 1];
+        w_.column_rows.push_back(k);
+        w_.column_values.push_back(xv[k]);
       }
+    w_.column_start.push_back(static_cast<int>(w_.column_rows.size()));
     return pairs < budget;
   });
   if (!ok) return false;
-  G.setZero(s, s);
-  for (const auto& row : by_row)
-    for (const auto& [a, va] : row) {
-      double* column = &G(0, a);
-      for (const auto& [b, vb] : row) column[b] += va * vb;
+  // W by rows, each row's columns in increasing order.
+  for (int k = 0; k < n; ++k) w_.row_start[k + 1] += w_.row_start[k];
+  w_.next.assign(w_.row_start.begin(), w_.row_start.end() - 1);
+  w_.row_columns.resize(w_.column_rows.size());
+  w_.row_values.resize(w_.column_rows.size());
+  for (int a = 0; a < s; ++a)
+    for (int e = w_.column_start[a]; e < w_.column_start[a + 1]; ++e) {
+      const int at = w_.next[w_.column_rows[e]]++;
+      w_.row_columns[at] = a;
+      w_.row_values[at] = w_.column_values[e];
     }
+  // G = W^T W row by row of W (k increasing, the order of every entry's sum), its upper
+  // triangle only, then mirrored: G(a, b) would sum the same products w_kb w_ka in the same
+  // order, so the mirror is that sum to the last bit.
+  G.setZero(s, s);
+  for (int k = 0; k < n; ++k) {
+    const int* col = w_.row_columns.data() + w_.row_start[k];
+    const double* val = w_.row_values.data() + w_.row_start[k];
+    const int m = w_.row_start[k + 1] - w_.row_start[k];
+    for (int i = 0; i < m; ++i) {
+      double* column = &G(0, col[i]);
+      const double va = val[i];
+      for (int j = 0; j <= i; ++j) column[col[j]] += va * val[j];
+    }
+  }
+  for (int a = 0; a < s; ++a)
+    for (int b = 0; b < a; ++b) G(a, b) = G(b, a);
   return true;
 }
 

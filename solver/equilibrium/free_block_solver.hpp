@@ -49,6 +49,12 @@ class CholmodFactor : public Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<dou
   // factor: `use(column, rows of x, values of x, count)` sees each; false from it stops.
   bool forward_solves(const Eigen::SparseMatrix<double>& columns,
                       const std::function<bool(int, const int*, const double*, int)>& use);
+  // inverse_block's W = L^-1 P E by columns, then by rows (row k's entries from row_start[k]),
+  // kept from call to call: G is formed afresh at every real solve on a curved obstacle.
+  struct SolvedColumns {
+    std::vector<int> column_start, column_rows, row_start, next, row_columns;
+    std::vector<double> column_values, row_values;
+  } w_;
 };
 
 class FreeBlockSolver {
