@@ -154,8 +154,10 @@ class ContinuumBody final : public Body {
 
  private:
   ShapeGradients element_displacements(const Vector& q, int e) const;
-  // Finite kinematics: element e's force fe and tangent Ke (if asked) at q, u its work storage.
-  void element_kernel(const Vector& q, int e, ShapeGradients& u, Vector& fe, Matrix* Ke) const;
+  // Finite kinematics: element e's force fe and tangent Ke (if asked) at q, u and base_u its
+  // work storage; `base`: the tangent's stress base (TangentSink::stress_base), or null.
+  void element_kernel(const Vector& q, int e, ShapeGradients& u, Vector& fe, Matrix* Ke, const Vector* base,
+                      ShapeGradients& base_u) const;
   // Adds fe into `force` at element e's dofs and hands Ke to the sink.
   void add_element(int e, const Vector& fe, const Matrix& Ke, Vector& force, TangentSink* tangent) const;
   // internal_force's finite kinematics with the kernels over parallel_ (storage in blocks_).
@@ -205,7 +207,8 @@ class ContinuumBody final : public Body {
   struct ElementBlocks {
     std::vector<Vector> fe;
     std::vector<Matrix> Ke;
-    std::vector<ShapeGradients> u;  // the element's displacements
+    std::vector<ShapeGradients> u;       // the element's displacements
+    std::vector<ShapeGradients> base_u;  // and at the tangent's stress base
   };
   mutable std::mutex blocks_mutex_;
   mutable ElementBlocks blocks_;

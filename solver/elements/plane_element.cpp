@@ -272,10 +272,13 @@ namespace {
 template <int N, int R>
 void total_lagrangian_fixed(const std::vector<ElementPoint>& points, const ShapeGradients& u_dynamic,
                             const PlaneMaterial& material, Vector& fe_out, Matrix* Ke_out, const PointLaw& law,
-                            const HoopLaw& hoop_law) {
+                            const HoopLaw& hoop_law, const ShapeGradients* base_u) {
   constexpr int M = 2 * N;
   using Nodes2 = Eigen::Matrix<double, N, 2>;
   const Nodes2 u = u_dynamic;
+  const bool linearized = base_u && Ke_out;
+  Nodes2 h = Nodes2::Zero();  // the displacement from the stress's base
+  if (linearized) h = u - *base_u;
   Eigen::Matrix<double, M, 1> fe = Eigen::Matrix<double, M, 1>::Zero();
   Eigen::Matrix<double, M, M> Ke;
   if (Ke_out) Ke.setZero();
@@ -304,6 +307,22 @@ void total_lagrangian_fixed(const std::vector<ElementPoint>& points, const Shape
     Mat2 S;
     S << S_voigt[0], S_voigt[2], S_voigt[2], S_voigt[1];
     const Mat2 P = F * S;  // first Piola-Kirchhoff stress
+    // The geometric stiffness's stress: S, or that of the linearized strain E - H^T H / 2.
+    Mat2 S_g = S;
+    double S33_g = S33;
+    if (linearized) {
+      const Mat2 H = h.transpose() * dN;
+      const Mat2 dE = 0.5 * H.transpose() * H;
+      Eigen::Matrix<double, R, 1> dE_voigt;
+      dE_voigt.template head<3>() << dE(0, 0), dE(1, 1), 2 * dE(0, 1);
+      if constexpr (R == 4) {
+        const double hoop = p.N.dot(h.col(0)) / p.radius;
+        dE_voigt[3] = 0.5 * hoop * hoop;
+      }
+      const Eigen::Matrix<double, R, 1> dS = D * dE_voigt;
+      S_g << S(0, 0) - dS[0], S(0, 1) - dS[2], S(1, 0) - dS[2], S(1, 1) - dS[1];
+      if constexpr (R == 4) S33_g = S33 - dS[3];
+    }
     // dE = B du: rows E11, E22, 2 E12 (and E33 in axisymmetry); column pair of node a.
     for (int a = 0; a < N; ++a) {
       const double gx = dN(a, 0), gy = dN(a, 1);
@@ -326,13 +345,13 @@ void total_lagrangian_fixed(const std::vector<ElementPoint>& points, const Shape
       }
     // Geometric stiffness dN_a . S dN_b on both components (and the hoop term S33 N_a N_b / R^2).
     for (int b = 0; b < N; ++b) {
-      const double sx = p.dV * (S(0, 0) * dN(b, 0) + S(0, 1) * dN(b, 1));
-      const double sy = p.dV * (S(1, 0) * dN(b, 0) + S(1, 1) * dN(b, 1));
+      const double sx = p.dV * (S_g(0, 0) * dN(b, 0) + S_g(0, 1) * dN(b, 1));
+      const double sy = p.dV * (S_g(1, 0) * dN(b, 0) + S_g(1, 1) * dN(b, 1));
       for (int a = 0; a <= b; ++a) {
         const double g = dN(a, 0) * sx + dN(a, 1) * sy;
         Ke(2 * a, 2 * b) += g;
         Ke(2 * a + 1, 2 * b + 1) += g;
-        if constexpr (R == 4) Ke(2 * a, 2 * b) += p.dV * S33 * p.N[a] * p.N[b] / (p.radius * p.radius);
+        if constexpr (R == 4) Ke(2 * a, 2 * b) += p.dV * S33_g * p.N[a] * p.N[b] / (p.radius * p.radius);
       }
     }
   }
@@ -346,26 +365,27 @@ void total_lagrangian_fixed(const std::vector<ElementPoint>& points, const Shape
 template <int N>
 void total_lagrangian_nodes(const std::vector<ElementPoint>& points, const ShapeGradients& u,
                             const PlaneMaterial& material, Vector& fe, Matrix* Ke, const PointLaw& law,
-                            const HoopLaw& hoop_law) {
-  if (points.front().radius > 0) total_lagrangian_fixed<N, 4>(points, u, material, fe, Ke, law, hoop_law);
-  else total_lagrangian_fixed<N, 3>(points, u, material, fe, Ke, law, hoop_law);
+                            const HoopLaw& hoop_law, const ShapeGradients* base_u) {
+  if (points.front().radius > 0) total_lagrangian_fixed<N, 4>(points, u, material, fe, Ke, law, hoop_law, base_u);
+  else total_lagrangian_fixed<N, 3>(points, u, material, fe, Ke, law, hoop_law, base_u);
 }
 
 }  // namespace
 
 void total_lagrangian(const std::vector<ElementPoint>& points, const ShapeGradients& u, const PlaneMaterial& material,
-                      Vector& fe, Matrix* Ke, const PointLaw& law, const HoopLaw& hoop_law) {
+                      Vector& fe, Matrix* Ke, const PointLaw& law, const HoopLaw& hoop_law,
+                      const ShapeGradients* base_u) {
   switch (u.rows()) {
     case 3:
-      return total_lagrangian_nodes<3>(points, u, material, fe, Ke, law, hoop_law);
+      return total_lagrangian_nodes<3>(points, u, material, fe, Ke, law, hoop_law, base_u);
     case 4:
-      return total_lagrangian_nodes<4>(points, u, material, fe, Ke, law, hoop_law);
+      return total_lagrangian_nodes<4>(points, u, material, fe, Ke, law, hoop_law, base_u);
     case 6:
-      return total_lagrangian_nodes<6>(points, u, material, fe, Ke, law, hoop_law);
+      return total_lagrangian_nodes<6>(points, u, material, fe, Ke, law, hoop_law, base_u);
     case 8:
-      return total_lagrangian_nodes<8>(points, u, material, fe, Ke, law, hoop_law);
+      return total_lagrangian_nodes<8>(points, u, material, fe, Ke, law, hoop_law, base_u);
     case 9:
-      return total_lagrangian_nodes<9>(points, u, material, fe, Ke, law, hoop_law);
+      return total_lagrangian_nodes<9>(points, u, material, fe, Ke, law, hoop_law, base_u);
   }
   throw std::logic_error("total_lagrangian: no element of " + std::to_string(u.rows()) + " nodes");
 }

@@ -97,8 +97,13 @@ inline void green_lagrange_rows(BMatrix& B, int a, const Mat2& F, double gx, dou
 using PointLaw = std::function<MaterialResponse(int point, const Mat2& E)>;
 // `hoop_law`, if given, answers for `material` at axisymmetric points from E and the hoop E33.
 using HoopLaw = std::function<HoopResponse(int point, const Mat2& E, double E33)>;
+// `base_u`, if given with Ke: the element's displacements at the state the geometric stiffness's
+// stress is linearized about (TangentSink::stress_base): Ke takes S - D dE, dE = H^T H / 2 with H
+// the gradient of u - base_u, the stress of E(base) + dE/du (u - base_u) where S is linear in E
+// (Saint Venant-Kirchhoff), to first order otherwise; axisymmetric: E33 likewise. fe is at u.
 void total_lagrangian(const std::vector<ElementPoint>& points, const ShapeGradients& u, const PlaneMaterial& material,
-                      Vector& fe, Matrix* Ke, const PointLaw& law = {}, const HoopLaw& hoop_law = {});
+                      Vector& fe, Matrix* Ke, const PointLaw& law = {}, const HoopLaw& hoop_law = {},
+                      const ShapeGradients* base_u = nullptr);
 
 // F-bar in plane strain: the law sees F_bar = (J0 / J)^(1/2) F, whose in-plane determinant is
 // J0 = det F at the element's centre (`centre`), so that every point changes volume as the

@@ -78,6 +78,8 @@ void RigidHubs::internal_force(const Vector& q, Vector& force, TangentSink* tang
   Vector f = Vector::Zero(full.size());
   Triplets inner_tangent;  // mapped through the links below, entry by entry
   TripletSink inner_sink(inner_tangent);
+  const Vector base = tangent && tangent->stress_base ? expand(*tangent->stress_base) : Vector();
+  if (base.size()) inner_sink.stress_base = &base;
   inner_->internal_force(full, f, tangent ? &inner_sink : nullptr);
   Link l[2];
   for (int d = 0; d < f.size(); ++d)

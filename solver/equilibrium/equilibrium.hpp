@@ -194,6 +194,9 @@ class Equilibrium {
   // (compliance.cpp: newton_factor_serves).
   long newton_factor_solve_ = -1;
   Vector newton_factor_q_;
+  // The last state a Newton solve converged at: the stress base of the next solve's first
+  // tangent (newton.cpp, the linearized stress).
+  Vector converged_q_;
   bool newton_factor_serves(const EquilibriumState& state, int surface_dofs) const;
   // The factorization G (and predicted_change) comes from: lu_ (g_from_newton_, valid during
   // the real solve g_solve_ only) or body_lu_.

@@ -35,6 +35,7 @@ TangentSink& FreeBlockSolver::assemble(const std::vector<int>& free_index, int f
   recorded_dofs_.clear();
   recorded_values_.clear();
   if (following_) std::fill(matrix_.valuePtr(), matrix_.valuePtr() + matrix_.nonZeros(), 0.0);
+  assembly_.stress_base = nullptr;  // the exact tangent unless the caller says otherwise
   return assembly_;
 }
 

@@ -108,6 +108,8 @@ class Body {
     // stiffness is its tension's, which the stiffness of contact forces turning with a curved
     // obstacle may nearly cancel (docs/algorithm.md#the-contact-compliance).
     bool reference_stiffness = true;
+    // Its tangent takes TangentSink::stress_base (a finite-strain continuum).
+    bool linearized_stress = false;
   };
   virtual Traits traits() const { return {}; }
   // A section of a body of revolution (x = r, y = z: the axis): of its rigid motions only the

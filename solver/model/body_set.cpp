@@ -58,6 +58,8 @@ void BodySet::internal_force(const Vector& q, Vector& force, TangentSink* tangen
     const int n = parts_[b]->dof_count(), o = dof_offset_[b];
     Vector f = Vector::Zero(n);
     OffsetSink part_tangent(tangent, o);
+    const Vector base = tangent && tangent->stress_base ? Vector(part_q(*tangent->stress_base, b)) : Vector();
+    if (base.size()) part_tangent.stress_base = &base;
     parts_[b]->internal_force(part_q(q, b), f, tangent ? &part_tangent : nullptr);
     force.segment(o, n) += f;
   }
@@ -131,14 +133,22 @@ Vector BodySet::rigid_rotation() const {
 }
 
 Body::Traits BodySet::traits() const {
-  Traits t{false, false, true, true};
+  Traits t{false, false, true, true, true};
+  bool changing = false;  // some part's tangent changes
   for (const auto& p : parts_) {
     const Traits pt = p->traits();
+    // Newton's first correction is taken in full only where every changing tangent takes the
+    // linearized stress (newton.cpp).
+    if (!pt.constant_tangent) {
+      changing = true;
+      t.linearized_stress &= pt.linearized_stress;
+    }
     t.geometric_nonlinearity |= pt.geometric_nonlinearity;
     t.plasticity |= pt.plasticity;
     t.constant_tangent &= pt.constant_tangent;
     t.reference_stiffness &= pt.reference_stiffness;
   }
+  t.linearized_stress &= changing;
   return t;
 }
 

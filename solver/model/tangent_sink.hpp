@@ -19,6 +19,10 @@ class TangentSink {
   virtual void add(int row, int col, double value) = 0;
   // An element's dense block: block(i, j) at (dofs[i], dofs[j]), row by row.
   virtual void add_block(const int* dofs, const Matrix& block) = 0;
+  // Where set, a body whose traits say linearized_stress forms its geometric stiffness from the
+  // stress of the strain linearized about this state (its own dofs), not from the stress at q
+  // (MIP Newton, docs/algorithm.md#newtons-tangent-the-linearized-stress); the force is at q.
+  const Vector* stress_base = nullptr;
 };
 
 // Records the entries as triplets, appended to `out`.

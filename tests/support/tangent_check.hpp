@@ -25,10 +25,12 @@ inline Vector internal_force(const Body& body, const Vector& q) {
   return f;
 }
 
-inline Matrix assembled_tangent(const Body& body, const Vector& q, Vector& f) {
+// `stress_base`: the state the geometric stiffness's stress is linearized about (Newton's).
+inline Matrix assembled_tangent(const Body& body, const Vector& q, Vector& f, const Vector* stress_base = nullptr) {
   f = Vector::Zero(q.size());
   Triplets t;
   TripletSink sink(t);
+  sink.stress_base = stress_base;
   body.internal_force(q, f, &sink);
   Eigen::SparseMatrix<double> K(q.size(), q.size());
   K.setFromTriplets(t.begin(), t.end());

@@ -192,6 +192,29 @@ TEST_P(ContinuumFinite, AgreesWithLinearForSmallStrain) {
   }
 }
 
+// Newton's linearized stress (docs/algorithm.md#newtons-tangent-the-linearized-stress): the
+// tangent about a stress base b differs from the exact one only by the geometric stiffness of
+// the stress of -H^T H / 2, H the gradient of q - b: not at all where b = q, and by exactly a
+// quarter where q - b halves for Saint Venant-Kirchhoff (its stress is linear in E); symmetric,
+// and the force stays the exact one.
+TEST_P(ContinuumFinite, LinearizedStressChangesTheTangentAtSecondOrder) {
+  const Variant v = GetParam();
+  const PlaneMesh mesh = distorted_patch(element_shape(v.element));
+  const ContinuumBody body(mesh, mesh.sets.at("bottom"), {std::make_shared<HookeMaterial>(1000.0, 0.3, v.analysis)},
+                           ContinuumOptions{v.element, v.kinematics, v.analysis, 0.5});
+  const Vector q = random_state(body, 0.05, 6), d = random_state(body, 0.05, 7);
+  Vector f, f_base;
+  const Matrix K = assembled_tangent(body, q, f);
+  EXPECT_EQ(assembled_tangent(body, q, f_base, &q), K);
+  const Vector far = q - d, near = q - 0.5 * d;
+  const Matrix change = assembled_tangent(body, q, f_base, &far) - K;
+  EXPECT_EQ(f_base, f);
+  const Matrix quarter = assembled_tangent(body, q, f_base, &near) - K;
+  EXPECT_GT(change.norm(), 1e-4 * K.norm());
+  EXPECT_LT((change - 4 * quarter).norm(), 1e-10 * change.norm());
+  EXPECT_LT((change - change.transpose()).norm(), 1e-12 * change.norm());
+}
+
 // t3, t6, q4, q8 and q9 in both analyses and kinematics; q4_bbar (linear plane strain only).
 std::vector<Variant> variants(bool linear, bool finite) {
   std::vector<Variant> v;
