@@ -128,9 +128,13 @@ class CevStep : public StepSolver {
       halvings += h;
       double change = 0.0;
       for (const Candidate& c : problem_.candidates) change = std::max(change, std::abs(next[c.eta] - pl[c.eta]));
-      sl += model_change(dense, next - pl);
-      pl = next;
-      project_to_cone(problem_, pl);
+      // s moves with the projected force: the error below is the model's at what is returned
+      // (with s of the unprojected force it passed the strip on a cylinder's updates whose
+      // projection moved s by 2e-3, and the real solve found that error).
+      Vector projected = next;
+      project_to_cone(problem_, projected);
+      sl += model_change(dense, projected - pl);
+      pl = std::move(projected);
       if (contact_error(problem_, pl, sl, friction_bounds(problem_, pl), out_.state.enabled).norm2 <= target ||
           change == 0.0)
         break;
