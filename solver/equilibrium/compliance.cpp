@@ -33,7 +33,7 @@ void Equilibrium::extend_surface_compliance(const std::vector<int>& added) {
   }
   const int m = static_cast<int>(surface_free_.size());
   counters_.compliance_columns += m - m0;
-  const bool sparse_solves = m0 == 0 && !g_from_newton_ && body_lu_.inverse_block(surface_free_, g_);
+  const bool sparse_solves = m0 == 0 && !g_from_newton_ && body_lu_.inverse_block(surface_free_, g_, params_.parallel);
   counters_.dissected_factorizations = body_lu_.dissected_factorizations();
   if (sparse_solves) return;  // a new G: sparse solves
   g_.conservativeResize(m, m);

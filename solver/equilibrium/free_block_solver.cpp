@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 
 namespace grip {
 
@@ -405,7 +406,7 @@ bool partial_solves_pay(const cholmod_factor* L, const std::vector<int>& rows) {
 
 }  // namespace
 
-bool FreeBlockSolver::inverse_block(const std::vector<int>& rows, Matrix& G) {
+bool FreeBlockSolver::inverse_block(const std::vector<int>& rows, Matrix& G, const ParallelFor& parallel) {
   if (!ok_ || !symmetric_) return false;
   if (split_) {  // K^-1 is block diagonal: each body's rows from its own factor
     std::vector<std::vector<int>> local(parts_.size()), at(parts_.size());
@@ -428,7 +429,7 @@ bool FreeBlockSolver::inverse_block(const std::vector<int>& rows, Matrix& G) {
   }
   std::vector<int> ordered_rows(rows.size());
   for (size_t a = 0; a < rows.size(); ++a) ordered_rows[a] = order_.indices()[rows[a]];
-  if (llt_.inverse_block(ordered_rows, G)) return true;
+  if (llt_.inverse_block(ordered_rows, G, parallel)) return true;
   // More rows only lengthen the partial solves against the same factor's pattern.
   if (dissected_fails_at_ && rows.size() >= dissected_fails_at_) return false;
   if (!dissected_analysed_) {
@@ -438,7 +439,7 @@ bool FreeBlockSolver::inverse_block(const std::vector<int>& rows, Matrix& G) {
   }
   ++dissected_factorizations_;
   dissected_.factorize(matrix_);
-  if (dissected_.info() == Eigen::Success && dissected_.inverse_block(rows, G)) {
+  if (dissected_.info() == Eigen::Success && dissected_.inverse_block(rows, G, parallel)) {
     // From now on the block's own factor takes this order: one factorization serves the solves
     // and G (the dissected order costs the solves little more on a thin strip's block).
     if (!llt_dissected_) llt_analysed_ = false;
@@ -501,7 +502,7 @@ bool CholmodFactor::forward_solves(const Eigen::SparseMatrix<double>& columns,
   return ok;
 }
 
-bool CholmodFactor::inverse_block(const std::vector<int>& rows, Matrix& G) {
+bool CholmodFactor::inverse_block(const std::vector<int>& rows, Matrix& G, const ParallelFor& parallel) {
   if (!m_cholmodFactor || !partial_solves_pay(m_cholmodFactor, rows)) return false;
   const cholmod_factor* L = m_cholmodFactor;
   const int n = static_cast<int>(L->n), s = static_cast<int>(rows.size());
@@ -551,18 +552,40 @@ bool CholmodFactor::inverse_block(const std::vector<int>& rows, Matrix& G) {
     }
   // G = W^T W row by row of W (k increasing, the order of every entry's sum), its upper
   // triangle only, then mirrored: G(a, b) would sum the same products w_kb w_ka in the same
-  // order, so the mirror is that sum to the last bit.
+  // order, so the mirror is that sum to the last bit. Through `parallel`, tasks take column
+  // ranges of equal work (entry i of a row costs column col[i] i + 1 products): each entry is
+  // summed by one task in the same order, so G is the same to the last bit on any thread count.
   G.setZero(s, s);
-  for (int k = 0; k < n; ++k) {
-    const int* col = w_.row_columns.data() + w_.row_start[k];
-    const double* val = w_.row_values.data() + w_.row_start[k];
-    const int m = w_.row_start[k + 1] - w_.row_start[k];
-    for (int i = 0; i < m; ++i) {
-      double* column = &G(0, col[i]);
-      const double va = val[i];
-      for (int j = 0; j <= i; ++j) column[col[j]] += va * val[j];
+  std::vector<int> bounds{0, s};
+  if (parallel && s >= kParallelColumns) {
+    std::vector<double> work(s, 0.0);
+    for (int k = 0; k < n; ++k)
+      for (int i = 0; i < w_.row_start[k + 1] - w_.row_start[k]; ++i)
+        work[w_.row_columns[w_.row_start[k] + i]] += i + 1;
+    const double total = std::accumulate(work.begin(), work.end(), 0.0);
+    bounds.assign(1, 0);
+    double sum = 0.0;
+    for (int a = 0; a < s; ++a) {
+      sum += work[a];
+      if (sum >= total * static_cast<double>(bounds.size()) / kSumTasks && a + 1 < s) bounds.push_back(a + 1);
     }
+    bounds.push_back(s);
   }
+  run_each(parallel, static_cast<int>(bounds.size()) - 1, [&](int task) {
+    const int lo = bounds[task], hi = bounds[task + 1];
+    for (int k = 0; k < n; ++k) {
+      const int* col = w_.row_columns.data() + w_.row_start[k];
+      const double* val = w_.row_values.data() + w_.row_start[k];
+      const int m = w_.row_start[k + 1] - w_.row_start[k];
+      // The row's columns increase: this task's entries are a contiguous range of it.
+      const int first = static_cast<int>(std::lower_bound(col, col + m, lo) - col);
+      for (int i = first; i < m && col[i] < hi; ++i) {
+        double* column = &G(0, col[i]);
+        const double va = val[i];
+        for (int j = 0; j <= i; ++j) column[col[j]] += va * val[j];
+      }
+    }
+  });
   for (int a = 0; a < s; ++a)
     for (int b = 0; b < a; ++b) G(a, b) = G(b, a);
   return true;

@@ -37,8 +37,8 @@ class CholmodFactor : public Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<dou
   // K^-1 on the given rows, |rows|^2, as W^T W with W = L^-1 P E: each column of W is a sparse
   // forward solve that touches only the elimination-tree path of its row (CHOLMOD's partial
   // solve, on a simplicial copy of the factor), where a dense solve costs 2 nnz(L) flops per
-  // row. False where CHOLMOD fails.
-  bool inverse_block(const std::vector<int>& rows, Matrix& G);
+  // row. False where CHOLMOD fails. W^T W's sums run through `parallel` for many rows.
+  bool inverse_block(const std::vector<int>& rows, Matrix& G, const ParallelFor& parallel = {});
   // t_j^T K^-1 t_j = |L^-1 P t_j|^2 for every column of t (free dofs x columns), by partial
   // forward solves. False where CHOLMOD fails, or (with `max_mean_reach` > 0) where the first
   // columns' solves reach more than that many rows on average (long elimination-tree paths).
@@ -51,6 +51,9 @@ class CholmodFactor : public Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<dou
                       const std::function<bool(int, const int*, const double*, int)>& use);
   // inverse_block's W = L^-1 P E by columns, then by rows (row k's entries from row_start[k]),
   // kept from call to call: G is formed afresh at every real solve on a curved obstacle.
+  // G's sums in tasks of equal work from this many rows on (a thread's start is tens of
+  // microseconds; G over 64 rows is a few).
+  static constexpr int kParallelColumns = 64, kSumTasks = 4;
   struct SolvedColumns {
     std::vector<int> column_start, column_rows, row_start, next, row_columns;
     std::vector<double> column_values, row_values;
@@ -91,7 +94,7 @@ class FreeBlockSolver {
   // beam's or a membrane's band: its analysis and factorization were 21 % of the beam's time).
   // Where it paid, the block's own later factorizations (a changing tangent's) take that order,
   // and G comes from them without a second one.
-  bool inverse_block(const std::vector<int>& rows, Matrix& G);
+  bool inverse_block(const std::vector<int>& rows, Matrix& G, const ParallelFor& parallel = {});
   // t_j^T K^-1 t_j for every column of t (free dofs x columns) where K is Cholesky-factorized
   // (partial forward solves; on a nested-dissection factorization where the body's own gives
   // long elimination-tree paths, as for G); an empty vector otherwise.

@@ -3,6 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
+#include <functional>
+#include <thread>
+#include <vector>
 
 #include "solver/equilibrium/free_block_solver.hpp"
 
@@ -37,8 +40,9 @@ TEST_P(InverseBlock, SparseForwardSolvesEqualFullSolves) {
   factor.compute(K);
   ASSERT_EQ(factor.info(), Eigen::Success);
   ASSERT_EQ(factor.factor()->is_super != 0, GetParam() == CHOLMOD_SUPERNODAL);
-  std::vector<int> rows;  // one edge of the grid, as a contact surface
-  for (int i = 0; i < nx; ++i) rows.push_back(i * ny);
+  std::vector<int> rows;                                // two edges of the grid, as a contact surface (more rows than
+  for (int i = 0; i < nx; ++i) rows.push_back(i * ny);  // G's sums take to run in tasks)
+  for (int i = 0; i < nx; ++i) rows.push_back(i * ny + ny - 1);
   Matrix E = Matrix::Zero(K.rows(), rows.size());
   for (size_t a = 0; a < rows.size(); ++a) E(rows[a], a) = 1.0;
   const Matrix X = factor.solve(E);
@@ -56,6 +60,16 @@ TEST_P(InverseBlock, SparseForwardSolvesEqualFullSolves) {
   Matrix again;
   ASSERT_TRUE(factor.inverse_block(rows, again));
   EXPECT_EQ((again - G).norm(), 0.0);
+  // Its sums in tasks on threads of their own: each entry is summed by one task in the same
+  // order, so G is the same to the last bit.
+  const ParallelFor on_threads = [](int count, const std::function<void(int)>& task) {
+    std::vector<std::thread> threads;
+    for (int k = 0; k < count; ++k) threads.emplace_back(task, k);
+    for (auto& t : threads) t.join();
+  };
+  Matrix parallel;
+  ASSERT_TRUE(factor.inverse_block(rows, parallel, on_threads));
+  EXPECT_EQ((parallel - G).norm(), 0.0);
 }
 
 INSTANTIATE_TEST_SUITE_P(Kinds, InverseBlock, ::testing::Values(CHOLMOD_SUPERNODAL, CHOLMOD_SIMPLICIAL),
