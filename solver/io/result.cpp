@@ -61,6 +61,7 @@ json step_finished_event(const Problem& problem, const StepRecord& rec, const Ou
     j["failure"] = failure_json(rec.failure, rec.reason, rec.index);
   }
   if (!rec.warning.empty()) j["warning"] = rec.warning;
+  if (!rec.notes.empty()) j["notes"] = rec.notes;
   if (!output.quantities.empty() && rec.converged) j["outputs"] = quantity_values(problem, rec, output.quantities);
   return j;
 }
@@ -315,7 +316,6 @@ json step_json(const Problem& problem, const StepRecord& rec, const OutputOption
                  {"normal_turn", c.normal_turn},
                  {"obstacle_motion", c.obstacle_motion},
                  {"boundary_points", c.boundary_points}};
-  if (!rec.notes.empty()) j["notes"] = rec.notes;
   if (rec.converged)
     j["equilibrium"] = {{"relative_residual", rec.state.relative_residual}, {"at_round_off_floor", rec.state.at_floor}};
   if (!rec.epsilon_used.empty()) j["epsilon"] = rec.epsilon_used;

@@ -69,6 +69,17 @@ bool is_coulomb_loop(const ContactParams& c) {
          c.acceleration == kAccelerationInfinity;
 }
 
+// cev's default loop (given or held real solves) takes ssn's semismooth Newton as the last
+// resort of an increment: the same tolerance, budgets and contact error, q and p moved together.
+bool takes_semismooth_last_resort(const ContactParams& c) {
+  return c.method == ContactMethod::cev && c.loop == ContactLoop::inner && c.friction_loop == FrictionLoop::inner;
+}
+
+ContactParams semismooth(ContactParams c) {
+  c.method = ContactMethod::ssn;
+  return c;
+}
+
 // Adds an attempt's counts and events to the step's record.
 void count_attempt(StepRecord& rec, const StepOutcome& out) {
   rec.passes += out.passes;
@@ -164,6 +175,12 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
     // attempts again with Newton from the last converged state (`chain`: where they began).
     bool from_converged = false;
     std::tuple<double, int, bool> chain{increment, depth, from_previous_force};
+    // The last resort, after those failed too: the increment's attempts by ssn's semismooth Newton
+    // from the last converged state (cev's default loop only); `cev_failed` says why cev stopped.
+    bool by_ssn = false;
+    std::string cev_failed;
+    FailureKind cev_failure = FailureKind::none;
+    const ContactParams ssn_params = semismooth(params.contact);
     LoadFactors probed;  // the last target whose friction limit was decided
     // After an update of the body's multipliers: the increment again from its converged state.
     std::optional<std::pair<Vector, Vector>> again;
@@ -183,9 +200,9 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
                                             : Vector(q + (q - q_before) * ratio);
       // The contact forces start from the same extrapolation (the strategies bring it back
       // into the cone): a step then starts near its answer, not a whole increment away.
-      Vector p_guess = repeat                                       ? again->second
-                       : from_previous_force || !extrapolate_forces ? p
-                                                                    : Vector(p + (p - p_before) * ratio);
+      Vector p_guess = repeat                                                 ? again->second
+                       : from_previous_force || by_ssn || !extrapolate_forces ? p
+                                                                              : Vector(p + (p - p_before) * ratio);
       const bool extrapolated = !repeat && p_guess != p;
       again.reset();
       // Rigid amplitudes not extrapolated follow the supports: a pin left where it was turns a
@@ -223,8 +240,8 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
         ++rec.cuts;
         continue;
       }
-      StepOutcome out = solve_contact_step(*eq, guess, p_guess, p, params.contact, step, observer.iteration,
-                                           observer.stop_requested, v_first);
+      StepOutcome out = solve_contact_step(*eq, guess, p_guess, p, by_ssn ? ssn_params : params.contact, step,
+                                           observer.iteration, observer.stop_requested, v_first);
       count_attempt(rec, out);
       bool refused = false;  // converged, but the step checks refused the state
       if (out.converged) {
@@ -313,7 +330,7 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
         // default's own attempt, from the compliance of its previous step, stopped 1.3e-4 away
         // in the squeeze force. Run once a target (a retry from the previous force has the same
         // target); after cev default's own attempt only where that attempt shows the limit.
-        if (!refused && !out.stopped && problem.rigid.count() && target != probed &&
+        if (!refused && !out.stopped && !by_ssn && problem.rigid.count() && target != probed &&
             (!is_coulomb_loop(params.contact) ||
              !friction_limit_exceeded(problem, out.state, out.p, out.tau, target).empty())) {
           probed = target;
@@ -362,13 +379,35 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
           std::tie(increment, depth, from_previous_force) = chain;
           continue;
         }
+        // Those failed too: ssn's semismooth Newton from the last converged state, the increment's
+        // attempts once more (its own cuts). Its Newton moves q and p together, the plate holding
+        // the pressing points, where cev's solves under given (or held) forces pass a limit point
+        // of the body's own (the filleted bulging block, docs/verification.md). Only here: inside
+        // cev's attempts it would take over what a cut recovers (the beam on a cylinder), and
+        // where cev converges nothing changes.
+        if (depth >= params.max_cuts && !out.stopped && !out.definitive && !spent && from_converged && !by_ssn &&
+            takes_semismooth_last_resort(params.contact)) {
+          cev_failed = out.reason + " (after " + std::to_string(depth) + " cuts of the increment)";
+          cev_failure = out.failure;
+          rec.notes.push_back("cev failed from the last converged state as well (" + cev_failed +
+                              "): the increment by ssn's semismooth Newton from the last converged state");
+          by_ssn = true;
+          std::tie(increment, depth, from_previous_force) = chain;
+          continue;
+        }
         if (depth >= params.max_cuts || out.stopped || out.definitive || spent) {
           rec.failure = out.failure;
           rec.reason = out.reason;
           // A stop names its cause where the caller gives one (the service: a job limit, a dismissal).
           if (out.stopped && observer.stop_reason) std::tie(rec.failure, rec.reason) = observer.stop_reason();
           if (depth) rec.reason += " (after " + std::to_string(depth) + " cuts of the increment)";
-          if (from_converged) rec.reason += ", from the last converged state as well";
+          if (by_ssn && !out.stopped) {  // the step's kind is cev's, ssn's reason follows
+            rec.reason = cev_failed +
+                         ", from the last converged state as well; ssn's semismooth Newton from there: " + rec.reason;
+            rec.failure = cev_failure;
+          } else if (from_converged) {
+            rec.reason += ", from the last converged state as well";
+          }
           rec.p = out.p;
           rec.tau = out.tau;
           rec.state = std::move(out.state);
@@ -405,6 +444,7 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
       zeta = eq->zetas(out.state);
       updates = 0;
       from_converged = false;
+      by_ssn = false;
       chain = {increment, depth, from_previous_force};
       problem.body->commit(q);
       if (t == 1.0) {

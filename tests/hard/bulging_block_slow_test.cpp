@@ -32,13 +32,20 @@ Pressed press(int level, double mu, int steps = 30) {
   return p;
 }
 
+// The penalty strategy's run on level 0 with friction, which the cev runs are compared with: run once.
+const Pressed& penalty_coarse() {
+  static const Pressed p = press(0, 0.3);
+  return p;
+}
+
 void expect_all_sound(const Pressed& p, int steps = 30) {
   ASSERT_EQ(p.force.size(), static_cast<size_t>(steps));
   expect_sound(p);
 }
 
 TEST(BulgingBlockSlow, FilletedBlockCompressedThirtyPercentThroughFriction) {
-  const Pressed coarse = press(0, 0.3), middle = press(1, 0.3);
+  const Pressed& coarse = penalty_coarse();
+  const Pressed middle = press(1, 0.3);
   for (const Pressed* p : {&coarse, &middle}) {
     expect_all_sound(*p);
     // At 30 % the side has rolled over the fillet onto the plate.
@@ -92,12 +99,29 @@ void expect_like_penalty(const Pressed& cev, const Pressed& penalty, const char*
 
 TEST(BulgingBlockSlow, CevPassesTheDeadLoadLimitPointsWithTheSemismoothFallback) {
   const nlohmann::json held = {{"method", "cev"}, {"tolerance", 1e-9}, {"real_solve", "held"}};
-  const Pressed cev_held = press_block_with(0, 0.3, 30, held), penalty = press(0, 0.3);
+  const Pressed cev_held = press_block_with(0, 0.3, 30, held);
   ASSERT_TRUE(cev_held.completed) << cev_held.reason;
-  expect_like_penalty(cev_held, penalty, "cev with held solves");
+  expect_like_penalty(cev_held, penalty_coarse(), "cev with held solves");
   // At 30 % the side has rolled over the fillet onto the plate.
   EXPECT_GT(cev_held.reach.back(), kFilletEnd);
   EXPECT_GT(cev_held.length.back(), kFilletEnd + 0.05);
+}
+
+// cev by default (real solves under given contact forces) on level 0: its solves fall away from
+// the answer near the limit points of the body under given forces, and at 23 % every attempt fails,
+// from the extrapolated and the converged state, after 5 cuts each. There load stepping's last
+// resort, ssn's semismooth Newton from the last converged state (docs/algorithm.md#load-stepping-and-cuts),
+// takes the increment: measured, it ran at 23 and 28 %, and cev reaches 30 % (22 % without it),
+// its force within 3.9e-5 of the penalty strategy's. Asserted: it reaches 30 % with the last resort
+// taken, and the penalty runs' invariants and force at every step.
+TEST(BulgingBlockSlow, DefaultCevReachesThirtyPercentWithTheSemismoothLastResort) {
+  const Pressed cev = press_block(0, 0.3, 30, "cev");
+  ASSERT_TRUE(cev.completed) << cev.reason;
+  EXPECT_FALSE(cev.by_ssn.empty());
+  for (int step : cev.by_ssn) std::printf("ssn's semismooth Newton took an increment of step %d\n", step);
+  expect_like_penalty(cev, penalty_coarse(), "cev");
+  EXPECT_GT(cev.reach.back(), kFilletEnd);
+  EXPECT_GT(cev.length.back(), kFilletEnd + 0.05);
 }
 
 }  // namespace

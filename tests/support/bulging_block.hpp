@@ -78,6 +78,9 @@ struct Pressed {
   // penetration (penalty's error), the cuts of the step's increment.
   std::vector<double> force, length, reach, penetration;
   std::vector<int> cuts;
+  // The steps (from 1) where load stepping's last resort, ssn's semismooth Newton from the last
+  // converged state, took an increment (docs/algorithm.md#load-stepping-and-cuts).
+  std::vector<int> by_ssn;
   double travel_step = 0;  // the plate's travel in one step
   double bulge = 0;        // u_x of the side's middle (1, 0) at the last step
   double worst_volume = 0, balance = 0, cone = 0;
@@ -108,6 +111,10 @@ inline Pressed press_block_with(int level, double mu, int steps, const nlohmann:
     out.force.push_back(-contact.y());
     out.length.push_back(quantity_value(problem, rec, s.scene.output.quantities.at(0)));
     out.cuts.push_back(rec.cuts);
+    if (std::ranges::any_of(rec.notes, [](const std::string& n) {
+          return n.find("the increment by ssn's semismooth Newton") != std::string::npos;
+        }))
+      out.by_ssn.push_back(rec.index);
     out.balance = std::max(out.balance, (contact + reactions).norm() / -contact.y());
     for (int e = 0; e < body.element_count(); ++e)
       out.worst_volume = std::max(out.worst_volume, std::abs(body.element_volume_change(rec.state.q, e)));
