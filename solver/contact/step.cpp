@@ -36,6 +36,15 @@ constexpr long kProgressNewton = 200;
 // difference of, per contact component (bound_at).
 constexpr double kRoundOffGaps = 4.0;
 
+// The gaps within which a candidate joins the linear model (relevant_components), in units of
+// the body's length L: before the step has a gap change of its own (its first update, from the
+// extrapolated start: on the 150 x 4 strip points 0.03 L away close within it), and the least
+// once it has; and the multiple of a point's last gap change that it may move in the next
+// update (the changes shrink from update to update where the loop converges).
+constexpr double kFirstWindow = 0.05;
+constexpr double kReachFloor = 1e-3;
+constexpr double kReach = 3.0;
+
 double inf_norm(const Matrix& A) { return A.size() ? A.cwiseAbs().rowwise().sum().maxCoeff() : 0.0; }
 
 }  // namespace
@@ -297,6 +306,7 @@ bool StepSolver::approach_motion(Vector& dq) {
 }
 
 void StepSolver::accept(EquilibriumState s, const Vector& p) {
+  if (out_.state.s.size() == s.s.size()) s_before_ = std::move(out_.state.s);
   out_.state = std::move(s);
   out_.p = p;
   tol_ = bound_at(out_.state, &scale_, &at_round_off_);
@@ -573,16 +583,22 @@ Direction StepSolver::held_direction(const Compliance& C, const ContactError& e,
   }
 }
 
-// Every component with a force or a friction bound, the rigid amplitudes, and those of candidates penetrating or
-// within a few per cent of the body's length of their obstacle. The others are frozen (a far
-// point that the real solve brings into contact joins at the next iteration).
+// Every component with a force or a friction bound, the rigid amplitudes, and those of
+// candidates that may close in the coming update: penetrating, or with a gap within
+// max(kReachFloor x L, kReach x the gap's change over the last update) once the step has
+// accepted two states, within kFirstWindow x L before. The others are frozen (a point that the
+// real solve brings into contact anyway penetrates there, and joins at the next update).
 std::vector<int> StepSolver::relevant_components() const {
-  const double window = 0.05 * problem_.body->characteristic_length();
+  const double L = problem_.body->characteristic_length();
+  const Vector& s = out_.state.s;
+  const bool moved = s_before_.size() == s.size();
   std::vector<int> out;
   for (size_t i = 0; i < problem_.candidates.size(); ++i) {
     const Candidate& c = problem_.candidates[i];
     if (!out_.state.enabled[c.eta]) continue;
-    const bool near = out_.p[c.eta] < 0 || out_.tau[i] > 0 || out_.state.s[c.eta] > -window;
+    const double reach =
+        moved ? std::max(kReachFloor * L, kReach * std::abs(s[c.eta] - s_before_[c.eta])) : kFirstWindow * L;
+    const bool near = out_.p[c.eta] < 0 || out_.tau[i] > 0 || s[c.eta] > -reach;
     if (!near) continue;
     out.push_back(c.eta);
     if (c.xi >= 0 && out_.state.enabled[c.xi]) out.push_back(c.xi);

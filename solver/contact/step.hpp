@@ -194,6 +194,7 @@ class StepSolver {
   double scale_ = 0.0;           // the displacement it is relative to
   bool at_round_off_ = false;    // the round-off of the gaps set it, not tolerance x scale_
   Vector length_scales_;         // of the body's dofs (a rotation's: a length)
+  Vector s_before_;              // the gaps of the state accepted before out_.state (relevant_components)
   bool strict_balance_ = false;  // error_met tests the amplitudes' rows
   double balance_tol_ = 0.0;     // their bound, at the accepted state (accept)
   NewtonParams newton_base_;     // Newton's tests at the contact tolerance (couple_newton)

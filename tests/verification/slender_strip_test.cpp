@@ -177,6 +177,30 @@ TEST(SlenderStrip, WrapsOntoACylinderWithFriction) {
   }
 }
 
+// The linear model's rows (docs/algorithm.md, the contact compliance): after a step's first
+// update a candidate joins only within 3 x its own last gap change (at least 1e-3 L), not
+// within the 0.05 L window, which on this strip takes in most of the wrapped lower face (1 to 3
+// of its points press). Each G formed covers 2 free dofs per candidate in the rows: with the
+// window alone 3626 columns in 27 forms, 134 a form (1.9 x the 70 candidates within 0.05 L at
+// the last step: the test fails there); with the reach 2248, 83 a form (measured, 48 real solves
+// either way). The points that close from outside the rows are still caught: every step
+// converges with the contact conditions met at every candidate (expect_every_step_sound).
+TEST(SlenderStrip, ModelRowsFollowTheGapsReach) {
+  const auto s = solve_scene(testing::example_scene("strip-on-cylinder"));
+  expect_every_step_sound(s);
+  ASSERT_EQ(s.run.steps.size(), 20u);
+  const double L = s.scene.problem.body->characteristic_length();
+  int within = 0;
+  for (const Candidate& c : s.scene.problem.candidates) within += s.run.steps.back().state.s[c.eta] > -0.05 * L;
+  ASSERT_GT(s.run.counters.compliance_forms, 0);
+  const double per_form =
+      static_cast<double>(s.run.counters.compliance_columns) / static_cast<double>(s.run.counters.compliance_forms);
+  std::printf("%ld columns of G in %ld forms (%.1f a form), %d candidates within 0.05 L at the end, %ld real solves\n",
+              s.run.counters.compliance_columns, s.run.counters.compliance_forms, per_form, within,
+              s.run.counters.solves);
+  EXPECT_LT(per_form, 1.6 * within);
+}
+
 // The von Karman beam as a cantilever (L/d = 60, so that shear adds only 2e-4 to the
 // deflection): its tip deflection departs from the elastica like 0.45 theta^2 (1 % at
 // 0.15 rad), and the step record warns exactly where the largest rotation passes 0.15 rad.
