@@ -8,12 +8,13 @@ after a change, and GetFEM, in the same run.
 - hertz a/h 40 mu 0.3 and the flat with 2000 contact nodes of bench/scaling.py (the scenes of
   bench/results/scaling.md), which must be no slower.
 
-Each case runs RUNS times per program (one thread); the table keeps the best run by CPU
+Each case runs RUNS times per program (one thread, or --threads N: grip solve's default is the
+machine's cores, which its element kernels and G's sums use); the table keeps the best run by CPU
 seconds (user + system of the whole process: what the load of other work inflates least) and
 shows its wall seconds too. With --kernels-bench, grip_kernels_bench gives the CPU time of one
 numeric factorization of the strip's stiffness and of one assembly, beside the CPU time per
 Newton iteration. Usage:
-  bench/kernels.py --grip NEW [--before OLD] [--runs 3] [--getfem] [--kernels-bench BIN]
+  bench/kernels.py --grip NEW [--before OLD] [--runs 3] [--threads 1] [--getfem] [--kernels-bench BIN]
 Timing is a benchmark, never a test: no pass/fail here.
 """
 import argparse
@@ -74,6 +75,7 @@ def main():
     ap.add_argument("--grip", required=True)
     ap.add_argument("--before")
     ap.add_argument("--runs", type=int, default=3)
+    ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--getfem", action="store_true")
     ap.add_argument("--kernels-bench")
     args = ap.parse_args()
@@ -86,7 +88,7 @@ def main():
     print("|---|---|---|---|---|---|---|---|---|---|")
     for label, scene in cases:
         for name, grip in programs:
-            r = best([run_grip(grip, copy.deepcopy(scene)) for _ in range(args.runs)])
+            r = best([run_grip(grip, copy.deepcopy(scene), args.threads) for _ in range(args.runs)])
             c = r["counters"]
             split = (f"{c['factorizations']} ({c['newton_factorizations']} + {c['body_factorizations']} + "
                      f"{c['dissected_factorizations']})" if "newton_factorizations" in c else f"{c['factorizations']}")
