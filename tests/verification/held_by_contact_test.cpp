@@ -31,15 +31,15 @@ int node_at(const json& scene, const Vec2& x) {
 }
 
 // Measured with the budget raised (tests/hard held_by_contact_hard_test.cpp, where p* settles to
-// tau_tolerance): the paper's loop with n = 3 takes 830-2971 real solves a level on the beam lying
-// on a flat, uzawa 752-13966 (a fixed-alpha gradient on a reduced compliance of condition ~650):
-// over the 500 of a step. Both run in tests/hard (HeldByContactHardSlow), as does uzawa on the
-// disc (730).
+// tau_tolerance, at the bound tol x D): the paper's loop with n = 3 takes 1858-9084 real solves a
+// level on the beam lying on a flat, uzawa 34518-160872 (a fixed-alpha gradient on a reduced
+// compliance of condition ~650): over the 500 of a step. Both run in tests/hard
+// (HeldByContactHardSlow), as does uzawa on the disc (up to 2395 an attempt).
 const char* const kPaperBeamSlow =
-    "the paper's loop with n = 3 needs 830 to 2971 real solves a level on the beam lying on a flat, over the 500 of "
+    "the paper's loop with n = 3 needs 1858 to 9084 real solves a level on the beam lying on a flat, over the 500 of "
     "a step; it runs in tests/hard";
 const char* const kUzawaSlow =
-    "uzawa's fixed alpha needs 752 to 13966 real solves a level on the beam's compliance, and 730 on the disc, "
+    "uzawa's fixed alpha needs 34518 to 160872 real solves a level on the beam's compliance, and 2395 on the disc, "
     "over the 500 of a step (both run in tests/hard); on the block it stalls above the bound tol x D";
 
 // Penalty converges only where its answer meets the tolerance (docs/algorithm.md#tolerance): its
