@@ -70,7 +70,10 @@ std::vector<double> expect_press_fit(const Solved& s, const char* label, double 
       torque += kR * rec.p[problem.candidates[i].xi];
       const ContactState st = contact_state(problem, i, rec.p, rec.tau);
       stick += st == ContactState::stick;
-      slip += st == ContactState::slip;
+      // Slipping: on the friction bound and moving. The seam nodes, each in both halves' pairs,
+      // carry a force whose split between the pairs is not unique; a split may put one pair's
+      // part on its bound while the node does not move (a slip of 3e-12 mm).
+      slip += st == ContactState::slip && std::abs(rec.state.s[problem.candidates[i].xi]) > 1e-9 * kR;
     }
     // The rim's reaction moment balances the contact forces' on the hub (both about the origin,
     // at the reference positions as linear kinematics has them). Once the hub slips by an angle
@@ -92,7 +95,7 @@ std::vector<double> expect_press_fit(const Solved& s, const char* label, double 
       EXPECT_NEAR(torque, 0.0, 1e-6 * slip_torque);
     } else if (angle * stiffness < 0.9 * slip_torque) {
       // Turned less than the slip needs: the rings twist as one, the torque their torsion's.
-      // (At most the two seam nodes, each in both halves' pairs, share their force unevenly.)
+      // Only the points next to the seam slip (nodes 226, 536, 755, 1054: 3e-5 to 1.1e-4 mm).
       EXPECT_NEAR(torque, angle * stiffness, 0.01 * angle * stiffness) << "step " << k + 1;
       EXPECT_LE(slip, 4) << "step " << k + 1;
     } else {
