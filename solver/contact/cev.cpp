@@ -56,56 +56,13 @@ class CevStep : public StepSolver {
       int trials = 0;
       const std::optional<HeldPlan> held = held_plan(C, pl);
       const Update u = real_update(pl, du, trials, held ? &*held : nullptr);
-      if (u == Update::failed) return semismooth_fallback();
+      if (u == Update::failed) return;
       if (u == Update::retry) continue;
       ++m_;
       emit(trials, inner, halvings, 0, 1.0);
     }
     out_.converged = true;
     final_check();
-  }
-
-  // Where no trial along the model's prediction lowers the contact error (each fraction of the
-  // update, down to 2^-10, converges on another branch or fails: the body under given contact
-  // forces near a limit point of its own, the bulging block of docs/verification.md), ssn's
-  // semismooth Newton on the whole contact problem (q and p together, the contact's rows holding
-  // the pressing points) from the accepted state, judged by the same contact error; its outcome
-  // is the attempt's. Not after a spent budget or a stop. Only with held solves: under given forces
-  // a failed line search is also how the beam on a cylinder reaches a cut that recovers it
-  // (docs/algorithm.md#the-semismooth-fallback).
-  void semismooth_fallback() {
-    if (!held() || out_.failure != FailureKind::contact_stalled || out_.stopped || !budget_left()) return;
-    ContactParams ssn = params_;
-    ssn.method = ContactMethod::ssn;
-    const std::string why = out_.reason;
-    const long newton0 = eq_.counters().newton_iterations;
-    StepOutcome sub = solve_ssn_step(eq_, out_.state.q, out_.p, out_.p, ssn, step_, observer_, stop_);
-    // Its Newton iterations outside the oracle, and its events (which count its real solves and
-    // its Newton iterations; cev's rejected trials before it go in the attempt's closing event).
-    const long oracle = eq_.counters().newton_iterations - newton0;
-    own_newton_iterations_ += sub.newton_iterations - oracle;
-    newton_emitted_ += oracle;
-    out_.history.insert(out_.history.end(), sub.history.begin(), sub.history.end());
-    out_.inner_iterations += sub.inner_iterations;
-    out_.stopped = sub.stopped;
-    if (!sub.converged) {  // the attempt ends at cev's last accepted state
-      out_.reason = why + "; ssn's semismooth Newton from the accepted state: " + sub.reason;
-      out_.failure = sub.failure;
-      return;
-    }
-    // A converged attempt's reason says how it converged: the step's notes take it.
-    out_.converged = true;
-    out_.failure = FailureKind::none;
-    out_.reason =
-        "cev's update found no decrease of the contact error: finished by ssn's semismooth Newton from its "
-        "accepted state";
-    out_.p = std::move(sub.p);
-    out_.tau = std::move(sub.tau);
-    out_.state = std::move(sub.state);
-    error_ = error_at(out_.p, out_.state.s, out_.state.enabled);
-    tol_ = sub.bound;
-    scale_ = sub.scale;
-    at_round_off_ = sub.at_round_off;
   }
 
   // The semismooth Newton on the model; where it stalls, tau passes on the model (Tresca

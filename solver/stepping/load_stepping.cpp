@@ -88,9 +88,6 @@ void count_attempt(StepRecord& rec, const StepOutcome& out) {
   rec.inner_iterations += out.inner_iterations;
   rec.history.insert(rec.history.end(), out.history.begin(), out.history.end());
   if (!out.epsilon_used.empty()) rec.epsilon_used = out.epsilon_used;
-  // A converged attempt with a reason took a fallback (cev's semismooth one): a note, once a step.
-  if (out.converged && !out.reason.empty() && std::ranges::find(rec.notes, out.reason) == rec.notes.end())
-    rec.notes.push_back(out.reason);
   rec.contact_error = out.v2;
   rec.bound = out.bound;
   rec.scale = out.scale;

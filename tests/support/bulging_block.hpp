@@ -84,7 +84,7 @@ struct Pressed {
   double travel_step = 0;  // the plate's travel in one step
   double bulge = 0;        // u_x of the side's middle (1, 0) at the last step
   double worst_volume = 0, balance = 0, cone = 0;
-  int most_solves = 0, points = 0;
+  int most_solves = 0, solves = 0, points = 0;
   bool all_stick = true;  // every pressing point sticks at every step
   bool completed = false;
   std::string reason;  // why the run stopped
@@ -133,17 +133,19 @@ inline Pressed press_block_with(int level, double mu, int steps, const nlohmann:
     out.reach.push_back(reach);
     out.penetration.push_back(penetration);
     out.most_solves = std::max(out.most_solves, rec.solves);
+    out.solves += rec.solves;
     for (int k = 0; k < body.node_count(); ++k)
       if ((body.mesh().nodes[k] - Vec2(1, 0)).norm() < 1e-12) out.bulge = rec.state.q[2 * k];
   }
   std::printf(
       "%s block%s, %s, mu %g, %zu of %d steps: force %.6f, bulge %.6f, contact length %.6f, %d points; "
-      "farthest pressing node %.4f; volume change worst element %.1e, balance %.1e, cone %+.1e, at most %d real "
-      "solves a step%s%s\n",
+      "farthest pressing node %.4f; volume change worst element %.1e, balance %.1e, cone %+.1e, %d real solves, at "
+      "most %d a step%s%s\n",
       level >= 0 ? "filleted" : "sharp", level >= 0 ? (" level " + std::to_string(level)).c_str() : " 4 x 4",
       method.c_str(), mu, out.force.size(), steps, out.force.empty() ? 0.0 : out.force.back(), out.bulge,
       out.length.empty() ? 0.0 : out.length.back(), out.points, out.reach.empty() ? 0.0 : out.reach.back(),
-      out.worst_volume, out.balance, out.cone, out.most_solves, out.completed ? "" : "; stopped: ", out.reason.c_str());
+      out.worst_volume, out.balance, out.cone, out.solves, out.most_solves,
+      out.completed ? "" : "; stopped: ", out.reason.c_str());
   return out;
 }
 
