@@ -91,12 +91,27 @@ void write_problem(int fd, int status, const char* reason, const std::string& sl
   (void)::send(fd, all.data(), all.size(), MSG_NOSIGNAL | MSG_DONTWAIT);
 }
 
-// Closes after the answer: what the client sent and we did not read is dropped first, so
-// that the close does not reset the connection before the client reads the answer.
-void close_connection(int fd) {
+// Closes after the answer. What the client sent and we did not read is read and dropped
+// first: closing a socket with unread bytes resets the connection, and a client that writes
+// its whole body before it reads (cpp-httplib's does) then sees a write error instead of the
+// answer. Bounded: what has arrived (up to 1 MiB) and, waiting for it, up to `discard` bytes
+// more (at most kMaxLingerBytes) within `patience`, 64 KiB at a time and nothing kept; it
+// ends as soon as the client closes.
+void close_connection(int fd, std::uint64_t discard = 0, std::chrono::milliseconds patience = {}) {
   ::shutdown(fd, SHUT_WR);
-  char sink[4096];
-  while (::recv(fd, sink, sizeof sink, MSG_DONTWAIT) > 0) {
+  char sink[65536];
+  std::uint64_t left = std::min(discard, HttpFront::kMaxLingerBytes) + (std::uint64_t{1} << 20);
+  const auto until = Clock::now() + patience;
+  while (left > 0) {
+    const ssize_t n = ::recv(fd, sink, sizeof sink, MSG_DONTWAIT);
+    if (n > 0) {
+      left -= std::min<std::uint64_t>(left, static_cast<std::uint64_t>(n));
+      if (discard > 0 && Clock::now() >= until) break;
+      continue;
+    }
+    if (n < 0 && errno == EINTR) continue;
+    // Nothing more for now: wait only for an announced body, and not past `patience`.
+    if (n == 0 || errno != EAGAIN || discard == 0 || wait_for(fd, POLLIN, millis_until(until)) <= 0) break;
   }
   ::close(fd);
 }
@@ -372,7 +387,7 @@ bool HttpFront::process_and_close_socket(socket_t sock) {
   t_note = nullptr;
   --open_;
   leave(note.client);
-  close_connection(sock);
+  close_connection(sock, note.discard, limits_.body);
   return true;
 }
 

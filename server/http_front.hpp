@@ -21,6 +21,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <map>
 #include <memory>
@@ -40,6 +41,11 @@ struct ConnectionNote {
   bool head_too_large = false;   // the head over kMaxHead
   bool overflow = false;         // served by a reserved thread: health and readiness only
   bool close = false;            // close the connection after this response
+  // Body bytes the client announced and the server answered without reading (an early 413):
+  // read and dropped before the close, within bounds (HttpFront::kMaxLingerBytes, the body
+  // deadline), so that the close does not reset the connection before the client has read
+  // the answer.
+  std::uint64_t discard = 0;
   // Starts the body's deadline again: a handler that waited before reading the body (the
   // memory budget of server/body_budget.hpp) gives the client its whole deadline.
   std::function<void()> restart_body_deadline;
@@ -49,6 +55,8 @@ class HttpFront : public httplib::Server {
  public:
   static constexpr std::size_t kMaxLine = 8192;  // httplib's compiled-in line limit
   static constexpr std::size_t kMaxHead = 65536;
+  // At most this much of an unread body is read and dropped before a close (ConnectionNote::discard).
+  static constexpr std::uint64_t kMaxLingerBytes = std::uint64_t{1} << 30;
 
   explicit HttpFront(FrontLimits limits);
   ~HttpFront() override;

@@ -236,6 +236,13 @@ struct HttpServer::Impl {
 
   void routes();
   void hooks();
+  // The most a request's body may hold: --max-mesh for an upload, --max-body for the other
+  // POSTs, the larger of the two for the rest (httplib's payload limit).
+  std::size_t body_limit(const Request& req) const;
+  // A declared Content-Length over body_limit: the 413 at once, before any of the body is
+  // read (to a client that sent Expect: 100-continue, instead of the 100); the connection
+  // then closes after dropping the body (bounded: server/http_front.hpp). True if answered.
+  bool refuse_declared_body(const Request& req, Response& res);
 
   // ---- handlers
   void submit(const Request& req, Response& res, const httplib::ContentReader& reader, bool ogc);
@@ -277,6 +284,27 @@ struct HttpServer::Impl {
   }
 };
 
+std::size_t HttpServer::Impl::body_limit(const Request& req) const {
+  if (req.path == "/v1/meshes") return options.max_mesh_bytes;
+  if (req.method == "POST") return options.max_body_bytes;
+  return std::max(options.max_body_bytes, options.max_mesh_bytes);
+}
+
+bool HttpServer::Impl::refuse_declared_body(const Request& req, Response& res) {
+  const std::size_t limit = body_limit(req);
+  const auto declared = parse_count(req.get_header_value("Content-Length"));
+  if (!declared || static_cast<std::uint64_t>(*declared) <= limit) return false;
+  if (ConnectionNote* note = HttpFront::note()) {
+    note->close = true;
+    note->discard = static_cast<std::uint64_t>(*declared);
+  }
+  res.set_header("Connection", "close");
+  problem(res, req, 413, "payload-too-large", "Payload too large",
+          "the request body (Content-Length " + std::to_string(*declared) + ") is over this server's limit of " +
+              std::to_string(limit) + " bytes");
+  return true;
+}
+
 void HttpServer::Impl::hooks() {
   // Threads, deadlines and limits per connection: HttpFront (server/http_front.hpp).
   // The larger of the two: each route holds its own limit (read_body).
@@ -292,10 +320,20 @@ void HttpServer::Impl::hooks() {
     if (listen_fd < 0) listen_fd = sock;
   });
 
-  svr.set_pre_routing_handler([this](const Request& req, Response& res) {
+  // A client that asks before it sends its body: 100, or the 413 when it announced too much.
+  svr.set_expect_100_continue_handler([this](const Request& req, Response& res) {
     request_start = std::chrono::steady_clock::now();
-    // Echoed in the answer, logged, and attached to a job it creates.
     res.set_header("X-Request-Id", request_id_for(req.get_header_value("X-Request-Id")));
+    return refuse_declared_body(req, res) ? 413 : 100;
+  });
+
+  svr.set_pre_routing_handler([this](const Request& req, Response& res) {
+    // Set already when the expect handler answered 100.
+    if (!res.has_header("X-Request-Id")) {
+      request_start = std::chrono::steady_clock::now();
+      // Echoed in the answer, logged, and attached to a job it creates.
+      res.set_header("X-Request-Id", request_id_for(req.get_header_value("X-Request-Id")));
+    }
     ConnectionNote* note = HttpFront::note();
     if (note && note->overflow && req.path != "/v1/health" && req.path != "/v1/ready") {
       res.set_header("Retry-After", "1");
@@ -314,6 +352,10 @@ void HttpServer::Impl::hooks() {
               req.method + " needs a Content-Length (or Transfer-Encoding: chunked)");
       return httplib::Server::HandlerResponse::Handled;
     }
+    // Answered before the body is read: a client that reads while it sends (curl, browsers)
+    // stops at once, and the body is dropped 64 KiB at a time rather than through httplib's
+    // 4 KiB reads.
+    if (refuse_declared_body(req, res)) return httplib::Server::HandlerResponse::Handled;
     if (!options.token || req.path == "/v1/health" || is_page_request(req))
       return httplib::Server::HandlerResponse::Unhandled;
     const std::string auth = req.get_header_value("Authorization");

@@ -236,6 +236,83 @@ TEST(HostileClients, APostWithoutALengthIsAnswered411AtOnce) {
   EXPECT_NE(p.value("detail", std::string()).find("Content-Length"), std::string::npos) << answer;
 }
 
+// A body announced over the limit (200 MB against --max-mesh's 64 MiB) is refused before any
+// of it is read: with Expect: 100-continue the 413 comes instead of the 100; without, it comes
+// while the client is still sending, before the body deadline (--body-timeout 5 here). Then
+// the server drops what the client sends, but only up to that deadline (or 1 GiB): a client
+// that keeps the connection open, silent or streaming, has it closed.
+TEST(HostileClients, ABodyAnnouncedOverTheLimitIs413BeforeItIsSentAndHoldsNoThread) {
+  TempDir dir;
+  ServerProcess server(dir.path() / "grip.sqlite", {"--body-timeout", "5"}, dir.path() / "server.log");
+  auto post = [&](const std::string& length, bool expect) {
+    const int fd = connect_from("127.0.0.1", server.port());
+    send_all(fd,
+             "POST /v1/meshes HTTP/1.1\r\nHost: grip\r\nContent-Type: application/octet-stream\r\n"
+             "Content-Length: " +
+                 length + "\r\n" + (expect ? "Expect: 100-continue\r\n" : "") + "\r\n");
+    return fd;
+  };
+  // Sends `piece` every `pause` until a send fails (the server has closed: a reset), at most
+  // 15 s; the bytes sent.
+  struct Cut {
+    bool cut = false;
+    double bytes = 0, ms = 0;
+  };
+  auto send_until_cut = [](int fd, const std::string& piece, std::chrono::milliseconds pause) {
+    timeval second{1, 0};
+    ::setsockopt(fd, SOL_SOCKET, SO_SNDTIMEO, &second, sizeof second);
+    const auto start = Clock::now();
+    Cut c;
+    while (!c.cut && ms_since(start) < 15000) {
+      const ssize_t n = ::send(fd, piece.data(), piece.size(), MSG_NOSIGNAL);
+      c.cut = n < 0 && errno != EAGAIN && errno != EWOULDBLOCK && errno != EINTR;
+      if (n > 0) c.bytes += static_cast<double>(n);
+      std::this_thread::sleep_for(pause);
+    }
+    c.ms = ms_since(start);
+    ::close(fd);
+    return c;
+  };
+
+  // Asked first: the problem document, and no 100 Continue.
+  int fd = post("209715200", true);
+  ASSERT_GE(fd, 0);
+  ::shutdown(fd, SHUT_WR);  // nothing follows: the server's drain ends at once
+  std::string answer = read_answer(fd, std::chrono::milliseconds(3000));
+  ::close(fd);
+  EXPECT_EQ(answer.rfind("HTTP/1.1 413", 0), 0u) << answer;
+  const json p = problem_of(answer);
+  ASSERT_TRUE(p.is_object()) << answer;
+  EXPECT_EQ(p.value("type", std::string()), "urn:grip:problem:payload-too-large") << answer;
+  EXPECT_NE(p.value("detail", std::string()).find("67108864"), std::string::npos) << answer;
+  EXPECT_NE(p.value("detail", std::string()).find("209715200"), std::string::npos) << answer;
+
+  // Not asked: answered after the first MiB of the 200, the rest unsent; then a byte every
+  // 100 ms, dropped until the body deadline, when the connection is cut.
+  fd = post("209715200", false);
+  ASSERT_GE(fd, 0);
+  send_all(fd, std::string(1u << 20, ' '));
+  answer = read_head(fd, std::chrono::milliseconds(3000));
+  EXPECT_EQ(answer.rfind("HTTP/1.1 413", 0), 0u) << answer;
+  EXPECT_NE(answer.find("Connection: close"), std::string::npos) << answer;
+  const Cut slow = send_until_cut(fd, " ", std::chrono::milliseconds(100));
+  std::printf("[ info ] a byte every 100 ms after the 413: cut after %.0f bytes, %.0f ms (deadline 5 s)\n", slow.bytes,
+              slow.ms);
+  EXPECT_TRUE(slow.cut);
+
+  // 10 GB announced and streamed as fast as loopback takes it: dropped up to 1 GiB or the
+  // deadline, then cut.
+  fd = post("10000000000", false);
+  ASSERT_GE(fd, 0);
+  const Cut fast = send_until_cut(fd, std::string(1u << 16, ' '), std::chrono::milliseconds(0));
+  std::printf("[ info ] a 10 GB body streamed after its 413: cut after %.0f MB, %.0f ms (deadline 5 s, 1 GiB)\n",
+              fast.bytes / 1e6, fast.ms);
+  EXPECT_TRUE(fast.cut);
+  EXPECT_LT(fast.bytes, 2e9);
+  const Api api(server.port());
+  EXPECT_EQ(api.get("/v1/health")->status, 200);
+}
+
 // Past the limit per client address, a connection is refused at once with a problem
 // document and Retry-After; other addresses are served.
 TEST(HostileClients, ConnectionsPastTheLimitPerAddressAreRefusedWith503) {
