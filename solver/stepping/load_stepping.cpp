@@ -139,6 +139,11 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
   // unequal materials, step 2: 59 real solves and 1958 Newton iterations instead of 4 and 24).
   const bool extrapolate_forces = std::none_of(problem.obstacles.begin(), problem.obstacles.end(),
                                                [](const ObstacleInstance& o) { return o.master.has_value(); });
+  // Where the load turns back, the forces extrapolated back along the last increment are the
+  // answer only for a body whose state does not depend on its path: a yielding body unloads
+  // elastically, not along its loading path, and starts better from the last forces (J2Contact's
+  // plastic cylinder: its first release step 3 -> 2 real solves, the elastic one's stays 1).
+  const bool path_dependent = problem.body->traits().plasticity;
   LoadFactors current(cases, 0.0), before = current;
   eq->set_step(current, std::vector<double>(problem.candidates.size(), 0.0));
   std::vector<double> zeta = eq->zetas(eq->evaluate(q));
@@ -197,9 +202,11 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
                                             : Vector(q + (q - q_before) * ratio);
       // The contact forces start from the same extrapolation (the strategies bring it back
       // into the cone): a step then starts near its answer, not a whole increment away.
-      Vector p_guess = repeat                                                 ? again->second
-                       : from_previous_force || by_ssn || !extrapolate_forces ? p
-                                                                              : Vector(p + (p - p_before) * ratio);
+      const bool turned_back = path_dependent && ratio < 0;
+      Vector p_guess = repeat ? again->second
+                       : from_previous_force || by_ssn || !extrapolate_forces || turned_back
+                           ? p
+                           : Vector(p + (p - p_before) * ratio);
       const bool extrapolated = !repeat && p_guess != p;
       again.reset();
       // Rigid amplitudes not extrapolated follow the supports: a pin left where it was turns a
