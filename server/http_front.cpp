@@ -96,22 +96,24 @@ void write_problem(int fd, int status, const char* reason, const std::string& sl
 // its whole body before it reads (cpp-httplib's does) then sees a write error instead of the
 // answer. Bounded: what has arrived (up to 1 MiB) and, waiting for it, up to `discard` bytes
 // more (at most kMaxLingerBytes) within `patience`, 64 KiB at a time and nothing kept; it
-// ends as soon as the client closes.
+// ends as soon as the client closes, and waits no more once `discard` bytes have arrived.
 void close_connection(int fd, std::uint64_t discard = 0, std::chrono::milliseconds patience = {}) {
   ::shutdown(fd, SHUT_WR);
   char sink[65536];
-  std::uint64_t left = std::min(discard, HttpFront::kMaxLingerBytes) + (std::uint64_t{1} << 20);
+  discard = std::min(discard, HttpFront::kMaxLingerBytes);
+  std::uint64_t left = discard + (std::uint64_t{1} << 20), got = 0;
   const auto until = Clock::now() + patience;
   while (left > 0) {
     const ssize_t n = ::recv(fd, sink, sizeof sink, MSG_DONTWAIT);
     if (n > 0) {
       left -= std::min<std::uint64_t>(left, static_cast<std::uint64_t>(n));
+      got += static_cast<std::uint64_t>(n);
       if (discard > 0 && Clock::now() >= until) break;
       continue;
     }
     if (n < 0 && errno == EINTR) continue;
-    // Nothing more for now: wait only for an announced body, and not past `patience`.
-    if (n == 0 || errno != EAGAIN || discard == 0 || wait_for(fd, POLLIN, millis_until(until)) <= 0) break;
+    // Nothing more for now: wait only for the rest of an announced body, and not past `patience`.
+    if (n == 0 || errno != EAGAIN || got >= discard || wait_for(fd, POLLIN, millis_until(until)) <= 0) break;
   }
   ::close(fd);
 }
@@ -199,6 +201,8 @@ class GuardedStream final : public httplib::Stream {
         note_.head_too_large = true;
         return -1;
       }
+    } else {
+      note_.body_read += n;
     }
     std::memcpy(out, buffer_ + pos_, n);
     pos_ += n;

@@ -41,11 +41,15 @@ struct ConnectionNote {
   bool head_too_large = false;   // the head over kMaxHead
   bool overflow = false;         // served by a reserved thread: health and readiness only
   bool close = false;            // close the connection after this response
-  // Body bytes the client announced and the server answered without reading (an early 413):
-  // read and dropped before the close, within bounds (HttpFront::kMaxLingerBytes, the body
-  // deadline), so that the close does not reset the connection before the client has read
-  // the answer.
+  // Body bytes the client announced and the server answered without reading (an early 413,
+  // 401, 503...): read and dropped before the close, within bounds (HttpFront::kMaxLingerBytes,
+  // the body deadline), so that the close does not reset the connection before the client has
+  // read the answer, and none of them is read as a request.
   std::uint64_t discard = 0;
+  // Body bytes httplib has taken from the connection since the end of the head.
+  std::uint64_t body_read = 0;
+  // A chunked body was read to its end (its length is known only then).
+  bool body_complete = false;
   // Starts the body's deadline again: a handler that waited before reading the body (the
   // memory budget of server/body_budget.hpp) gives the client its whole deadline.
   std::function<void()> restart_body_deadline;

@@ -243,6 +243,13 @@ struct HttpServer::Impl {
   // read (to a client that sent Expect: 100-continue, instead of the 100); the connection
   // then closes after dropping the body (bounded: server/http_front.hpp). True if answered.
   bool refuse_declared_body(const Request& req, Response& res);
+  // The request announced a body that has not been read to its end.
+  bool body_unread(const Request& req) const;
+  // An answer given with the request's body unread (before it, as a 401 or a 413, or without
+  // it, as to a GET with a body): it says `Connection: close`, and what the client sends of the
+  // body is read and dropped within bounds (server/http_front.hpp) before the connection
+  // closes, so that none of it is read as a request.
+  void close_with_body_unread(const Request& req, Response& res);
 
   // ---- handlers
   void submit(const Request& req, Response& res, const httplib::ContentReader& reader, bool ogc);
@@ -294,15 +301,36 @@ bool HttpServer::Impl::refuse_declared_body(const Request& req, Response& res) {
   const std::size_t limit = body_limit(req);
   const auto declared = parse_count(req.get_header_value("Content-Length"));
   if (!declared || static_cast<std::uint64_t>(*declared) <= limit) return false;
-  if (ConnectionNote* note = HttpFront::note()) {
-    note->close = true;
-    note->discard = static_cast<std::uint64_t>(*declared);
-  }
-  res.set_header("Connection", "close");
+  close_with_body_unread(req, res);
   problem(res, req, 413, "payload-too-large", "Payload too large",
           "the request body (Content-Length " + std::to_string(*declared) + ") is over this server's limit of " +
               std::to_string(limit) + " bytes");
   return true;
+}
+
+bool HttpServer::Impl::body_unread(const Request& req) const {
+  const ConnectionNote* note = HttpFront::note();
+  if (!note) return false;
+  // Chunked (httplib reads chunks whatever the Content-Length says): unread until read_body
+  // saw its end; with a Content-Length as well, never taken as read (RFC 9112 6.3).
+  if (req.has_header("Transfer-Encoding")) return !note->body_complete || req.has_header("Content-Length");
+  if (!req.has_header("Content-Length")) return false;
+  const auto declared = parse_count(req.get_header_value("Content-Length"));
+  return !declared || note->body_read < static_cast<std::uint64_t>(*declared);  // unreadable: not read
+}
+
+void HttpServer::Impl::close_with_body_unread(const Request& req, Response& res) {
+  res.headers.erase("Keep-Alive");  // httplib's, when it meant to keep the connection
+  res.headers.erase("Connection");
+  res.set_header("Connection", "close");
+  ConnectionNote* note = HttpFront::note();
+  if (!note) return;
+  note->close = true;
+  if (note->deadline_missed) return;  // the body had its time: closed without waiting more
+  const auto declared = parse_count(req.get_header_value("Content-Length"));
+  if (req.has_header("Transfer-Encoding")) note->discard = body_limit(req);  // no length known: up to the route's limit
+  else if (declared)
+    note->discard = static_cast<std::uint64_t>(*declared) - std::min<std::uint64_t>(*declared, note->body_read);
 }
 
 void HttpServer::Impl::hooks() {
@@ -346,8 +374,7 @@ void HttpServer::Impl::hooks() {
     // data held a thread for 10 s).
     if ((req.method == "POST" || req.method == "PUT" || req.method == "PATCH") && !req.has_header("Content-Length") &&
         !req.has_header("Transfer-Encoding")) {
-      if (note) note->close = true;
-      res.set_header("Connection", "close");
+      close_with_body_unread(req, res);
       problem(res, req, 411, "length-required", "Length required",
               req.method + " needs a Content-Length (or Transfer-Encoding: chunked)");
       return httplib::Server::HandlerResponse::Handled;
@@ -368,6 +395,14 @@ void HttpServer::Impl::hooks() {
             auth.empty() ? "this server requires a bearer token (Authorization: Bearer ...)"
                          : "the bearer token is not valid");
     return httplib::Server::HandlerResponse::Handled;
+  });
+
+  // Every answer, written after this: one whose request body was not read to its end (a 401 or
+  // a 503 answered before it, a body on a GET or HEAD, which httplib never reads, a chunked
+  // body that broke off) closes the connection as the 413 does, the rest of the body dropped:
+  // else its bytes were read as the connection's next request.
+  svr.set_post_routing_handler([this](const Request& req, Response& res) {
+    if (body_unread(req)) close_with_body_unread(req, res);
   });
 
   // Errors that no handler described (unknown route, 413, unreadable request): a problem
@@ -668,6 +703,7 @@ bool HttpServer::Impl::read_body(const Request& req, Response& res, const httpli
     if (!too_large) text.append(data, n);
     return true;
   });
+  if (ConnectionNote* note = HttpFront::note()) note->body_complete = complete;
   if (too_large || res.status == 413) {
     problem(res, req, 413, "payload-too-large", "Payload too large",
             "the request body is over this server's limit of " + std::to_string(limit) + " bytes");
