@@ -313,6 +313,109 @@ TEST(HostileClients, ABodyAnnouncedOverTheLimitIs413BeforeItIsSentAndHoldsNoThre
   EXPECT_EQ(api.get("/v1/health")->status, 200);
 }
 
+// An answer given before the request's body is read (a 401 for a wrong or missing token, a
+// 503 from a reserved thread) or without it ever being read (httplib reads no body on a GET)
+// closes the connection, as the 413 does, and drops the body: a body that is itself a request
+// is never served as the connection's next one (request smuggling). On a kept-alive
+// connection the 401 was followed by a 200 for the GET /v1/health in its body.
+TEST(HostileClients, AnAnswerBeforeTheBodyClosesAndNoneOfTheBodyIsServed) {
+  const std::string inner = "GET /v1/health HTTP/1.1\r\nHost: grip\r\n\r\n";
+  const std::string length = "Content-Length: " + std::to_string(inner.size()) + "\r\n";
+  // Everything the server sends on a connection after `request`, until it closes (`closed`,
+  // an orderly close) or 3 s pass; `responses`: the status lines among it.
+  struct Exchange {
+    std::string text;
+    bool closed = false;
+    int responses = 0;
+  };
+  auto exchange = [](int port, const std::string& request) {
+    Exchange e;
+    const int fd = connect_from("127.0.0.1", port);
+    if (fd < 0) return e;
+    send_all(fd, request);
+    const auto until = Clock::now() + std::chrono::milliseconds(3000);
+    char buf[4096];
+    while (Clock::now() < until) {
+      pollfd p{fd, POLLIN, 0};
+      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(until - Clock::now()).count();
+      if (::poll(&p, 1, static_cast<int>(std::max<long long>(left, 0))) <= 0) break;
+      const ssize_t n = ::recv(fd, buf, sizeof buf, 0);
+      if (n <= 0) {
+        e.closed = n == 0;
+        break;
+      }
+      e.text.append(buf, static_cast<size_t>(n));
+    }
+    ::close(fd);
+    for (size_t at = e.text.find("HTTP/1.1 "); at != std::string::npos; at = e.text.find("HTTP/1.1 ", at + 1))
+      ++e.responses;
+    return e;
+  };
+  auto expect_one_then_close = [](const Exchange& e, const std::string& status) {
+    EXPECT_EQ(e.text.rfind("HTTP/1.1 " + status, 0), 0u) << e.text;
+    EXPECT_EQ(e.responses, 1) << e.text;
+    EXPECT_TRUE(e.closed) << e.text;
+    const std::string head = e.text.substr(0, e.text.find("\r\n\r\n"));
+    EXPECT_NE(head.find("Connection: close"), std::string::npos) << e.text;
+    EXPECT_EQ(head.find("Keep-Alive"), std::string::npos) << e.text;
+  };
+  // A field of the answer's problem document (or JSON body); "" when it has none.
+  auto field = [](const Exchange& e, const char* name) {
+    const json p = problem_of(e.text);
+    return p.is_object() && p.contains(name) && p[name].is_string() ? p[name].get<std::string>() : std::string();
+  };
+  {
+    TempDir dir;
+    ServerProcess server(dir.path() / "grip.sqlite", {"--token", "s3cret"}, dir.path() / "server.log");
+    const std::string post = "POST /v1/jobs HTTP/1.1\r\nHost: grip\r\nContent-Type: application/json\r\n";
+    // A wrong token, the body sent with the head.
+    Exchange e = exchange(server.port(), post + "Authorization: Bearer wrong\r\n" + length + "\r\n" + inner);
+    expect_one_then_close(e, "401");
+    EXPECT_EQ(field(e, "type"), "urn:grip:problem:unauthorized") << e.text;
+    EXPECT_EQ(field(e, "detail"), "the bearer token is not valid") << e.text;
+    // No token.
+    e = exchange(server.port(), post + length + "\r\n" + inner);
+    expect_one_then_close(e, "401");
+    EXPECT_EQ(field(e, "type"), "urn:grip:problem:unauthorized") << e.text;
+    EXPECT_NE(field(e, "detail").find("requires a bearer token"), std::string::npos) << e.text;
+    // A wrong token, the request in a chunked body.
+    char size[16];
+    std::snprintf(size, sizeof size, "%zx", inner.size());
+    e = exchange(server.port(), post + "Authorization: Bearer wrong\r\nTransfer-Encoding: chunked\r\n\r\n" + size +
+                                    "\r\n" + inner + "\r\n0\r\n\r\n");
+    expect_one_then_close(e, "401");
+    EXPECT_EQ(field(e, "type"), "urn:grip:problem:unauthorized") << e.text;
+    // A GET with a body (no token needed for health): answered, the body dropped.
+    e = exchange(server.port(), "GET /v1/health HTTP/1.1\r\nHost: grip\r\n" + length + "\r\n" + inner);
+    expect_one_then_close(e, "200");
+    EXPECT_EQ(field(e, "status"), "ok") << e.text;
+    // The right token: the body is read, and a request after it on the same connection is
+    // served (a 400 for the body that is no scene, then the health check).
+    e = exchange(server.port(), post + "Authorization: Bearer s3cret\r\n" + length + "\r\n" + inner + inner);
+    EXPECT_EQ(e.text.rfind("HTTP/1.1 400", 0), 0u) << e.text;
+    EXPECT_EQ(e.responses, 2) << e.text;
+    EXPECT_NE(e.text.find("{\"status\":\"ok\"}"), std::string::npos) << e.text;
+  }
+  {
+    // Both connection threads held by unfinished heads: a reserved thread refuses the POST.
+    TempDir dir;
+    ServerProcess server(dir.path() / "grip.sqlite", {"--http-threads", "2"}, dir.path() / "server.log");
+    std::vector<int> held;
+    for (int i = 0; i < 2; ++i) {
+      held.push_back(connect_from("127.0.2.1", server.port()));
+      send_all(held.back(), "GET /v1/health HTTP/1.1\r\nHost: grip\r\n");  // never ends
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    const Exchange e = exchange(server.port(),
+                                "POST /v1/jobs HTTP/1.1\r\nHost: grip\r\nContent-Type: "
+                                "application/json\r\n" +
+                                    length + "\r\n" + inner);
+    expect_one_then_close(e, "503");
+    EXPECT_EQ(field(e, "type"), "urn:grip:problem:server-busy") << e.text;
+    for (int fd : held) ::close(fd);
+  }
+}
+
 // Past the limit per client address, a connection is refused at once with a problem
 // document and Retry-After; other addresses are served.
 TEST(HostileClients, ConnectionsPastTheLimitPerAddressAreRefusedWith503) {
