@@ -137,6 +137,17 @@ class Equilibrium {
   // Step length along the Newton correction dq at q: the natural monotonicity test with the
   // factorization `solver` of the step's tangent; at most the body's trust-region fraction.
   double line_search(const Vector& q, const Vector& dq, const Vector& p, const FreeBlockSolver& solver) const;
+  // The chord test (newton.cpp): from q with its residual r, the correction with the tangent
+  // Newton factorized last (an earlier iterate's, this solve's or the one before's). Where it
+  // is within the correction test and a second chord correction from there shows that tangent
+  // still contracts (at most kChordContraction of the first), state.q moves by both and the
+  // solve is converged without a factorization. False (state unchanged) otherwise.
+  bool chord_converges(EquilibriumState& state, const Vector& r, const Vector& p);
+  // lu_ holds Newton's factorization of a changing tangent without the held or penalty law's
+  // springs, the factorization of number chord_factorization_ (lu_.factorizations()), and the
+  // body's tangent is the linearized-stress one (Saint Venant-Kirchhoff at finite strain): the
+  // only kind measured to gain (bench/results/kernels.md, chords).
+  bool chord_ready() const;
   double free_length_norm(const Vector& dq) const;
   double scaled_free_max(const Vector& r) const;
   void add_rigid_border(const EquilibriumState& state);
@@ -194,6 +205,7 @@ class Equilibrium {
   // (compliance.cpp: newton_factor_serves).
   long newton_factor_solve_ = -1;
   Vector newton_factor_q_;
+  long chord_factorization_ = -1;
   // The last state a Newton solve converged at: the stress base of the next solve's first
   // tangent (newton.cpp, the linearized stress).
   Vector converged_q_;

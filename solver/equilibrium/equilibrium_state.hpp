@@ -39,6 +39,8 @@ struct EquilibriumState {
 struct EquilibriumCounters {
   long solves = 0;  // calls of solve(): real equilibrium solves
   long newton_iterations = 0;
+  // Solves (and continued ones) that chord corrections ended, without a factorization of their own.
+  long chord_solves = 0;
   // newton_ and body_factorizations together (docs/algorithm.md#where-factorizations-come-from)
   long factorizations = 0;
   long newton_factorizations = 0;     // Newton's tangent, and the penalty law's last correction
@@ -46,6 +48,19 @@ struct EquilibriumCounters {
   long dissected_factorizations = 0;  // the body's tangent again, in nested-dissection order, for G only
   long compliance_forms = 0;          // G formed afresh (each on a factorization of its own)
   long compliance_columns = 0;        // columns of G solved for, all forms together
+
+  EquilibriumCounters& operator+=(const EquilibriumCounters& o) {
+    solves += o.solves;
+    newton_iterations += o.newton_iterations;
+    chord_solves += o.chord_solves;
+    factorizations += o.factorizations;
+    newton_factorizations += o.newton_factorizations;
+    body_factorizations += o.body_factorizations;
+    dissected_factorizations += o.dissected_factorizations;
+    compliance_forms += o.compliance_forms;
+    compliance_columns += o.compliance_columns;
+    return *this;
+  }
 };
 
 }  // namespace grip

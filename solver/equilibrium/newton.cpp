@@ -34,6 +34,14 @@ double Equilibrium::free_length_norm(const Vector& dq) const {
 
 namespace {
 
+// Chords (chord_converges): each correction at most this fraction of the one before, so that
+// the old tangent still contracts and what remains after the last is at most that last one
+// (a geometric series); begun only from a first correction within this many times the
+// correction test, and at most this many corrections (each a residual and a solve).
+constexpr double kChordContraction = 0.5;
+constexpr double kChordStart = 10.0;
+constexpr int kChordCorrections = 4;
+
 // y solving (I + B) y = c by GMRES (Arnoldi with modified Gram-Schmidt, Givens rotations, no
 // restart), `apply` giving B v: stops where the residual is below `tolerance` |c|, or after
 // `most` iterations (then the least-residual iterate of that space).
@@ -211,7 +219,9 @@ EquilibriumState Equilibrium::newton(const Vector& q_guess, const Vector& p) {
     }
     double force_scale = 0.0;
     // low_rank: the contact terms only (the body's are in its kept factorization).
-    const Vector r = residual(state.q, state, p, tangent(), &force_scale, !low_rank);
+    // Where the chord test may end the solve, the tangent is assembled only if it does not.
+    const bool chord = it == 1 && !reuse && chord_ready();
+    Vector r = residual(state.q, state, p, chord ? nullptr : tangent(), &force_scale, !low_rank);
     const double r_max = scaled_free_max(r);
     state.relative_residual = force_scale > 0 ? r_max / force_scale : 0.0;
     if (!std::isfinite(r_max)) {
@@ -237,6 +247,13 @@ EquilibriumState Equilibrium::newton(const Vector& q_guess, const Vector& p) {
       return penalty_ ? finish_penalty(state) : finish(state, held_ ? held_forces(state.q, state, p, nullptr) : p);
     }
     if (it > params_.max_iterations) break;
+    if (chord) {
+      if (chord_converges(state, r, p)) {
+        converged_q_ = state.q;
+        return finish(state, p);
+      }
+      r = residual(state.q, state, p, tangent(), nullptr, !low_rank);
+    }
     Vector r_step;
     if (!branch.empty()) {
       stick_branch_ = std::move(branch);
@@ -260,6 +277,7 @@ EquilibriumState Equilibrium::newton(const Vector& q_guess, const Vector& p) {
       }
       // The held law's springs are in it: no compliance of the body (compliance.cpp).
       newton_factor_solve_ = held_ ? -1 : counters_.solves;
+      chord_factorization_ = held_ ? -1 : lu_.factorizations();
     }
     Vector r_free(free_count_);
     for (int i = 0; i < r.size(); ++i)
@@ -302,6 +320,45 @@ EquilibriumState Equilibrium::newton(const Vector& q_guess, const Vector& p) {
   state.reason = "Newton did not converge in " + std::to_string(params_.max_iterations) +
                  " iterations (free residual " + number_text(state.relative_residual) + " of the force scale)";
   return state;
+}
+
+bool Equilibrium::chord_ready() const {
+  return !penalty_ && !held_ && problem_.body->traits().linearized_stress && lu_.ok() &&
+         lu_.factorizations() == chord_factorization_;
+}
+
+bool Equilibrium::chord_converges(EquilibriumState& state, const Vector& r, const Vector& p) {
+  const double tolerance = params_.displacement_tolerance;
+  Vector q = state.q, dq = Vector::Zero(q.size()), residual_at = r;
+  double last = 0.0, relative_residual = state.relative_residual;
+  for (int k = 0; k < kChordCorrections; ++k) {
+    if (k) {
+      EquilibriumState paired;
+      pair(q, paired);
+      double force_scale = 0.0;
+      residual_at = residual(q, paired, p, nullptr, &force_scale);
+      relative_residual = force_scale > 0 ? scaled_free_max(residual_at) / force_scale : 0.0;
+    }
+    Vector r_free(free_count_);
+    for (int i = 0; i < q.size(); ++i)
+      if (free_index_[i] >= 0) r_free[free_index_[i]] = -residual_at[i];
+    const Vector dq_free = lu_.solve(r_free);
+    for (int i = 0; i < q.size(); ++i)
+      if (free_index_[i] >= 0) dq[i] = dq_free[free_index_[i]];
+    const double size = (dq.array() * length_scales_.array()).abs().maxCoeff();
+    // Too far for chords, or the tangent no longer contracts: Newton goes on from state.q.
+    if (!(size <= (k ? kChordContraction * last : kChordStart * tolerance))) return false;
+    q += dq;
+    if (k && size <= tolerance) {
+      state.q = q;
+      state.relative_residual = relative_residual;  // the last residual evaluated, as Newton's
+      pair(state.q, state);
+      ++counters_.chord_solves;
+      return true;
+    }
+    last = size;
+  }
+  return false;
 }
 
 EquilibriumState& Equilibrium::finish(EquilibriumState& state, const Vector& p) const {

@@ -427,6 +427,7 @@ json counters_json(const RunResult& run) {
           {"factorizations_per_solve", per(all, c.solves)},
           {"equilibrium_solves", c.solves},
           {"newton_iterations", c.newton_iterations},
+          {"chord_solves", c.chord_solves},
           {"tau_passes", passes}};
 }
 

@@ -260,14 +260,7 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
           if (g.grew()) {
             // The same increment again with the new candidates, from the last accepted state.
             rec.notes.push_back(g.note);
-            spent.solves += eq->counters().solves;
-            spent.newton_iterations += eq->counters().newton_iterations;
-            spent.factorizations += eq->counters().factorizations;
-            spent.newton_factorizations += eq->counters().newton_factorizations;
-            spent.body_factorizations += eq->counters().body_factorizations;
-            spent.dissected_factorizations += eq->counters().dissected_factorizations;
-            spent.compliance_forms += eq->counters().compliance_forms;
-            spent.compliance_columns += eq->counters().compliance_columns;
+            spent += eq->counters();
             eq = std::make_unique<Equilibrium>(problem, params.newton);
             p = grown_components(p, g, problem);
             p_before = grown_components(p_before, g, problem);
@@ -469,14 +462,7 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
   }
   result.completed = result.reason.empty();
   result.counters = eq->counters();
-  result.counters.solves += spent.solves;
-  result.counters.newton_iterations += spent.newton_iterations;
-  result.counters.factorizations += spent.factorizations;
-  result.counters.newton_factorizations += spent.newton_factorizations;
-  result.counters.body_factorizations += spent.body_factorizations;
-  result.counters.dissected_factorizations += spent.dissected_factorizations;
-  result.counters.compliance_forms += spent.compliance_forms;
-  result.counters.compliance_columns += spent.compliance_columns;
+  result.counters += spent;
 }
 
 }  // namespace

@@ -154,6 +154,9 @@ TEST(SlenderStrip, WrapsOntoACylinder) {
 // bounds leave room for a path that round-off moves by a solve or two. The model's semismooth
 // Newton takes 276 iterations in all with its nonmonotone line search, 962 with a monotone one,
 // which stalled at the stick/slip kinks and left the updates to the tau passes on the model.
+// Chords with the last solve's factorization end most of the updates' solves without a
+// factorization (docs/algorithm.md, Newton's stopping tests): 100 Newton iterations and 29
+// chord-ended solves measured, where Newton alone took 133 (the bound fails it).
 TEST(SlenderStrip, WrapsOntoACylinderWithFriction) {
   const auto s = solve_scene(testing::example_scene("strip-on-cylinder"));
   expect_every_step_sound(s);
@@ -161,9 +164,11 @@ TEST(SlenderStrip, WrapsOntoACylinderWithFriction) {
   int slipping = 0;
   for (const auto& p : s.scene.problem.candidates) slipping += std::abs(s.run.steps.back().p[p.xi]) > 0;
   EXPECT_GE(slipping, 1);
-  std::printf("%ld real solves, %ld Newton iterations\n", s.run.counters.solves, s.run.counters.newton_iterations);
+  std::printf("%ld real solves, %ld Newton iterations, %ld ended by chords\n", s.run.counters.solves,
+              s.run.counters.newton_iterations, s.run.counters.chord_solves);
   EXPECT_LE(s.run.counters.solves, 50);
-  EXPECT_LE(s.run.counters.newton_iterations, 140);
+  EXPECT_LE(s.run.counters.newton_iterations, 110);
+  EXPECT_GE(s.run.counters.chord_solves, 20);
   int inner = 0;
   for (const StepRecord& rec : s.run.steps) inner += rec.inner_iterations;
   std::printf("%d iterations on the linear model\n", inner);
