@@ -56,6 +56,18 @@ bool send_all(int fd, const std::string& s) {
   return ::send(fd, s.data(), s.size(), MSG_NOSIGNAL) == static_cast<ssize_t>(s.size());
 }
 
+// Holds each of a server's `threads` connection threads (--http-threads) with a head that never
+// ends, from 127.0.2.1, and lets the server take them; the connections to close afterwards.
+std::vector<int> hold_connection_threads(int port, int threads) {
+  std::vector<int> held;
+  for (int i = 0; i < threads; ++i) {
+    held.push_back(connect_from("127.0.2.1", port));
+    send_all(held.back(), "GET /v1/health HTTP/1.1\r\nHost: grip\r\n");  // never ends
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  return held;
+}
+
 // What the server sent until it closed or `patience` passed.
 std::string read_answer(int fd, std::chrono::milliseconds patience) {
   std::string text;
@@ -400,12 +412,7 @@ TEST(HostileClients, AnAnswerBeforeTheBodyClosesAndNoneOfTheBodyIsServed) {
     // Both connection threads held by unfinished heads: a reserved thread refuses the POST.
     TempDir dir;
     ServerProcess server(dir.path() / "grip.sqlite", {"--http-threads", "2"}, dir.path() / "server.log");
-    std::vector<int> held;
-    for (int i = 0; i < 2; ++i) {
-      held.push_back(connect_from("127.0.2.1", server.port()));
-      send_all(held.back(), "GET /v1/health HTTP/1.1\r\nHost: grip\r\n");  // never ends
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    const std::vector<int> held = hold_connection_threads(server.port(), 2);
     const Exchange e = exchange(server.port(),
                                 "POST /v1/jobs HTTP/1.1\r\nHost: grip\r\nContent-Type: "
                                 "application/json\r\n" +
@@ -445,12 +452,7 @@ TEST(HostileClients, ConnectionsPastTheLimitPerAddressAreRefusedWith503) {
 TEST(HostileClients, HealthIsAnsweredWhenEveryConnectionThreadIsTaken) {
   TempDir dir;
   ServerProcess server(dir.path() / "grip.sqlite", {"--http-threads", "2"}, dir.path() / "server.log");
-  std::vector<int> held;
-  for (int i = 0; i < 2; ++i) {
-    held.push_back(connect_from("127.0.2.1", server.port()));
-    send_all(held.back(), "GET /v1/health HTTP/1.1\r\nHost: grip\r\n");  // never ends
-  }
-  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  const std::vector<int> held = hold_connection_threads(server.port(), 2);
   const Api api(server.port());
   const auto health = api.client(3).Get("/v1/health");
   ASSERT_TRUE(health);
