@@ -68,8 +68,8 @@ std::vector<int> hold_connection_threads(int port, int threads) {
   return held;
 }
 
-// What the server sent until it closed or `patience` passed.
-std::string read_answer(int fd, std::chrono::milliseconds patience) {
+// What the server sent until it closed or `patience` passed; `closed`: it closed in order.
+std::string read_answer(int fd, std::chrono::milliseconds patience, bool* closed = nullptr) {
   std::string text;
   const auto until = Clock::now() + patience;
   char buf[4096];
@@ -78,7 +78,10 @@ std::string read_answer(int fd, std::chrono::milliseconds patience) {
     const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(until - Clock::now()).count();
     if (::poll(&p, 1, static_cast<int>(std::max<long long>(left, 0))) <= 0) break;
     const ssize_t n = ::recv(fd, buf, sizeof buf, 0);
-    if (n <= 0) break;
+    if (n <= 0) {
+      if (closed) *closed = n == 0;
+      break;
+    }
     text.append(buf, static_cast<size_t>(n));
   }
   return text;
@@ -345,19 +348,7 @@ TEST(HostileClients, AnAnswerBeforeTheBodyClosesAndNoneOfTheBodyIsServed) {
     const int fd = connect_from("127.0.0.1", port);
     if (fd < 0) return e;
     send_all(fd, request);
-    const auto until = Clock::now() + std::chrono::milliseconds(3000);
-    char buf[4096];
-    while (Clock::now() < until) {
-      pollfd p{fd, POLLIN, 0};
-      const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(until - Clock::now()).count();
-      if (::poll(&p, 1, static_cast<int>(std::max<long long>(left, 0))) <= 0) break;
-      const ssize_t n = ::recv(fd, buf, sizeof buf, 0);
-      if (n <= 0) {
-        e.closed = n == 0;
-        break;
-      }
-      e.text.append(buf, static_cast<size_t>(n));
-    }
+    e.text = read_answer(fd, std::chrono::milliseconds(3000), &e.closed);
     ::close(fd);
     for (size_t at = e.text.find("HTTP/1.1 "); at != std::string::npos; at = e.text.find("HTTP/1.1 ", at + 1))
       ++e.responses;
