@@ -149,6 +149,9 @@ class Equilibrium {
   // only kind measured to gain (bench/results/kernels.md, chords).
   bool chord_ready() const;
   double free_length_norm(const Vector& dq) const;
+  // K^-1 r on the free dofs with `solver`'s factorization (r and the result by dof, zero on
+  // the prescribed ones): the line search's simplified correction, the chords'.
+  Vector free_solve(const FreeBlockSolver& solver, const Vector& r) const;
   double scaled_free_max(const Vector& r) const;
   void add_rigid_border(const EquilibriumState& state);
   // free_index_ from the supports, the start-up's dofs and (unless pins_free_) the pins.

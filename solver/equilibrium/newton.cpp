@@ -322,6 +322,17 @@ EquilibriumState Equilibrium::newton(const Vector& q_guess, const Vector& p) {
   return state;
 }
 
+Vector Equilibrium::free_solve(const FreeBlockSolver& solver, const Vector& r) const {
+  Vector r_free(free_count_);
+  for (int i = 0; i < r.size(); ++i)
+    if (free_index_[i] >= 0) r_free[free_index_[i]] = r[i];
+  const Vector x_free = solver.solve(r_free);
+  Vector x = Vector::Zero(r.size());
+  for (int i = 0; i < r.size(); ++i)
+    if (free_index_[i] >= 0) x[i] = x_free[free_index_[i]];
+  return x;
+}
+
 bool Equilibrium::chord_ready() const {
   return !penalty_ && !held_ && problem_.body->traits().linearized_stress && lu_.ok() &&
          lu_.factorizations() == chord_factorization_;
@@ -329,7 +340,7 @@ bool Equilibrium::chord_ready() const {
 
 bool Equilibrium::chord_converges(EquilibriumState& state, const Vector& r, const Vector& p) {
   const double tolerance = params_.displacement_tolerance;
-  Vector q = state.q, dq = Vector::Zero(q.size()), residual_at = r;
+  Vector q = state.q, dq, residual_at = r;
   double last = 0.0, relative_residual = state.relative_residual;
   for (int k = 0; k < kChordCorrections; ++k) {
     if (k) {
@@ -339,12 +350,7 @@ bool Equilibrium::chord_converges(EquilibriumState& state, const Vector& r, cons
       residual_at = residual(q, paired, p, nullptr, &force_scale);
       relative_residual = force_scale > 0 ? scaled_free_max(residual_at) / force_scale : 0.0;
     }
-    Vector r_free(free_count_);
-    for (int i = 0; i < q.size(); ++i)
-      if (free_index_[i] >= 0) r_free[free_index_[i]] = -residual_at[i];
-    const Vector dq_free = lu_.solve(r_free);
-    for (int i = 0; i < q.size(); ++i)
-      if (free_index_[i] >= 0) dq[i] = dq_free[free_index_[i]];
+    dq = -free_solve(lu_, residual_at);
     const double size = (dq.array() * length_scales_.array()).abs().maxCoeff();
     // Too far for chords, or the tangent no longer contracts: Newton goes on from state.q.
     if (!(size <= (k ? kChordContraction * last : kChordStart * tolerance))) return false;
@@ -390,14 +396,7 @@ double Equilibrium::line_search(const Vector& q, const Vector& dq, const Vector&
     EquilibriumState paired;
     pair(qa, paired);
     const Vector r = residual(qa, paired, p, nullptr);
-    Vector r_free(free_count_);
-    for (int i = 0; i < r.size(); ++i)
-      if (free_index_[i] >= 0) r_free[free_index_[i]] = r[i];
-    const Vector simplified = solver.solve(r_free);
-    Vector full = Vector::Zero(q.size());
-    for (int i = 0; i < q.size(); ++i)
-      if (free_index_[i] >= 0) full[i] = simplified[free_index_[i]];
-    const double norm = free_length_norm(full);
+    const double norm = free_length_norm(free_solve(solver, r));
     if (std::isfinite(norm) && norm <= (1.0 - 0.25 * a) * dq_norm) return a;
   }
   return a;
