@@ -375,10 +375,17 @@ bool StepSolver::budget_left() {
 bool StepSolver::line_search(const Vector& pl, const Vector& du, int& trials, const HeldPlan* held) {
   const Vector p0 = out_.p;
   const double v0 = error_.norm2;
+  // A held trial that left the cone is solved once more with the points that left it let go
+  // (released_from_cone); the update's later trials keep them let go.
+  HeldPlan plan;
+  if (held) held = &(plan = *held);
+  std::vector<int> let_go;
+  bool let_go_once = false;
   for (int h = 0; h <= params_.line_search_steps; ++h) {
     if (!budget_left()) return false;
     const double f = std::ldexp(1.0, -h);
-    const Vector pt = h == 0 ? pl : Vector(p0 + f * (pl - p0));
+    Vector pt = h == 0 ? pl : Vector(p0 + f * (pl - p0));
+    for (int j : let_go) pt[j] = 0.0;
     ++trials;
     if (held) {
       HeldContact law = held->law;
@@ -393,6 +400,13 @@ bool StepSolver::line_search(const Vector& pl, const Vector& du, int& trials, co
     EquilibriumState trial = eq_.solve(out_.state.q + f * du, pt);
     tighten_newton();
     bool ok = sound(trial);  // a diverging trial is a failed trial: halve
+    if (held && trial.converged && !ok && !let_go_once) {
+      let_go_once = true;
+      released_from_cone(plan, trial.p, let_go);
+      eq_.set_held(std::nullopt);
+      --h;  // the same trial length again
+      continue;
+    }
     ContactError e;
     if (ok) e = error_at(held ? trial.p : pt, trial.s, trial.enabled);
     // A loose trial that ends the step is finished at the full precision (no solve counted:
@@ -421,6 +435,29 @@ bool StepSolver::line_search(const Vector& pl, const Vector& du, int& trials, co
   if (reached_precision()) return true;
   return fail(FailureKind::contact_stalled,
               "no decrease of the contact error along the predicted force change (||v|| = " + number_text(v0) + ")");
+}
+
+void StepSolver::released_from_cone(HeldPlan& plan, const Vector& carried, std::vector<int>& let_go) const {
+  HeldContact& law = plan.law;
+  for (size_t i = 0; i < problem_.candidates.size(); ++i) {
+    const Candidate& c = problem_.candidates[i];
+    const bool held_xi = c.xi >= 0 && law.stiffness[c.xi] > 0;
+    if (law.stiffness[c.eta] > 0 && carried[c.eta] > 0) {
+      // Pulled: no longer held, its force the given zero (across and along).
+      law.stiffness[c.eta] = 0.0;
+      let_go.push_back(c.eta);
+      if (c.xi >= 0) {
+        law.stiffness[c.xi] = 0.0;
+        law.slip[i] = 0;
+        let_go.push_back(c.xi);
+      }
+    } else if (held_xi &&
+               std::abs(carried[c.xi]) > problem_.obstacles[c.obstacle].friction * -carried[c.eta] * (1 + 1e-9)) {
+      // Stuck beyond its bound: it slips the way its force pointed.
+      law.stiffness[c.xi] = 0.0;
+      law.slip[i] = carried[c.xi] > 0 ? 1 : -1;
+    }
+  }
 }
 
 bool StepSolver::held_admissible(const HeldContact& law, const Vector& p) const {

@@ -87,11 +87,16 @@ class StepSolver {
   // with a smaller ||v|| is accepted. du is the linear model's displacement change for pl - p
   // (Newton starts from it). `trials` counts the real solves.
   // With `held`, each trial is a held real solve, judged (and accepted) at the forces the body
-  // carried; a trial whose carried forces leave the cone where it held them is rejected.
+  // carried; a trial whose carried forces leave the cone where it held them is solved once more
+  // with those points let go (released_from_cone), and rejected if it leaves the cone again.
   bool line_search(const Vector& pl, const Vector& du, int& trials, const HeldPlan* held = nullptr);
   // The carried forces p meet the cone where the law held them: no tension, a sticking force
   // within mu |p_eta| (to 1e-9).
   bool held_admissible(const HeldContact& law, const Vector& p) const;
+  // Lets go the points whose carried forces left the cone where `plan` held them: one pulled
+  // across its obstacle carries the given force zero (its components appended to `let_go`), one
+  // stuck beyond mu |p_eta| slips the way its force pointed.
+  void released_from_cone(HeldPlan& plan, const Vector& carried, std::vector<int>& let_go) const;
   // No real solve lowers ||v|| any more (the line search, or alpha's halvings) where it is
   // within tolerance x L, the bound before it moved with D: the precision the real solves allow
   // is reached (their round-off: the mortar pairs of two bodies). The step converges there with
