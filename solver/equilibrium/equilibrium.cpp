@@ -44,6 +44,7 @@ void Equilibrium::index_free_dofs() {
 void Equilibrium::set_step(LoadFactors factors, std::vector<double> zeta_previous) {
   factors_ = std::move(factors);
   zeta_previous_ = std::move(zeta_previous);
+  new_load_ = true;
 }
 
 double Equilibrium::stiffness_scale(const Vector& q) const {

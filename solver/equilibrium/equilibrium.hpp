@@ -209,6 +209,7 @@ class Equilibrium {
   long newton_factor_solve_ = -1;
   Vector newton_factor_q_;
   long chord_factorization_ = -1;
+  bool new_load_ = false;  // set_step since the last Newton solve: no chords (newton.cpp)
   // The last state a Newton solve converged at: the stress base of the next solve's first
   // tangent (newton.cpp, the linearized stress).
   Vector converged_q_;

@@ -137,7 +137,7 @@ Body::Traits BodySet::traits() const {
   bool changing = false;  // some part's tangent changes
   for (const auto& p : parts_) {
     const Traits pt = p->traits();
-    // Newton's first correction is taken in full only where every changing tangent takes the
+    // Newton's corrections are taken in full only where every changing tangent takes the
     // linearized stress (newton.cpp).
     if (!pt.constant_tangent) {
       changing = true;

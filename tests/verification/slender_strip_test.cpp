@@ -41,9 +41,11 @@ TEST(Elastica, ReproducesMattiassonsTable) {
 // (tip rotation 82 deg) in 20 steps: at every step its tip is the elastica's within 0.3 %
 // of L (the continuum's own extension and shear, about (t/L)^2 and the load's spread over
 // the end section), and Newton needs no cut of the increment. With the linearized stress in
-// the tangent (docs/algorithm.md#newtons-tangent-the-linearized-stress) Newton converges from
-// the straight strip in 4 iterations and from each extrapolated start in 3-7: measured 85 for the
-// run (116, 18 at the first step and up to 9 after it, with the stress at each iterate).
+// the tangent (docs/algorithm.md#newtons-tangent-the-linearized-stress) and every correction
+// taken in full, Newton converges from the straight strip in 4 iterations and from each
+// extrapolated start in 3-5: measured 80 for the run (85 where Deuflhard's test judged the
+// corrections after the first, which the bound fails; 116, 18 at the first step and up to 9
+// after it, with the stress at each iterate).
 TEST(SlenderStrip, CantileverFollowsTheElastica) {
   const StripSpec spec;
   const auto s = solve_scene(strip_scene(spec));
@@ -64,10 +66,10 @@ TEST(SlenderStrip, CantileverFollowsTheElastica) {
   }
   int newton = 0;
   for (const StepRecord& rec : s.run.steps) {
-    EXPECT_LE(rec.newton_iterations, rec.index == 1 ? 5 : 8) << "step " << rec.index;
+    EXPECT_LE(rec.newton_iterations, rec.index == 1 ? 5 : 6) << "step " << rec.index;
     newton += rec.newton_iterations;
   }
-  EXPECT_LE(newton, 90);
+  EXPECT_LE(newton, 82);
 }
 
 // Doubling the mesh along the strip changes the tip by far less than the distance to the
@@ -155,8 +157,9 @@ TEST(SlenderStrip, WrapsOntoACylinder) {
 // Newton takes 276 iterations in all with its nonmonotone line search, 962 with a monotone one,
 // which stalled at the stick/slip kinks and left the updates to the tau passes on the model.
 // Chords with the last solve's factorization end most of the updates' solves without a
-// factorization (docs/algorithm.md, Newton's stopping tests): 100 Newton iterations and 29
-// chord-ended solves measured, where Newton alone took 133 (the bound fails it).
+// factorization (docs/algorithm.md, Newton's stopping tests): 95 Newton iterations and 29
+// chord-ended solves measured, where Newton alone took 133 and Newton with Deuflhard's test after
+// the first correction 100 (the bound fails both).
 TEST(SlenderStrip, WrapsOntoACylinderWithFriction) {
   const auto s = solve_scene(testing::example_scene("strip-on-cylinder"));
   expect_every_step_sound(s);
@@ -167,7 +170,7 @@ TEST(SlenderStrip, WrapsOntoACylinderWithFriction) {
   std::printf("%ld real solves, %ld Newton iterations, %ld ended by chords\n", s.run.counters.solves,
               s.run.counters.newton_iterations, s.run.counters.chord_solves);
   EXPECT_LE(s.run.counters.solves, 50);
-  EXPECT_LE(s.run.counters.newton_iterations, 110);
+  EXPECT_LE(s.run.counters.newton_iterations, 97);
   EXPECT_GE(s.run.counters.chord_solves, 20);
   int inner = 0;
   for (const StepRecord& rec : s.run.steps) inner += rec.inner_iterations;
