@@ -26,7 +26,7 @@ struct Rows {
 class Model {
  public:
   Model(const Problem& problem, const Compliance& C, const Vector& p0, const Vector& s0, double augmentation)
-      : compliance_(C), p0_full_(p0), s0_full_(s0), problem_(problem) {
+      : compliance_(C), finite_(C.sparse() || C.block.allFinite()), p0_full_(p0), s0_full_(s0), problem_(problem) {
     const int m = C.size();
     component_.assign(m, -1);
     for (size_t j = 0; j < C.position.size(); ++j)
@@ -58,7 +58,9 @@ class Model {
   }
 
   const Vector& x0() const { return x0_; }
-  Vector s(const Vector& x) const { return s0_ + compliance_.apply(x - x0_); }
+  Vector s(const Vector& x) const {
+    return s0_ + (finite_ ? compliance_.apply_finite(x - x0_) : compliance_.apply(x - x0_));
+  }
 
   // The Alart-Curnier function at x (with s = s(x)) and, if asked, the kinds of its
   // generalized Jacobian's rows (NewtonRows).
@@ -115,6 +117,7 @@ class Model {
 
  private:
   const Compliance& compliance_;
+  const bool finite_;  // C's dense block is finite: its products skip the zeros of x - x0
   const Vector& p0_full_;
   const Vector& s0_full_;
   const Problem& problem_;

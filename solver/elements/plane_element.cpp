@@ -283,6 +283,7 @@ void total_lagrangian_fixed(const std::vector<ElementPoint>& points, const Shape
   Eigen::Matrix<double, M, M> Ke;
   if (Ke_out) Ke.setZero();
   Eigen::Matrix<double, R, M> B, DB;
+  Eigen::Matrix<double, M, R> Bt;
   for (size_t k = 0; k < points.size(); ++k) {
     const ElementPoint& p = points[k];
     const Eigen::Map<const Nodes2> dN(p.dN.data());
@@ -337,12 +338,17 @@ void total_lagrangian_fixed(const std::vector<ElementPoint>& points, const Shape
     }
     if (!Ke_out) continue;
     DB.noalias() = (p.dV * D) * B;
-    for (int j = 0; j < M; ++j)
+    // Column j's entries i <= j from B^T (rows i contiguous): the same sums, entry by entry, as
+    // B's columns would give, two entries at a time in the vector registers.
+    Bt = B.transpose();
+    for (int j = 0; j < M; ++j) {
+      double* column = &Ke(0, j);
       for (int i = 0; i <= j; ++i) {
         double sum = 0.0;
-        for (int r = 0; r < R; ++r) sum += B(r, i) * DB(r, j);
-        Ke(i, j) += sum;
+        for (int r = 0; r < R; ++r) sum += Bt(i, r) * DB(r, j);
+        column[i] += sum;
       }
+    }
     // Geometric stiffness dN_a . S dN_b on both components (and the hoop term S33 N_a N_b / R^2).
     for (int b = 0; b < N; ++b) {
       const double sx = p.dV * (S_g(0, 0) * dN(b, 0) + S_g(0, 1) * dN(b, 1));

@@ -40,6 +40,9 @@ struct Compliance {
   double diagonal(int i) const { return sparse() ? diagonal_entries[i] : block(i, i); }
   // C z over the rows (one sparse solve in the sparse form).
   Vector apply(const Vector& z) const;
+  // The same, for a finite `block` (the caller knows it is): the columns where z is zero are
+  // skipped (the Coulomb model's changes x - x0 are zero on its open rows).
+  Vector apply_finite(const Vector& z) const;
   // Dense form only:
   double operator()(int a, int b) const {
     const int i = position[a], j = position[b];

@@ -64,6 +64,38 @@ void FreeBlockSolver::Assembly::add_block(const int* dofs, const Matrix& block) 
     if (p.size == m && std::equal(dofs, dofs + m, o.dofs_.data() + p.dofs)) {
       ++o.next_piece_;
       double* v = o.matrix_.valuePtr();
+      if (p.pairs >= 0 && (!o.length_scales_ || o.unit_scales_)) {
+        // Column by column, a node's two rows at a time: the entries are distinct slots, so the
+        // order within the block changes no sum, and each row's magnitudes are still summed
+        // with increasing column.
+        const int h = m / 2;
+        const int* pair = o.pair_slots_.data() + p.pairs;
+        const double* x = block.data();
+        if (!o.length_scales_) {
+          for (int j = 0; j < m; ++j, x += m, pair += h)
+            for (int a = 0; a < h; ++a) {
+              double* t = v + pair[a];
+              const double x0 = x[2 * a], x1 = x[2 * a + 1];
+              t[0] += x0;
+              t[1] += x1;
+            }
+          return;
+        }
+        const std::vector<int>& free = *o.free_index_;
+        double sums[kMaxPairedBlock];
+        for (int i = 0; i < m; ++i) sums[i] = o.row_sums_[free[dofs[i]]];
+        for (int j = 0; j < m; ++j, x += m, pair += h)
+          for (int a = 0; a < h; ++a) {
+            double* t = v + pair[a];
+            const double x0 = x[2 * a], x1 = x[2 * a + 1];
+            t[0] += x0;
+            t[1] += x1;
+            sums[2 * a] += std::abs(x0);
+            sums[2 * a + 1] += std::abs(x1);
+          }
+        for (int i = 0; i < m; ++i) o.row_sums_[free[dofs[i]]] = sums[i];
+        return;
+      }
       const int* slot = o.slots_.data() + p.slots;
       if (!o.length_scales_) {
         for (int i = 0; i < m; ++i)  // row by row, as the pattern was built
@@ -207,6 +239,25 @@ void FreeBlockSolver::build_pattern() {
       const double* t = &matrix_.coeffRef(it.col(), it.row());
       mirror_[&it.valueRef() - matrix_.valuePtr()] = static_cast<int>(t - matrix_.valuePtr());
     }
+  // The blocks taken by pairs (Piece::pairs).
+  pair_slots_.clear();
+  std::vector<int> sorted;
+  for (Piece& p : pieces_) {
+    p.pairs = -1;
+    const int m = p.size;
+    if (m == 0 || m % 2 || m > kMaxPairedBlock) continue;
+    const int* slot = slots_.data() + p.slots;  // row by row
+    sorted.assign(slot, slot + m * m);
+    std::sort(sorted.begin(), sorted.end());
+    if (sorted.front() < 0 || std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end()) continue;
+    bool paired = true;
+    for (int j = 0; paired && j < m; ++j)
+      for (int a = 0; paired && a < m / 2; ++a) paired = slot[(2 * a + 1) * m + j] == slot[2 * a * m + j] + 1;
+    if (!paired) continue;
+    p.pairs = static_cast<int>(pair_slots_.size());
+    for (int j = 0; j < m; ++j)
+      for (int a = 0; a < m / 2; ++a) pair_slots_.push_back(slot[2 * a * m + j]);
+  }
   lu_analysed_ = llt_analysed_ = dissected_analysed_ = llt_dissected_ = false;
   dissected_fails_at_ = 0;
   coupled_ = starts_.size() < 3;  // one body
@@ -579,7 +630,28 @@ bool CholmodFactor::inverse_block(const std::vector<int>& rows, Matrix& G, const
       const int m = w_.row_start[k + 1] - w_.row_start[k];
       // The row's columns increase: this task's entries are a contiguous range of it.
       const int first = static_cast<int>(std::lower_bound(col, col + m, lo) - col);
-      for (int i = first; i < m && col[i] < hi; ++i) {
+      // Four entries of the row at a time share the loads of the entries j before them (each
+      // entry of G still gets one product per k, in the same order), then their triangle.
+      int i = first;
+      for (; i + 3 < m && col[i + 3] < hi; i += 4) {
+        double *c0 = &G(0, col[i]), *c1 = &G(0, col[i + 1]), *c2 = &G(0, col[i + 2]), *c3 = &G(0, col[i + 3]);
+        const double v0 = val[i], v1 = val[i + 1], v2 = val[i + 2], v3 = val[i + 3];
+        for (int j = 0; j <= i; ++j) {
+          const int r = col[j];
+          const double w = val[j];
+          c0[r] += v0 * w;
+          c1[r] += v1 * w;
+          c2[r] += v2 * w;
+          c3[r] += v3 * w;
+        }
+        c1[col[i + 1]] += v1 * val[i + 1];
+        c2[col[i + 1]] += v2 * val[i + 1];
+        c2[col[i + 2]] += v2 * val[i + 2];
+        c3[col[i + 1]] += v3 * val[i + 1];
+        c3[col[i + 2]] += v3 * val[i + 2];
+        c3[col[i + 3]] += v3 * val[i + 3];
+      }
+      for (; i < m && col[i] < hi; ++i) {
         double* column = &G(0, col[i]);
         const double va = val[i];
         for (int j = 0; j <= i; ++j) column[col[j]] += va * val[j];

@@ -115,6 +115,7 @@ class FreeBlockSolver {
     pieces_.clear();
     dofs_.clear();
     slots_.clear();
+    pair_slots_.clear();
     ok_ = false;
     dissected_analysed_ = false;
     dissected_fails_at_ = 0;
@@ -140,8 +141,11 @@ class FreeBlockSolver {
   friend class Assembly;
   // An element's block (size m: m dofs, m x m slots row by row) or one entry (size 0: its row
   // and column in dofs_, one slot), in the order emitted.
+  // pairs: where every slot of a block is taken (a free row and column), each row pair (2a,
+  // 2a + 1) lands on two adjacent values in every column (a node's two dofs) and no two entries
+  // share a slot, the index in pair_slots_ of its column-major list of slot(2a, j); else -1.
   struct Piece {
-    int size, dofs, slots;
+    int size, dofs, slots, pairs = -1;
   };
   // Where the assembly departs from the pattern: the pieces matched so far stay, the rest is
   // recorded.
@@ -175,7 +179,8 @@ class FreeBlockSolver {
   // The pattern's sequence of pieces, their dofs, and each entry's index in matrix_'s values
   // (-1: dropped, a prescribed row or column).
   std::vector<Piece> pieces_;
-  std::vector<int> dofs_, slots_;
+  std::vector<int> dofs_, slots_, pair_slots_;
+  static constexpr int kMaxPairedBlock = 32;  // the largest block taken by pairs
   // The assembly under way: the next piece expected, whether every one so far followed the
   // pattern, and from where not, the pieces recorded (slots: index in recorded_values_).
   Assembly assembly_{*this};
