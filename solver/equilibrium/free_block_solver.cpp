@@ -56,6 +56,28 @@ void FreeBlockSolver::Assembly::add(int row, int col, double value) {
   o.record(0, dofs, &value);
 }
 
+namespace {
+
+// An m x m block added column by column, a node's two rows at a time, at the slots `pair`
+// (one per node pair and column); with kSums each row's magnitudes summed too.
+template <bool kSums>
+void scatter_by_pairs(double* v, const int* pair, const double* x, int m, double* sums) {
+  const int h = m / 2;
+  for (int j = 0; j < m; ++j, x += m, pair += h)
+    for (int a = 0; a < h; ++a) {
+      double* t = v + pair[a];
+      const double x0 = x[2 * a], x1 = x[2 * a + 1];
+      t[0] += x0;
+      t[1] += x1;
+      if constexpr (kSums) {
+        sums[2 * a] += std::abs(x0);
+        sums[2 * a + 1] += std::abs(x1);
+      }
+    }
+}
+
+}  // namespace
+
 void FreeBlockSolver::Assembly::add_block(const int* dofs, const Matrix& block) {
   FreeBlockSolver& o = owner_;
   const int m = static_cast<int>(block.rows());
@@ -68,31 +90,15 @@ void FreeBlockSolver::Assembly::add_block(const int* dofs, const Matrix& block) 
         // Column by column, a node's two rows at a time: the entries are distinct slots, so the
         // order within the block changes no sum, and each row's magnitudes are still summed
         // with increasing column.
-        const int h = m / 2;
         const int* pair = o.pair_slots_.data() + p.pairs;
-        const double* x = block.data();
         if (!o.length_scales_) {
-          for (int j = 0; j < m; ++j, x += m, pair += h)
-            for (int a = 0; a < h; ++a) {
-              double* t = v + pair[a];
-              const double x0 = x[2 * a], x1 = x[2 * a + 1];
-              t[0] += x0;
-              t[1] += x1;
-            }
+          scatter_by_pairs<false>(v, pair, block.data(), m, nullptr);
           return;
         }
         const std::vector<int>& free = *o.free_index_;
         double sums[kMaxPairedBlock];
         for (int i = 0; i < m; ++i) sums[i] = o.row_sums_[free[dofs[i]]];
-        for (int j = 0; j < m; ++j, x += m, pair += h)
-          for (int a = 0; a < h; ++a) {
-            double* t = v + pair[a];
-            const double x0 = x[2 * a], x1 = x[2 * a + 1];
-            t[0] += x0;
-            t[1] += x1;
-            sums[2 * a] += std::abs(x0);
-            sums[2 * a + 1] += std::abs(x1);
-          }
+        scatter_by_pairs<true>(v, pair, block.data(), m, sums);
         for (int i = 0; i < m; ++i) o.row_sums_[free[dofs[i]]] = sums[i];
         return;
       }
