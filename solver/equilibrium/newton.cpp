@@ -232,7 +232,7 @@ EquilibriumState Equilibrium::newton(const Vector& q_guess, const Vector& p) {
     const bool expect_end =
         it > 2 && !reuse &&
         last_step * last_step * last_step <= params_.displacement_tolerance * step_before * step_before;
-    bool with_tangent = !chord && !expect_end;
+    const bool with_tangent = !chord && !expect_end;
     Vector r = residual(state.q, state, p, with_tangent ? tangent() : nullptr, &force_scale, !low_rank);
     const double r_max = scaled_free_max(r);
     state.relative_residual = force_scale > 0 ? r_max / force_scale : 0.0;
