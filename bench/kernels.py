@@ -13,7 +13,8 @@ machine's cores, which its element kernels and G's sums use); the table keeps th
 seconds (user + system of the whole process: what the load of other work inflates least) and
 shows its wall seconds too. With --kernels-bench, grip_kernels_bench gives the CPU time of one
 numeric factorization of the strip's stiffness and of one assembly, beside the CPU time per
-Newton iteration. Usage:
+Newton iteration: of the whole solve, and of Newton's own work (the CPU time inside its solves,
+without the contact loop's compliance between them). Usage:
   bench/kernels.py --grip NEW [--before OLD] [--runs 3] [--threads 1] [--getfem] [--kernels-bench BIN]
 Timing is a benchmark, never a test: no pass/fail here.
 """
@@ -113,8 +114,12 @@ def main():
                     out = subprocess.run([args.kernels_bench, str(path)], capture_output=True, text=True).stdout
                     runs.append(json.loads(out.strip().splitlines()[-1]))
                 k = min(runs, key=lambda r: r["solve_cpu_s"])
-                print(f"\nstrip q9 {nx} x {ny}: {json.dumps(k)}; per Newton iteration / one factorization = "
-                      f"{k['ms_per_newton_iteration'] / k['factorize_ms']:.2f}")
+                f = k["factorize_ms"]
+                print(f"\nstrip q9 {nx} x {ny}: {json.dumps(k)}\n"
+                      f"  over one numeric factorization ({f:.2f} ms): the whole solve per Newton iteration "
+                      f"{k['ms_per_newton_iteration'] / f:.2f} x; Newton's own work per iteration "
+                      f"{k['newton_own_ms_per_iteration'] / f:.2f} x; the compliance's forms "
+                      f"{100 * k['compliance_cpu_s'] / k['solve_cpu_s']:.0f} % of the solve")
 
 
 if __name__ == "__main__":

@@ -124,6 +124,7 @@ bool only_body_in_newton_tangent(const Problem& problem, const EquilibriumState&
 
 const Compliance& Equilibrium::compliance(const EquilibriumState& state, const std::vector<int>& components,
                                           int sparse_from) {
+  const CpuSpan timed(counters_.compliance_cpu_s);
   const int k = static_cast<int>(components.size());
   bool tangent_ok = false;
   if (k > 0) {

@@ -1,5 +1,6 @@
 #pragma once
 // An equilibrium solve's answer: the state, its pairing and s, and the solver's counters.
+#include <ctime>
 #include <memory>
 #include <string>
 #include <vector>
@@ -48,6 +49,11 @@ struct EquilibriumCounters {
   long dissected_factorizations = 0;  // the body's tangent again, in nested-dissection order, for G only
   long compliance_forms = 0;          // G formed afresh (each on a factorization of its own)
   long compliance_columns = 0;        // columns of G solved for, all forms together
+  // Process CPU seconds inside Newton's solves and inside the compliance's forms: where a run's
+  // time goes, for the benchmarks (bench/kernels.py). Not in the result: they differ from run
+  // to run.
+  double newton_cpu_s = 0.0;
+  double compliance_cpu_s = 0.0;
 
   EquilibriumCounters& operator+=(const EquilibriumCounters& o) {
     solves += o.solves;
@@ -59,8 +65,23 @@ struct EquilibriumCounters {
     dissected_factorizations += o.dissected_factorizations;
     compliance_forms += o.compliance_forms;
     compliance_columns += o.compliance_columns;
+    newton_cpu_s += o.newton_cpu_s;
+    compliance_cpu_s += o.compliance_cpu_s;
     return *this;
   }
+};
+
+// Adds the process CPU time of its scope to `seconds`.
+class CpuSpan {
+ public:
+  explicit CpuSpan(double& seconds) : seconds_(seconds), start_(std::clock()) {}
+  ~CpuSpan() { seconds_ += static_cast<double>(std::clock() - start_) / CLOCKS_PER_SEC; }
+  CpuSpan(const CpuSpan&) = delete;
+  CpuSpan& operator=(const CpuSpan&) = delete;
+
+ private:
+  double& seconds_;
+  std::clock_t start_;
 };
 
 }  // namespace grip

@@ -156,6 +156,7 @@ void Equilibrium::continue_solve(EquilibriumState& state, const Vector& p) {
 }
 
 EquilibriumState Equilibrium::newton(const Vector& q_guess, const Vector& p) {
+  const CpuSpan timed(counters_.newton_cpu_s);
   EquilibriumState state;
   state.q = q_guess;
   for (const Constraint& c : problem_.constraints)

@@ -1,6 +1,8 @@
 // grip_kernels_bench: what a Newton iteration costs beside one numeric factorization of the
 // stiffness (issue 39; bench/results/kernels.md). For a scene file: the whole solve's CPU
-// seconds over its Newton iterations, and, at the reference state, the median CPU time of the
+// seconds over its Newton iterations, the CPU seconds inside Newton's solves alone (their
+// residuals, tangents, factorizations, solves and line searches, chord-ended solves included)
+// over the same iterations and inside the compliance's forms, and, at the reference state, the median CPU time of the
 // body's internal force with its tangent assembled into the free block as Newton does it (the
 // element kernels and the entries added into the block's values) and of one numeric
 // factorization of the assembled block (FreeBlockSolver::factorize, pattern and ordering already
@@ -223,8 +225,10 @@ int main(int argc, char** argv) {
   std::printf(
       ", \"solve_cpu_s\": %.4f, \"solve_wall_s\": %.4f, \"completed\": %s, \"real_solves\": %ld, "
       "\"newton_iterations\": %ld, \"factorizations\": %ld, \"newton_factorizations\": %ld, "
-      "\"body_factorizations\": %ld, \"dissected_factorizations\": %ld, \"ms_per_newton_iteration\": %.4f}\n",
+      "\"body_factorizations\": %ld, \"dissected_factorizations\": %ld, \"ms_per_newton_iteration\": %.4f, "
+      "\"newton_cpu_s\": %.4f, \"newton_own_ms_per_iteration\": %.4f, \"compliance_cpu_s\": %.4f}\n",
       run_s, run_wall_s, run.completed ? "true" : "false", c.solves, c.newton_iterations, c.factorizations,
       c.newton_factorizations, c.body_factorizations, c.dissected_factorizations,
-      c.newton_iterations ? 1e3 * run_s / c.newton_iterations : 0.0);
+      c.newton_iterations ? 1e3 * run_s / c.newton_iterations : 0.0, c.newton_cpu_s,
+      c.newton_iterations ? 1e3 * c.newton_cpu_s / c.newton_iterations : 0.0, c.compliance_cpu_s);
 }
