@@ -12,6 +12,8 @@ CalculiX: CPE4 on the same quadrilaterals, and CPE8R (8-node, reduced integratio
 CalculiX's users take near incompressibility) on quadrilaterals of 2 h, whose nodes are as
 dense as the 4-node mesh's. Each code's whole process is timed (start, solve, writing its
 answer): wall and CPU (user + system) seconds, one thread each, one run. The load is the sum of the punch nodes' reactions.
+run_grip and run_ccx (rough=True: the punch's nodes held in x too) also give the load at every
+step or increment (bench/prandtl_curve.py draws them).
 Usage: prandtl_ccx.py [GRIP] [--h 0.05] [--steps 20]
 """
 import argparse
@@ -84,7 +86,8 @@ def mesh(h, order):
     return nodes, elements, sets
 
 
-def run_grip(grip, h, steps, work):
+def run_grip(grip, h, steps, work, rough=False):
+    """grip on the q4 mesh; "curve": (penetration / b, load, Newton iterations) per step."""
     nodes, elements, sets = mesh(h, 1)
     scene = {
         "body": {
@@ -95,7 +98,7 @@ def run_grip(grip, h, steps, work):
             "supports": [
                 {"set": "left", "fix": ["x"]}, {"set": "right", "fix": ["x"]},
                 {"set": "bottom", "fix": ["x", "y"]},
-                {"set": "punch", "fix": ["y"], "values": {"y": -0.1}},
+                {"set": "punch", "fix": ["x", "y"] if rough else ["y"], "values": {"y": -0.1}},
             ],
         },
         # grip solves contact problems: a flat far below the base, never touched.
@@ -112,13 +115,16 @@ def run_grip(grip, h, steps, work):
         raise SystemExit("grip failed: " + done.stderr[-2000:])
     result = json.loads((work / "result.json").read_text())
     punch_dofs = {2 * n + 1 for n in sets["punch"]}
+    curve = [(0.1 * s["load_factor"], -sum(r["force"] for r in s["reactions"] if r["dof"] in punch_dofs),
+              s["newton_iterations"]) for s in result["steps"]]
     last = result["steps"][-1]
-    load = -sum(r["force"] for r in last["reactions"] if r["dof"] in punch_dofs)
     return {"code": "grip", "element": "q4_bbar", "nodes": len(nodes), "elements": len(elements),
-            "load": load, "seconds": seconds, "cpu": cpu, "converged": last["converged"] and len(result["steps"]) == steps}
+            "load": curve[-1][1], "seconds": seconds, "cpu": cpu,
+            "converged": last["converged"] and len(result["steps"]) == steps, "curve": curve}
 
 
-def run_ccx(h, steps, order, work):
+def run_ccx(h, steps, order, work, rough=False):
+    """CalculiX; "curve": (penetration / b, load, iterations) per converged increment (its .dat and .sta)."""
     nodes, elements, sets = mesh(h, order)
     kind = "CPE4" if order == 1 else "CPE8R"
     lines = ["*NODE, NSET=NALL"]
@@ -133,6 +139,7 @@ def run_ccx(h, steps, order, work):
         "*SOLID SECTION, ELSET=EALL, MATERIAL=STEEL", "1.",
         "*STEP, INC=1000", "*STATIC", f"{1 / steps:.12g}, 1., {1e-3 / steps:.12g}, {1 / steps:.12g}",
         "*BOUNDARY", "LEFT, 1, 1", "RIGHT, 1, 1", "BOTTOM, 1, 2", "PUNCH, 2, 2, -0.1",
+        *(["PUNCH, 1, 1"] if rough else []),
         "*NODE PRINT, NSET=PUNCH, TOTALS=ONLY", "RF", "*END STEP",
     ]
     (work / "punch.inp").write_text("\n".join(lines) + "\n")
@@ -145,8 +152,16 @@ def run_ccx(h, steps, order, work):
     if done.returncode or not totals:
         raise SystemExit("ccx failed: " + done.stdout[-2000:])
     time_reached, _, fy = totals[-1]
+    # .sta: STEP INC ATT ITRS TOT-TIME STEP-TIME INC-TIME, an attempt a line ("1U": not converged,
+    # the increment cut); the converged ones in the order of the .dat's totals
+    sta = (work / "punch.sta").read_text() if (work / "punch.sta").exists() else ""
+    its = [int(f[3]) for f in map(str.split, sta.splitlines()) if len(f) == 7 and f[0].isdigit() and f[2].isdigit()]
+    if len(its) != len(totals):
+        its = [None] * len(totals)
+    curve = [(0.1 * float(t), -float(y), n) for (t, _, y), n in zip(totals, its)]
     return {"code": "CalculiX", "element": kind, "nodes": len(nodes), "elements": len(elements),
-            "load": -float(fy), "seconds": seconds, "cpu": cpu, "converged": abs(float(time_reached) - 1) < 1e-9}
+            "load": -float(fy), "seconds": seconds, "cpu": cpu, "converged": abs(float(time_reached) - 1) < 1e-9,
+            "curve": curve}
 
 
 def main():
@@ -163,6 +178,7 @@ def main():
     for run in runs:
         r = run()
         r["error_percent"] = 100 * (r["load"] / LIMIT - 1)
+        del r["curve"]
         print(json.dumps(r), flush=True)
     shutil.rmtree(work)
 
