@@ -104,7 +104,8 @@ class StepSolver {
   bool reached_precision();
   // Inexact real solves (kInexactNewton, step.cpp): Newton's correction test for a trial
   // whose contact error starts at v_ref, loosened to that fraction of v_ref (true if looser
-  // than the full precision); and back to the full precision.
+  // than the full precision); and back to the full precision. Both divided by
+  // newton_amplification_ (a held trial's: line_search), not below newton_floor_.
   bool loosen_newton(double v_ref);
   void tighten_newton();
 
@@ -203,6 +204,11 @@ class StepSolver {
   bool strict_balance_ = false;  // error_met tests the amplitudes' rows
   double balance_tol_ = 0.0;     // their bound, at the accepted state (accept)
   NewtonParams newton_base_;     // Newton's tests at the contact tolerance (couple_newton)
+
+  // The rounding of the positions: no correction test below it.
+  double newton_floor_ = 0.0;
+  // A held trial's 1 + held_stiffness while its line search runs (line_search), else 1.
+  double newton_amplification_ = 1.0;
   int pass_ = 0, m_ = 0;
   long solves_at_start_ = 0;
   long newton_emitted_ = 0;  // the Newton counter at the last event
