@@ -78,8 +78,9 @@ struct ContactParams {
   // cev's default loop: the real solves of its line search under the given forces (given), or
   // held by the obstacles where the linear model presses or sticks (held: springs of stiffness
   // held_stiffness / C_jj toward the model's kinematics; docs/algorithm.md#the-held-real-solve).
+  // A scene's default is held where a body has plasticity, given otherwise (read_solver).
   RealSolve real_solve = RealSolve::given;
-  double held_stiffness = 30.0;
+  double held_stiffness = 300.0;
   // penalty: k_n and k_t (force / length); 0 means penalty_factor times the largest diagonal
   // entry of the body's stiffness (k_t defaults to k_n).
   double penalty_normal = 0.0;

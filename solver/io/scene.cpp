@@ -368,12 +368,15 @@ void hold_rigid_modes(Reader& r, Problem& problem) {
   problem.component_count += count;
 }
 
-void read_solver(Reader& r, json& scene, SteppingParams& params) {
+// `plastic`: a body of the scene yields (its traits' plasticity), which makes cev's real solves
+// held by default (docs/algorithm.md#the-held-real-solve).
+void read_solver(Reader& r, json& scene, SteppingParams& params, bool plastic) {
+  ContactParams& c = params.contact;
+  c.real_solve = plastic ? RealSolve::held : RealSolve::given;
   json* solver = r.object(scene, "", "solver", false);
   if (!solver) return;
   const std::string sp = "/solver";
   json* contact = r.object(*solver, sp, "contact", false);
-  ContactParams& c = params.contact;
   if (contact) {
     const std::string cp = sp + "/contact";
     const std::string method = r.choice(*contact, cp, "method", {"cev", "uzawa", "penalty", "ssn"}, "cev");
@@ -395,8 +398,9 @@ void read_solver(Reader& r, json& scene, SteppingParams& params) {
     c.loop = loop == "paper" ? ContactLoop::paper : ContactLoop::inner;
     const std::string friction_loop = r.choice(*contact, cp, "friction_loop", {"inner", "passes"}, "inner");
     c.friction_loop = friction_loop == "passes" ? FrictionLoop::passes : FrictionLoop::inner;
-    c.real_solve =
-        r.choice(*contact, cp, "real_solve", {"given", "held"}, "given") == "held" ? RealSolve::held : RealSolve::given;
+    c.real_solve = r.choice(*contact, cp, "real_solve", {"given", "held"}, plastic ? "held" : "given") == "held"
+                       ? RealSolve::held
+                       : RealSolve::given;
     c.held_stiffness = r.positive(*contact, cp, "held_stiffness", c.held_stiffness);
     c.augmentation = r.positive(*contact, cp, "augmentation", c.augmentation);
     c.max_iterations = r.integer(*contact, cp, "max_iterations", 1, 1000000, c.max_iterations);
@@ -688,7 +692,7 @@ Scene read_checked_scene(const nlohmann::json& input, const MeshResolver& meshes
   scene.problem.case_names = r.cases;
   if (scene.problem.body)
     for (size_t k = 0; k < r.cases.size(); ++k) scene_io::case_load(scene.problem, static_cast<int>(k));
-  read_solver(r, e, scene.params);
+  read_solver(r, e, scene.params, scene.problem.body && scene.problem.body->traits().plasticity);
   read_output(r, e, scene);
   if (r.issues.empty() && scene.problem.body) {
     const auto& recorded = scene.params.record_fields;

@@ -17,6 +17,7 @@
 #include <cstdio>
 
 #include "solver/elements/continuum.hpp"
+#include "solver/io/gmsh_mesh.hpp"
 #include "tests/support/contact_profile.hpp"
 #include "tests/support/scenes.hpp"
 
@@ -142,10 +143,14 @@ struct Strategy {
 
 TEST(J2Contact, RealSolvesWithinOneAndAHalfOfTheElasticBody) {
   const std::vector<Strategy> strategies = {
-      // Not met (1.87 x; bench/results/plasticity.md): one update is exact on the linear
-      // elastic body, while on the plastic one each update moves the plastic zone's edge, which
-      // the tangent at the state does not foresee (0.1-0.3 of the error left per update at first).
-      {"cev", {{"method", "cev"}}, false},
+      // cev's default: held real solves on the plastic body, given ones on the elastic body
+      // (docs/algorithm.md#the-held-real-solve).
+      {"cev", {{"method", "cev"}}},
+      // Under given forces throughout: not met (1.87 x; bench/results/plasticity.md): one update
+      // is exact on the linear elastic body, while on the plastic one each update moves the
+      // plastic zone's edge, which the tangent at the state does not foresee (0.1-0.3 of the
+      // error left per update at first).
+      {"cev given", {{"method", "cev"}, {"real_solve", "given"}}, false},
       {"cev loop paper", {{"method", "cev"}, {"loop", "paper"}}},
       {"ssn", {{"method", "ssn"}}},
       // One real solve per step whatever the body; its error is about |p| / k, so the
@@ -182,14 +187,14 @@ TEST(J2Contact, RealSolvesWithinOneAndAHalfOfTheElasticBody) {
   }
 }
 
-// cev with held real solves (solver.contact.real_solve: held, docs/algorithm.md#the-held-real-solve):
-// the same answer as with solves under the given forces, the contact forces and displacements of
-// every step to what the contact tolerance pins them to, in fewer real solves: each update's
-// solve holds the pressing points toward the linear model's gaps, so the yielding the tangent at
-// the state does not foresee no longer leaves 0.1-0.3 of the error (measured: 23 real solves
-// against 28, 1.53 x the linear elastic body's 15; the 1.5 x is not met).
+// cev with held real solves (solver.contact.real_solve: held, the default on a plastic body,
+// docs/algorithm.md#the-held-real-solve): the same answer as with solves under the given forces,
+// the contact forces and displacements of every step to what the contact tolerance pins them to,
+// in fewer real solves: each update's solve holds the pressing points toward the linear model's
+// gaps, so the yielding the tangent at the state does not foresee no longer leaves 0.1-0.3 of the
+// error (measured: 19 real solves against 28, 1.27 x the linear elastic body's 15).
 TEST(J2Contact, HeldRealSolvesGiveTheSameAnswerInFewerSolves) {
-  const Solved given = solve_scene(pressed_and_released(true, "cev"));
+  const Solved given = solve_scene(pressed_and_released_by(true, {{"method", "cev"}, {"real_solve", "given"}}));
   const Solved held = solve_scene(pressed_and_released_by(true, {{"method", "cev"}, {"real_solve", "held"}}));
   const Solved elastic = solve_scene(pressed_and_released(false, "cev"));
   ASSERT_TRUE(given.run.completed && held.run.completed && elastic.run.completed);
@@ -211,7 +216,7 @@ TEST(J2Contact, HeldRealSolvesGiveTheSameAnswerInFewerSolves) {
   // The displacements to 1e-8 of the 0.05 mm approach, the forces to 1e-6 of the largest.
   EXPECT_LT(displacement_gap, 1e-8 * 0.05);
   EXPECT_LT(force_gap, 1e-6);
-  EXPECT_LE(held_solves, 23);
+  EXPECT_LE(held_solves, 1.5 * elastic_solves);
   EXPECT_LT(held_solves, given_solves);
 }
 
@@ -247,6 +252,70 @@ TEST(J2Contact, HeldSolvesLetGoOfPointsThatLeaveTheCone) {
   EXPECT_LT(held_solves, given_solves);
   EXPECT_LT(displacement_gap, 1e-8 * 0.05);
   EXPECT_LT(force_gap, 1e-6);
+}
+
+// A held trial's Newton correction test is divided by 1 + held_stiffness (its carried forces move
+// by k_j = c / C_jj times Newton's last correction; docs/algorithm.md#the-held-real-solve). With
+// the test of a solve under given forces, hertz-t6's plastic body (the shipped t6 mesh with the
+// J2 law above, pressed in 4 steps and released in 4) at c = 100 took 19 real solves in its
+// first release step against 5 given: every trial of its second update found 2e-4 of Newton's
+// inexactness as contact error, above the 2.3e-5 it started from, at every length, and the step
+// was cut. Asserted: at c = 100 and at the default, no step takes more real solves held than
+// given, and the answers agree.
+TEST(J2Contact, HeldStepsTakeNoMoreRealSolvesThanGivenOnGmshTriangles) {
+  const auto examples = [](const json& ref) {
+    return std::make_shared<const GmshMesh>(
+        read_gmsh_file(std::string(GRIP_SOURCE_DIR) + "/schemas/examples/" + ref["file"].get<std::string>()));
+  };
+  const auto t6 = [&](const json& contact) {
+    json j = example_scene("hertz-t6");
+    j["body"]["material"].update(
+        {{"law", "j2_plasticity"}, {"yield_stress", 2000.0}, {"hardening", {{"linear", 20000.0}}}});
+    j.erase("steps");
+    j["stages"] = json::array({{{"steps", 4}, {"factors", {{"main", 1}}}}, {{"steps", 4}, {"factors", {{"main", 0}}}}});
+    j["solver"]["contact"].update(contact);
+    return solve_scene(j, examples);
+  };
+  const Solved given = t6({{"real_solve", "given"}});
+  ASSERT_TRUE(given.run.completed) << given.run.reason;
+  for (const json& held_contact : {json{{"held_stiffness", 100.0}}, json::object()}) {
+    SCOPED_TRACE(held_contact.dump());
+    const Solved held = t6(held_contact);
+    ASSERT_TRUE(held.run.completed) << held.run.reason;
+    EXPECT_EQ(held.scene.effective["solver"]["contact"]["real_solve"], "held");
+    ASSERT_EQ(given.run.steps.size(), held.run.steps.size());
+    std::string counts;
+    for (size_t k = 0; k < given.run.steps.size(); ++k) {
+      const StepRecord &a = given.run.steps[k], &b = held.run.steps[k];
+      counts += " " + std::to_string(b.solves) + "/" + std::to_string(a.solves);
+      EXPECT_LE(b.solves, a.solves) << "step " << a.index;
+      EXPECT_LT((a.p - b.p).cwiseAbs().maxCoeff(), 1e-6 * std::max(1.0, a.p.cwiseAbs().maxCoeff()))
+          << "step " << a.index;
+      EXPECT_LT((a.state.q - b.state.q).cwiseAbs().maxCoeff(), 1e-8 * 0.05) << "step " << a.index;
+    }
+    std::printf("plastic hertz-t6, real solves per step held / given:%s\n", counts.c_str());
+  }
+}
+
+// cev's real solves by default: held where a body has plasticity (one of several bodies
+// included), given otherwise, and as the scene says where it says.
+TEST(J2Contact, PlasticBodiesTakeHeldRealSolvesByDefault) {
+  const auto real_solve = [](const json& j) {
+    const Scene s = read_scene(j);
+    const std::string written = s.effective["solver"]["contact"]["real_solve"];
+    EXPECT_EQ(written == "held", s.params.contact.real_solve == RealSolve::held) << written;
+    return written;
+  };
+  EXPECT_EQ(real_solve(pressed_and_released(true, "cev")), "held");
+  EXPECT_EQ(real_solve(pressed_and_released(false, "cev")), "given");
+  EXPECT_EQ(real_solve(pressed_and_released_by(true, {{"real_solve", "given"}})), "given");
+  EXPECT_EQ(real_solve(pressed_and_released_by(false, {{"real_solve", "held"}})), "held");
+  json pair = example_scene("two-cylinders");
+  EXPECT_EQ(real_solve(pair), "given");
+  pair["bodies"][1]["element"] = "q4_bbar";
+  pair["bodies"][1]["material"].update(
+      {{"law", "j2_plasticity"}, {"yield_stress", 2000.0}, {"hardening", {{"linear", 20000.0}}}});
+  EXPECT_EQ(real_solve(pair), "held");
 }
 
 }  // namespace
