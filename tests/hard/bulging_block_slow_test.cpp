@@ -79,14 +79,14 @@ TEST(BulgingBlockSlow, FilletedBlockCompressedThirtyPercentThroughFriction) {
   EXPECT_NEAR(f0 / f2, 1.0, 1e-3);
 }
 
-// cev on level 0. With held real solves (solver.contact.real_solve: held,
-// docs/algorithm.md#the-held-real-solve) its solves pass the limit point of the body under given
-// contact forces (13 %); where every attempt of an increment then fails, load stepping's last
-// resort, ssn's semismooth Newton from the last converged state (docs/algorithm.md#load-stepping-and-cuts),
-// takes the increment: measured, it reaches 30 %, its force within 3.8e-5 of the penalty
-// strategy's. At every step it reaches: the invariants of the penalty runs above, and the plate's
-// force equal to the penalty strategy's (its error |p| / k, about 1e-4 of the force at factor 1e4
-// and tolerance 1e-4).
+// cev on level 0. Held real solves (solver.contact.real_solve: held,
+// docs/algorithm.md#the-held-real-solve) pass the limit points of the body under given contact
+// forces (13 %), since their Newton test was divided by 1 + held_stiffness each step on its own:
+// measured, 30 % in 1274 real solves at the default held_stiffness (1347 at 30), no increment
+// handed to load stepping's last resort (before, at 24 % every attempt failed and ssn took the
+// increment: 1652 real solves). At every step: the invariants of the penalty runs above, and
+// the plate's force equal to the penalty strategy's (its error |p| / k, about 1e-4 of the force at
+// factor 1e4 and tolerance 1e-4).
 void expect_like_penalty(const Pressed& cev, const Pressed& penalty, const char* name) {
   expect_sound(cev);
   double largest = 0;
@@ -97,20 +97,20 @@ void expect_like_penalty(const Pressed& cev, const Pressed& penalty, const char*
   EXPECT_LT(largest, 1e-4);
 }
 
-// cev to 30 % with load stepping's last resort taken at least once, like penalty at every step,
-// and at 30 % the side rolled over the fillet onto the plate.
-void expect_thirty_percent_by_the_last_resort(const Pressed& cev, const char* name) {
+// cev to 30 %, like penalty at every step, and at 30 % the side rolled over the fillet onto the
+// plate; `by_last_resort`: load stepping's last resort taken at least once, or never.
+void expect_thirty_percent(const Pressed& cev, const char* name, bool by_last_resort) {
   ASSERT_TRUE(cev.completed) << cev.reason;
-  EXPECT_FALSE(cev.by_ssn.empty());
+  EXPECT_EQ(cev.by_ssn.empty(), !by_last_resort);
   for (int step : cev.by_ssn) std::printf("ssn's semismooth Newton took an increment of step %d\n", step);
   expect_like_penalty(cev, penalty_coarse(), name);
   EXPECT_GT(cev.reach.back(), kFilletEnd);
   EXPECT_GT(cev.length.back(), kFilletEnd + 0.05);
 }
 
-TEST(BulgingBlockSlow, HeldCevPassesTheDeadLoadLimitPointsWithTheSemismoothLastResort) {
+TEST(BulgingBlockSlow, HeldCevPassesTheDeadLoadLimitPointsOnItsOwn) {
   const nlohmann::json held = {{"method", "cev"}, {"tolerance", 1e-9}, {"real_solve", "held"}};
-  expect_thirty_percent_by_the_last_resort(press_block_with(0, 0.3, 30, held), "cev with held solves");
+  expect_thirty_percent(press_block_with(0, 0.3, 30, held), "cev with held solves", false);
 }
 
 // cev by default (real solves under given contact forces) on level 0: its solves fall away from
@@ -121,7 +121,7 @@ TEST(BulgingBlockSlow, HeldCevPassesTheDeadLoadLimitPointsWithTheSemismoothLastR
 // its force within 3.9e-5 of the penalty strategy's. Asserted: it reaches 30 % with the last resort
 // taken, and the penalty runs' invariants and force at every step.
 TEST(BulgingBlockSlow, DefaultCevReachesThirtyPercentWithTheSemismoothLastResort) {
-  expect_thirty_percent_by_the_last_resort(press_block(0, 0.3, 30, "cev"), "cev");
+  expect_thirty_percent(press_block(0, 0.3, 30, "cev"), "cev", true);
 }
 
 }  // namespace
