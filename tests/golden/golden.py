@@ -52,7 +52,11 @@ EXAMPLES = os.path.join(HERE, "..", "..", "schemas", "examples")
 # (strip-on-cylinder, SVK, slender), q4 (hertz, block-on-foundation: two linear bodies), t6 from
 # gmsh (hertz-t6), t3 finite in a pair of bodies (two-cylinders-finite-t3), plasticity at small
 # and finite strain (hertz-j2-bbar, hertz-j2-finite), axisymmetric q8 and finite q9
-# (hertz-sphere, hertz-sphere-finite).
+# (hertz-sphere, hertz-sphere-finite); the geometrically exact beam (strip-on-drum-beam, the
+# elastica strip-cantilever); mixed u-p rubber (seal-o-ring); partial slip (cattaneo-mindlin);
+# the membranes (sheet-stretching, the axisymmetric bulge and punch stretching); two linear
+# bodies (two-cylinders); an axisymmetric flat punch. Not here, slower than a second: the gear
+# pair (2-6 s) and the press-fit (19 s).
 CASES = {
     "hertz": os.path.join(EXAMPLES, "hertz.json"),
     "sliding-block": os.path.join(EXAMPLES, "sliding-block.json"),
@@ -67,6 +71,15 @@ CASES = {
     "hertz-j2-bbar": os.path.join(HERE, "hertz-j2-bbar.json"),
     "hertz-j2-finite": os.path.join(HERE, "hertz-j2-finite.json"),
     "hertz-sphere-finite": os.path.join(HERE, "hertz-sphere-finite.json"),
+    "strip-on-drum-beam": os.path.join(EXAMPLES, "strip-on-drum-beam.json"),
+    "strip-cantilever": os.path.join(EXAMPLES, "strip-cantilever.json"),
+    "seal-o-ring": os.path.join(EXAMPLES, "seal-o-ring.json"),
+    "cattaneo-mindlin": os.path.join(EXAMPLES, "cattaneo-mindlin.json"),
+    "sheet-stretching": os.path.join(EXAMPLES, "sheet-stretching.json"),
+    "two-cylinders": os.path.join(EXAMPLES, "two-cylinders.json"),
+    "flat-punch-axisymmetric": os.path.join(EXAMPLES, "flat-punch-axisymmetric.json"),
+    "hydraulic-bulge-axisymmetric": os.path.join(EXAMPLES, "hydraulic-bulge-axisymmetric.json"),
+    "punch-stretching-axisymmetric": os.path.join(EXAMPLES, "punch-stretching-axisymmetric.json"),
 }
 
 RELATIVE = 1e-12
