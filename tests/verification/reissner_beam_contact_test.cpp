@@ -1,5 +1,6 @@
 // The geometrically exact beam in contact with rigid obstacles: a strip wrapped onto a drum by
-// its lower face against the same strip as a continuum, with every contact strategy, and a
+// its lower face against the same strip as a continuum, with every contact strategy, the same
+// strip mirrored under a drum above it (its upper face against the drum), and a
 // belt pulled over a drum (the capstan) as its bending stiffness goes to zero.
 #include <gtest/gtest.h>
 
@@ -89,6 +90,82 @@ TEST(ReissnerBeamContact, StripOnDrumAgreesWithTheContinuum) {
       EXPECT_EQ(c.side, -1);
     }
   EXPECT_GE(touching, 5);
+}
+
+// The same strip mirrored about its axis (y = 0): the drum above it (centre (0, 1.05)), the end
+// load up, so that its upper face wraps onto the drum. Every candidate is on the upper face (side
+// +1); the contact points are the axis' nodes moved t/2 along the section's direction
+// (sin theta, cos theta), and none lies inside the drum by more than the contact tolerance
+// (those that press lie on it within it); the contact resultant balances the end load and the
+// clamp's reactions; and the run is the lower face's mirrored: the same u, opposite w and theta,
+// the same contact forces mirrored, to 1e-8 (measured: equal bit for bit; 3 points touch at F 0.5
+// and 7 at F 1, the deepest 1.7e-8 inside the drum against the tolerance 3e-8).
+TEST(ReissnerBeamContact, UpperFaceOnADrumAboveMirrorsTheLowerFace) {
+  nlohmann::json scene = strip_on_drum_beam();
+  scene["obstacles"][0]["shape"]["centre"] = {0.0, 1.05};
+  scene["body"]["loads"][0]["force"] = {0.0, 1.0};
+  const auto up = solve_scene(scene);
+  const auto down = solve_scene(strip_on_drum_beam());
+  testing::expect_every_step_sound(up);
+  ASSERT_TRUE(down.run.completed) << down.run.reason;
+  ASSERT_EQ(up.run.steps.size(), down.run.steps.size());
+  const Problem &problem = up.scene.problem, &mirror = down.scene.problem;
+  ASSERT_EQ(problem.candidates.size(), mirror.candidates.size());
+  const double half = 0.05, R = 1.0, tol = testing::tolerances_of(up.scene).length;
+  const Vec2 centre(0.0, 1.05);
+  double worst_q = 0.0, worst_f = 0.0, p_max = 0.0, worst_point = 0.0, deepest = 0.0;
+  for (size_t k = 0; k < up.run.steps.size(); ++k) {
+    const StepRecord &rec = up.run.steps[k], &ref = down.run.steps[k];
+    ASSERT_TRUE(rec.converged) << k + 1;
+    for (int n = 0; n < problem.body->dof_count() / 3; ++n) {
+      const double du = rec.state.q[3 * n] - ref.state.q[3 * n], dw = rec.state.q[3 * n + 1] + ref.state.q[3 * n + 1],
+                   dt = rec.state.q[3 * n + 2] + ref.state.q[3 * n + 2];
+      worst_q = std::max({worst_q, std::abs(du), std::abs(dw), std::abs(dt)});
+    }
+    for (const Candidate& c : mirror.candidates) p_max = std::max(p_max, std::abs(ref.p[c.eta]));
+    int touching = 0;
+    for (size_t i = 0; i < problem.candidates.size(); ++i) {
+      const Candidate &c = problem.candidates[i], &m = mirror.candidates[i];
+      ASSERT_EQ(c.site, m.site);
+      EXPECT_EQ(c.side, +1) << "site " << c.site;
+      EXPECT_EQ(m.side, -1) << "site " << m.site;
+      // The contact point: the axis node moved t/2 along the section's direction.
+      const int node = c.site;
+      const double theta = rec.state.q[ReissnerBeam::node_dof(node, 2)];
+      const Vec2 axis = problem.body->site_reference(node) + Vec2(rec.state.q[ReissnerBeam::node_dof(node, 0)],
+                                                                  rec.state.q[ReissnerBeam::node_dof(node, 1)]);
+      const Vec2 x = rec.state.points[i].point.x;
+      worst_point = std::max(worst_point, (x - (axis + half * Vec2(std::sin(theta), std::cos(theta)))).norm());
+      const double gap = (x - centre).norm() - R;
+      deepest = std::max(deepest, -gap);
+      EXPECT_GT(gap, -tol) << "step " << k + 1 << " site " << c.site;
+      EXPECT_NEAR(rec.state.points[i].projection.gap, gap, 1e-12) << "step " << k + 1 << " site " << c.site;
+      if (rec.p[c.eta] < 0) {
+        ++touching;
+        EXPECT_LT(std::abs(gap), tol) << "step " << k + 1 << " site " << c.site;
+      }
+      // The mirrored force of the lower face's run.
+      const Vec2 f = rec.p[c.eta] * rec.state.points[i].eta + rec.p[c.xi] * rec.state.points[i].xi;
+      const Vec2 g = ref.p[m.eta] * ref.state.points[i].eta + ref.p[m.xi] * ref.state.points[i].xi;
+      worst_f = std::max(worst_f, (f - Vec2(g.x(), -g.y())).norm());
+    }
+    // Force balance: the contact resultant against the end load and the clamp's reactions.
+    const Vec2 contact = testing::contact_resultant(problem, rec),
+               reactions = testing::reaction_resultant(problem, rec);
+    const Vec2 load(0.0, rec.load_factor);
+    EXPECT_LT((contact + reactions + load).norm(), 1e-9) << "step " << k + 1;
+    if (k == 19 || k == 9)
+      std::printf("F %.2f: upper face, %d points touching, contact resultant (%.6f, %.6f), clamp (%.6f, %.6f)\n",
+                  rec.load_factor, touching, contact.x(), contact.y(), reactions.x(), reactions.y());
+    if (k == up.run.steps.size() - 1) EXPECT_GE(touching, 5);
+  }
+  std::printf(
+      "mirrored: displacements within %.1e, forces within %.1e of the largest; contact points %.1e from axis "
+      "+ t/2 n, deepest %.1e (tolerance %.1e)\n",
+      worst_q, worst_f / p_max, worst_point, deepest, tol);
+  EXPECT_LT(worst_q, 1e-8);
+  EXPECT_LT(worst_f, 1e-8 * p_max);
+  EXPECT_LT(worst_point, 1e-12);
 }
 
 // Every strategy that converges on it gives the same strip: ssn, penalty and cev's friction
