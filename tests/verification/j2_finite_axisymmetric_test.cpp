@@ -72,9 +72,10 @@ const Formulation kFBarQ4{ContinuumElement::q4, Incompressibility::f_bar};
 
 // The one-dimensional return in Kirchhoff stress against log strain x with modulus M:
 // tau = M (x - eps_p), |tau| <= sigma_y(alpha); a plastic step moves eps_p and alpha by the
-// same |d| (bisection: the power law's closed form is implicit).
+// same |d| (bisection: the power law's closed form is implicit), on the law's curve from its
+// data (Law::yield_stress), not the material's.
 struct Uniaxial {
-  const J2Material& m;
+  const Law& m;
   double modulus;
   double eps_p = 0.0, alpha = 0.0;
 
@@ -95,7 +96,7 @@ struct Uniaxial {
 
 // Loading to `peak` in 15 steps, unloading elastically to tau = -tau_peak / 2, reloading to
 // `last` in 10 steps (x: the log strain of the closed form).
-std::vector<double> load_unload_reload(const J2Material& m, double modulus, double peak, double last) {
+std::vector<double> load_unload_reload(const Law& m, double modulus, double peak, double last) {
   Uniaxial loaded{m, modulus};
   for (int k = 1; k <= 15; ++k) loaded.tau(peak * k / 15);
   const double unload = 1.5 * loaded.tau(peak) / modulus;
@@ -138,10 +139,10 @@ TEST(J2FiniteAxisymmetric, RingPulledAlongItsAxisFollowsTheClosedForm) {
       for (int n : mesh.sets.at("bottom")) held[2 * n + 1] = 1;
       for (int n : mesh.sets.at("top")) held[2 * n + 1] = 1;
       Driver d(body, held);
-      Uniaxial closed{*m, kYoung};
+      Uniaxial closed{law, kYoung};
       const int outer = mesh.sets.at("right").front();
       double worst = 0.0, worst_lateral = 0.0, worst_free = 0.0;
-      for (double eps : load_unload_reload(*m, kYoung, 0.3, 0.5)) {
+      for (double eps : load_unload_reload(law, kYoung, 0.3, 0.5)) {
         d.solve(
             [&](Vector& q) {
               for (int n : mesh.sets.at("top")) q[2 * n + 1] = std::exp(eps) - 1;
@@ -181,10 +182,10 @@ TEST(J2FiniteAxisymmetric, RingExpandedInRadiusAndHoopFollowsTheClosedForm) {
       for (int n : mesh.sets.at("bottom")) held[2 * n + 1] = 1;
       Driver d(body, held);
       const double modulus = kYoung / (2 * (1 - kPoisson));
-      Uniaxial closed{*m, modulus};
+      Uniaxial closed{law, modulus};
       const int top = mesh.sets.at("top").front();
       double worst = 0.0, worst_axial = 0.0, worst_free = 0.0;
-      for (double x : load_unload_reload(*m, modulus, 0.4, 0.6)) {
+      for (double x : load_unload_reload(law, modulus, 0.4, 0.6)) {
         const double lambda = std::exp(x / 2);
         d.solve(
             [&](Vector& q) {
