@@ -27,6 +27,10 @@ struct PunchCurve {
   std::vector<double> depth, load;  // the punch's penetration and force (half model), per step
   std::vector<int> newton;          // Newton iterations per step
   int punch_nodes = 0;
+  double h = 0.0;  // the element size near the punch's edge
+  // At the last step, per element: its centre and its equivalent plastic strain (volume mean).
+  std::vector<Vec2> centre;
+  std::vector<double> alpha;
 };
 
 // The half model with elements of size h within 2.5 b of the punch's edge (growing beyond, nx x
@@ -69,7 +73,46 @@ inline PunchCurve press_punch(double h, int nx, int ny, double depth, const std:
     c.load.push_back(-load);
     c.newton.push_back(static_cast<int>(d.residuals.size()) - 1);
   }
+  c.h = h;
+  const auto rows = body.element_fields(d.q).rows;
+  for (size_t e = 0; e < mesh.elements.size(); ++e) {
+    Vec2 centre = Vec2::Zero();
+    for (int n : mesh.elements[e]) centre += mesh.nodes[n];
+    c.centre.push_back(centre / static_cast<double>(mesh.elements[e].size()));
+    c.alpha.push_back(rows[e][4]);
+  }
   return c;
+}
+
+// The element whose centre is nearest to p.
+inline size_t element_near(const PunchCurve& c, Vec2 p) {
+  size_t best = 0;
+  for (size_t e = 1; e < c.centre.size(); ++e)
+    if ((c.centre[e] - p).norm() < (c.centre[best] - p).norm()) best = e;
+  return best;
+}
+
+// Where the plastic strain is at the last step: the largest in an element at the punch's edge
+// (centre within 2 h of x = b and of the surface), that element's alpha more than `centre_ratio`
+// times the one under the punch's centre at the same depth, and the one 2 b further along the
+// surface below `far_fraction` of it. A plastic strain spread evenly fails all three.
+inline void check_edge_localisation(const PunchCurve& c, double centre_ratio, double far_fraction, const char* name) {
+  const size_t peak = std::max_element(c.alpha.begin(), c.alpha.end()) - c.alpha.begin();
+  const Vec2 at = c.centre[peak];
+  const double a = c.alpha[peak];
+  const size_t under = element_near(c, {0.0, at.y()}), far = element_near(c, {at.x() + 2.0, at.y()});
+  std::printf(
+      "%s: largest alpha %.4e at (%.3f, %.3f) (h = %.2f); under the centre (%.3f, %.3f) %.3e (1/%.0f); 2 b along "
+      "(%.3f, %.3f) %.3e (1/%.0f)\n",
+      name, a, at.x(), at.y(), c.h, c.centre[under].x(), c.centre[under].y(), c.alpha[under],
+      a / std::max(c.alpha[under], 1e-300), c.centre[far].x(), c.centre[far].y(), c.alpha[far],
+      a / std::max(c.alpha[far], 1e-300));
+  EXPECT_LE(std::abs(at.x() - 1.0), 2 * c.h);
+  EXPECT_GE(at.y(), -2 * c.h);
+  EXPECT_LT(std::abs(c.centre[under].y() - at.y()), 1e-9);
+  EXPECT_LT(std::abs(c.centre[far].y() - at.y()), 1e-9);
+  EXPECT_GT(a, centre_ratio * c.alpha[under]);
+  EXPECT_LT(c.alpha[far], far_fraction * a);
 }
 
 // The curve against the limit: the last load within `within` of it, the last three steps within
