@@ -11,6 +11,7 @@
 #include "solver/contact/held_by_contact.hpp"
 #include "solver/problem/rigid_modes.hpp"
 #include "solver/stepping/candidate_growth.hpp"
+#include "solver/stepping/limit_load.hpp"
 
 namespace grip {
 namespace {
@@ -158,6 +159,7 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
     }
   }
   auto checker = std::make_unique<StepChecker>(problem, params.contact, params.contact_reach);
+  LoadPathStiffness along_load(problem);
   AcceptedContact accepted = accepted_contact(eq->evaluate(q), p);
 
   for (size_t k = 0; k < steps.size(); ++k) {
@@ -405,6 +407,13 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
           } else if (from_converged) {
             rec.reason += ", from the last converged state as well";
           }
+          // Newton's drift past a limit load is no numerical accident: the step says so.
+          if (!out.stopped && !spent &&
+              (rec.failure == FailureKind::newton_diverged || rec.failure == FailureKind::contact_stalled))
+            if (std::string why = along_load.beyond_limit(current, target); !why.empty()) {
+              rec.reason = why + " (" + rec.reason + ")";
+              rec.failure = FailureKind::no_equilibrium;
+            }
           rec.p = out.p;
           rec.tau = out.tau;
           rec.state = std::move(out.state);
@@ -429,6 +438,7 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
       // Commit.
       rec.checks.worst_of(attempt);
       accepted = accepted_contact(out.state, out.p);
+      along_load.committed(current, target, out.state.q - q);
       v_first = start_q || out.history.empty() ? 0.0 : out.history.front().v2;
       start_q.reset();
       q_before = q;
