@@ -1,7 +1,8 @@
 // The geometrically exact beam in contact with rigid obstacles: a strip wrapped onto a drum by
 // its lower face against the same strip as a continuum, with every contact strategy, the same
-// strip mirrored under a drum above it (its upper face against the drum), and a
-// belt pulled over a drum (the capstan) as its bending stiffness goes to zero.
+// strip mirrored under a drum above it (its upper face against the drum), a belt pressed between
+// two drums with both faces at once, and a belt pulled over a drum (the capstan) as its bending
+// stiffness goes to zero.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -165,6 +166,80 @@ TEST(ReissnerBeamContact, UpperFaceOnADrumAboveMirrorsTheLowerFace) {
       worst_q, worst_f / p_max, worst_point, deepest, tol);
   EXPECT_LT(worst_q, 1e-8);
   EXPECT_LT(worst_f, 1e-8 * p_max);
+  EXPECT_LT(worst_point, 1e-12);
+}
+
+// A belt touching with both faces at once: the strip of issue 39 (L 3, t 0.1, 30 b3) pinned at
+// both ends, a drum of radius 0.5 below it at x = 1 pushed up 0.2 and one above it at x = 2
+// pushed down 0.2, friction 0.2 on both, 20 steps: an S. The lower drum pairs with the lower face
+// (side -1) only and the upper drum with the upper face (side +1) only, and both press at the end
+// (3 points each); the contact points lie on the faces (the axis node moved t/2 along the
+// section: measured 0) and outside each drum by no more than the contact tolerance; the scene is
+// symmetric under the half turn about (1.5, 0), which swaps the drums, and so is the run: u and w
+// of node n opposite to node 30 - n's, theta equal, the drums' resultants opposite, to 1e-8
+// (measured 5e-15 and 3e-13 of the largest force); every step balanced and on Coulomb's cone
+// (expect_every_step_sound).
+nlohmann::json s_belt_beam() {
+  nlohmann::json scene = strip_on_drum_beam();
+  scene["body"]["supports"] = {{{"node", 0}, {"fix", {"u", "w"}}}, {{"node", 30}, {"fix", {"u", "w"}}}};
+  scene["body"].erase("loads");
+  scene["obstacles"] = {{{"name", "below"},
+                         {"shape", {{"type", "circle"}, {"centre", {1.0, -0.55}}, {"radius", 0.5}}},
+                         {"friction", 0.2},
+                         {"motion", {{"translation", {0.0, 0.2}}}}},
+                        {{"name", "above"},
+                         {"shape", {{"type", "circle"}, {"centre", {2.0, 0.55}}, {"radius", 0.5}}},
+                         {"friction", 0.2},
+                         {"motion", {{"translation", {0.0, -0.2}}}}}};
+  return scene;
+}
+
+TEST(ReissnerBeamContact, BeltBetweenTwoDrumsTouchesWithBothFaces) {
+  const auto s = solve_scene(s_belt_beam());
+  testing::expect_every_step_sound(s);
+  ASSERT_EQ(s.run.steps.size(), 20u);
+  const Problem& problem = s.scene.problem;
+  const double half = 0.05, tol = testing::tolerances_of(s.scene).length;
+  const Vec2 centre[2] = {{1.0, -0.55}, {2.0, 0.55}};
+  const Vec2 motion[2] = {{0.0, 0.2}, {0.0, -0.2}};
+  double worst_q = 0.0, worst_f = 0.0, worst_point = 0.0;
+  for (const StepRecord& rec : s.run.steps) {
+    double p_max = 0.0;
+    for (const Candidate& c : problem.candidates) p_max = std::max(p_max, std::abs(rec.p[c.eta]));
+    int touching[2] = {0, 0};
+    for (size_t i = 0; i < problem.candidates.size(); ++i) {
+      const Candidate& c = problem.candidates[i];
+      EXPECT_EQ(c.side, c.obstacle == 0 ? -1 : +1) << "site " << c.site << " obstacle " << c.obstacle;
+      const double theta = rec.state.q[ReissnerBeam::node_dof(c.site, 2)];
+      const Vec2 axis = problem.body->site_reference(c.site) + Vec2(rec.state.q[ReissnerBeam::node_dof(c.site, 0)],
+                                                                    rec.state.q[ReissnerBeam::node_dof(c.site, 1)]);
+      const Vec2 x = rec.state.points[i].point.x;
+      worst_point = std::max(worst_point, (x - (axis + c.side * half * Vec2(std::sin(theta), std::cos(theta)))).norm());
+      const double gap = (x - centre[c.obstacle] - rec.load_factor * motion[c.obstacle]).norm() - 0.5;
+      EXPECT_GT(gap, -tol) << "step " << rec.index << " site " << c.site;
+      if (rec.p[c.eta] < 0) ++touching[c.obstacle];
+    }
+    if (rec.index == 20) {
+      std::printf("S belt, last step: %d points press on the lower drum, %d on the upper\n", touching[0], touching[1]);
+      EXPECT_GE(touching[0], 2);
+      EXPECT_GE(touching[1], 2);
+    }
+    // The half turn about (1.5, 0): node n's motion is node (30 - n)'s turned.
+    for (int n = 0; n <= 30; ++n) {
+      const int m = 30 - n;
+      worst_q = std::max({worst_q, std::abs(rec.state.q[3 * n] + rec.state.q[3 * m]),
+                          std::abs(rec.state.q[3 * n + 1] + rec.state.q[3 * m + 1]),
+                          std::abs(rec.state.q[3 * n + 2] - rec.state.q[3 * m + 2])});
+    }
+    const Vec2 lower = testing::contact_resultant(problem, rec, 0), upper = testing::contact_resultant(problem, rec, 1);
+    worst_f = std::max(worst_f, (lower + upper).norm() / std::max(p_max, 1e-300));
+  }
+  std::printf(
+      "S belt: half-turn symmetry of q within %.1e, drum forces opposite within %.1e of the largest; contact "
+      "points %.1e from the faces\n",
+      worst_q, worst_f, worst_point);
+  EXPECT_LT(worst_q, 1e-8);
+  EXPECT_LT(worst_f, 1e-8);
   EXPECT_LT(worst_point, 1e-12);
 }
 
