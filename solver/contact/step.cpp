@@ -32,6 +32,9 @@ constexpr double kInexactNewton = 0.05;
 // last event emits one anyway (budget_left).
 constexpr long kProgressNewton = 200;
 
+// Accepted states over which a crawl of the contact error is measured (accept).
+constexpr size_t kCrawlUpdates = 10;
+
 // The round-off of a gap or slip, in units of eps x the size of the coordinates it is a
 // difference of, per contact component (bound_at).
 constexpr double kRoundOffGaps = 4.0;
@@ -330,6 +333,24 @@ void StepSolver::accept(EquilibriumState s, const Vector& p) {
     for (const Candidate& c : problem_.candidates) size += std::hypot(p[c.eta], c.xi >= 0 ? p[c.xi] : 0.0);
     balance_tol_ = problem_.rigid.scale * (strict_balance_ ? params_.newton_fraction : 1.0) * params_.tolerance * size;
   }
+  // A crawl: over the last kCrawlUpdates accepted states ||v|| fell at a rate that reaches its
+  // bound only far beyond the budget left (4 x). Such an attempt ends at the next budget check:
+  // spending the budget only delays the cut. Not for uzawa, linear by design. (A plastic block
+  // pressed by a load onto a rigid punch past its limit: ||v|| 8.87e-5 -> 8.84e-5 in 2 updates of
+  // 3 s each, the bound 4e-10; before, each attempt spent its 500 real solves, 835 s in all.)
+  accepted_errors_.push_back(error_.norm2);
+  if (const size_t n = accepted_errors_.size();
+      params_.method != ContactMethod::uzawa && n > kCrawlUpdates && !error_met(error_) && error_.norm2 > tol_) {
+    const double from = accepted_errors_[n - 1 - kCrawlUpdates];
+    const double rate = std::pow(error_.norm2 / from, 1.0 / kCrawlUpdates);
+    const long left = solves_at_start_ + params_.max_iterations - eq_.counters().solves;
+    const double needed = rate < 1 ? std::log(tol_ / error_.norm2) / std::log(rate) : HUGE_VAL;
+    if (needed > 4.0 * static_cast<double>(left))
+      crawl_ = "contact error " + number_text(error_.norm2) + " above its bound " + number_text(tol_) +
+               ": it fell from " + number_text(from) + " over the last " + std::to_string(kCrawlUpdates) +
+               " updates, a rate that needs about " + (needed < 1e9 ? number_text(std::round(needed)) : "unbounded") +
+               " more against the " + std::to_string(left) + " contact iterations left";
+  }
   // A load beyond what friction holds (friction_limit.hpp), shown at two accepted states in a
   // row, ends the step at the next budget check: the paper's loop otherwise spends its whole
   // budget turning a disc about its squeezed shape (500 real solves, 26 s of CPU on 33 x 33).
@@ -355,6 +376,7 @@ bool StepSolver::budget_left() {
     return fail(FailureKind::stopped, "stopped on request");
   }
   if (!friction_limit_.empty()) return fail(FailureKind::friction_limit, friction_limit_);
+  if (!crawl_.empty()) return fail(FailureKind::contact_stalled, crawl_);
   // A long stretch of rejected trials (halvings of alpha, a line search) still reports: an
   // event with no new update (trials 0, the accepted state's error), so that no step runs
   // thousands of Newton iterations in silence (two cylinders with uzawa: 7,000 in 118 s).

@@ -219,8 +219,10 @@ class StepSolver {
   bool passes_to_budget_ = false;   // the tau passes end at the budget, not max_tau_passes (uzawa)
   long own_newton_iterations_ = 0;  // Newton iterations made outside the oracle (ssn)
   std::vector<char> is_normal_;
-  int beyond_friction_ = 0;     // accepted states in a row beyond what friction holds (accept)
-  std::string friction_limit_;  // why, once shown: budget_left ends the step with it
+  int beyond_friction_ = 0;              // accepted states in a row beyond what friction holds (accept)
+  std::string friction_limit_;           // why, once shown: budget_left ends the step with it
+  std::vector<double> accepted_errors_;  // ||v|| at each accepted state of the attempt
+  std::string crawl_;                    // why the budget cannot reach the bound (accept)
   ContactError error_;
   StepOutcome out_;
 

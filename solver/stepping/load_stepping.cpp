@@ -370,8 +370,15 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
         // where Newton falls away (the bulging block, docs/verification.md#bulging-block). Not
         // for a body without reference stiffness (a start-up): at a zero increment its tangent
         // is singular (the rigid-plastic sheet).
+        // Past a limit load under load control (limit_load.hpp) neither fallback below can help:
+        // no state carries the load.
+        const std::string limit =
+            depth >= params.max_cuts && !out.stopped && !spent &&
+                    (out.failure == FailureKind::newton_diverged || out.failure == FailureKind::contact_stalled)
+                ? along_load.beyond_limit(current, target)
+                : std::string();
         if (depth >= params.max_cuts && !out.stopped && !out.definitive && !spent && !from_converged &&
-            !problem.start && ratio != 0) {
+            !problem.start && ratio != 0 && limit.empty()) {
           rec.notes.push_back("every attempt from the extrapolated state failed (" + out.reason +
                               "): the increment again from the last converged state");
           from_converged = true;
@@ -385,7 +392,7 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
         // cev's attempts it would take over what a cut recovers (the beam on a cylinder), and
         // where cev converges nothing changes.
         if (depth >= params.max_cuts && !out.stopped && !out.definitive && !spent && from_converged && !by_ssn &&
-            takes_semismooth_last_resort(params.contact)) {
+            takes_semismooth_last_resort(params.contact) && limit.empty()) {
           cev_failed = out.reason + " (after " + std::to_string(depth) + " cuts of the increment)";
           cev_failure = out.failure;
           rec.notes.push_back("cev failed from the last converged state as well (" + cev_failed +
@@ -408,12 +415,11 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
             rec.reason += ", from the last converged state as well";
           }
           // Newton's drift past a limit load is no numerical accident: the step says so.
-          if (!out.stopped && !spent &&
-              (rec.failure == FailureKind::newton_diverged || rec.failure == FailureKind::contact_stalled))
-            if (std::string why = along_load.beyond_limit(current, target); !why.empty()) {
-              rec.reason = why + " (" + rec.reason + ")";
-              rec.failure = FailureKind::no_equilibrium;
-            }
+          if (!limit.empty() &&
+              (rec.failure == FailureKind::newton_diverged || rec.failure == FailureKind::contact_stalled)) {
+            rec.reason = limit + " (" + rec.reason + ")";
+            rec.failure = FailureKind::no_equilibrium;
+          }
           rec.p = out.p;
           rec.tau = out.tau;
           rec.state = std::move(out.state);
