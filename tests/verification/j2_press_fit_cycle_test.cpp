@@ -13,6 +13,10 @@
 //   way the bar moves;
 // - the equivalent plastic strain of no element decreases from one step to the next, and it
 //   grows somewhere on each leg (in, out, in again).
+// And a cut step restores the plastic history (docs/algorithm.md#load-stepping-and-cuts): the
+// same scene with one step of the in leg and one of the out leg refused at their whole
+// increment (a test's observer, SteppingObserver::refuse_attempt: the attempt converged, its
+// plastic flow was evaluated) and so cut in halves, against the run whose steps are those halves.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -73,9 +77,9 @@ std::vector<double> plastic_strain(const StepRecord& rec) {
   return alpha;
 }
 
-Solved run_cycle(const json& j) {
+Solved run_cycle(const json& j, const SteppingObserver& observer = {}) {
   Solved s{read_scene(j), {}};
-  s.run = run_load_steps(s.scene.problem, s.scene.steps, s.scene.params);
+  s.run = run_load_steps(s.scene.problem, s.scene.steps, s.scene.params, observer);
   return s;
 }
 
@@ -147,6 +151,74 @@ TEST(J2PressFitCycle, PlasticStrainNeverDecreasesOverInOutIn) {
       ++leg;
     }
   }
+}
+
+// (a) in 4 steps and out in 4; (b) the same with step 2 (in, 0 -> 0.25) and step 6 (out,
+// 1 -> 0.75) refused at their whole increment, so each is cut once; (c) the run whose steps are
+// the halves that the cuts made (0.125 and 0.875 added). (b) and (c) pass through the same
+// states, so they agree to the solves' tolerances: the plastic strain of every element, the
+// displacements, the contact forces. Had the refused attempt (its whole increment converged,
+// its plastic flow evaluated) left its history behind, (b) would start its halves from it.
+TEST(J2PressFitCycle, ACutStepRestoresThePlasticHistory) {
+  const Solved a = run_cycle(bar_through_plate({{4, 1.0}, {4, 0.0}}));
+  SteppingObserver refusing;
+  std::vector<std::string> refused;
+  refusing.refuse_attempt = [&](int step, double from, double to) {
+    const bool refuse = (step == 2 || step == 6) && from == 0.0 && to == 1.0;
+    if (refuse) refused.push_back(std::to_string(step));
+    return refuse;
+  };
+  const Solved b = run_cycle(bar_through_plate({{4, 1.0}, {4, 0.0}}), refusing);
+  const Solved c = run_cycle(bar_through_plate({{2, 0.25}, {3, 1.0}, {2, 0.75}, {3, 0.0}}));
+  for (const Solved* s : {&a, &b, &c}) {
+    ASSERT_TRUE(s->run.completed) << s->run.reason;
+    for (const StepRecord& rec : s->run.steps)
+      EXPECT_TRUE(step_invariants(s->scene.problem, rec, tolerances_of(s->scene))) << "step " << rec.index;
+  }
+  ASSERT_EQ(a.run.steps.size(), 9u);
+  ASSERT_EQ(b.run.steps.size(), 9u);
+  ASSERT_EQ(c.run.steps.size(), 11u);
+  // Each refused step was cut once (its whole increment refused, then its halves taken); (c)
+  // needed no cut; (a)'s whole increments of those steps made plastic flow.
+  for (size_t k = 0; k < 9; ++k) {
+    const bool cut = k == 1 || k == 5;
+    EXPECT_EQ(b.run.steps[k].cuts, cut ? 1 : 0) << "step " << k + 1;
+    EXPECT_EQ(a.run.steps[k].cuts, 0) << "step " << k + 1;
+  }
+  EXPECT_EQ(refused.size(), 2u);
+  for (const StepRecord& rec : c.run.steps) EXPECT_EQ(rec.cuts, 0) << "step " << rec.index;
+  for (size_t k : {1, 5}) {
+    const std::vector<double> from = plastic_strain(a.run.steps[k - 1]), to = plastic_strain(a.run.steps[k]);
+    double grown = 0;
+    for (size_t e = 0; e < to.size(); ++e) grown = std::max(grown, to[e] - from[e]);
+    std::printf("(a) step %zu: plastic strain grown by up to %.3e over the whole increment\n", k + 1, grown);
+    EXPECT_GT(grown, 1e-5);
+  }
+  // (b)'s steps against (c)'s: (c) has a step more in each leg.
+  const std::vector<size_t> in_c = {0, 2, 3, 4, 5, 7, 8, 9, 10};
+  double alpha_bc = 0, q_bc = 0, p_bc = 0, alpha_ab = 0, q_ab = 0, alpha_max = 0, q_max = 0, p_max = 0;
+  for (size_t k = 0; k < 9; ++k) {
+    const StepRecord &ra = a.run.steps[k], &rb = b.run.steps[k], &rc = c.run.steps[in_c[k]];
+    EXPECT_EQ(rb.factors, rc.factors) << "step " << k + 1;
+    const std::vector<double> aa = plastic_strain(ra), ab = plastic_strain(rb), ac = plastic_strain(rc);
+    for (size_t e = 0; e < ab.size(); ++e) {
+      alpha_bc = std::max(alpha_bc, std::abs(ab[e] - ac[e]));
+      alpha_ab = std::max(alpha_ab, std::abs(ab[e] - aa[e]));
+      alpha_max = std::max(alpha_max, ab[e]);
+    }
+    q_bc = std::max(q_bc, (rb.state.q - rc.state.q).cwiseAbs().maxCoeff());
+    q_ab = std::max(q_ab, (rb.state.q - ra.state.q).cwiseAbs().maxCoeff());
+    q_max = std::max(q_max, rb.state.q.cwiseAbs().maxCoeff());
+    p_bc = std::max(p_bc, (rb.p - rc.p).cwiseAbs().maxCoeff());
+    p_max = std::max(p_max, rb.p.cwiseAbs().maxCoeff());
+  }
+  std::printf(
+      "cut (b) against its halves (c): plastic strain %.1e (of %.2e), displacement %.1e mm (of %.2f), contact forces "
+      "%.1e N/mm (of %.1f); (b) against the uncut (a): plastic strain %.1e, displacement %.1e mm\n",
+      alpha_bc, alpha_max, q_bc, q_max, p_bc, p_max, alpha_ab, q_ab);
+  EXPECT_LT(alpha_bc, 1e-8);
+  EXPECT_LT(q_bc, 1e-8);
+  EXPECT_LT(p_bc, 1e-6 * p_max);
 }
 
 }  // namespace
