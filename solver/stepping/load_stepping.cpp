@@ -297,6 +297,12 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
           out.failure = FailureKind::check_failed;
           refused = true;
         }
+        if (!refused && observer.refuse_attempt && observer.refuse_attempt(step, done, t)) {
+          out.converged = false;
+          out.reason = "refused by the observer (a test's forced failure)";
+          out.failure = FailureKind::check_failed;
+          refused = true;
+        }
         // Constraints held by multipliers (exact incompressibility): where they do not hold yet,
         // the multipliers moved, and the increment is solved again from this state.
         if (!refused)

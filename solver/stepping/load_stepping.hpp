@@ -61,6 +61,11 @@ struct SteppingObserver {
   // records instead of "stopped on request".
   std::function<std::pair<FailureKind, std::string>()> stop_reason;
   std::function<void(const StepRecord&)> step_finished;
+  // Tests only (tests/verification/j2_press_fit_cycle_test.cpp): asked of every attempt that
+  // converged and passed the step checks, with the step (from 1) and the part of it the attempt
+  // took (from, to: fractions of the step); true refuses the attempt as a failed one (retried,
+  // then cut). Nothing else sets it.
+  std::function<bool(int step, double from, double to)> refuse_attempt;
 };
 
 struct RunResult {

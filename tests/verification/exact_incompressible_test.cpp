@@ -6,6 +6,8 @@
 //   incompressible law, sigma = 2 (l^2 - 1/l) (c10 + c01 / l) and 2 (l^2 - l^-4) (c10 + c01 l^2),
 //   the free stretch l^(-1/2) (l^-2), and the volume kept; the tangent with the pressures'
 //   term p (theta - 1) against differences at stretch 3;
+//   the same for the neo-Hookean law (young and poisson), its closed form mu (l^2 - 1/l) and
+//   mu (l^2 - l^-4);
 // - a block compressed 10 % between rough rigid plates through contact (plane strain, a quarter
 //   by symmetry), meshes 4, 8, 16: the plate's force and the bulge converging with the mesh,
 //   the volume of every element kept to 1e-6, where the mixed form at bulk 1e4 x shear changes
@@ -15,11 +17,13 @@
 
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <memory>
 #include <string>
 
 #include "solver/elements/continuum.hpp"
 #include "solver/materials/mooney_rivlin.hpp"
+#include "solver/materials/plane_material.hpp"
 #include "tests/support/contact_profile.hpp"
 #include "tests/support/newton_driver.hpp"
 #include "tests/support/scenes.hpp"
@@ -45,18 +49,21 @@ int solve_exactly(Driver& d, const std::function<void(Vector&)>& prescribe) {
   return updates;
 }
 
-TEST(ExactIncompressibility, UniaxialAndEquibiaxialStretchFollowTheClosedForm) {
+// A cylinder of the law stretched uniaxially along its axis and equibiaxially to 3 in the exact
+// form, against the incompressible law's closed form sigma(l, equibiaxial).
+void stretch_to_three(const std::string& law_name, const std::shared_ptr<const PlaneMaterial>& law,
+                      const std::function<double(double, bool)>& closed_form) {
   for (ContinuumElement element : {ContinuumElement::q9, ContinuumElement::t6})
     for (bool equibiaxial : {false, true}) {
-      const std::string name = std::string(element_name(element)) + (equibiaxial ? " equibiaxial" : " uniaxial");
+      const std::string name =
+          law_name + " " + std::string(element_name(element)) + (equibiaxial ? " equibiaxial" : " uniaxial");
       SCOPED_TRACE(name);
       // A cylinder of radius 1 and height 1 (2 x 2 elements), axis at x = 0.
       RectangleSpec spec;
       spec.nx = spec.ny = 2;
       const PlaneMesh mesh = rectangle_mesh(spec, element_shape(element));
       ContinuumBody body(
-          mesh, mesh.sets.at("top"),
-          {std::make_shared<MooneyRivlinMaterial>(kC10, kC01, 1e3 * kShear, PlaneAnalysis::axisymmetric)},
+          mesh, mesh.sets.at("top"), {law},
           {element, ContinuumKinematics::finite, PlaneAnalysis::axisymmetric, 1.0, Incompressibility::exact});
       // u_r held on the axis (equibiaxial: everywhere, u_r = (l - 1) r), u_z at the bottom
       // (uniaxial: at the top too, u_z = (l - 1) z).
@@ -80,8 +87,7 @@ TEST(ExactIncompressibility, UniaxialAndEquibiaxialStretchFollowTheClosedForm) {
                                   }
                                 }));
         // The closed form of the incompressible law; the free stretch (the top's or the rim's).
-        const double sigma = equibiaxial ? 2 * (l * l - std::pow(l, -4)) * (kC10 + kC01 * l * l)
-                                         : 2 * (l * l - 1 / l) * (kC10 + kC01 / l);
+        const double sigma = closed_form(l, equibiaxial);
         const double free = equibiaxial ? 1 / (l * l) : 1 / std::sqrt(l);
         for (int n = 0; n < body.node_count(); ++n) {
           const Vec2 X = mesh.nodes[n];
@@ -113,6 +119,26 @@ TEST(ExactIncompressibility, UniaxialAndEquibiaxialStretchFollowTheClosedForm) {
       EXPECT_LT(check.error(), 1e-7);
       EXPECT_LT(check.asymmetry(), 1e-12);
     }
+}
+
+TEST(ExactIncompressibility, UniaxialAndEquibiaxialStretchFollowTheClosedForm) {
+  stretch_to_three("mooney-rivlin",
+                   std::make_shared<MooneyRivlinMaterial>(kC10, kC01, 1e3 * kShear, PlaneAnalysis::axisymmetric),
+                   [](double l, bool equibiaxial) {
+                     return equibiaxial ? 2 * (l * l - std::pow(l, -4)) * (kC10 + kC01 * l * l)
+                                        : 2 * (l * l - 1 / l) * (kC10 + kC01 / l);
+                   });
+}
+
+// The neo-Hookean law (young, poisson; its bulk modulus the exact form's penalty: nu = 0.4995,
+// bulk about 1e3 x shear) held to J = 1: the incompressible neo-Hookean solid of shear modulus
+// mu, sigma = mu (l^2 - 1/l) uniaxially and mu (l^2 - l^-4) equibiaxially (Mooney-Rivlin with
+// c10 = mu / 2, c01 = 0).
+TEST(ExactIncompressibility, NeoHookeanStretchFollowsTheIncompressibleClosedForm) {
+  constexpr double nu = 0.4995, young = 2 * (1 + nu) * kShear;
+  stretch_to_three(
+      "neo-hookean", std::make_shared<NeoHookeMaterial>(young, nu, PlaneAnalysis::axisymmetric),
+      [](double l, bool equibiaxial) { return kShear * (equibiaxial ? l * l - std::pow(l, -4) : l * l - 1 / l); });
 }
 
 struct Bulged {
