@@ -418,9 +418,9 @@ void FreeBlockSolver::analyse_ordered() {
 }
 
 CholmodFactor::~CholmodFactor() {
-  cholmod_free_dense(&solve_x_, &m_cholmod);
-  cholmod_free_dense(&solve_y_, &m_cholmod);
-  cholmod_free_dense(&solve_e_, &m_cholmod);
+  cholmod_free_dense(&solve_x_, &cholmod());
+  cholmod_free_dense(&solve_y_, &cholmod());
+  cholmod_free_dense(&solve_e_, &cholmod());
 }
 
 bool CholmodFactor::solve_kept(const double* b, double* x) const {
@@ -432,7 +432,15 @@ bool CholmodFactor::solve_kept(const double* b, double* x) const {
   B.x = const_cast<double*>(b);
   B.xtype = CHOLMOD_REAL;
   B.dtype = CHOLMOD_DOUBLE;
-  if (!cholmod_solve2(CHOLMOD_A, m_cholmodFactor, &B, nullptr, &solve_x_, nullptr, &solve_y_, &solve_e_, &m_cholmod))
+  cholmod_common* cc = &const_cast<CholmodFactor*>(this)->cholmod();  // Eigen's is mutable, its accessor not const
+  // A simplicial factor's workspace Y is 4 x n (leading dimension 4: up to four right-hand sides
+  // at a time), which cholmod_solve2 leaves shaped for the one it solved (1 x n); its
+  // cholmod_ensure_dense reallocates a Y of any other shape. The shape restored, Y is kept.
+  if (solve_y_ && !m_cholmodFactor->is_super && solve_y_->nzmax >= 4 * n) {
+    solve_y_->nrow = solve_y_->d = 4;
+    solve_y_->ncol = n;
+  }
+  if (!cholmod_solve2(CHOLMOD_A, m_cholmodFactor, &B, nullptr, &solve_x_, nullptr, &solve_y_, &solve_e_, cc))
     return false;
   const double* solved = static_cast<const double*>(solve_x_->x);
   std::copy(solved, solved + n, x);
