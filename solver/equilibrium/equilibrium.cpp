@@ -76,8 +76,7 @@ void Equilibrium::residual_into(const Vector& q, const EquilibriumState& paired,
   // problem_.load(factors_), summed in its order into kept storage.
   Vector& external = external_work_;
   external.setZero(problem_.body->dof_count());
-  for (size_t k = 0; k < problem_.loads.size() && k < factors_.size(); ++k)
-    external += factors_[k] * problem_.loads[k];
+  for (size_t k = 0; k < problem_.loads.size() && k < factors_.size(); ++k) external += factors_[k] * problem_.loads[k];
   if (problem_.body->has_follower_loads()) {
     Triplets& follow = follow_work_;  // r = A - F(q): the follower load's derivative enters with a minus
     follow.clear();

@@ -105,8 +105,8 @@ class Equilibrium {
   Vector residual(const Vector& q, const EquilibriumState& paired, const Vector& p, TangentSink* tangent,
                   double* force_scale = nullptr, bool body_tangent = true) const;
   // The same into r: r and the work storage below keep their storage (Newton's loop).
-  void residual_into(const Vector& q, const EquilibriumState& paired, const Vector& p, TangentSink* tangent,
-                     Vector& r, double* force_scale = nullptr, bool body_tangent = true) const;
+  void residual_into(const Vector& q, const EquilibriumState& paired, const Vector& p, TangentSink* tangent, Vector& r,
+                     double* force_scale = nullptr, bool body_tangent = true) const;
   // Newton's step K_t^-1 rhs for the constant body tangent plus the pair's stiffness (the
   // `contact` triplets): the body's factorization and a Krylov solve on the pair's dofs.
   Vector low_rank_step(const Triplets& contact, const Vector& rhs) const;

@@ -53,8 +53,8 @@ struct EquilibriumCounters {
   // the body's own tangent's (with its second, nested-dissection factor's for G).
   long newton_analyses = 0;
   long body_analyses = 0;
-  long compliance_forms = 0;          // G formed afresh (each on a factorization of its own)
-  long compliance_columns = 0;        // columns of G solved for, all forms together
+  long compliance_forms = 0;    // G formed afresh (each on a factorization of its own)
+  long compliance_columns = 0;  // columns of G solved for, all forms together
   // Process CPU seconds inside Newton's solves and inside the compliance's forms: where a run's
   // time goes, for the benchmarks (bench/kernels.py). Not in the result: they differ from run
   // to run.

@@ -224,7 +224,7 @@ class FreeBlockSolver {
   CholmodFactor dissected_;  // nested-dissection order, for inverse_block only
   bool lu_analysed_ = false, llt_analysed_ = false, dissected_analysed_ = false;
   long factorizations_ = 0, dissected_factorizations_ = 0, analyses_ = 0;
-  mutable Vector permuted_;  // solve_into's right-hand side in the factor's order
+  mutable Vector permuted_;        // solve_into's right-hand side in the factor's order
   size_t dissected_fails_at_ = 0;  // the fewest rows for which the dissected factor did not pay; 0: none yet
   // The dissected factor paid for G on this pattern: the next factorizations take the
   // nested-dissection order themselves, so that G needs no second factorization.

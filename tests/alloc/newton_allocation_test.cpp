@@ -116,11 +116,12 @@ Counts run_strip(int nx, int ny) {
       c.worst_later = std::max(c.worst_later, spent);
     }
   }
-  std::printf("q9 %d x %d: %ld Newton iterations (%ld factorizations); %ld first iterations measured, %ld "
-              "allocations (%.1f each); %ld later ones, %ld allocations (at most %ld in one)\n",
-              nx, ny, c.newton_iterations, c.newton_factorizations, c.first_iterations, c.first_allocations,
-              c.first_iterations ? static_cast<double>(c.first_allocations) / c.first_iterations : 0.0,
-              c.later_iterations, c.later_allocations, c.worst_later);
+  std::printf(
+      "q9 %d x %d: %ld Newton iterations (%ld factorizations); %ld first iterations measured, %ld "
+      "allocations (%.1f each); %ld later ones, %ld allocations (at most %ld in one)\n",
+      nx, ny, c.newton_iterations, c.newton_factorizations, c.first_iterations, c.first_allocations,
+      c.first_iterations ? static_cast<double>(c.first_allocations) / c.first_iterations : 0.0, c.later_iterations,
+      c.later_allocations, c.worst_later);
   return c;
 }
 

@@ -236,6 +236,6 @@ int main(int argc, char** argv) {
       run_s, run_wall_s, run.completed ? "true" : "false", c.solves, c.newton_iterations, c.factorizations,
       c.newton_factorizations, c.body_factorizations, c.dissected_factorizations,
       c.newton_iterations ? 1e3 * run_s / c.newton_iterations : 0.0, c.newton_cpu_s,
-      c.newton_iterations ? 1e3 * c.newton_cpu_s / c.newton_iterations : 0.0, c.compliance_cpu_s,
-      c.newton_analyses, c.body_analyses);
+      c.newton_iterations ? 1e3 * c.newton_cpu_s / c.newton_iterations : 0.0, c.compliance_cpu_s, c.newton_analyses,
+      c.body_analyses);
 }

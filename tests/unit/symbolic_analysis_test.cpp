@@ -69,18 +69,20 @@ TEST(SymbolicAnalysis, SolveIntoIsSolveBitForBit) {
     const Vector y = solver.solve(b);
     ASSERT_EQ(x.size(), y.size());
     for (int i = 0; i < y.size(); ++i) EXPECT_EQ(x[i], y[i]) << i;
-    b *= -1.5;
+    // And it solves: K x = b to round-off.
+    const Vector residual = solver.matrix() * x - b;
+    EXPECT_LT(residual.cwiseAbs().maxCoeff(), 1e-12 * b.cwiseAbs().maxCoeff());
+    b = b.reverse().eval() * -1.5;
   }
-  // And it solves: K x = b to round-off.
-  const Vector residual = solver.matrix() * x - b;
-  EXPECT_LT(residual.cwiseAbs().maxCoeff(), 1e-12 * b.cwiseAbs().maxCoeff());
 }
 
 // The finite-strain strip on a cylinder (q9 50 x 2, a changing tangent: one factorization of
 // Newton's tangent per iteration). Its candidates and supports stay the same through the run
 // (counted: no candidate added), so Newton's tangent keeps one pattern: one analysis for all
-// its factorizations. The body's own tangent (the compliance's) has one pattern too; its
-// analyses do not grow with the run either (10 steps and 20 alike), however many factorizations.
+// its factorizations, and one more where G came from Newton's factor and its order turned to
+// nested dissection (FreeBlockSolver::inverse_block; measured: 2 in 10 steps, 1 in 20). The
+// body's own tangent (the compliance's) has one pattern too: its analysis, its nested-dissection
+// factor's for G and the turn of its own order, 3 in either run, however many factorizations.
 TEST(SymbolicAnalysis, OncePerPatternThroughTheFiniteStrip) {
   EquilibriumCounters counters[2];
   for (const int steps : {10, 20}) {
@@ -94,12 +96,14 @@ TEST(SymbolicAnalysis, OncePerPatternThroughTheFiniteStrip) {
     ASSERT_EQ(scene.problem.candidates.size(), candidates);  // one pattern: no candidate added
     const EquilibriumCounters& c = run.counters;
     counters[steps == 20] = c;
-    std::printf("%d steps: %ld Newton factorizations, %ld Newton analyses; %ld body factorizations (+ %ld "
-                "dissected), %ld body analyses\n",
-                steps, c.newton_factorizations, c.newton_analyses, c.body_factorizations, c.dissected_factorizations,
-                c.body_analyses);
+    std::printf(
+        "%d steps: %ld Newton factorizations, %ld Newton analyses; %ld body factorizations (+ %ld "
+        "dissected), %ld body analyses\n",
+        steps, c.newton_factorizations, c.newton_analyses, c.body_factorizations, c.dissected_factorizations,
+        c.body_analyses);
     EXPECT_GE(c.newton_factorizations, 2 * steps);
-    EXPECT_EQ(c.newton_analyses, 1);
+    EXPECT_GE(c.newton_analyses, 1);
+    EXPECT_LE(c.newton_analyses, 2);
     EXPECT_GE(c.body_factorizations, 1);
     EXPECT_GE(c.body_analyses, 1);
     // The body's pattern, and at most its nested-dissection factor's and the switch of its own
