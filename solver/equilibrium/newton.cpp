@@ -269,12 +269,15 @@ EquilibriumState Equilibrium::newton(const Vector& q_guess, const Vector& p) {
       state.noise = state.at_floor ? last_step : 0.0;
       converged_q_ = state.q;
       if (!penalty_) newton_factor_q_ = state.q;
-      return penalty_ ? finish_penalty(state) : finish(state, held_ ? held_forces(state.q, state, p, nullptr) : p);
+      if (penalty_) finish_penalty(state);
+      else finish(state, held_ ? held_forces(state.q, state, p, nullptr) : p);
+      return state;  // moved out (finish's reference copied every surface point's Jacobian)
     }
     if (it > params_.max_iterations) break;
     if (chord && chord_converges(state, r, p)) {
       converged_q_ = state.q;
-      return finish(state, p);
+      finish(state, p);
+      return state;
     }
     if (!with_tangent) residual_into(state.q, state, p, tangent(), r, nullptr, !low_rank);
     if (!branch.empty()) {
@@ -332,7 +335,9 @@ EquilibriumState Equilibrium::newton(const Vector& q_guess, const Vector& p) {
       pair(state.q, state);
       converged_q_ = state.q;
       if (!penalty_) newton_factor_q_ = state.q;
-      return penalty_ ? finish_penalty(state) : finish(state, held_ ? held_forces(state.q, state, p, nullptr) : p);
+      if (penalty_) finish_penalty(state);
+      else finish(state, held_ ? held_forces(state.q, state, p, nullptr) : p);
+      return state;  // moved out (finish's reference copied every surface point's Jacobian)
     }
     const double a = full_steps ? problem_.body->newton_step_fraction(state.q, dq)
                                 : line_search(state.q, dq, p, reuse ? body_lu_ : lu_);
