@@ -350,10 +350,13 @@ void ContinuumBody::internal_force(const Vector& q, Vector& force, TangentSink* 
     const std::unique_lock<std::mutex> lock(blocks_mutex_, std::try_to_lock);
     if (lock.owns_lock()) return parallel_internal_force(q, force, tangent);
   }
-  // Work storage kept across elements: the loop allocates nothing.
-  Vector fe;
-  Matrix Ke;
-  ShapeGradients u(element_node_count(shape_), 2), base_u = u;
+  // Work storage kept across elements and calls (one set a thread: the force may be asked on
+  // several at once): neither the loop nor, once sized, a call allocates (Newton's loop).
+  thread_local Vector fe;
+  thread_local Matrix Ke;
+  thread_local ShapeGradients u, base_u;
+  u.resize(element_node_count(shape_), 2);
+  base_u.resize(u.rows(), 2);
   const Vector* base = tangent ? tangent->stress_base : nullptr;
   for (int e = 0; e < element_count(); ++e) {
     element_kernel(q, e, u, fe, tangent ? &Ke : nullptr, base, base_u);
@@ -446,6 +449,16 @@ SurfacePoint ContinuumBody::surface_point(const VectorRef& q, int site, int /*si
   p.x = mesh_.nodes[node] + Vec2(q[dx], q[dy]);
   p.jacobian = {{dx, Vec2::UnitX()}, {dy, Vec2::UnitY()}};
   return p;
+}
+
+void ContinuumBody::surface_point_into(const VectorRef& q, int site, int /*side*/, SurfacePoint& out) const {
+  const int node = contact_.nodes[site];
+  const int dx = node_dof(node, 0), dy = node_dof(node, 1);
+  out.x = mesh_.nodes[node] + Vec2(q[dx], q[dy]);
+  out.jacobian.resize(2);  // the storage of the point's last pairing
+  out.jacobian[0] = {dx, Vec2::UnitX()};
+  out.jacobian[1] = {dy, Vec2::UnitY()};
+  out.clearance = 0.0;
 }
 
 Vector ContinuumBody::rigid_translation(const Vec2& d) const {

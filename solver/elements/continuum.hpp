@@ -101,6 +101,7 @@ class ContinuumBody final : public Body {
   int site_node(int site) const override { return contact_.nodes[site]; }
   Vec2 site_reference(int site) const override { return mesh_.nodes[contact_.nodes[site]]; }
   SurfacePoint surface_point(const VectorRef& q, int site, int side) const override;
+  void surface_point_into(const VectorRef& q, int site, int side, SurfacePoint& out) const override;
   // The contact sides, a quadratic side (t6, q8, q9) as its two halves.
   std::vector<std::array<int, 2>> surface_segments() const override;
   std::vector<int> nodes_without_site() const override;

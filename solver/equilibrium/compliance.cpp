@@ -35,6 +35,8 @@ void Equilibrium::extend_surface_compliance(const std::vector<int>& added) {
   counters_.compliance_columns += m - m0;
   const bool sparse_solves = m0 == 0 && !g_from_newton_ && body_lu_.inverse_block(surface_free_, g_, params_.parallel);
   counters_.dissected_factorizations = body_lu_.dissected_factorizations();
+  counters_.body_analyses = body_lu_.analyses();
+  counters_.newton_analyses = lu_.analyses();
   if (sparse_solves) return;  // a new G: sparse solves
   g_.conservativeResize(m, m);
   // Unit right-hand sides in blocks: the work storage stays (free dofs) x kBlock.
@@ -247,6 +249,8 @@ const Compliance& Equilibrium::sparse_compliance(const EquilibriumState& state, 
   sparse_version_ = tangent_version_;
   sparse_.diagonal_entries = body_lu_.quadratic_forms(sparse_.t);
   counters_.dissected_factorizations = body_lu_.dissected_factorizations();
+  counters_.body_analyses = body_lu_.analyses();
+  counters_.newton_analyses = lu_.analyses();
   return sparse_;
 }
 

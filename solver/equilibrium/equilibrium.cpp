@@ -60,19 +60,32 @@ double Equilibrium::stiffness_scale(const Vector& q) const {
 
 Vector Equilibrium::residual(const Vector& q, const EquilibriumState& paired, const Vector& p_given,
                              TangentSink* tangent, double* force_scale, bool body_tangent) const {
-  const Vector p = penalty_ ? penalty_forces(q, paired, tangent)
-                   : held_  ? held_forces(q, paired, p_given, tangent)
-                            : p_given;
-  Vector r = Vector::Zero(q.size());
+  Vector r;
+  residual_into(q, paired, p_given, tangent, r, force_scale, body_tangent);
+  return r;
+}
+
+void Equilibrium::residual_into(const Vector& q, const EquilibriumState& paired, const Vector& p_given,
+                                TangentSink* tangent, Vector& r, double* force_scale, bool body_tangent) const {
+  Vector law_p;  // a law's forces (given ones are read in place)
+  if (penalty_) law_p = penalty_forces(q, paired, tangent);
+  else if (held_) law_p = held_forces(q, paired, p_given, tangent);
+  const Vector& p = penalty_ || held_ ? law_p : p_given;
+  r.setZero(q.size());
   problem_.body->internal_force(q, r, body_tangent ? tangent : nullptr);
-  Vector external = problem_.load(factors_);
+  // problem_.load(factors_), summed in its order into kept storage.
+  Vector& external = external_work_;
+  external.setZero(problem_.body->dof_count());
+  for (size_t k = 0; k < problem_.loads.size() && k < factors_.size(); ++k) external += factors_[k] * problem_.loads[k];
   if (problem_.body->has_follower_loads()) {
-    Triplets follow;  // r = A - F(q): the follower load's derivative enters with a minus
+    Triplets& follow = follow_work_;  // r = A - F(q): the follower load's derivative enters with a minus
+    follow.clear();
     problem_.body->follower_load(q, factors_, external, body_tangent && tangent ? &follow : nullptr);
     for (const auto& e : follow) tangent->add(e.row(), e.col(), -e.value());
   }
-  Vector contact = Vector::Zero(q.size());
-  Triplets pair_terms;
+  Vector& contact = contact_work_;
+  contact.setZero(q.size());
+  Triplets& pair_terms = pair_terms_work_;
   for (size_t i = 0; i < problem_.candidates.size(); ++i) {
     const Candidate& c = problem_.candidates[i];
     const PairedPoint& pp = paired.points[i];
@@ -112,7 +125,6 @@ Vector Equilibrium::residual(const Vector& q, const EquilibriumState& paired, co
       r[pin] += penalty_->pin_spring * q[pin];
       if (tangent) tangent->add(pin, pin, penalty_->pin_spring);
     }
-  return r;
 }
 
 Vector Equilibrium::residual(const Vector& q, const Vector& p, Triplets* tangent) const {

@@ -104,6 +104,9 @@ class Equilibrium {
   // tangent's contact terms only.
   Vector residual(const Vector& q, const EquilibriumState& paired, const Vector& p, TangentSink* tangent,
                   double* force_scale = nullptr, bool body_tangent = true) const;
+  // The same into r: r and the work storage below keep their storage (Newton's loop).
+  void residual_into(const Vector& q, const EquilibriumState& paired, const Vector& p, TangentSink* tangent, Vector& r,
+                     double* force_scale = nullptr, bool body_tangent = true) const;
   // Newton's step K_t^-1 rhs for the constant body tangent plus the pair's stiffness (the
   // `contact` triplets): the body's factorization and a Krylov solve on the pair's dofs.
   Vector low_rank_step(const Triplets& contact, const Vector& rhs) const;
@@ -222,6 +225,12 @@ class Equilibrium {
   // The contact terms of Newton's tangent for the low-rank step, kept so that their storage is
   // allocated once, not at every real solve (the factorized tangents are assembled in place).
   Triplets newton_triplets_;
+  // Work storage of Newton's iterates, sized at the first and reused by the next (newton.cpp):
+  // the residual (and the stick branch's), its free part, the correction on the free dofs and
+  // on all; residual_into's applied and contact forces and its pair and follower terms.
+  Vector r_work_, r_step_work_, r_free_work_, dq_free_work_, dq_work_;
+  mutable Vector external_work_, contact_work_;
+  mutable Triplets pair_terms_work_, follow_work_;
   double body_tangent_norm_ = 0.0;  // |K|_inf of the constant body tangent (round-off scale)
   std::vector<int> surface_free_;   // surface row of G -> free index
   std::vector<int> surface_row_;    // free index -> surface row of G, -1 off the surface

@@ -47,8 +47,14 @@ struct EquilibriumCounters {
   long newton_factorizations = 0;     // Newton's tangent, and the penalty law's last correction
   long body_factorizations = 0;       // the body's own tangent: the compliance's, or a constant one
   long dissected_factorizations = 0;  // the body's tangent again, in nested-dissection order, for G only
-  long compliance_forms = 0;          // G formed afresh (each on a factorization of its own)
-  long compliance_columns = 0;        // columns of G solved for, all forms together
+  // Symbolic analyses (a fill-reducing ordering and the elimination tree; SparseLU's for a block
+  // that is not positive definite): one per sparsity pattern of each block, and one more where
+  // its order changes to nested dissection (FreeBlockSolver::analyses). Newton's tangent's, and
+  // the body's own tangent's (with its second, nested-dissection factor's for G).
+  long newton_analyses = 0;
+  long body_analyses = 0;
+  long compliance_forms = 0;    // G formed afresh (each on a factorization of its own)
+  long compliance_columns = 0;  // columns of G solved for, all forms together
   // Process CPU seconds inside Newton's solves and inside the compliance's forms: where a run's
   // time goes, for the benchmarks (bench/kernels.py). Not in the result: they differ from run
   // to run.
@@ -63,6 +69,8 @@ struct EquilibriumCounters {
     newton_factorizations += o.newton_factorizations;
     body_factorizations += o.body_factorizations;
     dissected_factorizations += o.dissected_factorizations;
+    newton_analyses += o.newton_analyses;
+    body_analyses += o.body_analyses;
     compliance_forms += o.compliance_forms;
     compliance_columns += o.compliance_columns;
     newton_cpu_s += o.newton_cpu_s;

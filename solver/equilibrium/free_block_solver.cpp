@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 
 namespace grip {
@@ -300,7 +301,10 @@ bool FreeBlockSolver::factorize(double near_symmetric_tolerance) {
     check_symmetry(near_symmetric_tolerance);
     return factorize_parts(near_symmetric_tolerance);
   }
-  if (!llt_analysed_) analyse_ordered();  // the ordering: once per pattern
+  if (!llt_analysed_) {  // the ordering: once per pattern
+    analyse_ordered();
+    ++analyses_;
+  }
   llt_analysed_ = true;
   // The ordered triangle's values, and the symmetry check on the way: each pair of entries is
   // one entry of the triangle and its transpose.
@@ -327,7 +331,10 @@ bool FreeBlockSolver::factorize(double near_symmetric_tolerance) {
     if (ok_) return true;
     symmetric_ = false;  // fall back to LU
   }
-  if (!lu_analysed_) lu_.analyzePattern(matrix_);
+  if (!lu_analysed_) {
+    lu_.analyzePattern(matrix_);
+    ++analyses_;
+  }
   lu_analysed_ = true;
   lu_.factorize(matrix_);
   ok_ = lu_.info() == Eigen::Success;
@@ -408,6 +415,36 @@ void FreeBlockSolver::analyse_ordered() {
   llt_.cholmod().supernodal = CHOLMOD_AUTO;
   llt_.cholmod().final_ll = 1;
   llt_.analyze_ordered(ordered_, ordered_stype_);
+}
+
+CholmodFactor::~CholmodFactor() {
+  cholmod_free_dense(&solve_x_, &cholmod());
+  cholmod_free_dense(&solve_y_, &cholmod());
+  cholmod_free_dense(&solve_e_, &cholmod());
+}
+
+bool CholmodFactor::solve_kept(const double* b, double* x) const {
+  if (!m_cholmodFactor) return false;
+  const size_t n = m_cholmodFactor->n;
+  cholmod_dense B{};  // a view of b
+  B.nrow = B.nzmax = B.d = n;
+  B.ncol = 1;
+  B.x = const_cast<double*>(b);
+  B.xtype = CHOLMOD_REAL;
+  B.dtype = CHOLMOD_DOUBLE;
+  cholmod_common* cc = &const_cast<CholmodFactor*>(this)->cholmod();  // Eigen's is mutable, its accessor not const
+  // A simplicial factor's workspace Y is 4 x n (leading dimension 4: up to four right-hand sides
+  // at a time), which cholmod_solve2 leaves shaped for the one it solved (1 x n); its
+  // cholmod_ensure_dense reallocates a Y of any other shape. The shape restored, Y is kept.
+  if (solve_y_ && !m_cholmodFactor->is_super && solve_y_->nzmax >= 4 * n) {
+    solve_y_->nrow = solve_y_->d = 4;
+    solve_y_->ncol = n;
+  }
+  if (!cholmod_solve2(CHOLMOD_A, m_cholmodFactor, &B, nullptr, &solve_x_, nullptr, &solve_y_, &solve_e_, cc))
+    return false;
+  const double* solved = static_cast<const double*>(solve_x_->x);
+  std::copy(solved, solved + n, x);
+  return true;
 }
 
 void CholmodFactor::analyze_ordered(const Eigen::SparseMatrix<double>& triangle, int stype) {
@@ -493,6 +530,7 @@ bool FreeBlockSolver::inverse_block(const std::vector<int>& rows, Matrix& G, con
     order_by_nested_dissection(dissected_);
     dissected_.analyzePattern(matrix_);
     dissected_analysed_ = true;
+    ++analyses_;
   }
   ++dissected_factorizations_;
   dissected_.factorize(matrix_);
@@ -713,9 +751,16 @@ Vector FreeBlockSolver::quadratic_forms(const Eigen::SparseMatrix<double>& t) {
   if (llt_.quadratic_forms(ordered_t, out, matrix_.rows() / 32.0)) return out;
   CholmodFactor dissected;
   ++dissected_factorizations_;
+  ++analyses_;  // compute(): an analysis and a factorization
   factorize_dissected(dissected, matrix_);
   if (dissected.info() == Eigen::Success && dissected.quadratic_forms(t, out, 0.0)) return out;
   return Vector();
+}
+
+long FreeBlockSolver::analyses() const {
+  long count = analyses_;
+  for (const auto& part : parts_) count += part->analyses();
+  return count;
 }
 
 long FreeBlockSolver::dissected_factorizations() const {
@@ -770,6 +815,25 @@ Vector FreeBlockSolver::solve(const Vector& b) const {
     x.segment(s, n) = parts_[k]->solve(Vector(b.segment(s, n)));
   });
   return x;
+}
+
+void FreeBlockSolver::solve_into(const Vector& b, Vector& x) const {
+  if (split_ || !symmetric_) {
+    x = solve(b);
+    return;
+  }
+  // order_ * b, the solve, order_^T * x: solve()'s permutations, entry by entry.
+  const int n = static_cast<int>(b.size());
+  const int* position = order_.indices().data();
+  permuted_.resize(n);
+  for (int i = 0; i < n; ++i) permuted_[position[i]] = b[i];
+  x.resize(n);
+  double* y = permuted_.data();
+  if (!llt_.solve_kept(y, y)) {
+    x.setConstant(std::numeric_limits<double>::quiet_NaN());
+    return;
+  }
+  for (int i = 0; i < n; ++i) x[i] = y[position[i]];
 }
 
 Matrix FreeBlockSolver::solve(const Matrix& b) const {

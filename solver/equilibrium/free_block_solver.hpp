@@ -26,6 +26,9 @@ namespace grip {
 class CholmodFactor : public Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>> {
  public:
   CholmodFactor() { cholmod().print = 0; }  // a non-SPD block is a result, not a message
+  ~CholmodFactor();
+  CholmodFactor(const CholmodFactor&) = delete;
+  CholmodFactor& operator=(const CholmodFactor&) = delete;
   double rcond() { return m_cholmodFactor ? cholmod_rcond(m_cholmodFactor, &cholmod()) : 0.0; }
   const cholmod_factor* factor() const { return m_cholmodFactor; }
   // A block already in its fill-reducing order, given as the one triangle (stype +1: upper,
@@ -43,8 +46,14 @@ class CholmodFactor : public Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<dou
   // forward solves. False where CHOLMOD fails, or (with `max_mean_reach` > 0) where the first
   // columns' solves reach more than that many rows on average (long elimination-tree paths).
   bool quadratic_forms(const Eigen::SparseMatrix<double>& t, Vector& out, double max_mean_reach);
+  // x = A^-1 b (n values each, b already in the factor's order) by cholmod_solve2 with the
+  // solution and workspace kept from call to call: no allocation once sized. The same
+  // arithmetic as solve() (cholmod_solve is cholmod_solve2 with workspace of its own). False
+  // where CHOLMOD fails.
+  bool solve_kept(const double* b, double* x) const;
 
  private:
+  mutable cholmod_dense *solve_x_ = nullptr, *solve_y_ = nullptr, *solve_e_ = nullptr;
   // x = L^-1 P b for each sparse column b of `columns` (free dofs), on a simplicial copy of the
   // factor: `use(column, rows of x, values of x, count)` sees each; false from it stops.
   bool forward_solves(const Eigen::SparseMatrix<double>& columns,
@@ -86,6 +95,10 @@ class FreeBlockSolver {
   void set_blocks(std::vector<int> starts, ParallelFor parallel);
   Vector solve(const Vector& b) const;
   Matrix solve(const Matrix& b) const;
+  // solve(b) into x, with no allocation once x and the solver's work storage are sized where the
+  // block is one Cholesky factor (Newton's loop); the same values bit for bit. A split block or
+  // an LU factorization goes through solve(b).
+  void solve_into(const Vector& b, Vector& x) const;
   // K^-1 on the given rows where K is Cholesky-factorized (CholmodFactor::inverse_block);
   // false otherwise (then solve() for unit right-hand sides). Where the factor's own ordering
   // gives the rows long elimination-tree paths (thin strips: a fill-reducing ordering there is
@@ -104,6 +117,10 @@ class FreeBlockSolver {
   // together), and the second ones in nested-dissection order that serve G or C's diagonal only.
   long factorizations() const { return factorizations_; }
   long dissected_factorizations() const;
+  // Symbolic analyses so far, a split block's parts together: the ordered block's (one per
+  // pattern, and one more where its order turns to nested dissection), SparseLU's, and those of
+  // the nested-dissection factor for G.
+  long analyses() const;
   // Factorized body by body (set_blocks).
   bool split() const { return split_; }
   // Factorized by Cholesky (symmetric positive definite).
@@ -206,7 +223,8 @@ class FreeBlockSolver {
   int ordered_stype_ = 1;
   CholmodFactor dissected_;  // nested-dissection order, for inverse_block only
   bool lu_analysed_ = false, llt_analysed_ = false, dissected_analysed_ = false;
-  long factorizations_ = 0, dissected_factorizations_ = 0;
+  long factorizations_ = 0, dissected_factorizations_ = 0, analyses_ = 0;
+  mutable Vector permuted_;        // solve_into's right-hand side in the factor's order
   size_t dissected_fails_at_ = 0;  // the fewest rows for which the dissected factor did not pay; 0: none yet
   // The dissected factor paid for G on this pattern: the next factorizations take the
   // nested-dissection order themselves, so that G needs no second factorization.

@@ -1,6 +1,7 @@
 // Newton's method for the equilibrium at given contact forces (or the penalty law's): the
 // iteration, its stopping tests, the line search and the low-rank step of a constant tangent.
 #include "solver/equilibrium/equilibrium.hpp"
+#include "solver/equilibrium/newton_probe.hpp"
 
 #include <Eigen/Dense>
 #include <algorithm>
@@ -12,6 +13,8 @@
 #include "solver/problem/rigid_modes.hpp"
 
 namespace grip {
+
+NewtonIterationProbe newton_iteration_probe = nullptr;
 
 // The largest residual over the free dofs in force units: a rotation's (moment) residual is
 // divided by its dof's length scale, so that the stopping test does not depend on the unit of
@@ -205,7 +208,16 @@ EquilibriumState Equilibrium::newton(const Vector& q_guess, const Vector& p) {
   new_load_ = false;
   double last_step = 0.0, step_before = 0.0;
   std::vector<signed char> signs;  // the penalty law's trial signs at the last iterate
+  // The iterates' work storage (members, sized at the first iterate of the first solve): an
+  // iteration allocates nothing where the tangent is one Cholesky factorization and the body's
+  // surface points reuse their storage (tests/unit/newton_allocation_test.cpp).
+  Vector& r = r_work_;
+  Vector& r_step = r_step_work_;
+  Vector& r_free = r_free_work_;
+  Vector& dq_free = dq_free_work_;
+  Vector& dq = dq_work_;
   for (int it = 1; it <= params_.max_iterations + 1; ++it) {
+    if (newton_iteration_probe) newton_iteration_probe(it);
     pair(state.q, state);
     // A penalty point whose trial tangential force changed sign since the last iterate has
     // crossed the cone's interior, its stick band (width 2 mu |p_eta| / k_t, a few 1e-6 of the
@@ -234,7 +246,7 @@ EquilibriumState Equilibrium::newton(const Vector& q_guess, const Vector& p) {
         it > 2 && !reuse &&
         last_step * last_step * last_step <= params_.displacement_tolerance * step_before * step_before;
     const bool with_tangent = !chord && !expect_end;
-    Vector r = residual(state.q, state, p, with_tangent ? tangent() : nullptr, &force_scale, !low_rank);
+    residual_into(state.q, state, p, with_tangent ? tangent() : nullptr, r, &force_scale, !low_rank);
     const double r_max = scaled_free_max(r);
     state.relative_residual = force_scale > 0 ? r_max / force_scale : 0.0;
     if (!std::isfinite(r_max)) {
@@ -257,18 +269,20 @@ EquilibriumState Equilibrium::newton(const Vector& q_guess, const Vector& p) {
       state.noise = state.at_floor ? last_step : 0.0;
       converged_q_ = state.q;
       if (!penalty_) newton_factor_q_ = state.q;
-      return penalty_ ? finish_penalty(state) : finish(state, held_ ? held_forces(state.q, state, p, nullptr) : p);
+      if (penalty_) finish_penalty(state);
+      else finish(state, held_ ? held_forces(state.q, state, p, nullptr) : p);
+      return state;  // moved out (finish's reference copied every surface point's Jacobian)
     }
     if (it > params_.max_iterations) break;
     if (chord && chord_converges(state, r, p)) {
       converged_q_ = state.q;
-      return finish(state, p);
+      finish(state, p);
+      return state;
     }
-    if (!with_tangent) r = residual(state.q, state, p, tangent(), nullptr, !low_rank);
-    Vector r_step;
+    if (!with_tangent) residual_into(state.q, state, p, tangent(), r, nullptr, !low_rank);
     if (!branch.empty()) {
       stick_branch_ = std::move(branch);
-      r_step = residual(state.q, state, p, tangent(), nullptr, !low_rank);
+      residual_into(state.q, state, p, tangent(), r_step, nullptr, !low_rank);
     }
     const Vector& r_newton = stick_branch_.empty() ? r : r_step;
     if (reuse) {
@@ -281,7 +295,9 @@ EquilibriumState Equilibrium::newton(const Vector& q_guess, const Vector& p) {
       ++counters_.factorizations;
       ++counters_.newton_factorizations;
       newton_factor_solve_ = -1;
-      if (!lu_.factorize(1e-4)) {
+      const bool factorized = lu_.factorize(1e-4);
+      counters_.newton_analyses = lu_.analyses();
+      if (!factorized) {
         state.reason = "singular tangent stiffness in Newton iteration " + std::to_string(it);
         state.failure = FailureKind::newton_diverged;
         return state;
@@ -290,15 +306,15 @@ EquilibriumState Equilibrium::newton(const Vector& q_guess, const Vector& p) {
       newton_factor_solve_ = held_ ? -1 : counters_.solves;
       chord_factorization_ = held_ ? -1 : lu_.factorizations();
     }
-    Vector r_free(free_count_);
+    // -r on the free dofs (negated in place: the same values as -r_free).
+    r_free.resize(free_count_);
     for (int i = 0; i < r.size(); ++i)
-      if (free_index_[i] >= 0) r_free[free_index_[i]] = r_newton[i];
-    const Vector dq_free = low_rank ? low_rank_step(triplets, Vector(-r_free))
-                           : reuse  ? body_lu_.solve(Vector(-r_free))
-                                    : lu_.solve(Vector(-r_free));
+      if (free_index_[i] >= 0) r_free[free_index_[i]] = -r_newton[i];
+    if (low_rank) dq_free = low_rank_step(triplets, r_free);
+    else (reuse ? body_lu_ : lu_).solve_into(r_free, dq_free);
     state.newton_iterations = it;
     ++counters_.newton_iterations;
-    Vector dq = Vector::Zero(state.q.size());
+    dq.setZero(state.q.size());
     for (int i = 0; i < state.q.size(); ++i)
       if (free_index_[i] >= 0) dq[i] = dq_free[free_index_[i]];
     const double step = (dq.array() * length_scales_.array()).abs().maxCoeff();
@@ -319,7 +335,9 @@ EquilibriumState Equilibrium::newton(const Vector& q_guess, const Vector& p) {
       pair(state.q, state);
       converged_q_ = state.q;
       if (!penalty_) newton_factor_q_ = state.q;
-      return penalty_ ? finish_penalty(state) : finish(state, held_ ? held_forces(state.q, state, p, nullptr) : p);
+      if (penalty_) finish_penalty(state);
+      else finish(state, held_ ? held_forces(state.q, state, p, nullptr) : p);
+      return state;  // moved out (finish's reference copied every surface point's Jacobian)
     }
     const double a = full_steps ? problem_.body->newton_step_fraction(state.q, dq)
                                 : line_search(state.q, dq, p, reuse ? body_lu_ : lu_);
@@ -429,6 +447,7 @@ bool Equilibrium::factorize_body_tangent(const Vector& q, const EquilibriumState
     // Read by Newton only for a constant tangent (a changing one has its own).
     if (constant_tangent_) body_tangent_norm_ = body_lu_.row_sum_norm();
     const bool ok = body_lu_.factorize();
+    counters_.body_analyses = body_lu_.analyses();
     if (!turns || (ok && body_lu_.symmetric())) {
       g_turns_ = turns;
       return ok;

@@ -9,7 +9,7 @@ namespace grip {
 void Equilibrium::pair(const Vector& q, EquilibriumState& state) const {
   const auto& cands = problem_.candidates;
   state.points.resize(cands.size());
-  state.s = Vector::Zero(problem_.component_count);
+  state.s.setZero(problem_.component_count);
   state.enabled.assign(problem_.component_count, 0);
   for (int k = 0; k < problem_.rigid.count(); ++k) state.enabled[problem_.rigid.first + k] = 1;
   // Deformable masters in their current configuration (mortar, segment-to-segment).
@@ -22,7 +22,7 @@ void Equilibrium::pair(const Vector& q, EquilibriumState& state) const {
     const Candidate& c = cands[i];
     const ObstacleInstance& obstacle = problem_.obstacles[c.obstacle];
     PairedPoint& pp = state.points[i];
-    pp.point = problem_.body->surface_point(q, c.site, c.side);
+    problem_.body->surface_point_into(q, c.site, c.side, pp.point);
     if (const auto& master = masters[c.obstacle]) {
       // The Jacobian of the relative point x - x_m: the pair's forces act on both bodies.
       MasterPoint mp = master->project(pp.point.x, c.site);

@@ -125,7 +125,9 @@ EquilibriumState& Equilibrium::finish_penalty(EquilibriumState& state) {
   const Vector r = residual(state.q, state, state.p, &lu_.assemble(free_index_, free_count_));
   ++counters_.factorizations;
   ++counters_.newton_factorizations;
-  if (!lu_.factorize(1e-4)) return finish(state, penalty_forces(state.q, state, nullptr));
+  const bool factorized = lu_.factorize(1e-4);
+  counters_.newton_analyses = lu_.analyses();
+  if (!factorized) return finish(state, penalty_forces(state.q, state, nullptr));
   Vector r_free(free_count_);
   for (int i = 0; i < r.size(); ++i)
     if (free_index_[i] >= 0) r_free[free_index_[i]] = -r[i];

@@ -59,6 +59,11 @@ class Body {
   virtual int site_node(int site) const { return site; }
   // The surface point of `site` on side +1 (upper) or -1 (lower), at state q.
   virtual SurfacePoint surface_point(const VectorRef& q, int site, int side) const = 0;
+  // The same point into `out`, whose Jacobian's storage a model may reuse (Newton's pairing at
+  // every iterate then allocates nothing). Default: surface_point's, moved in.
+  virtual void surface_point_into(const VectorRef& q, int site, int side, SurfacePoint& out) const {
+    out = surface_point(q, site, side);
+  }
   // The straight pieces of the contact surface between sites, each [a, b] with the body on
   // the left of a -> b: what a slave surface of another body pairs with (mortar segments).
   // Empty where the model offers no master surface.

@@ -97,6 +97,12 @@ SurfacePoint BodySet::surface_point(const VectorRef& q, int site, int side) cons
   return p;
 }
 
+void BodySet::surface_point_into(const VectorRef& q, int site, int side, SurfacePoint& out) const {
+  const int b = body_of_site(site);
+  parts_[b]->surface_point_into(q.segment(dof_offset_[b], parts_[b]->dof_count()), site - site_offset_[b], side, out);
+  for (auto& j : out.jacobian) j.dof += dof_offset_[b];
+}
+
 std::vector<std::array<int, 2>> BodySet::surface_segments() const {
   std::vector<std::array<int, 2>> all;
   for (int b = 0; b < part_count(); ++b)

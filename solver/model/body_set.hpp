@@ -36,6 +36,7 @@ class BodySet final : public Body {
   Vec2 site_reference(int site) const override;
   int site_node(int site) const override;
   SurfacePoint surface_point(const VectorRef& q, int site, int side) const override;
+  void surface_point_into(const VectorRef& q, int site, int side, SurfacePoint& out) const override;
   std::vector<std::array<int, 2>> surface_segments() const override;
   std::vector<int> nodes_without_site() const override;
   Vec2 node_position(const VectorRef& q, int node) const override;

@@ -231,9 +231,11 @@ int main(int argc, char** argv) {
       ", \"solve_cpu_s\": %.4f, \"solve_wall_s\": %.4f, \"completed\": %s, \"real_solves\": %ld, "
       "\"newton_iterations\": %ld, \"factorizations\": %ld, \"newton_factorizations\": %ld, "
       "\"body_factorizations\": %ld, \"dissected_factorizations\": %ld, \"ms_per_newton_iteration\": %.4f, "
-      "\"newton_cpu_s\": %.4f, \"newton_own_ms_per_iteration\": %.4f, \"compliance_cpu_s\": %.4f}\n",
+      "\"newton_cpu_s\": %.4f, \"newton_own_ms_per_iteration\": %.4f, \"compliance_cpu_s\": %.4f, "
+      "\"newton_analyses\": %ld, \"body_analyses\": %ld}\n",
       run_s, run_wall_s, run.completed ? "true" : "false", c.solves, c.newton_iterations, c.factorizations,
       c.newton_factorizations, c.body_factorizations, c.dissected_factorizations,
       c.newton_iterations ? 1e3 * run_s / c.newton_iterations : 0.0, c.newton_cpu_s,
-      c.newton_iterations ? 1e3 * c.newton_cpu_s / c.newton_iterations : 0.0, c.compliance_cpu_s);
+      c.newton_iterations ? 1e3 * c.newton_cpu_s / c.newton_iterations : 0.0, c.compliance_cpu_s, c.newton_analyses,
+      c.body_analyses);
 }
