@@ -5,7 +5,9 @@
 //     (sigma_zz = sigma_xx / 2 once the flow is incompressible), k = sigma_y / sqrt(3);
 //   - a uniform pressure on a strip footing of width 2 b on a deep block (Prandtl 1920, the
 //     same limit (2 + pi) k as the rigid punch), the coarse mesh of tests/support/prandtl_punch.hpp.
-// The same bodies with linear hardening carry the whole load: every step converges.
+// The same bodies with linear hardening carry the whole load: every step converges. And (slow) the
+// rigid punch as a contact obstacle pressed by a load: it stops at the plateau of the same punch
+// driven by a displacement.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -14,6 +16,7 @@
 #include <regex>
 
 #include "solver/elements/plane_mesh.hpp"
+#include "tests/support/contact_profile.hpp"
 #include "tests/support/scenes.hpp"
 
 namespace grip {
@@ -49,7 +52,8 @@ json bar(double t, int steps, double hardening, const std::string& kinematics) {
 
 // The half model of the footing (x >= 0, b = 1) on a 10 x 10 block, elements of b / 10 within
 // 2.5 b of the footing's edge: the pressure p on the top's nodes with x <= b.
-json footing(double p, int steps, double hardening) {
+// The block's mesh with its sets as scene JSON, the top's nodes with x <= b as "footing".
+json block_mesh() {
   RectangleSpec spec;
   spec.origin = {0, -10};
   spec.size = {10, 10};
@@ -65,12 +69,16 @@ json footing(double p, int steps, double hardening) {
   for (int n : mesh.sets.at("top"))
     if (mesh.nodes[n].x() <= 1 + 1e-9) loaded.push_back(n);
   sets["footing"] = loaded;
+  return {{"nodes", nodes}, {"elements", mesh.elements}, {"sets", sets}};
+}
+
+json footing(double p, int steps, double hardening) {
   json body = {{"model", "continuum"},
                {"kinematics", "linear"},
                {"analysis", "plane_strain"},
                {"element", "q4_bbar"},
                {"material", plastic(hardening)},
-               {"mesh", {{"nodes", nodes}, {"elements", mesh.elements}, {"sets", sets}}},
+               {"mesh", block_mesh()},
                {"contact_set", "bottom"},
                {"supports",
                 {{{"set", "left"}, {"fix", {"x"}}},
@@ -127,6 +135,46 @@ TEST(LimitLoad, FootingPressedPastPrandtlsPressureHasNoEquilibriumAndNamesTheLim
 
   const Solved hardening = solve_scene(footing(p, 12, 20.0));
   EXPECT_TRUE(hardening.run.completed) << hardening.run.reason;
+}
+
+// The rigid punch as a contact obstacle (a flat with a square edge at x = b, frictionless) on
+// the same block: driven down by 0.1 b its force levels off; the block pressed up against it by a
+// load on its base to 1.1 x (2 + pi) k b (held only by contact) fails with no_equilibrium, and the
+// last converged load it names is that plateau within 1 % (measured: plateau 0.930 of
+// (2 + pi) k b, the pressing edge the last node inside the punch, 0.9 b; the load control's last
+// converged 0.925). About 2 minutes: not in the default run.
+TEST(LimitLoadSlow, PunchAsAnObstacleUnderLoadStopsAtTheDisplacementDrivenPlateau) {
+  const double limit = (2 + std::numbers::pi) * k;
+  const json punch = {{"type", "profile"},
+                      {"pieces",
+                       {{{"type", "segment"}, {"from", {-2, 0}}, {"to", {1, 0}}},
+                        {{"type", "segment"}, {"from", {1, 0}}, {"to", {1, 5}}}}}};
+  json top = block_mesh();
+  std::vector<int> near;
+  for (size_t n = 0; n < top["nodes"].size(); ++n)
+    if (top["nodes"][n][1].get<double>() > -1e-9 && top["nodes"][n][0].get<double>() <= 2.5) near.push_back(n);
+  top["sets"]["near"] = near;
+  json body = {{"model", "continuum"},  {"kinematics", "linear"},   {"analysis", "plane_strain"},
+               {"element", "q4_bbar"},  {"material", plastic(0.0)}, {"mesh", top},
+               {"contact_set", "near"}, {"supports", json::array()}};
+  json driven = {{"body", body}, {"steps", 20}};
+  driven["body"]["supports"] = {
+      {{"set", "left"}, {"fix", {"x"}}}, {{"set", "right"}, {"fix", {"x"}}}, {{"set", "bottom"}, {"fix", {"x", "y"}}}};
+  driven["obstacles"] = {{{"name", "punch"}, {"shape", punch}, {"motion", {{"translation", {0, -0.1}}}}}};
+  const Solved d = solve_scene(driven);
+  ASSERT_TRUE(d.run.completed) << d.run.reason;
+  const double plateau = -testing::contact_resultant(d.scene.problem, d.run.steps.back()).y() / limit;
+
+  const double p = 1.1 * limit / 10;  // on the base, 10 b wide
+  json loaded = {{"body", body}, {"steps", 12}};
+  loaded["body"]["supports"] = {{{"set", "left"}, {"fix", {"x"}}}, {{"set", "right"}, {"fix", {"x"}}}};
+  loaded["body"]["loads"] = {{{"set", "bottom"}, {"traction", {0, p}}}};
+  loaded["obstacles"] = {{{"name", "punch"}, {"shape", punch}}};
+  const double reached = limit_factor(solve_scene(loaded)) * 1.1;
+  std::printf(
+      "punch as an obstacle: displacement-driven plateau %.4f, load control's last converged %.4f of (2 + pi) k b\n",
+      plateau, reached);
+  EXPECT_NEAR(reached, plateau, 0.01 * plateau);
 }
 
 }  // namespace
