@@ -17,6 +17,29 @@ inline nlohmann::json example_scene(const std::string& name) {
   return nlohmann::json::parse(in);
 }
 
+// The bulging block's quarter without friction: a 2 x 2 block, [0, 1] x [0, 1] on n x n elements
+// (symmetric about x = 0 and y = 0), compressed 10 % by a frictionless plate in 4 steps, the top
+// nodes' x held (sticking without a friction coefficient).
+inline nlohmann::json compressed_block(const std::string& element, const std::string& incompressibility,
+                                       const nlohmann::json& material, int n, const nlohmann::json& contact) {
+  return {
+      {"body",
+       {{"model", "continuum"},
+        {"element", element},
+        {"incompressibility", incompressibility},
+        {"material", material},
+        {"mesh", {{"rectangle", {{"size", {1, 1}}, {"divisions", {n, n}}}}}},
+        {"contact_set", "top"},
+        {"supports",
+         {{{"set", "left"}, {"fix", {"x"}}}, {{"set", "bottom"}, {"fix", {"y"}}}, {{"set", "top"}, {"fix", {"x"}}}}}}},
+      {"obstacles",
+       {{{"name", "plate"},
+         {"shape", {{"type", "segment"}, {"from", {-1, 1}}, {"to", {3, 1}}}},
+         {"motion", {{"translation", {0, -0.1}}}}}}},
+      {"steps", 4},
+      {"solver", {{"contact", contact}}}};
+}
+
 struct Solved {
   Scene scene;
   RunResult run;

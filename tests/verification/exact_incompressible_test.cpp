@@ -155,22 +155,9 @@ struct Bulged {
 // 30 % with a rounded corner: tests/hard/bulging_block_slow_test.cpp), the normal force through
 // contact.
 Bulged bulge_block(int n, const std::string& element, const std::string& incompressibility, double bulk) {
-  const json j = {
-      {"body",
-       {{"model", "continuum"},
-        {"element", element},
-        {"incompressibility", incompressibility},
-        {"material", {{"law", "mooney_rivlin"}, {"c10", kC10}, {"c01", kC01}, {"bulk", bulk}}},
-        {"mesh", {{"rectangle", {{"size", {1, 1}}, {"divisions", {n, n}}}}}},
-        {"contact_set", "top"},
-        {"supports",
-         {{{"set", "left"}, {"fix", {"x"}}}, {{"set", "bottom"}, {"fix", {"y"}}}, {{"set", "top"}, {"fix", {"x"}}}}}}},
-      {"obstacles",
-       {{{"name", "plate"},
-         {"shape", {{"type", "segment"}, {"from", {-1, 1}}, {"to", {3, 1}}}},
-         {"motion", {{"translation", {0, -0.1}}}}}}},
-      {"steps", 4},
-      {"solver", {{"contact", {{"method", "cev"}, {"tolerance", 1e-9}}}}}};
+  const json j = testing::compressed_block(element, incompressibility,
+                                           {{"law", "mooney_rivlin"}, {"c10", kC10}, {"c01", kC01}, {"bulk", bulk}}, n,
+                                           {{"method", "cev"}, {"tolerance", 1e-9}});
   const testing::Solved s = testing::solve_scene(j);
   EXPECT_TRUE(s.run.completed) << s.run.reason;
   Bulged out;
