@@ -376,6 +376,61 @@ void total_lagrangian_nodes(const std::vector<ElementPoint>& points, const Shape
   else total_lagrangian_fixed<N, 3>(points, u, material, fe, Ke, law, hoop_law, base_u);
 }
 
+// small_strain_history for N nodes: B (4 x 2N) as strain_matrix (and B-bar) builds it, with the
+// hoop row at axisymmetric points; B^T D B over the upper triangle, mirrored once.
+template <int N>
+void small_strain_history_fixed(const std::vector<ElementPoint>& points, const ShapeGradients* mean_dN,
+                                const ShapeGradients& u, const PlaneMaterial& material, const PointHistory* history,
+                                Vector& fe_out, Matrix* Ke_out) {
+  constexpr int M = 2 * N;
+  using Nodes2 = Eigen::Matrix<double, N, 2>;
+  Eigen::Matrix<double, M, 1> ue, fe = Eigen::Matrix<double, M, 1>::Zero();
+  for (int a = 0; a < N; ++a) ue.template segment<2>(2 * a) = u.row(a).transpose();
+  Eigen::Matrix<double, M, M> Ke;
+  if (Ke_out) Ke.setZero();
+  Eigen::Matrix<double, 4, M> B, DB;
+  Eigen::Matrix<double, M, 4> Bt;
+  for (size_t k = 0; k < points.size(); ++k) {
+    const ElementPoint& p = points[k];
+    const Eigen::Map<const Nodes2> dN(p.dN.data());
+    const bool hoop = p.radius > 0;
+    for (int a = 0; a < N; ++a) {
+      const double nx = dN(a, 0), ny = dN(a, 1);
+      B.col(2 * a) << nx, 0.0, ny, hoop ? p.N[a] / p.radius : 0.0;
+      B.col(2 * a + 1) << 0.0, ny, nx, 0.0;
+      if (mean_dN && !hoop) {
+        // eps11 and eps22 each gain half the difference of mean and local dilatation.
+        const double dx = 0.5 * ((*mean_dN)(a, 0) - nx), dy = 0.5 * ((*mean_dN)(a, 1) - ny);
+        B(0, 2 * a) += dx;
+        B(0, 2 * a + 1) += dy;
+        B(1, 2 * a) += dx;
+        B(1, 2 * a + 1) += dy;
+      }
+    }
+    Eigen::Vector4d strain = Eigen::Vector4d::Zero();
+    for (int i = 0; i < M; ++i) strain += B.col(i) * ue[i];
+    const PointResponse r = material.small_strain_response(strain, history[k]);
+    for (int i = 0; i < M; ++i) fe[i] += p.dV * B.col(i).dot(r.stress);
+    if (!Ke_out) continue;
+    const Eigen::Matrix4d D = 0.5 * (r.D + r.D.transpose());
+    DB.noalias() = (p.dV * D) * B;
+    Bt = B.transpose();
+    for (int j = 0; j < M; ++j) {
+      double* column = &Ke(0, j);
+      for (int i = 0; i <= j; ++i) {
+        double sum = 0.0;
+        for (int s = 0; s < 4; ++s) sum += Bt(i, s) * DB(s, j);
+        column[i] += sum;
+      }
+    }
+  }
+  fe_out = fe;
+  if (!Ke_out) return;
+  for (int j = 0; j < M; ++j)
+    for (int i = j + 1; i < M; ++i) Ke(i, j) = Ke(j, i);
+  *Ke_out = Ke;
+}
+
 }  // namespace
 
 void total_lagrangian(const std::vector<ElementPoint>& points, const ShapeGradients& u, const PlaneMaterial& material,
@@ -394,6 +449,24 @@ void total_lagrangian(const std::vector<ElementPoint>& points, const ShapeGradie
       return total_lagrangian_nodes<9>(points, u, material, fe, Ke, law, hoop_law, base_u);
   }
   throw std::logic_error("total_lagrangian: no element of " + std::to_string(u.rows()) + " nodes");
+}
+
+void small_strain_history(const std::vector<ElementPoint>& points, const ShapeGradients* mean_dN,
+                          const ShapeGradients& u, const PlaneMaterial& material, const PointHistory* history,
+                          Vector& fe, Matrix* Ke) {
+  switch (u.rows()) {
+    case 3:
+      return small_strain_history_fixed<3>(points, mean_dN, u, material, history, fe, Ke);
+    case 4:
+      return small_strain_history_fixed<4>(points, mean_dN, u, material, history, fe, Ke);
+    case 6:
+      return small_strain_history_fixed<6>(points, mean_dN, u, material, history, fe, Ke);
+    case 8:
+      return small_strain_history_fixed<8>(points, mean_dN, u, material, history, fe, Ke);
+    case 9:
+      return small_strain_history_fixed<9>(points, mean_dN, u, material, history, fe, Ke);
+  }
+  throw std::logic_error("small_strain_history: no element of " + std::to_string(u.rows()) + " nodes");
 }
 
 Mat2 f_bar(const ElementPoint& point, const ElementPoint& centre, const ShapeGradients& u) {
