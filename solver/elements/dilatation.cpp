@@ -149,20 +149,25 @@ void dilatation_fixed(const std::vector<ElementPoint>& points, const Dilatation&
   if constexpr (R == 4) Iv[3] = 1.0;
   Eigen::Matrix<double, R, M> B0;
   Eigen::Matrix<double, R, R> D;
+  double theta = 0.0;
   VecM dtheta;
   MatM d2theta, G;
   for (size_t k = 0; k < points.size(); ++k) {
     const ElementPoint& p = points[k];
     const FixedVolume<N>& own = at[k];
     const Eigen::Map<const Nodes2> dN(p.dN.data());
-    double theta = 0.0;
-    dtheta.setZero();
-    if (second) d2theta.setZero();
-    for (int j = 0; j < count; ++j) {
-      const double a = dilatation.A(k, j);
-      theta += a * at[j].J;
-      dtheta += a * at[j].dJ;
-      if (second) d2theta += a * at[j].d2J;
+    // theta = A J at point k; a row of A equal to the last one's (P0: every row) gives the same
+    // theta and derivatives, kept.
+    if (k == 0 || dilatation.A.row(k) != dilatation.A.row(k - 1)) {
+      theta = 0.0;
+      dtheta.setZero();
+      if (second) d2theta.setZero();
+      for (int j = 0; j < count; ++j) {
+        const double a = dilatation.A(k, j);
+        theta += a * at[j].J;
+        dtheta += a * at[j].dJ;
+        if (second) d2theta += a * at[j].d2J;
+      }
     }
     // beta = s^2 = (theta / J)^(2/d): C_bar = beta C (and C33_bar = beta C33).
     const double c = 2 * exponent(p);
