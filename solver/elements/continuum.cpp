@@ -316,30 +316,7 @@ double ContinuumBody::element_volume_change(const Vector& q, int e) const {
 }
 
 void ContinuumBody::internal_force(const Vector& q, Vector& force, TangentSink* tangent) const {
-  if (has_history_ && options_.kinematics == ContinuumKinematics::linear) {
-    const Integration& in = integration();
-    for (int e = 0; e < element_count(); ++e) {
-      const std::vector<PointResponse> r = point_responses(q, e);
-      const auto& el = mesh_.elements[e];
-      const int m = 2 * static_cast<int>(el.size());
-      Vector fe = Vector::Zero(m);
-      Matrix Ke = Matrix::Zero(m, m);
-      for (size_t k = 0; k < r.size(); ++k) {
-        const ElementPoint& p = in.points[e][k];
-        const Matrix B = strain_matrix4(p, mean_gradient(e));
-        fe.noalias() += p.dV * B.transpose() * r[k].stress;
-        if (tangent) Ke.noalias() += p.dV * B.transpose() * r[k].D * B;
-      }
-      std::vector<int> dofs(m);
-      for (int i = 0; i < m; ++i) {
-        dofs[i] = node_dof(el[i / 2], i % 2);
-        force[dofs[i]] += fe[i];
-      }
-      if (tangent) tangent->add_block(dofs.data(), Matrix(0.5 * (Ke + Ke.transpose())));
-    }
-    return;
-  }
-  if (options_.kinematics == ContinuumKinematics::linear) {
+  if (options_.kinematics == ContinuumKinematics::linear && !has_history_) {
     const Integration& in = integration();
     force += in.linear_K * q;
     if (tangent)
@@ -367,18 +344,22 @@ void ContinuumBody::internal_force(const Vector& q, Vector& force, TangentSink* 
 void ContinuumBody::element_kernel(const Vector& q, int e, ShapeGradients& u, Vector& fe, Matrix* Ke,
                                    const Vector* base, ShapeGradients& base_u) const {
   const Integration& in = integration();
-  // A law with history answers from the committed state of each point (read only here).
-  const size_t np = in.points[e].size();
-  PointLaw law;
-  HoopLaw hoop_law;
-  if (has_history_ && options_.analysis == PlaneAnalysis::axisymmetric)
-    hoop_law = [&](int k, const Mat2& E, double E33) {
-      return material(e).finite_hoop_response(E, E33, history_[e * np + k]).law;
-    };
-  else if (has_history_)
-    law = [&](int k, const Mat2& E) { return material(e).finite_response(E, history_[e * np + k]).law; };
   const auto& el = mesh_.elements[e];
   for (int a = 0; a < u.rows(); ++a) u.row(a) << q[node_dof(el[a], 0)], q[node_dof(el[a], 1)];
+  // A law with history answers from the committed state of each point (read only here).
+  const size_t np = in.points[e].size();
+  const PointHistory* history = has_history_ ? &history_[e * np] : nullptr;
+  if (options_.kinematics == ContinuumKinematics::linear)  // with history: without, K q
+    return small_strain_history(in.points[e], mean_gradient(e), u, material(e), history, fe, Ke);
+  // Two pointers captured: std::function keeps them in place (no allocation per element).
+  PointLaw law;
+  HoopLaw hoop_law;
+  const PlaneMaterial* m = &material(e);
+  if (has_history_ && options_.analysis == PlaneAnalysis::axisymmetric)
+    hoop_law = [m, history](int k, const Mat2& E, double E33) {
+      return m->finite_hoop_response(E, E33, history[k]).law;
+    };
+  else if (has_history_) law = [m, history](int k, const Mat2& E) { return m->finite_response(E, history[k]).law; };
   if (!in.dilatation.empty())
     dilatation_total_lagrangian(in.points[e], in.dilatation[e], u, material(e), fe, Ke, law, hoop_law,
                                 pressure_.empty() ? nullptr : &pressure_[e]);

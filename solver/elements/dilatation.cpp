@@ -1,48 +1,13 @@
 #include "solver/elements/dilatation.hpp"
 
 #include <Eigen/Dense>
+#include <array>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 namespace grip {
 namespace {
-
-// J at a point with its first and (if asked) second derivatives in the element's dofs.
-struct Volume {
-  double J = 1.0;
-  Vector dJ;
-  Matrix d2J;
-};
-
-Volume volume_of(const ElementPoint& p, const ShapeGradients& u, bool second) {
-  const int n = static_cast<int>(p.dN.rows());
-  const Mat2 F = deformation_gradient(p, u);
-  Volume v;
-  v.J = F.determinant();
-  v.dJ.resize(2 * n);
-  for (int a = 0; a < n; ++a) {
-    const double gx = p.dN(a, 0), gy = p.dN(a, 1);
-    v.dJ[2 * a] = F(1, 1) * gx - F(1, 0) * gy;
-    v.dJ[2 * a + 1] = F(0, 0) * gy - F(0, 1) * gx;
-  }
-  if (second) {
-    v.d2J = Matrix::Zero(2 * n, 2 * n);
-    for (int a = 0; a < n; ++a)
-      for (int b = 0; b < n; ++b) {
-        const double c = p.dN(a, 0) * p.dN(b, 1) - p.dN(a, 1) * p.dN(b, 0);
-        v.d2J(2 * a, 2 * b + 1) = c;
-        v.d2J(2 * a + 1, 2 * b) = -c;
-      }
-  }
-  if (p.radius > 0) {  // times the hoop stretch F33 = 1 + u_r / R, linear in u
-    const double F33 = 1 + p.N.dot(u.col(0)) / p.radius;
-    Vector dF33 = Vector::Zero(2 * n);
-    for (int a = 0; a < n; ++a) dF33[2 * a] = p.N[a] / p.radius;
-    if (second) v.d2J = F33 * v.d2J + v.dJ * dF33.transpose() + dF33 * v.dJ.transpose();
-    v.dJ = F33 * v.dJ + v.J * dF33;
-    v.J *= F33;
-  }
-  return v;
-}
 
 double exponent(const ElementPoint& p) { return p.radius > 0 ? 1.0 / 3.0 : 0.5; }
 
@@ -114,56 +79,121 @@ double centre_dilatation_scale(const ElementPoint& centre, const Dilatation& dil
   return std::pow(theta / volume_ratio(centre, u), exponent(centre));
 }
 
-void dilatation_total_lagrangian(const std::vector<ElementPoint>& points, const Dilatation& dilatation,
-                                 const ShapeGradients& u, const PlaneMaterial& material, Vector& fe, Matrix* Ke,
-                                 const PointLaw& law, const HoopLaw& hoop_law, const Vector* pressure) {
-  const int n = static_cast<int>(u.rows()), m = 2 * n;
-  const bool hoop = points.front().radius > 0;
-  const int R = hoop ? 4 : 3;
-  const bool second = Ke != nullptr;
-  std::vector<Volume> at;
-  for (const ElementPoint& p : dilatation.points) at.push_back(volume_of(p, u, second));
-  fe = Vector::Zero(m);
-  if (Ke) *Ke = Matrix::Zero(m, m);
-  Vector Cv(R), Iv = Vector::Zero(R), S(R), dtheta(m);
-  Iv.head<2>().setOnes();
-  if (hoop) Iv[3] = 1.0;
-  Matrix B0(R, m), D(R, R), d2theta;
+namespace {
+
+// J at a point with its first and (if asked) second derivatives, for N nodes: volume_of in
+// fixed-size matrices.
+template <int N>
+struct FixedVolume {
+  static constexpr int M = 2 * N;
+  double J = 1.0;
+  Eigen::Matrix<double, M, 1> dJ;
+  Eigen::Matrix<double, M, M> d2J;
+};
+
+template <int N>
+void fixed_volume(const ElementPoint& p, const Eigen::Matrix<double, N, 2>& u, bool second, FixedVolume<N>& v) {
+  constexpr int M = 2 * N;
+  using Nodes2 = Eigen::Matrix<double, N, 2>;
+  const Eigen::Map<const Nodes2> dN(p.dN.data());
+  const Mat2 F = Mat2::Identity() + u.transpose() * dN;
+  v.J = F.determinant();
+  for (int a = 0; a < N; ++a) {
+    const double gx = dN(a, 0), gy = dN(a, 1);
+    v.dJ[2 * a] = F(1, 1) * gx - F(1, 0) * gy;
+    v.dJ[2 * a + 1] = F(0, 0) * gy - F(0, 1) * gx;
+  }
+  if (second) {
+    v.d2J.setZero();
+    for (int a = 0; a < N; ++a)
+      for (int b = 0; b < N; ++b) {
+        const double c = dN(a, 0) * dN(b, 1) - dN(a, 1) * dN(b, 0);
+        v.d2J(2 * a, 2 * b + 1) = c;
+        v.d2J(2 * a + 1, 2 * b) = -c;
+      }
+  }
+  if (p.radius > 0) {  // times the hoop stretch F33 = 1 + u_r / R, linear in u
+    const double F33 = 1 + p.N.dot(u.col(0)) / p.radius;
+    Eigen::Matrix<double, M, 1> dF33 = Eigen::Matrix<double, M, 1>::Zero();
+    for (int a = 0; a < N; ++a) dF33[2 * a] = p.N[a] / p.radius;
+    if (second) v.d2J = F33 * v.d2J + v.dJ * dF33.transpose() + dF33 * v.dJ.transpose();
+    v.dJ = F33 * v.dJ + v.J * dF33;
+    v.J *= F33;
+  }
+}
+
+// dilatation_total_lagrangian for N nodes and R strain rows (3 in the plane, 4 with the hoop
+// strain), in fixed-size matrices: no allocation. The points' volumes are computed once: the
+// dilatation's points are the element's integration points (projected_dilatation).
+template <int N, int R>
+void dilatation_fixed(const std::vector<ElementPoint>& points, const Dilatation& dilatation,
+                      const ShapeGradients& u_dynamic, const PlaneMaterial& material, Vector& fe_out, Matrix* Ke_out,
+                      const PointLaw& law, const HoopLaw& hoop_law, const Vector* pressure) {
+  constexpr int M = 2 * N, kMaxPoints = 9;
+  using Nodes2 = Eigen::Matrix<double, N, 2>;
+  using VecM = Eigen::Matrix<double, M, 1>;
+  using MatM = Eigen::Matrix<double, M, M>;
+  using VecR = Eigen::Matrix<double, R, 1>;
+  const int count = static_cast<int>(dilatation.points.size());
+  if (count > kMaxPoints || points.size() != dilatation.points.size())
+    throw std::logic_error("dilatation_total_lagrangian: the dilatation's points are not the element's");
+  const Nodes2 u = u_dynamic;
+  const bool second = Ke_out != nullptr;
+  std::array<FixedVolume<N>, kMaxPoints> at;
+  for (int j = 0; j < count; ++j) fixed_volume<N>(dilatation.points[j], u, second, at[j]);
+  VecM fe = VecM::Zero();
+  MatM Ke;
+  if (second) Ke.setZero();
+  VecR Cv, Iv = VecR::Zero(), S;
+  Iv.template head<2>().setOnes();
+  if constexpr (R == 4) Iv[3] = 1.0;
+  Eigen::Matrix<double, R, M> B0;
+  Eigen::Matrix<double, R, R> D;
+  double theta = 0.0;
+  VecM dtheta;
+  MatM d2theta, G;
   for (size_t k = 0; k < points.size(); ++k) {
     const ElementPoint& p = points[k];
-    const Volume own = volume_of(p, u, second);
-    double theta = 0.0;
-    dtheta.setZero();
-    if (second) d2theta = Matrix::Zero(m, m);
-    for (size_t j = 0; j < at.size(); ++j) {
-      const double a = dilatation.A(k, j);
-      theta += a * at[j].J;
-      dtheta += a * at[j].dJ;
-      if (second) d2theta += a * at[j].d2J;
+    const FixedVolume<N>& own = at[k];
+    const Eigen::Map<const Nodes2> dN(p.dN.data());
+    // theta = A J at point k; a row of A equal to the last one's (P0: every row) gives the same
+    // theta and derivatives, kept.
+    if (k == 0 || dilatation.A.row(k) != dilatation.A.row(k - 1)) {
+      theta = 0.0;
+      dtheta.setZero();
+      if (second) d2theta.setZero();
+      for (int j = 0; j < count; ++j) {
+        const double a = dilatation.A(k, j);
+        theta += a * at[j].J;
+        dtheta += a * at[j].dJ;
+        if (second) d2theta += a * at[j].d2J;
+      }
     }
     // beta = s^2 = (theta / J)^(2/d): C_bar = beta C (and C33_bar = beta C33).
     const double c = 2 * exponent(p);
     const double beta = std::pow(theta / own.J, c);
-    const Vector dg = c * (dtheta / theta - own.dJ / own.J);
-    const Vector dbeta = beta * dg;
-    const Mat2 F = deformation_gradient(p, u);
+    const VecM dg = c * (dtheta / theta - own.dJ / own.J);
+    const VecM dbeta = beta * dg;
+    const Mat2 F = Mat2::Identity() + u.transpose() * dN;
     const Mat2 C = F.transpose() * F;
-    const double F33 = hoop ? 1 + p.N.dot(u.col(0)) / p.radius : 1.0;
-    Cv.head<3>() << C(0, 0), C(1, 1), 2 * C(0, 1);
-    if (hoop) Cv[3] = F33 * F33;
+    Cv.template head<3>() << C(0, 0), C(1, 1), 2 * C(0, 1);
+    double F33 = 1.0;
+    if constexpr (R == 4) {
+      F33 = 1 + p.N.dot(u.col(0)) / p.radius;
+      Cv[3] = F33 * F33;
+    }
     // dE = B0 du for the plain E = (C - I) / 2.
     B0.setZero();
-    for (int a = 0; a < n; ++a) {
-      const double gx = p.dN(a, 0), gy = p.dN(a, 1);
-      green_lagrange_rows(B0, a, F, gx, gy);
-      if (hoop) B0(3, 2 * a) = F33 * p.N[a] / p.radius;
+    for (int a = 0; a < N; ++a) {
+      green_lagrange_rows(B0, a, F, dN(a, 0), dN(a, 1));
+      if constexpr (R == 4) B0(3, 2 * a) = F33 * p.N[a] / p.radius;
     }
     // E_bar = (beta C - I) / 2 and dE_bar = B_bar du.
-    const Vector Ebar = 0.5 * (beta * Cv - Iv);
-    const Matrix Bbar = 0.5 * Cv * dbeta.transpose() + beta * B0;
+    const VecR Ebar = 0.5 * (beta * Cv - Iv);
+    const Eigen::Matrix<double, R, M> Bbar = 0.5 * Cv * dbeta.transpose() + beta * B0;
     Mat2 E;
     E << Ebar[0], 0.5 * Ebar[2], 0.5 * Ebar[2], Ebar[1];
-    if (hoop) {
+    if constexpr (R == 4) {
       const HoopResponse r = hoop_law ? hoop_law(static_cast<int>(k), E, Ebar[3]) : material.hoop_response(E, Ebar[3]);
       S = r.S;
       D = r.D;
@@ -175,28 +205,56 @@ void dilatation_total_lagrangian(const std::vector<ElementPoint>& points, const 
     fe.noalias() += p.dV * Bbar.transpose() * S;
     if (pressure) {  // the multiplier's term p (theta - 1): its gradient and second derivative
       fe.noalias() += p.dV * (*pressure)[k] * dtheta;
-      if (Ke) Ke->noalias() += p.dV * (*pressure)[k] * d2theta;
+      if (second) Ke.noalias() += p.dV * (*pressure)[k] * d2theta;
     }
-    if (!Ke) continue;
+    if (!second) continue;
     // The second derivative of sum W(E_bar): the material part, the second derivative of beta
     // times S . C / 2, the cross terms of d beta with dC, and beta times the plain geometric part.
-    const Matrix d2g = c * (d2theta / theta - dtheta * dtheta.transpose() / (theta * theta) - own.d2J / own.J +
-                            own.dJ * own.dJ.transpose() / (own.J * own.J));
-    const Matrix d2beta = beta * (dg * dg.transpose() + d2g);
-    const Vector w = B0.transpose() * S;
-    Matrix G = Matrix::Zero(m, m);
-    for (int a = 0; a < n; ++a)
-      for (int b = 0; b < n; ++b) {
+    const MatM d2g = c * (d2theta / theta - dtheta * dtheta.transpose() / (theta * theta) - own.d2J / own.J +
+                          own.dJ * own.dJ.transpose() / (own.J * own.J));
+    const MatM d2beta = beta * (dg * dg.transpose() + d2g);
+    const VecM w = B0.transpose() * S;
+    G.setZero();
+    for (int a = 0; a < N; ++a)
+      for (int b = 0; b < N; ++b) {
         const double g =
-            p.dN(a, 0) * (S[0] * p.dN(b, 0) + S[2] * p.dN(b, 1)) + p.dN(a, 1) * (S[2] * p.dN(b, 0) + S[1] * p.dN(b, 1));
+            dN(a, 0) * (S[0] * dN(b, 0) + S[2] * dN(b, 1)) + dN(a, 1) * (S[2] * dN(b, 0) + S[1] * dN(b, 1));
         G(2 * a, 2 * b) += g;
         G(2 * a + 1, 2 * b + 1) += g;
-        if (hoop) G(2 * a, 2 * b) += S[3] * p.N[a] * p.N[b] / (p.radius * p.radius);
+        if constexpr (R == 4) G(2 * a, 2 * b) += S[3] * p.N[a] * p.N[b] / (p.radius * p.radius);
       }
-    Ke->noalias() += p.dV * (Bbar.transpose() * D * Bbar + 0.5 * S.dot(Cv) * d2beta + dbeta * w.transpose() +
-                             w * dbeta.transpose() + beta * G);
+    Ke.noalias() += p.dV * (Bbar.transpose() * D * Bbar + 0.5 * S.dot(Cv) * d2beta + dbeta * w.transpose() +
+                            w * dbeta.transpose() + beta * G);
   }
-  if (Ke) *Ke = 0.5 * (*Ke + Ke->transpose());
+  fe_out = fe;
+  if (second) *Ke_out = 0.5 * (Ke + Ke.transpose());
+}
+
+template <int N>
+void dilatation_nodes(const std::vector<ElementPoint>& points, const Dilatation& dilatation, const ShapeGradients& u,
+                      const PlaneMaterial& material, Vector& fe, Matrix* Ke, const PointLaw& law,
+                      const HoopLaw& hoop_law, const Vector* pressure) {
+  if (points.front().radius > 0)
+    dilatation_fixed<N, 4>(points, dilatation, u, material, fe, Ke, law, hoop_law, pressure);
+  else dilatation_fixed<N, 3>(points, dilatation, u, material, fe, Ke, law, hoop_law, pressure);
+}
+
+}  // namespace
+
+// q9 and t6 (mixed and exact), q4 (F-bar in axisymmetry): the element kinds with a dilatation.
+void dilatation_total_lagrangian(const std::vector<ElementPoint>& points, const Dilatation& dilatation,
+                                 const ShapeGradients& u, const PlaneMaterial& material, Vector& fe, Matrix* Ke,
+                                 const PointLaw& law, const HoopLaw& hoop_law, const Vector* pressure) {
+  switch (u.rows()) {
+    case 4:
+      return dilatation_nodes<4>(points, dilatation, u, material, fe, Ke, law, hoop_law, pressure);
+    case 6:
+      return dilatation_nodes<6>(points, dilatation, u, material, fe, Ke, law, hoop_law, pressure);
+    case 9:
+      return dilatation_nodes<9>(points, dilatation, u, material, fe, Ke, law, hoop_law, pressure);
+  }
+  throw std::logic_error("dilatation_total_lagrangian: no element of " + std::to_string(u.rows()) +
+                         " nodes with a dilatation (q4, t6, q9)");
 }
 
 }  // namespace grip

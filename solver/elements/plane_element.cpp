@@ -376,6 +376,61 @@ void total_lagrangian_nodes(const std::vector<ElementPoint>& points, const Shape
   else total_lagrangian_fixed<N, 3>(points, u, material, fe, Ke, law, hoop_law, base_u);
 }
 
+// small_strain_history for N nodes: B (4 x 2N) as strain_matrix (and B-bar) builds it, with the
+// hoop row at axisymmetric points; B^T D B over the upper triangle, mirrored once.
+template <int N>
+void small_strain_history_fixed(const std::vector<ElementPoint>& points, const ShapeGradients* mean_dN,
+                                const ShapeGradients& u, const PlaneMaterial& material, const PointHistory* history,
+                                Vector& fe_out, Matrix* Ke_out) {
+  constexpr int M = 2 * N;
+  using Nodes2 = Eigen::Matrix<double, N, 2>;
+  Eigen::Matrix<double, M, 1> ue, fe = Eigen::Matrix<double, M, 1>::Zero();
+  for (int a = 0; a < N; ++a) ue.template segment<2>(2 * a) = u.row(a).transpose();
+  Eigen::Matrix<double, M, M> Ke;
+  if (Ke_out) Ke.setZero();
+  Eigen::Matrix<double, 4, M> B, DB;
+  Eigen::Matrix<double, M, 4> Bt;
+  for (size_t k = 0; k < points.size(); ++k) {
+    const ElementPoint& p = points[k];
+    const Eigen::Map<const Nodes2> dN(p.dN.data());
+    const bool hoop = p.radius > 0;
+    for (int a = 0; a < N; ++a) {
+      const double nx = dN(a, 0), ny = dN(a, 1);
+      B.col(2 * a) << nx, 0.0, ny, hoop ? p.N[a] / p.radius : 0.0;
+      B.col(2 * a + 1) << 0.0, ny, nx, 0.0;
+      if (mean_dN && !hoop) {
+        // eps11 and eps22 each gain half the difference of mean and local dilatation.
+        const double dx = 0.5 * ((*mean_dN)(a, 0) - nx), dy = 0.5 * ((*mean_dN)(a, 1) - ny);
+        B(0, 2 * a) += dx;
+        B(0, 2 * a + 1) += dy;
+        B(1, 2 * a) += dx;
+        B(1, 2 * a + 1) += dy;
+      }
+    }
+    Eigen::Vector4d strain = Eigen::Vector4d::Zero();
+    for (int i = 0; i < M; ++i) strain += B.col(i) * ue[i];
+    const PointResponse r = material.small_strain_response(strain, history[k]);
+    for (int i = 0; i < M; ++i) fe[i] += p.dV * B.col(i).dot(r.stress);
+    if (!Ke_out) continue;
+    const Eigen::Matrix4d D = 0.5 * (r.D + r.D.transpose());
+    DB.noalias() = (p.dV * D) * B;
+    Bt = B.transpose();
+    for (int j = 0; j < M; ++j) {
+      double* column = &Ke(0, j);
+      for (int i = 0; i <= j; ++i) {
+        double sum = 0.0;
+        for (int s = 0; s < 4; ++s) sum += Bt(i, s) * DB(s, j);
+        column[i] += sum;
+      }
+    }
+  }
+  fe_out = fe;
+  if (!Ke_out) return;
+  for (int j = 0; j < M; ++j)
+    for (int i = j + 1; i < M; ++i) Ke(i, j) = Ke(j, i);
+  *Ke_out = Ke;
+}
+
 }  // namespace
 
 void total_lagrangian(const std::vector<ElementPoint>& points, const ShapeGradients& u, const PlaneMaterial& material,
@@ -396,23 +451,49 @@ void total_lagrangian(const std::vector<ElementPoint>& points, const ShapeGradie
   throw std::logic_error("total_lagrangian: no element of " + std::to_string(u.rows()) + " nodes");
 }
 
+void small_strain_history(const std::vector<ElementPoint>& points, const ShapeGradients* mean_dN,
+                          const ShapeGradients& u, const PlaneMaterial& material, const PointHistory* history,
+                          Vector& fe, Matrix* Ke) {
+  switch (u.rows()) {
+    case 3:
+      return small_strain_history_fixed<3>(points, mean_dN, u, material, history, fe, Ke);
+    case 4:
+      return small_strain_history_fixed<4>(points, mean_dN, u, material, history, fe, Ke);
+    case 6:
+      return small_strain_history_fixed<6>(points, mean_dN, u, material, history, fe, Ke);
+    case 8:
+      return small_strain_history_fixed<8>(points, mean_dN, u, material, history, fe, Ke);
+    case 9:
+      return small_strain_history_fixed<9>(points, mean_dN, u, material, history, fe, Ke);
+  }
+  throw std::logic_error("small_strain_history: no element of " + std::to_string(u.rows()) + " nodes");
+}
+
 Mat2 f_bar(const ElementPoint& point, const ElementPoint& centre, const ShapeGradients& u) {
   const Mat2 F = deformation_gradient(point, u);
   return std::sqrt(deformation_gradient(centre, u).determinant() / F.determinant()) * F;
 }
 
-void f_bar_total_lagrangian(const std::vector<ElementPoint>& points, const ElementPoint& centre,
-                            const ShapeGradients& u, const PlaneMaterial& material, Vector& fe, Matrix* Ke,
-                            const PointLaw& law) {
-  const int n = static_cast<int>(u.rows());
-  fe = Vector::Zero(2 * n);
-  if (Ke) *Ke = Matrix::Zero(2 * n, 2 * n);
-  const Mat2 F0 = deformation_gradient(centre, u);
-  const ShapeGradients h0 = centre.dN * F0.inverse();  // row a: (F0^-T dN_a)^T
+namespace {
+
+// f_bar_total_lagrangian for N nodes, in fixed-size matrices (no allocation): h and h0 a row per node.
+template <int N>
+void f_bar_fixed(const std::vector<ElementPoint>& points, const ElementPoint& centre, const ShapeGradients& u_dynamic,
+                 const PlaneMaterial& material, Vector& fe_out, Matrix* Ke_out, const PointLaw& law) {
+  constexpr int M = 2 * N;
+  using Nodes2 = Eigen::Matrix<double, N, 2>;
+  const Nodes2 u = u_dynamic;
+  Eigen::Matrix<double, M, 1> fe = Eigen::Matrix<double, M, 1>::Zero();
+  Eigen::Matrix<double, M, M> Ke;
+  if (Ke_out) Ke.setZero();
+  const Eigen::Map<const Nodes2> dN0(centre.dN.data());
+  const Mat2 F0 = Mat2::Identity() + u.transpose() * dN0;
+  const Nodes2 h0 = dN0 * F0.inverse();  // row a: (F0^-T dN_a)^T
   const auto sym = [](const Mat2& A) { return Mat2(0.5 * (A + A.transpose())); };
   for (size_t i = 0; i < points.size(); ++i) {
     const ElementPoint& p = points[i];
-    const Mat2 F = deformation_gradient(p, u);
+    const Eigen::Map<const Nodes2> dN(p.dN.data());
+    const Mat2 F = Mat2::Identity() + u.transpose() * dN;
     const double alpha = std::sqrt(F0.determinant() / F.determinant());
     const Mat2 Fb = alpha * F;
     const Mat2 Eb = 0.5 * (Fb.transpose() * Fb - Mat2::Identity());
@@ -421,33 +502,55 @@ void f_bar_total_lagrangian(const std::vector<ElementPoint>& points, const Eleme
     S << r.S[0], r.S[2], r.S[2], r.S[1];
     const Mat2 tau = Fb * S * Fb.transpose();
     const double half_trace = 0.5 * tau.trace();
-    const ShapeGradients h = p.dN * F.inverse();  // row a: (F^-T dN_a)^T
-    for (int a = 0; a < n; ++a)
-      fe.segment<2>(2 * a) +=
+    const Nodes2 h = dN * F.inverse();  // row a: (F^-T dN_a)^T
+    for (int a = 0; a < N; ++a)
+      fe.template segment<2>(2 * a) +=
           p.dV * ((tau - half_trace * Mat2::Identity()) * h.row(a).transpose() + half_trace * h0.row(a).transpose());
-    if (!Ke) continue;
-    for (int b = 0; b < n; ++b)
+    if (!Ke_out) continue;
+    for (int b = 0; b < N; ++b)
       for (int k = 0; k < 2; ++k) {
         const Vec2 w = Vec2::Unit(k);
         // d alpha = alpha / 2 (w . h0_b - w . h_b); d F_bar = alpha (w (x) g_b) + F d alpha.
         const double s = 0.5 * (h0(b, k) - h(b, k));
-        const Mat2 dFb = alpha * (w * p.dN.row(b) + F * s);
+        const Mat2 dFb = alpha * (w * dN.row(b) + F * s);
         const Mat2 dE = sym(Fb.transpose() * dFb);
         const Eigen::Vector3d dS_voigt = r.D * Eigen::Vector3d(dE(0, 0), dE(1, 1), 2 * dE(0, 1));
         Mat2 dS;
         dS << dS_voigt[0], dS_voigt[2], dS_voigt[2], dS_voigt[1];
         const Mat2 dtau = dFb * S * Fb.transpose() + Fb * dS * Fb.transpose() + Fb * S * dFb.transpose();
         const double dhalf = 0.5 * dtau.trace();
-        for (int a = 0; a < n; ++a) {
+        for (int a = 0; a < N; ++a) {
           // d h_a = -h_b (w . h_a), d h0_a = -h0_b (w . h0_a).
           const Vec2 ha = h.row(a).transpose(), h0a = h0.row(a).transpose();
           const Vec2 dha = -h.row(b).transpose() * ha[k], dh0a = -h0.row(b).transpose() * h0a[k];
           const Vec2 df = (dtau - dhalf * Mat2::Identity()) * ha + (tau - half_trace * Mat2::Identity()) * dha +
                           dhalf * h0a + half_trace * dh0a;
-          Ke->block<2, 1>(2 * a, 2 * b + k) += p.dV * df;
+          Ke.template block<2, 1>(2 * a, 2 * b + k) += p.dV * df;
         }
       }
   }
+  fe_out = fe;
+  if (Ke_out) *Ke_out = Ke;
+}
+
+}  // namespace
+
+void f_bar_total_lagrangian(const std::vector<ElementPoint>& points, const ElementPoint& centre,
+                            const ShapeGradients& u, const PlaneMaterial& material, Vector& fe, Matrix* Ke,
+                            const PointLaw& law) {
+  switch (u.rows()) {
+    case 3:
+      return f_bar_fixed<3>(points, centre, u, material, fe, Ke, law);
+    case 4:
+      return f_bar_fixed<4>(points, centre, u, material, fe, Ke, law);
+    case 6:
+      return f_bar_fixed<6>(points, centre, u, material, fe, Ke, law);
+    case 8:
+      return f_bar_fixed<8>(points, centre, u, material, fe, Ke, law);
+    case 9:
+      return f_bar_fixed<9>(points, centre, u, material, fe, Ke, law);
+  }
+  throw std::logic_error("f_bar_total_lagrangian: no element of " + std::to_string(u.rows()) + " nodes");
 }
 
 Eigen::Vector4d cauchy_stress(const Mat2& F, const MaterialResponse& r) {

@@ -105,6 +105,16 @@ void total_lagrangian(const std::vector<ElementPoint>& points, const ShapeGradie
                       Vector& fe, Matrix* Ke, const PointLaw& law = {}, const HoopLaw& hoop_law = {},
                       const ShapeGradients* base_u = nullptr);
 
+// Small strain with a law that keeps history (J2 plasticity, linear kinematics): at each point k
+// the strain (11, 22, 2 x 12, 33) = B u (B-bar's rows with `mean_dN`; the hoop row u_r / r at
+// axisymmetric points, zero in the plane), the law's answer from that point's committed state
+// history[k]; fe = sum B^T stress dV and, if Ke is given, sum B^T D B dV with D symmetrized
+// ((D + D^T) / 2: the same Ke as B^T D B symmetrized). Fixed-size per element kind, like
+// total_lagrangian: no allocation.
+void small_strain_history(const std::vector<ElementPoint>& points, const ShapeGradients* mean_dN,
+                          const ShapeGradients& u, const PlaneMaterial& material, const PointHistory* history,
+                          Vector& fe, Matrix* Ke);
+
 // F-bar in plane strain: the law sees F_bar = (J0 / J)^(1/2) F, whose in-plane determinant is
 // J0 = det F at the element's centre (`centre`), so that every point changes volume as the
 // centre does (no volumetric locking as the law nears incompressibility). The element's energy
