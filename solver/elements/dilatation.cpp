@@ -6,6 +6,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "solver/elements/node_count_dispatch.hpp"
+
 namespace grip {
 namespace {
 
@@ -245,16 +247,9 @@ void dilatation_nodes(const std::vector<ElementPoint>& points, const Dilatation&
 void dilatation_total_lagrangian(const std::vector<ElementPoint>& points, const Dilatation& dilatation,
                                  const ShapeGradients& u, const PlaneMaterial& material, Vector& fe, Matrix* Ke,
                                  const PointLaw& law, const HoopLaw& hoop_law, const Vector* pressure) {
-  switch (u.rows()) {
-    case 4:
-      return dilatation_nodes<4>(points, dilatation, u, material, fe, Ke, law, hoop_law, pressure);
-    case 6:
-      return dilatation_nodes<6>(points, dilatation, u, material, fe, Ke, law, hoop_law, pressure);
-    case 9:
-      return dilatation_nodes<9>(points, dilatation, u, material, fe, Ke, law, hoop_law, pressure);
-  }
-  throw std::logic_error("dilatation_total_lagrangian: no element of " + std::to_string(u.rows()) +
-                         " nodes with a dilatation (q4, t6, q9)");
+  with_node_count<4, 6, 9>(u.rows(), "dilatation_total_lagrangian", [&](auto n) {
+    dilatation_nodes<n()>(points, dilatation, u, material, fe, Ke, law, hoop_law, pressure);
+  });
 }
 
 }  // namespace grip

@@ -7,6 +7,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "solver/elements/node_count_dispatch.hpp"
+
 namespace grip {
 namespace {
 
@@ -436,37 +438,17 @@ void small_strain_history_fixed(const std::vector<ElementPoint>& points, const S
 void total_lagrangian(const std::vector<ElementPoint>& points, const ShapeGradients& u, const PlaneMaterial& material,
                       Vector& fe, Matrix* Ke, const PointLaw& law, const HoopLaw& hoop_law,
                       const ShapeGradients* base_u) {
-  switch (u.rows()) {
-    case 3:
-      return total_lagrangian_nodes<3>(points, u, material, fe, Ke, law, hoop_law, base_u);
-    case 4:
-      return total_lagrangian_nodes<4>(points, u, material, fe, Ke, law, hoop_law, base_u);
-    case 6:
-      return total_lagrangian_nodes<6>(points, u, material, fe, Ke, law, hoop_law, base_u);
-    case 8:
-      return total_lagrangian_nodes<8>(points, u, material, fe, Ke, law, hoop_law, base_u);
-    case 9:
-      return total_lagrangian_nodes<9>(points, u, material, fe, Ke, law, hoop_law, base_u);
-  }
-  throw std::logic_error("total_lagrangian: no element of " + std::to_string(u.rows()) + " nodes");
+  with_node_count<3, 4, 6, 8, 9>(u.rows(), "total_lagrangian", [&](auto n) {
+    total_lagrangian_nodes<n()>(points, u, material, fe, Ke, law, hoop_law, base_u);
+  });
 }
 
 void small_strain_history(const std::vector<ElementPoint>& points, const ShapeGradients* mean_dN,
                           const ShapeGradients& u, const PlaneMaterial& material, const PointHistory* history,
                           Vector& fe, Matrix* Ke) {
-  switch (u.rows()) {
-    case 3:
-      return small_strain_history_fixed<3>(points, mean_dN, u, material, history, fe, Ke);
-    case 4:
-      return small_strain_history_fixed<4>(points, mean_dN, u, material, history, fe, Ke);
-    case 6:
-      return small_strain_history_fixed<6>(points, mean_dN, u, material, history, fe, Ke);
-    case 8:
-      return small_strain_history_fixed<8>(points, mean_dN, u, material, history, fe, Ke);
-    case 9:
-      return small_strain_history_fixed<9>(points, mean_dN, u, material, history, fe, Ke);
-  }
-  throw std::logic_error("small_strain_history: no element of " + std::to_string(u.rows()) + " nodes");
+  with_node_count<3, 4, 6, 8, 9>(u.rows(), "small_strain_history", [&](auto n) {
+    small_strain_history_fixed<n()>(points, mean_dN, u, material, history, fe, Ke);
+  });
 }
 
 Mat2 f_bar(const ElementPoint& point, const ElementPoint& centre, const ShapeGradients& u) {
@@ -538,19 +520,8 @@ void f_bar_fixed(const std::vector<ElementPoint>& points, const ElementPoint& ce
 void f_bar_total_lagrangian(const std::vector<ElementPoint>& points, const ElementPoint& centre,
                             const ShapeGradients& u, const PlaneMaterial& material, Vector& fe, Matrix* Ke,
                             const PointLaw& law) {
-  switch (u.rows()) {
-    case 3:
-      return f_bar_fixed<3>(points, centre, u, material, fe, Ke, law);
-    case 4:
-      return f_bar_fixed<4>(points, centre, u, material, fe, Ke, law);
-    case 6:
-      return f_bar_fixed<6>(points, centre, u, material, fe, Ke, law);
-    case 8:
-      return f_bar_fixed<8>(points, centre, u, material, fe, Ke, law);
-    case 9:
-      return f_bar_fixed<9>(points, centre, u, material, fe, Ke, law);
-  }
-  throw std::logic_error("f_bar_total_lagrangian: no element of " + std::to_string(u.rows()) + " nodes");
+  with_node_count<3, 4, 6, 8, 9>(u.rows(), "f_bar_total_lagrangian",
+                                 [&](auto n) { f_bar_fixed<n()>(points, centre, u, material, fe, Ke, law); });
 }
 
 Eigen::Vector4d cauchy_stress(const Mat2& F, const MaterialResponse& r) {
