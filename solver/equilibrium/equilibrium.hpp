@@ -152,9 +152,9 @@ class Equilibrium {
   // only kind measured to gain (bench/results/kernels.md, chords).
   bool chord_ready() const;
   double free_length_norm(const Vector& dq) const;
-  // K^-1 r on the free dofs with `solver`'s factorization (r and the result by dof, zero on
-  // the prescribed ones): the line search's simplified correction, the chords'.
-  Vector free_solve(const FreeBlockSolver& solver, const Vector& r) const;
+  // x = K^-1 r on the free dofs with `solver`'s factorization (r and x by dof, x zero on the
+  // prescribed ones): the line search's simplified correction, the chords'. Into kept storage.
+  void free_solve_into(const FreeBlockSolver& solver, const Vector& r, Vector& x) const;
   double scaled_free_max(const Vector& r) const;
   void add_rigid_border(const EquilibriumState& state);
   // free_index_ from the supports, the start-up's dofs and (unless pins_free_) the pins.
@@ -230,6 +230,10 @@ class Equilibrium {
   // on all; residual_into's applied and contact forces and its pair and follower terms.
   Vector r_work_, r_step_work_, r_free_work_, dq_free_work_, dq_work_;
   mutable Vector external_work_, contact_work_;
+  // The trial iterates of the line search and the chords: the point, its pairing, residual and
+  // simplified correction, and free_solve_into's free parts.
+  mutable Vector trial_q_, trial_r_, trial_dq_, trial_r_free_, trial_x_free_;
+  mutable EquilibriumState trial_state_;
   mutable Triplets pair_terms_work_, follow_work_;
   double body_tangent_norm_ = 0.0;  // |K|_inf of the constant body tangent (round-off scale)
   std::vector<int> surface_free_;   // surface row of G -> free index

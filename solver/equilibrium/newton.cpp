@@ -209,16 +209,19 @@ EquilibriumState Equilibrium::newton(const Vector& q_guess, const Vector& p) {
   double last_step = 0.0, step_before = 0.0;
   std::vector<signed char> signs;  // the penalty law's trial signs at the last iterate
   // The iterates' work storage (members, sized at the first iterate of the first solve): an
-  // iteration allocates nothing where the tangent is one Cholesky factorization and the body's
-  // surface points reuse their storage (tests/unit/newton_allocation_test.cpp).
+  // iteration allocates nothing where the tangent is one Cholesky factorization of a pattern
+  // already analysed (tests/alloc/newton_allocation_test.cpp).
   Vector& r = r_work_;
   Vector& r_step = r_step_work_;
   Vector& r_free = r_free_work_;
   Vector& dq_free = dq_free_work_;
   Vector& dq = dq_work_;
+  // The solve's state (its answer, moved out) is paired before the loop: sizing its surface
+  // points is the solve's one allocation that grows with the contact surface.
+  pair(state.q, state);
   for (int it = 1; it <= params_.max_iterations + 1; ++it) {
-    if (newton_iteration_probe) newton_iteration_probe(it);
-    pair(state.q, state);
+    if (newton_iteration_probe) newton_iteration_probe(it, lu_.analyses() + body_lu_.analyses());
+    if (it > 1) pair(state.q, state);
     // A penalty point whose trial tangential force changed sign since the last iterate has
     // crossed the cone's interior, its stick band (width 2 mu |p_eta| / k_t, a few 1e-6 of the
     // body when k_t is 1e3 x its stiffness): Newton from either slip branch predicts the other
@@ -352,15 +355,14 @@ EquilibriumState Equilibrium::newton(const Vector& q_guess, const Vector& p) {
   return state;
 }
 
-Vector Equilibrium::free_solve(const FreeBlockSolver& solver, const Vector& r) const {
-  Vector r_free(free_count_);
+void Equilibrium::free_solve_into(const FreeBlockSolver& solver, const Vector& r, Vector& x) const {
+  trial_r_free_.resize(free_count_);
   for (int i = 0; i < r.size(); ++i)
-    if (free_index_[i] >= 0) r_free[free_index_[i]] = r[i];
-  const Vector x_free = solver.solve(r_free);
-  Vector x = Vector::Zero(r.size());
+    if (free_index_[i] >= 0) trial_r_free_[free_index_[i]] = r[i];
+  solver.solve_into(trial_r_free_, trial_x_free_);
+  x.setZero(r.size());
   for (int i = 0; i < r.size(); ++i)
-    if (free_index_[i] >= 0) x[i] = x_free[free_index_[i]];
-  return x;
+    if (free_index_[i] >= 0) x[i] = trial_x_free_[free_index_[i]];
 }
 
 bool Equilibrium::chord_ready() const {
@@ -370,17 +372,21 @@ bool Equilibrium::chord_ready() const {
 
 bool Equilibrium::chord_converges(EquilibriumState& state, const Vector& r, const Vector& p) {
   const double tolerance = params_.displacement_tolerance;
-  Vector q = state.q, dq, residual_at = r;
+  Vector& q = trial_q_;
+  Vector& dq = trial_dq_;
+  q = state.q;
+  const Vector* residual_at = &r;
   double last = 0.0, relative_residual = state.relative_residual;
   for (int k = 0; k < kChordCorrections; ++k) {
     if (k) {
-      EquilibriumState paired;
-      pair(q, paired);
+      pair(q, trial_state_);
       double force_scale = 0.0;
-      residual_at = residual(q, paired, p, nullptr, &force_scale);
-      relative_residual = force_scale > 0 ? scaled_free_max(residual_at) / force_scale : 0.0;
+      residual_into(q, trial_state_, p, nullptr, trial_r_, &force_scale);
+      residual_at = &trial_r_;
+      relative_residual = force_scale > 0 ? scaled_free_max(trial_r_) / force_scale : 0.0;
     }
-    dq = -free_solve(lu_, residual_at);
+    free_solve_into(lu_, *residual_at, dq);
+    dq = -dq;
     const double size = (dq.array() * length_scales_.array()).abs().maxCoeff();
     // Too far for chords, or the tangent no longer contracts: Newton goes on from state.q.
     if (!(size <= (k ? kChordContraction * last : kChordStart * tolerance))) return false;
@@ -422,11 +428,11 @@ double Equilibrium::line_search(const Vector& q, const Vector& dq, const Vector&
   const double dq_norm = free_length_norm(dq);
   double a = problem_.body->newton_step_fraction(q, dq);
   for (int k = 0; k < params_.max_backtracks; ++k, a *= 0.5) {
-    const Vector qa = q + a * dq;
-    EquilibriumState paired;
-    pair(qa, paired);
-    const Vector r = residual(qa, paired, p, nullptr);
-    const double norm = free_length_norm(free_solve(solver, r));
+    trial_q_ = q + a * dq;
+    pair(trial_q_, trial_state_);
+    residual_into(trial_q_, trial_state_, p, nullptr, trial_r_);
+    free_solve_into(solver, trial_r_, trial_dq_);
+    const double norm = free_length_norm(trial_dq_);
     if (std::isfinite(norm) && norm <= (1.0 - 0.25 * a) * dq_norm) return a;
   }
   return a;
