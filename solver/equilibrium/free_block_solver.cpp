@@ -666,9 +666,42 @@ bool CholmodFactor::inverse_block(const std::vector<int>& rows, Matrix& G, const
     }
     bounds.push_back(s);
   }
+  // Runs of rows of W with the same columns (a chain of the elimination tree: every path that
+  // reaches its first row goes through all of it; a separator's rows in nested dissection):
+  // [group_start[g], group_start[g + 1]). For a run, the entries (j <= i) of G's column col[i]
+  // are gathered once, the run's rows added in a contiguous (vectorized) loop over j, k
+  // increasing, and scattered back once, instead of one scatter per row: each entry gets the
+  // same products added in the same order as row by row, so G is the same to the last bit.
+  std::vector<int> group_start{0};
+  for (int k = 1; k < n; ++k) {
+    const int len = w_.row_start[k + 1] - w_.row_start[k];
+    const bool same =
+        len > 0 && len == w_.row_start[k] - w_.row_start[k - 1] &&
+        std::equal(w_.row_columns.begin() + w_.row_start[k], w_.row_columns.begin() + w_.row_start[k] + len,
+                   w_.row_columns.begin() + w_.row_start[k - 1]);
+    if (!same) group_start.push_back(k);
+  }
+  group_start.push_back(n);
   run_each(parallel, static_cast<int>(bounds.size()) - 1, [&](int task) {
     const int lo = bounds[task], hi = bounds[task + 1];
-    for (int k = 0; k < n; ++k) {
+    std::vector<double> acc(s);
+    for (size_t g = 0; g + 1 < group_start.size(); ++g) {
+      const int k = group_start[g], rows_in = group_start[g + 1] - k;
+      if (rows_in > 1) {
+        const int* col = w_.row_columns.data() + w_.row_start[k];
+        const int m = w_.row_start[k + 1] - w_.row_start[k];
+        for (int i = static_cast<int>(std::lower_bound(col, col + m, lo) - col); i < m && col[i] < hi; ++i) {
+          double* column = &G(0, col[i]);
+          for (int j = 0; j <= i; ++j) acc[j] = column[col[j]];
+          for (int t = 0; t < rows_in; ++t) {
+            const double* v = w_.row_values.data() + w_.row_start[k + t];
+            const double vi = v[i];
+            for (int j = 0; j <= i; ++j) acc[j] += vi * v[j];
+          }
+          for (int j = 0; j <= i; ++j) column[col[j]] = acc[j];
+        }
+        continue;
+      }
       const int* col = w_.row_columns.data() + w_.row_start[k];
       const double* val = w_.row_values.data() + w_.row_start[k];
       const int m = w_.row_start[k + 1] - w_.row_start[k];
