@@ -360,12 +360,18 @@ void ContinuumBody::element_kernel(const Vector& q, int e, ShapeGradients& u, Ve
       return m->finite_hoop_response(E, E33, history[k]).law;
     };
   else if (has_history_) law = [m, history](int k, const Mat2& E) { return m->finite_response(E, history[k]).law; };
-  if (!in.dilatation.empty())
+  if (!in.dilatation.empty()) {
+    // The tangent at the dilatation linearized about the stress base
+    // (docs/algorithm.md#newtons-tangent-the-linearized-dilatation).
+    if (base && Ke)
+      for (int a = 0; a < u.rows(); ++a) base_u.row(a) << (*base)[node_dof(el[a], 0)], (*base)[node_dof(el[a], 1)];
     dilatation_total_lagrangian(in.points[e], in.dilatation[e], u, material(e), fe, Ke, law, hoop_law,
-                                pressure_.empty() ? nullptr : &pressure_[e]);
-  else if (options_.incompressibility == Incompressibility::f_bar)
-    f_bar_total_lagrangian(in.points[e], in.centroids[e], u, material(e), fe, Ke, law);
-  else {
+                                pressure_.empty() ? nullptr : &pressure_[e], base && Ke ? &base_u : nullptr);
+  } else if (options_.incompressibility == Incompressibility::f_bar) {
+    if (base && Ke)
+      for (int a = 0; a < u.rows(); ++a) base_u.row(a) << (*base)[node_dof(el[a], 0)], (*base)[node_dof(el[a], 1)];
+    f_bar_total_lagrangian(in.points[e], in.centroids[e], u, material(e), fe, Ke, law, base && Ke ? &base_u : nullptr);
+  } else {
     // The linearized stress (MIP Newton) on the plain elements of a Saint Venant-Kirchhoff law
     // (linear in E, so exact): F-bar's, the mixed forms' and the other laws' tangents take the
     // stress at q (linearized_stress below).
@@ -468,7 +474,8 @@ Body::Traits ContinuumBody::traits() const {
   return {.geometric_nonlinearity = !linear,
           .plasticity = has_history_,
           .constant_tangent = linear && !has_history_,
-          .linearized_stress = !linear && options_.incompressibility == Incompressibility::none && svk};
+          .linearized_stress = !linear && options_.incompressibility == Incompressibility::none && svk,
+          .volume_constrained = !linear && options_.incompressibility != Incompressibility::none};
 }
 
 std::vector<std::array<int, 2>> ContinuumBody::surface_segments() const {
