@@ -475,7 +475,9 @@ Body::Traits ContinuumBody::traits() const {
           .plasticity = has_history_,
           .constant_tangent = linear && !has_history_,
           .linearized_stress = !linear && options_.incompressibility == Incompressibility::none && svk,
-          .volume_constrained = !linear && options_.incompressibility != Incompressibility::none};
+          // Not the plastic laws: their elastic bulk modulus is a few times the shear modulus, and
+          // the volume their flow keeps is the law's (the finite J2 Hertz case's path stays).
+          .volume_constrained = !linear && options_.incompressibility != Incompressibility::none && !has_history_};
 }
 
 std::vector<std::array<int, 2>> ContinuumBody::surface_segments() const {
