@@ -360,12 +360,21 @@ void ContinuumBody::element_kernel(const Vector& q, int e, ShapeGradients& u, Ve
       return m->finite_hoop_response(E, E33, history[k]).law;
     };
   else if (has_history_) law = [m, history](int k, const Mat2& E) { return m->finite_response(E, history[k]).law; };
-  if (!in.dilatation.empty())
+  // The tangent at the dilatation linearized about the stress base, for a law without history
+  // (docs/algorithm.md#newtons-tangent-the-linearized-dilatation; traits().volume_constrained).
+  const bool at_linearized_dilatation = base && Ke && !has_history_;
+  if (!in.dilatation.empty()) {
+    if (at_linearized_dilatation)
+      for (int a = 0; a < u.rows(); ++a) base_u.row(a) << (*base)[node_dof(el[a], 0)], (*base)[node_dof(el[a], 1)];
     dilatation_total_lagrangian(in.points[e], in.dilatation[e], u, material(e), fe, Ke, law, hoop_law,
-                                pressure_.empty() ? nullptr : &pressure_[e]);
-  else if (options_.incompressibility == Incompressibility::f_bar)
-    f_bar_total_lagrangian(in.points[e], in.centroids[e], u, material(e), fe, Ke, law);
-  else {
+                                pressure_.empty() ? nullptr : &pressure_[e],
+                                at_linearized_dilatation ? &base_u : nullptr);
+  } else if (options_.incompressibility == Incompressibility::f_bar) {
+    if (at_linearized_dilatation)
+      for (int a = 0; a < u.rows(); ++a) base_u.row(a) << (*base)[node_dof(el[a], 0)], (*base)[node_dof(el[a], 1)];
+    f_bar_total_lagrangian(in.points[e], in.centroids[e], u, material(e), fe, Ke, law,
+                           at_linearized_dilatation ? &base_u : nullptr);
+  } else {
     // The linearized stress (MIP Newton) on the plain elements of a Saint Venant-Kirchhoff law
     // (linear in E, so exact): F-bar's, the mixed forms' and the other laws' tangents take the
     // stress at q (linearized_stress below).
@@ -468,7 +477,10 @@ Body::Traits ContinuumBody::traits() const {
   return {.geometric_nonlinearity = !linear,
           .plasticity = has_history_,
           .constant_tangent = linear && !has_history_,
-          .linearized_stress = !linear && options_.incompressibility == Incompressibility::none && svk};
+          .linearized_stress = !linear && options_.incompressibility == Incompressibility::none && svk,
+          // Not the plastic laws: their elastic bulk modulus is a few times the shear modulus, and
+          // the volume their flow keeps is the law's (the finite J2 Hertz case's path stays).
+          .volume_constrained = !linear && options_.incompressibility != Incompressibility::none && !has_history_};
 }
 
 std::vector<std::array<int, 2>> ContinuumBody::surface_segments() const {

@@ -130,7 +130,8 @@ void fixed_volume(const ElementPoint& p, const Eigen::Matrix<double, N, 2>& u, b
 template <int N, int R>
 void dilatation_fixed(const std::vector<ElementPoint>& points, const Dilatation& dilatation,
                       const ShapeGradients& u_dynamic, const PlaneMaterial& material, Vector& fe_out, Matrix* Ke_out,
-                      const PointLaw& law, const HoopLaw& hoop_law, const Vector* pressure) {
+                      const PointLaw& law, const HoopLaw& hoop_law, const Vector* pressure,
+                      const ShapeGradients* base_dynamic) {
   constexpr int M = 2 * N, kMaxPoints = 9;
   using Nodes2 = Eigen::Matrix<double, N, 2>;
   using VecM = Eigen::Matrix<double, M, 1>;
@@ -143,6 +144,21 @@ void dilatation_fixed(const std::vector<ElementPoint>& points, const Dilatation&
   const bool second = Ke_out != nullptr;
   std::array<FixedVolume<N>, kMaxPoints> at;
   for (int j = 0; j < count; ++j) fixed_volume<N>(dilatation.points[j], u, second, at[j]);
+  // The tangent's dilatation linearized about the stress base u_b (TangentSink::stress_base):
+  // J_j(u_b) + dJ_j(u_b) . (u - u_b) at each dilatation point.
+  const bool linearized = second && base_dynamic != nullptr;
+  std::array<double, kMaxPoints> J_lin{};
+  if (linearized) {
+    const Nodes2 ub = *base_dynamic;
+    const Nodes2 du = u - ub;
+    for (int j = 0; j < count; ++j) {
+      FixedVolume<N> b;
+      fixed_volume<N>(dilatation.points[j], ub, false, b);
+      double change = 0.0;
+      for (int a = 0; a < N; ++a) change += b.dJ[2 * a] * du(a, 0) + b.dJ[2 * a + 1] * du(a, 1);
+      J_lin[j] = b.J + change;
+    }
+  }
   VecM fe = VecM::Zero();
   MatM Ke;
   if (second) Ke.setZero();
@@ -151,7 +167,7 @@ void dilatation_fixed(const std::vector<ElementPoint>& points, const Dilatation&
   if constexpr (R == 4) Iv[3] = 1.0;
   Eigen::Matrix<double, R, M> B0;
   Eigen::Matrix<double, R, R> D;
-  double theta = 0.0;
+  double theta = 0.0, theta_lin = 0.0;
   VecM dtheta;
   MatM d2theta, G;
   for (size_t k = 0; k < points.size(); ++k) {
@@ -161,21 +177,17 @@ void dilatation_fixed(const std::vector<ElementPoint>& points, const Dilatation&
     // theta = A J at point k; a row of A equal to the last one's (P0: every row) gives the same
     // theta and derivatives, kept.
     if (k == 0 || dilatation.A.row(k) != dilatation.A.row(k - 1)) {
-      theta = 0.0;
+      theta = theta_lin = 0.0;
       dtheta.setZero();
       if (second) d2theta.setZero();
       for (int j = 0; j < count; ++j) {
         const double a = dilatation.A(k, j);
         theta += a * at[j].J;
+        theta_lin += a * J_lin[j];
         dtheta += a * at[j].dJ;
         if (second) d2theta += a * at[j].d2J;
       }
     }
-    // beta = s^2 = (theta / J)^(2/d): C_bar = beta C (and C33_bar = beta C33).
-    const double c = 2 * exponent(p);
-    const double beta = std::pow(theta / own.J, c);
-    const VecM dg = c * (dtheta / theta - own.dJ / own.J);
-    const VecM dbeta = beta * dg;
     const Mat2 F = Mat2::Identity() + u.transpose() * dN;
     const Mat2 C = F.transpose() * F;
     Cv.template head<3>() << C(0, 0), C(1, 1), 2 * C(0, 1);
@@ -190,29 +202,46 @@ void dilatation_fixed(const std::vector<ElementPoint>& points, const Dilatation&
       green_lagrange_rows(B0, a, F, dN(a, 0), dN(a, 1));
       if constexpr (R == 4) B0(3, 2 * a) = F33 * p.N[a] / p.radius;
     }
-    // E_bar = (beta C - I) / 2 and dE_bar = B_bar du.
-    const VecR Ebar = 0.5 * (beta * Cv - Iv);
-    const Eigen::Matrix<double, R, M> Bbar = 0.5 * Cv * dbeta.transpose() + beta * B0;
-    Mat2 E;
-    E << Ebar[0], 0.5 * Ebar[2], 0.5 * Ebar[2], Ebar[1];
-    if constexpr (R == 4) {
-      const HoopResponse r = hoop_law ? hoop_law(static_cast<int>(k), E, Ebar[3]) : material.hoop_response(E, Ebar[3]);
-      S = r.S;
-      D = r.D;
-    } else {
-      const MaterialResponse r = law ? law(static_cast<int>(k), E) : material.response(E);
-      S = r.S;
-      D = r.D;
-    }
+    // beta = s^2 = (th / J)^(2/d): C_bar = beta C (and C33_bar = beta C33); E_bar = (beta C -
+    // I) / 2 and dE_bar = B_bar du; the law's S and D at E_bar.
+    const double c = 2 * exponent(p);
+    double beta = 0.0;
+    VecM dg, dbeta;
+    Eigen::Matrix<double, R, M> Bbar;
+    const auto at_dilatation = [&](double th) {
+      beta = std::pow(th / own.J, c);
+      dg = c * (dtheta / th - own.dJ / own.J);
+      dbeta = beta * dg;
+      const VecR Ebar = 0.5 * (beta * Cv - Iv);
+      Bbar = 0.5 * Cv * dbeta.transpose() + beta * B0;
+      Mat2 E;
+      E << Ebar[0], 0.5 * Ebar[2], 0.5 * Ebar[2], Ebar[1];
+      if constexpr (R == 4) {
+        const HoopResponse r =
+            hoop_law ? hoop_law(static_cast<int>(k), E, Ebar[3]) : material.hoop_response(E, Ebar[3]);
+        S = r.S;
+        D = r.D;
+      } else {
+        const MaterialResponse r = law ? law(static_cast<int>(k), E) : material.response(E);
+        S = r.S;
+        D = r.D;
+      }
+    };
+    at_dilatation(theta);
     fe.noalias() += p.dV * Bbar.transpose() * S;
     if (pressure) {  // the multiplier's term p (theta - 1): its gradient and second derivative
       fe.noalias() += p.dV * (*pressure)[k] * dtheta;
       if (second) Ke.noalias() += p.dV * (*pressure)[k] * d2theta;
     }
     if (!second) continue;
+    // The tangent at the linearized dilatation (docs/algorithm.md#newtons-tangent-the-linearized-dilatation):
+    // the law's pressure there, not the bulk modulus times the second-order volume change of
+    // the last correction.
+    const double th = linearized && theta_lin > 0 ? theta_lin : theta;
+    if (th != theta) at_dilatation(th);
     // The second derivative of sum W(E_bar): the material part, the second derivative of beta
     // times S . C / 2, the cross terms of d beta with dC, and beta times the plain geometric part.
-    const MatM d2g = c * (d2theta / theta - dtheta * dtheta.transpose() / (theta * theta) - own.d2J / own.J +
+    const MatM d2g = c * (d2theta / th - dtheta * dtheta.transpose() / (th * th) - own.d2J / own.J +
                           own.dJ * own.dJ.transpose() / (own.J * own.J));
     const MatM d2beta = beta * (dg * dg.transpose() + d2g);
     const VecM w = B0.transpose() * S;
@@ -235,10 +264,10 @@ void dilatation_fixed(const std::vector<ElementPoint>& points, const Dilatation&
 template <int N>
 void dilatation_nodes(const std::vector<ElementPoint>& points, const Dilatation& dilatation, const ShapeGradients& u,
                       const PlaneMaterial& material, Vector& fe, Matrix* Ke, const PointLaw& law,
-                      const HoopLaw& hoop_law, const Vector* pressure) {
+                      const HoopLaw& hoop_law, const Vector* pressure, const ShapeGradients* base) {
   if (points.front().radius > 0)
-    dilatation_fixed<N, 4>(points, dilatation, u, material, fe, Ke, law, hoop_law, pressure);
-  else dilatation_fixed<N, 3>(points, dilatation, u, material, fe, Ke, law, hoop_law, pressure);
+    dilatation_fixed<N, 4>(points, dilatation, u, material, fe, Ke, law, hoop_law, pressure, base);
+  else dilatation_fixed<N, 3>(points, dilatation, u, material, fe, Ke, law, hoop_law, pressure, base);
 }
 
 }  // namespace
@@ -246,9 +275,10 @@ void dilatation_nodes(const std::vector<ElementPoint>& points, const Dilatation&
 // q9 and t6 (mixed and exact), q4 (F-bar in axisymmetry): the element kinds with a dilatation.
 void dilatation_total_lagrangian(const std::vector<ElementPoint>& points, const Dilatation& dilatation,
                                  const ShapeGradients& u, const PlaneMaterial& material, Vector& fe, Matrix* Ke,
-                                 const PointLaw& law, const HoopLaw& hoop_law, const Vector* pressure) {
+                                 const PointLaw& law, const HoopLaw& hoop_law, const Vector* pressure,
+                                 const ShapeGradients* base) {
   with_node_count<4, 6, 9>(u.rows(), "dilatation_total_lagrangian", [&](auto n) {
-    dilatation_nodes<n()>(points, dilatation, u, material, fe, Ke, law, hoop_law, pressure);
+    dilatation_nodes<n()>(points, dilatation, u, material, fe, Ke, law, hoop_law, pressure, base);
   });
 }
 

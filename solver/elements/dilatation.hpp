@@ -40,10 +40,12 @@ double centre_projected_ratio(const Dilatation& dilatation, const ShapeGradients
 double centre_dilatation_scale(const ElementPoint& centre, const Dilatation& dilatation, const ShapeGradients& u);
 // Internal force fe and (if given) the tangent Ke of the element. `law` and `hoop_law` as for
 // total_lagrangian, asked at each point's E_bar (and E33_bar in axisymmetry). `pressure` (the
-// exact form), a multiplier per point: the energy gains sum p_k (theta_k - 1) dV.
+// exact form), a multiplier per point: the energy gains sum p_k (theta_k - 1) dV. `base` (the
+// tangent's stress base, with Ke): Ke is taken at the dilatation linearized about it, theta_lin
+// = A (J(u_b) + dJ(u_b) (u - u_b)), in place of theta (the force stays exact).
 void dilatation_total_lagrangian(const std::vector<ElementPoint>& points, const Dilatation& dilatation,
                                  const ShapeGradients& u, const PlaneMaterial& material, Vector& fe, Matrix* Ke,
                                  const PointLaw& law = {}, const HoopLaw& hoop_law = {},
-                                 const Vector* pressure = nullptr);
+                                 const Vector* pressure = nullptr, const ShapeGradients* base = nullptr);
 
 }  // namespace grip

@@ -461,7 +461,8 @@ namespace {
 // f_bar_total_lagrangian for N nodes, in fixed-size matrices (no allocation): h and h0 a row per node.
 template <int N>
 void f_bar_fixed(const std::vector<ElementPoint>& points, const ElementPoint& centre, const ShapeGradients& u_dynamic,
-                 const PlaneMaterial& material, Vector& fe_out, Matrix* Ke_out, const PointLaw& law) {
+                 const PlaneMaterial& material, Vector& fe_out, Matrix* Ke_out, const PointLaw& law,
+                 const ShapeGradients* base) {
   constexpr int M = 2 * N;
   using Nodes2 = Eigen::Matrix<double, N, 2>;
   const Nodes2 u = u_dynamic;
@@ -472,6 +473,17 @@ void f_bar_fixed(const std::vector<ElementPoint>& points, const ElementPoint& ce
   const Mat2 F0 = Mat2::Identity() + u.transpose() * dN0;
   const Nodes2 h0 = dN0 * F0.inverse();  // row a: (F0^-T dN_a)^T
   const auto sym = [](const Mat2& A) { return Mat2(0.5 * (A + A.transpose())); };
+  // The tangent's J0 linearized about the stress base u_b (TangentSink::stress_base): det F0(u_b)
+  // + J0(u_b) h0(u_b) : (u - u_b) (docs/algorithm.md#newtons-tangent-the-linearized-dilatation).
+  double J0_lin = 0.0;
+  if (Ke_out && base) {
+    const Nodes2 ub = *base;
+    const Mat2 F0b = Mat2::Identity() + ub.transpose() * dN0;
+    const double J0b = F0b.determinant();
+    const Nodes2 h0b = dN0 * F0b.inverse();
+    const Nodes2 du = u - ub;
+    J0_lin = J0b * (1.0 + (du.array() * h0b.array()).sum());
+  }
   for (size_t i = 0; i < points.size(); ++i) {
     const ElementPoint& p = points[i];
     const Eigen::Map<const Nodes2> dN(p.dN.data());
@@ -489,24 +501,36 @@ void f_bar_fixed(const std::vector<ElementPoint>& points, const ElementPoint& ce
       fe.template segment<2>(2 * a) +=
           p.dV * ((tau - half_trace * Mat2::Identity()) * h.row(a).transpose() + half_trace * h0.row(a).transpose());
     if (!Ke_out) continue;
+    double at = alpha, ht = half_trace;
+    Mat2 Fbt = Fb, St = S, taut = tau;
+    MaterialResponse rt = r;
+    if (J0_lin > 0) {  // the law at the linearized J0
+      at = std::sqrt(J0_lin / F.determinant());
+      Fbt = at * F;
+      rt = law ? law(static_cast<int>(i), Mat2(0.5 * (Fbt.transpose() * Fbt - Mat2::Identity())))
+               : material.response(Mat2(0.5 * (Fbt.transpose() * Fbt - Mat2::Identity())));
+      St << rt.S[0], rt.S[2], rt.S[2], rt.S[1];
+      taut = Fbt * St * Fbt.transpose();
+      ht = 0.5 * taut.trace();
+    }
     for (int b = 0; b < N; ++b)
       for (int k = 0; k < 2; ++k) {
         const Vec2 w = Vec2::Unit(k);
         // d alpha = alpha / 2 (w . h0_b - w . h_b); d F_bar = alpha (w (x) g_b) + F d alpha.
         const double s = 0.5 * (h0(b, k) - h(b, k));
-        const Mat2 dFb = alpha * (w * dN.row(b) + F * s);
-        const Mat2 dE = sym(Fb.transpose() * dFb);
-        const Eigen::Vector3d dS_voigt = r.D * Eigen::Vector3d(dE(0, 0), dE(1, 1), 2 * dE(0, 1));
+        const Mat2 dFb = at * (w * dN.row(b) + F * s);
+        const Mat2 dE = sym(Fbt.transpose() * dFb);
+        const Eigen::Vector3d dS_voigt = rt.D * Eigen::Vector3d(dE(0, 0), dE(1, 1), 2 * dE(0, 1));
         Mat2 dS;
         dS << dS_voigt[0], dS_voigt[2], dS_voigt[2], dS_voigt[1];
-        const Mat2 dtau = dFb * S * Fb.transpose() + Fb * dS * Fb.transpose() + Fb * S * dFb.transpose();
+        const Mat2 dtau = dFb * St * Fbt.transpose() + Fbt * dS * Fbt.transpose() + Fbt * St * dFb.transpose();
         const double dhalf = 0.5 * dtau.trace();
         for (int a = 0; a < N; ++a) {
           // d h_a = -h_b (w . h_a), d h0_a = -h0_b (w . h0_a).
           const Vec2 ha = h.row(a).transpose(), h0a = h0.row(a).transpose();
           const Vec2 dha = -h.row(b).transpose() * ha[k], dh0a = -h0.row(b).transpose() * h0a[k];
-          const Vec2 df = (dtau - dhalf * Mat2::Identity()) * ha + (tau - half_trace * Mat2::Identity()) * dha +
-                          dhalf * h0a + half_trace * dh0a;
+          const Vec2 df =
+              (dtau - dhalf * Mat2::Identity()) * ha + (taut - ht * Mat2::Identity()) * dha + dhalf * h0a + ht * dh0a;
           Ke.template block<2, 1>(2 * a, 2 * b + k) += p.dV * df;
         }
       }
@@ -519,9 +543,9 @@ void f_bar_fixed(const std::vector<ElementPoint>& points, const ElementPoint& ce
 
 void f_bar_total_lagrangian(const std::vector<ElementPoint>& points, const ElementPoint& centre,
                             const ShapeGradients& u, const PlaneMaterial& material, Vector& fe, Matrix* Ke,
-                            const PointLaw& law) {
+                            const PointLaw& law, const ShapeGradients* base) {
   with_node_count<3, 4, 6, 8, 9>(u.rows(), "f_bar_total_lagrangian",
-                                 [&](auto n) { f_bar_fixed<n()>(points, centre, u, material, fe, Ke, law); });
+                                 [&](auto n) { f_bar_fixed<n()>(points, centre, u, material, fe, Ke, law, base); });
 }
 
 Eigen::Vector4d cauchy_stress(const Mat2& F, const MaterialResponse& r) {

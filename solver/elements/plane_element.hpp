@@ -120,10 +120,11 @@ void small_strain_history(const std::vector<ElementPoint>& points, const ShapeGr
 // centre does (no volumetric locking as the law nears incompressibility). The element's energy
 // is sum W(F_bar) dV; its gradient, f_a = sum [dev(tau) h_a + tr(tau) / 2 h0_a] dV with tau =
 // F_bar S F_bar^T, h_a = F^-T dN_a/dX and h0_a that of the centre, and Ke its exact (symmetric)
-// derivative.
+// derivative. `base` (the tangent's stress base, with Ke): Ke is taken at J0 linearized about
+// it, det F0(u_b) (1 + h0(u_b) : (u - u_b)), in place of J0 (the force stays exact).
 void f_bar_total_lagrangian(const std::vector<ElementPoint>& points, const ElementPoint& centre,
                             const ShapeGradients& u, const PlaneMaterial& material, Vector& fe, Matrix* Ke,
-                            const PointLaw& law = {});
+                            const PointLaw& law = {}, const ShapeGradients* base = nullptr);
 // F-bar's F_bar = (J0 / J)^(1/2) F at a point, J0 = det F at the centre.
 Mat2 f_bar(const ElementPoint& point, const ElementPoint& centre, const ShapeGradients& u);
 

@@ -153,6 +153,7 @@ Body::Traits BodySet::traits() const {
     t.plasticity |= pt.plasticity;
     t.constant_tangent &= pt.constant_tangent;
     t.reference_stiffness &= pt.reference_stiffness;
+    t.volume_constrained |= pt.volume_constrained;
   }
   t.linearized_stress &= changing;
   return t;

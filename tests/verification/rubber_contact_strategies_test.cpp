@@ -7,16 +7,18 @@
 // element and formulation:
 // - the bulging block of exact_incompressible_test.cpp (a 2 x 2 block, its quarter, compressed
 //   10 % in 4 steps by a frictionless rigid plate, the top's x held), Mooney-Rivlin with bulk
-//   1e3 x shear: q9 mixed on 4 x 4, q4 F-bar on 8 x 8;
+//   1e3 and 1e4 x shear: q9 mixed on 4 x 4, q4 F-bar on 8 x 8. At 1e4 x shear, measured
+//   2026-11-30: cev default 17 against 13 (q9 mixed) and 18 against 14 (q4 F-bar) real solves,
+//   the paper loop 20 against 16 on both, uzawa 249 against 262 and 186 against 171. Before the
+//   tangent took the linearized dilatation and a step's Newton started from the converged state
+//   (docs/algorithm.md#newtons-tangent-the-linearized-dilatation) they were 5.4 x and 8.9 x
+//   (cev default, failed attempts and cuts in the first and last steps), 2.5 x and 2.9 x (paper),
+//   1.7 x and 1.5 x (uzawa);
 // - the O-ring of schemas/examples/seal-o-ring.json (axisymmetric, bulk 2000 x shear, squeezed
 //   25 % in 10 steps, frictionless): q9 mixed on 8 arc divisions, q4 F-bar on 16 (the same
-//   nodes); cev's paper loop only: uzawa takes 2.5-3 x the compressible ring's real solves there
-//   (5663 against 1952 on q9 mixed, 24 s; 4004 against 1520 on q4 F-bar), its fixed step
-//   slowed as the contact widens; measured, not asserted.
-// Measured, not asserted: at bulk 1e4 x shear the block is not within 1.5 x for any strategy
-// (cev default 5.4 x on q9 mixed and 8.9 x on q4 F-bar, failed attempts and cuts in its first
-// and last steps; the paper loop 2.5 x and 2.9 x; uzawa 1.7 x and 1.5 x); the assertion fails
-// there.
+//   nodes); cev's paper loop only: uzawa takes 2.3-2.5 x the compressible ring's real solves there
+//   (4939 against 1952 on q9 mixed, 17 s; 3434 against 1520 on q4 F-bar; before the change above
+//   5663 and 4004), its fixed step slowed as the contact widens; measured, not asserted.
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -77,45 +79,47 @@ TEST(RubberContactStrategies, UzawaAndThePaperLoopOnTheBulgingBlock) {
     const char* incompressibility;
     int n;
   };
-  for (const Pair& pair : {Pair{"q9", "mixed", 4}, Pair{"q4", "f_bar", 8}}) {
-    const std::string body = std::string(pair.element) + " " + pair.incompressibility;
-    SCOPED_TRACE(body);
-    std::vector<double> reference;  // cev default's plate force per step
-    Vector reference_q;
-    for (const Strategy& st : strategies()) {
-      SCOPED_TRACE(st.name);
-      const Solved s =
-          solve_scene(compressed_block(pair.element, pair.incompressibility, rubber(1e3 * kShear), pair.n, st.contact));
-      const Solved e =
-          solve_scene(compressed_block(pair.element, pair.incompressibility, compressible(), pair.n, st.contact));
-      expect_sound(s);
-      expect_sound(e);
-      if (!s.run.completed || !e.run.completed) continue;
-      double worst = 0;
-      for (size_t k = 0; k < s.run.steps.size(); ++k) {
-        const double force = -contact_resultant(s.scene.problem, s.run.steps[k]).y();
-        if (st.name == "cev") reference.push_back(force);
-        else worst = std::max(worst, std::abs(force / reference.at(k) - 1));
+  for (const double bulk : {1e3, 1e4})
+    for (const Pair& pair : {Pair{"q9", "mixed", 4}, Pair{"q4", "f_bar", 8}}) {
+      const std::string body =
+          std::string(pair.element) + " " + pair.incompressibility + ", bulk " + (bulk == 1e3 ? "1e3" : "1e4");
+      SCOPED_TRACE(body);
+      std::vector<double> reference;  // cev default's plate force per step
+      Vector reference_q;
+      for (const Strategy& st : strategies()) {
+        SCOPED_TRACE(st.name);
+        const Solved s = solve_scene(
+            compressed_block(pair.element, pair.incompressibility, rubber(bulk * kShear), pair.n, st.contact));
+        const Solved e =
+            solve_scene(compressed_block(pair.element, pair.incompressibility, compressible(), pair.n, st.contact));
+        expect_sound(s);
+        expect_sound(e);
+        if (!s.run.completed || !e.run.completed) continue;
+        double worst = 0;
+        for (size_t k = 0; k < s.run.steps.size(); ++k) {
+          const double force = -contact_resultant(s.scene.problem, s.run.steps[k]).y();
+          if (st.name == "cev") reference.push_back(force);
+          else worst = std::max(worst, std::abs(force / reference.at(k) - 1));
+        }
+        const Vector& q = s.run.steps.back().state.q;
+        if (st.name == "cev") reference_q = q;
+        const double q_off = (q - reference_q).cwiseAbs().maxCoeff() / reference_q.cwiseAbs().maxCoeff();
+        const double ratio = double(real_solves(s)) / real_solves(e);
+        std::printf(
+            "bulging block %s, %s: plate force %.6f, against cev default %.1e (displacements %.1e); real solves rubber "
+            "%d, compressible %d: %.2f x\n",
+            body.c_str(), st.name.c_str(), reference.back(), worst, q_off, real_solves(s), real_solves(e), ratio);
+        EXPECT_LE(worst, st.agree);
+        EXPECT_LE(q_off, st.agree);
+        EXPECT_LE(ratio, 1.5);
+        // Nearly incompressible: the rubber's volume kept to about the pressure over the bulk.
+        const auto& cb = dynamic_cast<const ContinuumBody&>(*s.scene.problem.body);
+        double volume = 0;
+        for (int el = 0; el < cb.element_count(); ++el)
+          volume = std::max(volume, std::abs(cb.element_volume_change(q, el)));
+        EXPECT_LT(volume, 2e-3);
       }
-      const Vector& q = s.run.steps.back().state.q;
-      if (st.name == "cev") reference_q = q;
-      const double q_off = (q - reference_q).cwiseAbs().maxCoeff() / reference_q.cwiseAbs().maxCoeff();
-      const double ratio = double(real_solves(s)) / real_solves(e);
-      std::printf(
-          "bulging block %s, %s: plate force %.6f, against cev default %.1e (displacements %.1e); real solves rubber "
-          "%d, compressible %d: %.2f x\n",
-          body.c_str(), st.name.c_str(), reference.back(), worst, q_off, real_solves(s), real_solves(e), ratio);
-      EXPECT_LE(worst, st.agree);
-      EXPECT_LE(q_off, st.agree);
-      EXPECT_LE(ratio, 1.5);
-      // Nearly incompressible: the rubber's volume kept to about the pressure over the bulk.
-      const auto& cb = dynamic_cast<const ContinuumBody&>(*s.scene.problem.body);
-      double volume = 0;
-      for (int el = 0; el < cb.element_count(); ++el)
-        volume = std::max(volume, std::abs(cb.element_volume_change(q, el)));
-      EXPECT_LT(volume, 2e-3);
     }
-  }
 }
 
 TEST(RubberContactStrategies, ThePaperLoopOnTheORing) {
