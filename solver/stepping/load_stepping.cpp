@@ -152,6 +152,8 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
   // block at bulk 1e4 x shear, q9 mixed: the first solve of a step 25-40 Newton iterations with
   // the correction cut to 1/256, or failed; from the converged state 3-10;
   // docs/algorithm.md#newtons-tangent-the-linearized-dilatation). The forces stay extrapolated.
+  // Where every attempt of an increment failed from there, they run again from the extrapolated
+  // state (the fallback below, the other way round), so that the fallback still tries another start.
   const bool extrapolate_q = !problem.body->traits().volume_constrained;
   LoadFactors current(cases, 0.0), before = current;
   eq->set_step(current, std::vector<double>(problem.candidates.size(), 0.0));
@@ -206,10 +208,10 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
       const double ratio =
           !start_q && last > 0 ? turn(before, current, target) * distance(target, current) / last : 0.0;
       const bool repeat = again.has_value();
-      const Vector guess = repeat                             ? again->first
-                           : start_q                          ? *start_q
-                           : from_converged || !extrapolate_q ? q
-                                                              : Vector(q + (q - q_before) * ratio);
+      const Vector guess = repeat                            ? again->first
+                           : start_q                         ? *start_q
+                           : from_converged == extrapolate_q ? q
+                                                             : Vector(q + (q - q_before) * ratio);
       // The contact forces start from the same extrapolation (the strategies bring it back
       // into the cone): a step then starts near its answer, not a whole increment away.
       const bool turned_back = path_dependent && ratio < 0;
