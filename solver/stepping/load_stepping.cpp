@@ -145,7 +145,7 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
   // elastically, not along its loading path, and starts better from the last forces (J2Contact's
   // plastic cylinder: its first release step 3 -> 2 real solves, the elastic one's stays 1).
   const bool path_dependent = problem.body->traits().plasticity;
-  // A body whose elements hold the volume (mixed, exact, F-bar) starts Newton from the last
+  // A body whose elements hold the volume (mixed, F-bar) starts Newton from the last
   // converged state: the displacements extrapolated along the last increment change the volume
   // at second order, which the bulk modulus (1e3-1e4 x shear) turns into a residual hundreds of
   // times the body's stresses, and the tangent there was not positive definite (the bulging
