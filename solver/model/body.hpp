@@ -115,8 +115,8 @@ class Body {
     bool reference_stiffness = true;
     // Its tangent takes TangentSink::stress_base (a finite-strain continuum).
     bool linearized_stress = false;
-    // Its elements hold the volume by a dilatation of their own (incompressibility mixed, exact,
-    // f_bar; finite strain): its tangent takes the dilatation linearized about
+    // Its elements hold the volume by a dilatation of their own (incompressibility mixed, f_bar;
+    // finite strain, a law without history): its tangent takes the dilatation linearized about
     // TangentSink::stress_base, and a load step's Newton starts from the last converged state,
     // not one extrapolated from it (docs/algorithm.md#newtons-tangent-the-linearized-dilatation).
     bool volume_constrained = false;

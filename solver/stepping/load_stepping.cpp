@@ -145,13 +145,15 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
   // elastically, not along its loading path, and starts better from the last forces (J2Contact's
   // plastic cylinder: its first release step 3 -> 2 real solves, the elastic one's stays 1).
   const bool path_dependent = problem.body->traits().plasticity;
-  // A body whose elements hold the volume (mixed, exact, F-bar) starts Newton from the last
+  // A body whose elements hold the volume (mixed, F-bar) starts Newton from the last
   // converged state: the displacements extrapolated along the last increment change the volume
   // at second order, which the bulk modulus (1e3-1e4 x shear) turns into a residual hundreds of
   // times the body's stresses, and the tangent there was not positive definite (the bulging
   // block at bulk 1e4 x shear, q9 mixed: the first solve of a step 25-40 Newton iterations with
   // the correction cut to 1/256, or failed; from the converged state 3-10;
   // docs/algorithm.md#newtons-tangent-the-linearized-dilatation). The forces stay extrapolated.
+  // Where every attempt of an increment failed from there, they run again from the extrapolated
+  // state (the fallback below, the other way round), so that the fallback still tries another start.
   const bool extrapolate_q = !problem.body->traits().volume_constrained;
   LoadFactors current(cases, 0.0), before = current;
   eq->set_step(current, std::vector<double>(problem.candidates.size(), 0.0));
@@ -206,10 +208,10 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
       const double ratio =
           !start_q && last > 0 ? turn(before, current, target) * distance(target, current) / last : 0.0;
       const bool repeat = again.has_value();
-      const Vector guess = repeat                             ? again->first
-                           : start_q                          ? *start_q
-                           : from_converged || !extrapolate_q ? q
-                                                              : Vector(q + (q - q_before) * ratio);
+      const Vector guess = repeat                            ? again->first
+                           : start_q                         ? *start_q
+                           : from_converged == extrapolate_q ? q
+                                                             : Vector(q + (q - q_before) * ratio);
       // The contact forces start from the same extrapolation (the strategies bring it back
       // into the cone): a step then starts near its answer, not a whole increment away.
       const bool turned_back = path_dependent && ratio < 0;
