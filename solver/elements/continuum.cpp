@@ -360,31 +360,25 @@ void ContinuumBody::element_kernel(const Vector& q, int e, ShapeGradients& u, Ve
       return m->finite_hoop_response(E, E33, history[k]).law;
     };
   else if (has_history_) law = [m, history](int k, const Mat2& E) { return m->finite_response(E, history[k]).law; };
-  // The tangent at the dilatation linearized about the stress base where traits() says
-  // volume_constrained (docs/algorithm.md#newtons-tangent-the-linearized-dilatation).
-  const bool at_linearized_dilatation = base && Ke && !has_history_ &&
-                                        (options_.incompressibility == Incompressibility::mixed ||
-                                         options_.incompressibility == Incompressibility::f_bar);
-  if (!in.dilatation.empty()) {
-    if (at_linearized_dilatation)
-      for (int a = 0; a < u.rows(); ++a) base_u.row(a) << (*base)[node_dof(el[a], 0)], (*base)[node_dof(el[a], 1)];
+  // Which tangents take the stress base: the volume-holding forms' (mixed, F-bar; laws without
+  // history, traits().volume_constrained) at the dilatation linearized about it
+  // (docs/algorithm.md#newtons-tangent-the-linearized-dilatation); the plain elements' linearized
+  // stress (MIP Newton) on a Saint Venant-Kirchhoff law (linear in E, so exact). The others take
+  // the stress at q.
+  const bool dilatation_form = !in.dilatation.empty() || options_.incompressibility == Incompressibility::f_bar;
+  const bool takes_base = base && Ke &&
+                          (dilatation_form ? !has_history_ && (options_.incompressibility == Incompressibility::mixed ||
+                                                               options_.incompressibility == Incompressibility::f_bar)
+                                           : dynamic_cast<const HookeMaterial*>(&material(e)) != nullptr);
+  if (takes_base)
+    for (int a = 0; a < u.rows(); ++a) base_u.row(a) << (*base)[node_dof(el[a], 0)], (*base)[node_dof(el[a], 1)];
+  const ShapeGradients* base_gradients = takes_base ? &base_u : nullptr;
+  if (!in.dilatation.empty())
     dilatation_total_lagrangian(in.points[e], in.dilatation[e], u, material(e), fe, Ke, law, hoop_law,
-                                pressure_.empty() ? nullptr : &pressure_[e],
-                                at_linearized_dilatation ? &base_u : nullptr);
-  } else if (options_.incompressibility == Incompressibility::f_bar) {
-    if (at_linearized_dilatation)
-      for (int a = 0; a < u.rows(); ++a) base_u.row(a) << (*base)[node_dof(el[a], 0)], (*base)[node_dof(el[a], 1)];
-    f_bar_total_lagrangian(in.points[e], in.centroids[e], u, material(e), fe, Ke, law,
-                           at_linearized_dilatation ? &base_u : nullptr);
-  } else {
-    // The linearized stress (MIP Newton) on the plain elements of a Saint Venant-Kirchhoff law
-    // (linear in E, so exact): F-bar's, the mixed forms' and the other laws' tangents take the
-    // stress at q (linearized_stress below).
-    const bool linearized = base && Ke && dynamic_cast<const HookeMaterial*>(&material(e));
-    if (linearized)
-      for (int a = 0; a < u.rows(); ++a) base_u.row(a) << (*base)[node_dof(el[a], 0)], (*base)[node_dof(el[a], 1)];
-    total_lagrangian(in.points[e], u, material(e), fe, Ke, law, hoop_law, linearized ? &base_u : nullptr);
-  }
+                                pressure_.empty() ? nullptr : &pressure_[e], base_gradients);
+  else if (options_.incompressibility == Incompressibility::f_bar)
+    f_bar_total_lagrangian(in.points[e], in.centroids[e], u, material(e), fe, Ke, law, base_gradients);
+  else total_lagrangian(in.points[e], u, material(e), fe, Ke, law, hoop_law, base_gradients);
 }
 
 void ContinuumBody::add_element(int e, const Vector& fe, const Matrix& Ke, Vector& force, TangentSink* tangent) const {
