@@ -33,6 +33,9 @@ class Equilibrium {
   void set_step(LoadFactors factors, std::vector<double> zeta_previous);
   const LoadFactors& factors() const { return factors_; }
 
+  // A real solve: Newton under the given contact forces p. Where the body holds a constraint by
+  // multipliers (exact incompressibility), it moves them once at the answer and Newton goes on
+  // (move_multipliers): the contact loop's iterations are also the multipliers' Uzawa iterations.
   EquilibriumState solve(const Vector& q_guess, const Vector& p);
   // Newton continued from a converged state at the current tests (tightened since): the same
   // real solve finished more precisely, not counted as another.
@@ -189,6 +192,9 @@ class Equilibrium {
   // Newton is a modified Newton on it and the compliance reuses it. With `turning` (a changing
   // tangent of a body stiff in its reference state), plus the symmetrized stiffness of that
   // state's contact forces turning with curved obstacles, where it stays positive definite.
+  // Up to `updates` moves of the body's multipliers (Body::update_multipliers) at a converged
+  // state, Newton continued after each; none where the constraint already holds.
+  void move_multipliers(EquilibriumState& state, const Vector& p, int updates);
   bool factorize_body_tangent(const Vector& q, const EquilibriumState* turning = nullptr);
   // Adds scale x the symmetrized turning stiffness -J^T sym(df/dx) J of every candidate of
   // `state` (emitted even where zero: the pattern stays); true if some term is not zero.

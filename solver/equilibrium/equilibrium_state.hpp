@@ -42,6 +42,8 @@ struct EquilibriumCounters {
   long newton_iterations = 0;
   // Solves (and continued ones) that chord corrections ended, without a factorization of their own.
   long chord_solves = 0;
+  // Moves of the body's multipliers inside real solves (exact incompressibility).
+  long multiplier_updates = 0;
   // newton_ and body_factorizations together (docs/algorithm.md#where-factorizations-come-from)
   long factorizations = 0;
   long newton_factorizations = 0;     // Newton's tangent, and the penalty law's last correction
@@ -65,6 +67,7 @@ struct EquilibriumCounters {
     solves += o.solves;
     newton_iterations += o.newton_iterations;
     chord_solves += o.chord_solves;
+    multiplier_updates += o.multiplier_updates;
     factorizations += o.factorizations;
     newton_factorizations += o.newton_factorizations;
     body_factorizations += o.body_factorizations;

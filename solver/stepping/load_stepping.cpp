@@ -256,9 +256,11 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
         ++rec.cuts;
         continue;
       }
+      const long moved = eq->counters().multiplier_updates;
       StepOutcome out = solve_contact_step(*eq, guess, p_guess, p, by_ssn ? ssn_params : params.contact, step,
                                            observer.iteration, observer.stop_requested, v_first);
       count_attempt(rec, out);
+      rec.multiplier_updates += static_cast<int>(eq->counters().multiplier_updates - moved);
       bool refused = false;  // converged, but the step checks refused the state
       if (out.converged) {
         std::vector<OutsidePoint> outside;

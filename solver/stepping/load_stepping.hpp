@@ -39,7 +39,7 @@ struct StepRecord {
   StepChecks checks;                        // the step checks' worst values (step_checks.hpp)
   int cuts = 0;                             // sub-increments this step needed beyond one
   int restarts = 0;                         // attempts from the extrapolated force retried from the last one
-  int multiplier_updates = 0;               // solves again after the body's multipliers moved (exact incompressibility)
+  int multiplier_updates = 0;               // moves of the body's multipliers (exact incompressibility)
   int passes = 0, solves = 0, newton_iterations = 0, inner_iterations = 0;
   double seconds = 0.0;
   std::string epsilon_used;
