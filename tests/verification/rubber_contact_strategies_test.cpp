@@ -19,16 +19,16 @@
 //   25 % in 10 steps, frictionless): q9 mixed on 8 arc divisions, q4 F-bar on 16 (the same
 //   nodes); the paper loop, ssn and penalty (0.92-0.96 x). Not uzawa: it takes 2.5 x (q9 mixed:
 //   4939 against 1952 real solves, 17 s) and 2.3 x (q4 F-bar: 3434 against 1520) the
-//   compressible ring's real solves, and no choice of its step fixes that: the rubber, bulging
-//   more, presses the groove's wall from step 4 (the compressible ring from step 7) and with two
-//   points from step 7 (the compressible ring ends its steps with one). A wall point's compliance
-//   is 30-40 x a flat point's (the whole section moves radially, against the hoop stiffness
-//   only), and the two wall points share that motion: their difference is as stiff as a flat
-//   point. A step scaled by each point's own compliance (the diagonal, normalized to stay
-//   stable) took the compressible ring's count from 1952 to 326, but the rubber's only to 4447
-//   (13.6 x): the two wall points' difference mode has 1/73 of the largest eigenvalue of the
-//   scaled block, which no diagonal scaling separates (docs/algorithm.md#uzawa). Measured, not
-//   asserted.
+//   compressible ring's real solves, which is the contact, not the step: the rubber bulges more
+//   and presses the groove's outer wall from step 4 (q9) or 5 (q4), with two points from step 7
+//   or 8, where the compressible ring touches it from step 7 with one point. A wall point's
+//   compliance is 25-40 x a flat point's (the section moves out radially against the hoop
+//   stiffness only), and the two wall points share that motion: their difference is as stiff as
+//   a flat point, 1/73 of the largest eigenvalue of the block even scaled by its diagonal. A step
+//   scaled by each point's own compliance (1/C_jj, over the scaled block's infinity norm, trials
+//   accepted on the error weighted by 1/C_jj: the plain ||v|| rose at every length) took the
+//   compressible ring from 1952 to 326 real solves, the rubber only to 4447 (13.6 x); not kept
+//   (docs/algorithm.md#uzawa). Measured, not asserted.
 #include <gtest/gtest.h>
 
 #include <cstdio>
