@@ -22,7 +22,7 @@
 //   compressible ring's real solves, which is the contact, not the step: the rubber bulges more
 //   and presses the groove's outer wall from step 4 (q9) or 5 (q4), with two points from step 7
 //   or 8, where the compressible ring touches it from step 7 with one point. A wall point's
-//   compliance is 25-40 x a flat point's (the section moves out radially against the hoop
+//   compliance is 20-50 x a flat point's (the section moves out radially against the hoop
 //   stiffness only), and the two wall points share that motion: their difference is as stiff as
 //   a flat point, 1/73 of the largest eigenvalue of the block even scaled by its diagonal. A step
 //   scaled by each point's own compliance (1/C_jj, over the scaled block's infinity norm, trials
