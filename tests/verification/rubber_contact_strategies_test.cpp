@@ -1,24 +1,35 @@
-// Contact with uzawa and cev's paper loop on nearly incompressible rubber (issue 37, point 3:
-// every strategy on these bodies, the real solves within 1.5 x of the elastic case on the same
-// scene), in the two formulations against locking: q9 with the mixed u-p form and q4 with F-bar
+// Contact with every strategy on nearly incompressible rubber (issue 37, point 3: the real
+// solves within 1.5 x of the elastic case on the same scene), in the two formulations against
+// locking: q9 with the mixed u-p form and q4 with F-bar
 // (docs/algorithm.md#element-formulation-pairs). Each strategy's answer against cev's default on
 // the same body, and its real solves on the rubber against its own on the same scene with a
 // compressible elastic body (neo-Hookean, the rubber's shear modulus 1, nu = 0.3) in the same
 // element and formulation:
 // - the bulging block of exact_incompressible_test.cpp (a 2 x 2 block, its quarter, compressed
 //   10 % in 4 steps by a frictionless rigid plate, the top's x held), Mooney-Rivlin with bulk
-//   1e3 and 1e4 x shear: q9 mixed on 4 x 4, q4 F-bar on 8 x 8. At 1e4 x shear, measured
-//   2026-11-30: cev default 17 against 13 (q9 mixed) and 18 against 14 (q4 F-bar) real solves,
-//   the paper loop 20 against 16 on both, uzawa 249 against 262 and 186 against 171. Before the
-//   tangent took the linearized dilatation and a step's Newton started from the converged state
+//   1e3 and 1e4 x shear: q9 mixed on 4 x 4, q4 F-bar on 8 x 8, every strategy. At 1e4 x shear,
+//   measured 2026-11-30: cev default 17 against 13 (q9 mixed) and 18 against 14 (q4 F-bar) real
+//   solves, the paper loop 20 against 16 on both, uzawa 249 against 262 and 186 against 171, ssn
+//   15 against 16 on both, penalty 4 against 4. Before the tangent took the linearized dilatation
+//   and a step's Newton started from the converged state
 //   (docs/algorithm.md#newtons-tangent-the-linearized-dilatation) they were 5.4 x and 8.9 x
 //   (cev default, failed attempts and cuts in the first and last steps), 2.5 x and 2.9 x (paper),
 //   1.7 x and 1.5 x (uzawa);
 // - the O-ring of schemas/examples/seal-o-ring.json (axisymmetric, bulk 2000 x shear, squeezed
 //   25 % in 10 steps, frictionless): q9 mixed on 8 arc divisions, q4 F-bar on 16 (the same
-//   nodes); cev's paper loop only: uzawa takes 2.3-2.5 x the compressible ring's real solves there
-//   (4939 against 1952 on q9 mixed, 17 s; 3434 against 1520 on q4 F-bar; before the change above
-//   5663 and 4004), its fixed step slowed as the contact widens; measured, not asserted.
+//   nodes); the paper loop, ssn and penalty (0.92-0.96 x). Not uzawa: it takes 2.5 x (q9 mixed:
+//   4939 against 1952 real solves, 17 s) and 2.3 x (q4 F-bar: 3434 against 1520) the
+//   compressible ring's real solves, which is the contact, not the step: the rubber bulges more
+//   and presses the groove's outer wall from step 4 (q9) or 5 (q4), with two points from step 7
+//   or 8, where the compressible ring touches it from step 7 with one point. A wall point's
+//   compliance is 20-50 x a flat point's (the section moves out radially against the hoop
+//   stiffness only), and the two wall points share that motion: their difference is as stiff as
+//   a flat point, 1/73 of the largest eigenvalue of the block even scaled by its diagonal. A step
+//   scaled by each point's own compliance (1/C_jj, over the scaled block's infinity norm, trials
+//   accepted on the error weighted by 1/C_jj: no trial length lowered the plain ||v||) took the
+//   compressible ring from 1952 to 326 real solves, the rubber only to 4447 (13.6 x); not kept
+//   (docs/algorithm.md#uzawa). Measured, not asserted: tests/hard/o_ring_uzawa_slow_test.cpp
+//   (32 s) asserts its answer and the wall's points.
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -50,11 +61,16 @@ struct Strategy {
 
 // cev default and paper to 1e-9, the paper loop's answer within 1e-8 of cev default's
 // (measured 3e-10); uzawa (linear convergence) to 1e-5, its answer within 2e-5 of it (measured
-// 2e-6 in the force, 7e-6 in the displacements).
+// 2e-6 in the force, 7e-6 in the displacements); ssn to 1e-9, within 1e-8 (measured 1.5e-10);
+// penalty as in j2_contact_test.cpp (its error about |p| / k, the tolerance following the law's
+// stiffness: 1e-4 with k = 1e4 x the largest diagonal stiffness), within 1e-6 (measured 7e-8: k
+// follows the bulk modulus in the rubber's stiffness, far stiffer than its contact compliance).
 std::vector<Strategy> strategies() {
   return {{"cev", {{"method", "cev"}, {"tolerance", 1e-9}}, 0.0},
           {"cev loop paper", {{"method", "cev"}, {"loop", "paper"}, {"tolerance", 1e-9}}, 1e-8},
-          {"uzawa", {{"method", "uzawa"}, {"tolerance", 1e-5}, {"max_iterations", 20000}}, 2e-5}};
+          {"uzawa", {{"method", "uzawa"}, {"tolerance", 1e-5}, {"max_iterations", 20000}}, 2e-5},
+          {"ssn", {{"method", "ssn"}, {"tolerance", 1e-9}}, 1e-8},
+          {"penalty", {{"method", "penalty"}, {"tolerance", 1e-4}, {"penalty", {{"factor", 1e4}}}}, 1e-6}};
 }
 
 int real_solves(const Solved& s) {
@@ -73,7 +89,7 @@ void expect_sound(const Solved& s) {
   }
 }
 
-TEST(RubberContactStrategies, UzawaAndThePaperLoopOnTheBulgingBlock) {
+TEST(RubberContactStrategies, EveryStrategyOnTheBulgingBlock) {
   struct Pair {
     const char* element;
     const char* incompressibility;
@@ -122,12 +138,22 @@ TEST(RubberContactStrategies, UzawaAndThePaperLoopOnTheBulgingBlock) {
     }
 }
 
-TEST(RubberContactStrategies, ThePaperLoopOnTheORing) {
+TEST(RubberContactStrategies, ThePaperLoopSsnAndPenaltyOnTheORing) {
   struct Pair {
     const char* element;
     const char* incompressibility;
     int ns;
   };
+  struct RingStrategy {
+    std::string name;
+    json contact;
+    double agree;  // the sealing force of every step and the width against cev default's, relative
+  };
+  // Measured: the paper loop 7e-9, ssn 6e-9, penalty 4e-8 (the sealing force of the worst step).
+  const std::vector<RingStrategy> ring_strategies = {
+      {"cev loop paper", {{"method", "cev"}, {"loop", "paper"}, {"tolerance", 1e-8}}, 1e-6},
+      {"ssn", {{"method", "ssn"}, {"tolerance", 1e-8}}, 1e-7},
+      {"penalty", {{"method", "penalty"}, {"tolerance", 1e-4}, {"penalty", {{"factor", 1e4}}}}, 1e-6}};
   for (const Pair& pair : {Pair{"q9", "mixed", 8}, Pair{"q4", "f_bar", 16}}) {
     const std::string body = std::string(pair.element) + " " + pair.incompressibility;
     SCOPED_TRACE(body);
@@ -141,29 +167,39 @@ TEST(RubberContactStrategies, ThePaperLoopOnTheORing) {
       return solve_scene(j);
     };
     const json cev = {{"method", "cev"}, {"tolerance", 1e-8}};
-    const json paper = {{"method", "cev"}, {"loop", "paper"}, {"tolerance", 1e-8}};
-    const Solved by_cev = ring(cev, true), by_paper = ring(paper, true);
-    const Solved elastic_cev = ring(cev, false), elastic_paper = ring(paper, false);
-    for (const Solved* s : {&by_cev, &by_paper, &elastic_cev, &elastic_paper}) expect_every_step_sound(*s);
-    if (!by_cev.run.completed || !by_paper.run.completed || !elastic_cev.run.completed || !elastic_paper.run.completed)
-      continue;
-    const SealReading a = read_seal(by_cev), b = read_seal(by_paper);
-    double worst = 0;
-    for (size_t k = 0; k < by_cev.run.steps.size(); ++k) {
-      const double fa = -contact_resultant(by_cev.scene.problem, by_cev.run.steps[k], 0).y();
-      const double fb = -contact_resultant(by_paper.scene.problem, by_paper.run.steps[k], 0).y();
-      worst = std::max(worst, std::abs(fb / fa - 1));
+    const Solved by_cev = ring(cev, true), elastic_cev = ring(cev, false);
+    expect_every_step_sound(by_cev);
+    expect_every_step_sound(elastic_cev);
+    if (!by_cev.run.completed || !elastic_cev.run.completed) continue;
+    const SealReading a = read_seal(by_cev);
+    std::printf("O-ring %s: cev default sealing force %.6f, real solves rubber %d, compressible %d: %.2f x\n",
+                body.c_str(), a.force, real_solves(by_cev), real_solves(elastic_cev),
+                double(real_solves(by_cev)) / real_solves(elastic_cev));
+    for (const RingStrategy& st : ring_strategies) {
+      SCOPED_TRACE(st.name);
+      const Solved s = ring(st.contact, true), e = ring(st.contact, false);
+      for (const Solved* r : {&s, &e}) {
+        // ssn's iterates are not monotone in ||v|| (docs/algorithm.md#ssn): its steps sound and balanced.
+        if (st.name == "ssn") expect_sound(*r);
+        else expect_every_step_sound(*r);
+      }
+      if (!s.run.completed || !e.run.completed) continue;
+      const SealReading b = read_seal(s);
+      double worst = 0;
+      for (size_t k = 0; k < by_cev.run.steps.size(); ++k) {
+        const double fa = -contact_resultant(by_cev.scene.problem, by_cev.run.steps[k], 0).y();
+        const double fb = -contact_resultant(s.scene.problem, s.run.steps.at(k), 0).y();
+        worst = std::max(worst, std::abs(fb / fa - 1));
+      }
+      const double ratio = double(real_solves(s)) / real_solves(e);
+      std::printf(
+          "O-ring %s, %s: sealing force %.6f (worst step %.1e against cev default), width %+.1e; real solves rubber "
+          "%d, compressible %d: %.2f x\n",
+          body.c_str(), st.name.c_str(), b.force, worst, b.width / a.width - 1, real_solves(s), real_solves(e), ratio);
+      EXPECT_LT(worst, st.agree);
+      EXPECT_NEAR(b.width / a.width, 1.0, st.agree);
+      EXPECT_LE(ratio, 1.5);
     }
-    const double paper_ratio = double(real_solves(by_paper)) / real_solves(elastic_paper);
-    const double cev_ratio = double(real_solves(by_cev)) / real_solves(elastic_cev);
-    std::printf(
-        "O-ring %s: sealing force cev %.6f, paper %.6f (worst step %.1e), width %+.1e; real solves paper rubber %d, "
-        "compressible %d: %.2f x (cev default %d against %d: %.2f x)\n",
-        body.c_str(), a.force, b.force, worst, b.width / a.width - 1, real_solves(by_paper), real_solves(elastic_paper),
-        paper_ratio, real_solves(by_cev), real_solves(elastic_cev), cev_ratio);
-    EXPECT_LT(worst, 1e-6);
-    EXPECT_NEAR(b.width / a.width, 1.0, 1e-6);
-    EXPECT_LE(paper_ratio, 1.5);
   }
 }
 
