@@ -2,7 +2,7 @@
 // square-edged rigid punch, a frictionless `profile` obstacle, driven down 0.1 b in 10 steps into
 // the elastic-perfectly plastic block of tests/verification/prandtl_punch_test.cpp, on its mesh
 // with elements of b/5 near the edge (24 x 18), by cev (default and `loop: paper`), ssn and
-// penalty (uzawa: tests/hard/prandtl_punch_contact_slow_test.cpp, 12,000 real solves). Checked:
+// penalty (uzawa: tests/hard/prandtl_punch_contact_slow_test.cpp, 12,218 real solves). Checked:
 // - every step's invariants (no tension, no penetration, balance; frictionless: no tangential
 //   resultant), and the pressing nodes: exactly the five with x <= 0.8 b at every step, the edge
 //   node at x = b sliding out past the punch's corner (the outward flow under a smooth punch);
