@@ -44,6 +44,16 @@ class SsnStep : public StepSolver {
   // Starts from the previous step's force (p_previous): from the extrapolated one, small
   // augmentations led it to other equilibria of the beam's steps.
   void solve(const Vector& q_guess, const Vector&, const Vector& p_previous) override {
+    // The body's multipliers (exact incompressibility) stay as they are through the attempt: its
+    // own Newton iterations hold them, and a real solve that moved them changed the equations
+    // under those iterations (the exactly incompressible sharp block with friction,
+    // tests/hard/bulging_block_strategies_test.cpp, failed at step 13 of 19). Load stepping
+    // updates them after the contact solve.
+    struct HeldMultipliers {
+      Equilibrium& eq;
+      explicit HeldMultipliers(Equilibrium& e) : eq(e) { eq.set_multiplier_moves(false); }
+      ~HeldMultipliers() { eq.set_multiplier_moves(true); }
+    } held_multipliers(eq_);
     coulomb_ = true;
     pass_ = out_.passes = 1;
     out_.p = p_previous;

@@ -37,6 +37,9 @@ class Equilibrium {
   // multipliers (exact incompressibility), it moves them once at the answer and Newton goes on
   // (move_multipliers): the contact loop's iterations are also the multipliers' Uzawa iterations.
   EquilibriumState solve(const Vector& q_guess, const Vector& p);
+  // Off: real solves leave the multipliers as they are (ssn, whose own Newton iterations hold
+  // them; load stepping then updates them after the contact solve).
+  void set_multiplier_moves(bool on) { multiplier_moves_ = on; }
   // Newton continued from a converged state at the current tests (tightened since): the same
   // real solve finished more precisely, not counted as another.
   void continue_solve(EquilibriumState& state, const Vector& p);
@@ -202,8 +205,9 @@ class Equilibrium {
   // Adds scale x the symmetrized turning stiffness -J^T sym(df/dx) J of every candidate of
   // `state` (emitted even where zero: the pattern stays); true if some term is not zero.
   bool add_turning_stiffness(const EquilibriumState& state, TangentSink& sink, double scale) const;
-  bool turning_ = false;  // the compliance may carry the turning stiffness (factorize_body_tangent)
-  bool g_turns_ = false;  // G does (its state's: real solve g_solve_ at g_turns_q_)
+  bool multiplier_moves_ = true;  // solve() moves the body's multipliers (move_multipliers)
+  bool turning_ = false;          // the compliance may carry the turning stiffness (factorize_body_tangent)
+  bool g_turns_ = false;          // G does (its state's: real solve g_solve_ at g_turns_q_)
   Vector g_turns_q_;
   bool constant_tangent_ = false;
   bool has_pairs_ = false;  // a contact pair of two bodies (a deformable master)

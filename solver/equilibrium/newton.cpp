@@ -169,6 +169,7 @@ void Equilibrium::continue_solve(EquilibriumState& state, const Vector& p) {
 }
 
 void Equilibrium::move_multipliers(EquilibriumState& state, const Vector& p, int updates) {
+  if (!multiplier_moves_) return;
   for (int k = 0; k < updates && state.converged && !problem_.body->update_multipliers(state.q).empty(); ++k) {
     ++counters_.multiplier_updates;
     const int before = state.newton_iterations;
