@@ -62,12 +62,7 @@ TEST(RubberUzawaORingSlow, TheAnswerOfCevAndTheRatioMeasured) {
     if (!by_cev.run.completed || !elastic_cev.run.completed || !by_uzawa.run.completed || !elastic_uzawa.run.completed)
       continue;
     const SealReading a = read_seal(by_cev), b = read_seal(by_uzawa);
-    double worst = 0;
-    for (size_t k = 0; k < by_cev.run.steps.size(); ++k) {
-      const double fa = -contact_resultant(by_cev.scene.problem, by_cev.run.steps[k], 0).y();
-      const double fb = -contact_resultant(by_uzawa.scene.problem, by_uzawa.run.steps.at(k), 0).y();
-      worst = std::max(worst, std::abs(fb / fa - 1));
-    }
+    const double worst = worst_step_seal_difference(by_cev, by_uzawa);
     const double ratio = double(real_solves(by_uzawa)) / real_solves(elastic_uzawa);
     std::printf(
         "O-ring %s, uzawa: sealing force %.6f (worst step %.1e against cev default), width %+.1e; outer wall's points "

@@ -10,6 +10,7 @@
 // of the nodes that press) is printed beside it.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
@@ -62,6 +63,17 @@ inline SealReading read_seal(const Solved& s) {
       s.scene.effective["body"]["mesh"]["half_disc"]["divisions"][0].get<size_t>(), r.force, r.width, r.extent, r.walls,
       s.run.counters.solves);
   return r;
+}
+
+// The largest relative difference of the flat's force over the steps of two runs of a ring.
+inline double worst_step_seal_difference(const Solved& reference, const Solved& s) {
+  double worst = 0;
+  for (size_t k = 0; k < reference.run.steps.size(); ++k) {
+    const double fa = -contact_resultant(reference.scene.problem, reference.run.steps[k], 0).y();
+    const double fb = -contact_resultant(s.scene.problem, s.run.steps.at(k), 0).y();
+    worst = std::max(worst, std::abs(fb / fa - 1));
+  }
+  return worst;
 }
 
 // Every step converged and sound; the diameter's reactions carry the flat's force (the walls

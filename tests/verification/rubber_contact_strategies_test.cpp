@@ -185,12 +185,7 @@ TEST(RubberContactStrategies, ThePaperLoopSsnAndPenaltyOnTheORing) {
       }
       if (!s.run.completed || !e.run.completed) continue;
       const SealReading b = read_seal(s);
-      double worst = 0;
-      for (size_t k = 0; k < by_cev.run.steps.size(); ++k) {
-        const double fa = -contact_resultant(by_cev.scene.problem, by_cev.run.steps[k], 0).y();
-        const double fb = -contact_resultant(s.scene.problem, s.run.steps.at(k), 0).y();
-        worst = std::max(worst, std::abs(fb / fa - 1));
-      }
+      const double worst = worst_step_seal_difference(by_cev, s);
       const double ratio = double(real_solves(s)) / real_solves(e);
       std::printf(
           "O-ring %s, %s: sealing force %.6f (worst step %.1e against cev default), width %+.1e; real solves rubber "
