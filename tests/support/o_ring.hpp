@@ -27,12 +27,16 @@ struct SealReading {
 };
 
 // `element` and `incompressibility` other than the shipped q9 without one: the same ring in
-// another element-formulation pair.
-inline Solved solve_o_ring(int ns, const std::string& element = "q9", const std::string& incompressibility = "none") {
+// another element-formulation pair; `contact` (solver.contact) and `material` in place of the
+// shipped ones where given.
+inline Solved solve_o_ring(int ns, const std::string& element = "q9", const std::string& incompressibility = "none",
+                           const nlohmann::json& contact = nullptr, const nlohmann::json& material = nullptr) {
   nlohmann::json j = example_scene("seal-o-ring");
   j["body"]["mesh"]["half_disc"]["divisions"] = {ns, ns / 2};
   j["body"]["element"] = element;
   j["body"]["incompressibility"] = incompressibility;
+  if (!contact.is_null()) j["solver"]["contact"] = contact;
+  if (!material.is_null()) j["body"]["material"] = material;
   return solve_scene(j);
 }
 
