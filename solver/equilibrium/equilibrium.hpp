@@ -40,6 +40,7 @@ class Equilibrium {
   // Off: real solves leave the multipliers as they are (ssn, whose own Newton iterations hold
   // them; load stepping then updates them after the contact solve).
   void set_multiplier_moves(bool on) { multiplier_moves_ = on; }
+  bool multiplier_moves() const { return multiplier_moves_ && !moves_failed_; }
   // Newton continued from a converged state at the current tests (tightened since): the same
   // real solve finished more precisely, not counted as another.
   void continue_solve(EquilibriumState& state, const Vector& p);
@@ -206,6 +207,7 @@ class Equilibrium {
   // `state` (emitted even where zero: the pattern stays); true if some term is not zero.
   bool add_turning_stiffness(const EquilibriumState& state, TangentSink& sink, double scale) const;
   bool multiplier_moves_ = true;  // solve() moves the body's multipliers (move_multipliers)
+  bool moves_failed_ = false;     // a Newton solve after a move failed: no more moves (move_multipliers)
   bool turning_ = false;          // the compliance may carry the turning stiffness (factorize_body_tangent)
   bool g_turns_ = false;          // G does (its state's: real solve g_solve_ at g_turns_q_)
   Vector g_turns_q_;
