@@ -133,6 +133,12 @@ Vector Equilibrium::residual(const Vector& q, const Vector& p, Triplets* tangent
   return residual(q, evaluate(q), p, &sink);
 }
 
+double Equilibrium::relative_residual(const Vector& q, const Vector& p) const {
+  double force_scale = 0.0;
+  const Vector r = residual(q, evaluate(q), p, nullptr, &force_scale);
+  return force_scale > 0 ? scaled_free_max(r) / force_scale : 0.0;
+}
+
 Vector Equilibrium::applied_forces(const EquilibriumState& paired, const Vector& p) const {
   Vector f = problem_.load(factors_);
   problem_.body->follower_load(paired.q, factors_, f, nullptr);

@@ -80,6 +80,9 @@ class Equilibrium {
   // R = A(q) - lambda F - T(q) p on every dof, and (if asked) the triplets of dR/dq, with
   // the pairing evaluated at q.
   Vector residual(const Vector& q, const Vector& p, Triplets* tangent) const;
+  // Newton's relative residual at (q, p): the largest free residual over the force scale (the
+  // measure of its residual test, NewtonParams::residual_tolerance).
+  double relative_residual(const Vector& q, const Vector& p) const;
   // The applied loads and the contact forces p on every dof at a paired state: F + T p.
   Vector applied_forces(const EquilibriumState& paired, const Vector& p) const;
   // Residual forces at the fixed dofs (the reactions on the body), full dof vector.

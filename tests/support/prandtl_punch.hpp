@@ -15,6 +15,8 @@
 #include <numbers>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "solver/elements/continuum.hpp"
 #include "solver/materials/j2_plasticity.hpp"
 #include "tests/support/newton_driver.hpp"
@@ -33,10 +35,9 @@ struct PunchCurve {
   std::vector<double> alpha;
 };
 
-// The half model with elements of size h within 2.5 b of the punch's edge (growing beyond, nx x
-// ny in all), pressed to `depth` through the penetrations `fractions` of it.
-inline PunchCurve press_punch(double h, int nx, int ny, double depth, const std::vector<double>& fractions,
-                              bool rough) {
+// The block's mesh: elements of size h within 2.5 b of the punch's edge (growing beyond, nx x ny
+// in all).
+inline PlaneMesh punch_block_mesh(double h, int nx, int ny) {
   RectangleSpec spec;
   spec.origin = {0, -10};
   spec.size = {10, 10};
@@ -44,10 +45,17 @@ inline PunchCurve press_punch(double h, int nx, int ny, double depth, const std:
   spec.ny = ny;
   spec.refine = Refinement{h, 2.5};
   spec.towards = {1, 0};
-  PlaneMesh mesh = rectangle_mesh(spec, ElementShape::q4);
+  return rectangle_mesh(spec, ElementShape::q4);
+}
+
+// The half model on punch_block_mesh(h, nx, ny), pressed to `depth` through the penetrations
+// `fractions` of it; the punch the top's nodes with x <= half_width (b unless said).
+inline PunchCurve press_punch(double h, int nx, int ny, double depth, const std::vector<double>& fractions, bool rough,
+                              double half_width = 1.0) {
+  PlaneMesh mesh = punch_block_mesh(h, nx, ny);
   std::vector<int> punch;
   for (int n : mesh.sets.at("top"))
-    if (mesh.nodes[n].x() <= 1 + 1e-9) punch.push_back(n);
+    if (mesh.nodes[n].x() <= half_width + 1e-9) punch.push_back(n);
   auto law = std::make_shared<J2Material>(1000.0, 0.3, 1.0, IsotropicHardening{}, 0.0, PlaneAnalysis::plane_strain);
   ContinuumBody body(mesh, mesh.sets.at("top"), {law},
                      {ContinuumElement::q4_bbar, ContinuumKinematics::linear, PlaneAnalysis::plane_strain, 1.0});
@@ -135,6 +143,44 @@ inline std::vector<double> punch_path() {
   for (int k = 1; k <= 10; ++k) t.push_back(0.02 * k);
   for (int k = 5; k <= 10; ++k) t.push_back(0.1 * k);
   return t;
+}
+
+// The same block as a scene (the mesh written out, so that it is press_punch's node for node),
+// pressed by the punch as a contact obstacle: a frictionless `profile` with a square edge (the
+// flat from x = -2 b to b, its side x = b up to 5 b) moved down `depth` in `steps` equal steps,
+// the top's nodes with x <= 2.5 b its contact set. The elastic-perfectly plastic law, or
+// (plastic false) the linear elastic one with the same E and nu. `contact`: solver.contact.
+inline nlohmann::json punch_obstacle_scene(double h, int nx, int ny, double depth, int steps, bool plastic,
+                                           const nlohmann::json& contact) {
+  const PlaneMesh mesh = punch_block_mesh(h, nx, ny);
+  nlohmann::json nodes = nlohmann::json::array(), sets = nlohmann::json::object();
+  for (const Vec2& x : mesh.nodes) nodes.push_back({x.x(), x.y()});
+  for (const auto& [name, ids] : mesh.sets) sets[name] = ids;
+  std::vector<int> near;
+  for (int n : mesh.sets.at("top"))
+    if (mesh.nodes[n].x() <= 2.5 + 1e-9) near.push_back(n);
+  sets["near"] = near;
+  nlohmann::json material = {{"young", 1000}, {"poisson", 0.3}};
+  if (plastic) material.update({{"law", "j2_plasticity"}, {"yield_stress", 1}});
+  const nlohmann::json punch = {{"type", "profile"},
+                                {"pieces",
+                                 {{{"type", "segment"}, {"from", {-2, 0}}, {"to", {1, 0}}},
+                                  {{"type", "segment"}, {"from", {1, 0}}, {"to", {1, 5}}}}}};
+  return {{"body",
+           {{"model", "continuum"},
+            {"kinematics", "linear"},
+            {"analysis", "plane_strain"},
+            {"element", "q4_bbar"},
+            {"material", material},
+            {"mesh", {{"nodes", nodes}, {"elements", mesh.elements}, {"sets", sets}}},
+            {"contact_set", "near"},
+            {"supports",
+             {{{"set", "left"}, {"fix", {"x"}}},
+              {{"set", "right"}, {"fix", {"x"}}},
+              {{"set", "bottom"}, {"fix", {"x", "y"}}}}}}},
+          {"obstacles", {{{"name", "punch"}, {"shape", punch}, {"motion", {{"translation", {0, -depth}}}}}}},
+          {"steps", steps},
+          {"solver", {{"contact", contact}}}};
 }
 
 }  // namespace grip::testing
