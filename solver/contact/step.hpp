@@ -93,6 +93,9 @@ class StepSolver {
   // The carried forces p meet the cone where the law held them: no tension, a sticking force
   // within mu |p_eta| (to 1e-9).
   bool held_admissible(const HeldContact& law, const Vector& p) const;
+  // Moves a held trial's base forces to what its springs carry (base: the trial's given forces)
+  // and continues its Newton, until the springs hold the model's kinematics (step.cpp).
+  void move_held(EquilibriumState& trial, Vector& base, const Vector& target, const Vector& stiffness);
   // Lets go the points whose carried forces left the cone where `plan` held them: one pulled
   // across its obstacle carries the given force zero (its components appended to `let_go`), one
   // stuck beyond mu |p_eta| slips the way its force pointed.

@@ -44,6 +44,9 @@ class Equilibrium {
   // Newton continued from a converged state at the current tests (tightened since): the same
   // real solve finished more precisely, not counted as another.
   void continue_solve(EquilibriumState& state, const Vector& p);
+  // continue_solve after a move of the held law's base forces: chords from the held trial's
+  // last factorization first.
+  void continue_held(EquilibriumState& state, const Vector& p);
   // With a penalty law set, solve() ignores its p and finds p(q) from the law.
   // A body held by contact then has its pins free (PenaltyLaw::pin_spring).
   void set_penalty(std::optional<PenaltyLaw> law);
@@ -227,7 +230,9 @@ class Equilibrium {
   long newton_factor_solve_ = -1;
   Vector newton_factor_q_;
   long chord_factorization_ = -1;
-  bool new_load_ = false;  // set_step since the last Newton solve: no chords (newton.cpp)
+  long held_factorization_ = -1;  // Newton's last factorization with the held springs
+  bool held_chords_ = false;      // continue_held: chords may begin its Newton
+  bool new_load_ = false;         // set_step since the last Newton solve: no chords (newton.cpp)
   // The last state a Newton solve converged at: the stress base of the next solve's first
   // tangent (newton.cpp, the linearized stress).
   Vector converged_q_;

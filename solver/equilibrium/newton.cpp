@@ -168,6 +168,12 @@ void Equilibrium::continue_solve(EquilibriumState& state, const Vector& p) {
   move_multipliers(state, p, 1);
 }
 
+void Equilibrium::continue_held(EquilibriumState& state, const Vector& p) {
+  held_chords_ = true;
+  continue_solve(state, p);
+  held_chords_ = false;
+}
+
 void Equilibrium::move_multipliers(EquilibriumState& state, const Vector& p, int updates) {
   if (!multiplier_moves()) return;
   for (int k = 0; k < updates && state.converged && !problem_.body->update_multipliers(state.q).empty(); ++k) {
@@ -304,7 +310,7 @@ EquilibriumState Equilibrium::newton(const Vector& q_guess, const Vector& p) {
     if (it > params_.max_iterations) break;
     if (chord && chord_converges(state, r, p)) {
       converged_q_ = state.q;
-      finish(state, p);
+      finish(state, held_ ? held_forces(state.q, state, p, nullptr) : p);
       return state;
     }
     if (!with_tangent) residual_into(state.q, state, p, tangent(), r, nullptr, !low_rank);
@@ -333,6 +339,7 @@ EquilibriumState Equilibrium::newton(const Vector& q_guess, const Vector& p) {
       // The held law's springs are in it: no compliance of the body (compliance.cpp).
       newton_factor_solve_ = held_ ? -1 : counters_.solves;
       chord_factorization_ = held_ ? -1 : lu_.factorizations();
+      held_factorization_ = held_ ? lu_.factorizations() : -1;
     }
     // -r on the free dofs (negated in place: the same values as -r_free).
     r_free.resize(free_count_);
@@ -391,6 +398,7 @@ void Equilibrium::free_solve_into(const FreeBlockSolver& solver, const Vector& r
 }
 
 bool Equilibrium::chord_ready() const {
+  if (held_) return held_chords_ && lu_.ok() && lu_.factorizations() == held_factorization_;
   return !penalty_ && !held_ && problem_.body->traits().linearized_stress && lu_.ok() &&
          lu_.factorizations() == chord_factorization_;
 }
