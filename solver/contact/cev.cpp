@@ -22,8 +22,10 @@ constexpr double kStaleContraction = 0.03;
 class CevStep : public StepSolver {
  public:
   CevStep(Equilibrium& eq, const ContactParams& params, int step, const IterationObserver& obs, const StopRequest& stop,
-          double v_previous)
-      : StepSolver(eq, params, step, obs, stop), v_previous_(v_previous) {}
+          double v_previous, bool at_rest)
+      : StepSolver(eq, params, step, obs, stop), v_previous_(v_previous) {
+    at_rest_ = at_rest;
+  }
 
  private:
   void solve(const Vector& q_guess, const Vector& p_start, const Vector& p_star) override {
@@ -290,8 +292,8 @@ class CevStep : public StepSolver {
 
 StepOutcome solve_cev_step(Equilibrium& eq, const Vector& q_guess, const Vector& p_start, const Vector& p_star,
                            const ContactParams& params, int step, const IterationObserver& observer,
-                           const StopRequest& stop, double v_previous) {
-  return CevStep(eq, params, step, observer, stop, v_previous).run(q_guess, p_start, p_star);
+                           const StopRequest& stop, double v_previous, bool at_rest) {
+  return CevStep(eq, params, step, observer, stop, v_previous, at_rest).run(q_guess, p_start, p_star);
 }
 
 }  // namespace grip

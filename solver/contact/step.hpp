@@ -58,7 +58,11 @@ class StepSolver {
   // v_scale > 0 (the contact error expected there), Newton stops at kInexactNewton x v_scale;
   // it is finished to the full precision where the error found is within the tolerance, and
   // to kInexactNewton x that error where it is more than 10x below v_scale.
+  // Where the step starts at rest (at_rest_: q an equilibrium under out_.p, solve_contact_step),
+  // its first call takes q as it is if Equilibrium::at_rest confirms it: no real solve, an event
+  // with no trials.
   bool fresh_solve(const Vector& q, double v_scale = 0.0);
+  bool at_rest_ = false;
   // Some normal force of p presses.
   bool presses(const Vector& p) const;
   // Coulomb's law on the linear model C at the current state, from out_.p, solved to `target`
@@ -235,7 +239,7 @@ class StepSolver {
 // One entry per strategy file.
 StepOutcome solve_cev_step(Equilibrium& eq, const Vector& q_guess, const Vector& p_start, const Vector& p_star,
                            const ContactParams& params, int step, const IterationObserver& observer,
-                           const StopRequest& stop, double v_previous);
+                           const StopRequest& stop, double v_previous, bool at_rest = false);
 StepOutcome solve_uzawa_step(Equilibrium& eq, const Vector& q_guess, const Vector& p_start, const Vector& p_star,
                              const ContactParams& params, int step, const IterationObserver& observer,
                              const StopRequest& stop);
