@@ -6,8 +6,7 @@ namespace grip {
 
 StepOutcome solve_contact_step(Equilibrium& equilibrium, const Vector& q_guess, const Vector& p_start,
                                const Vector& p_star, const ContactParams& params, int step,
-                               const IterationObserver& observer, const StopRequest& stop, double v_previous,
-                               bool at_rest) {
+                               const IterationObserver& observer, const StopRequest& stop, double v_previous) {
   switch (params.method) {
     case ContactMethod::uzawa:
       return solve_uzawa_step(equilibrium, q_guess, p_start, p_star, params, step, observer, stop);
@@ -18,7 +17,7 @@ StepOutcome solve_contact_step(Equilibrium& equilibrium, const Vector& q_guess, 
     case ContactMethod::cev:
       break;
   }
-  return solve_cev_step(equilibrium, q_guess, p_start, p_star, params, step, observer, stop, v_previous, at_rest);
+  return solve_cev_step(equilibrium, q_guess, p_start, p_star, params, step, observer, stop, v_previous);
 }
 
 }  // namespace grip

@@ -139,13 +139,10 @@ struct StepOutcome {
 // extrapolated, like q_guess, the displacement to start Newton from), p_star the previous
 // step's force (the first pass's friction bound, penalty's springs). v_previous: the contact
 // error of the previous step's first solve (0: none), which cev's first solve of this step
-// takes as the scale of its own (its Newton tolerance, StepSolver::fresh_solve). at_rest:
-// q_guess is an equilibrium under p_start (= p_star) at the step's load factors
-// (Equilibrium::at_rest, the last converged state where only obstacles moved): cev's first
-// solve takes it as it is, without a real solve, where Newton's residual test holds there.
+// takes as the scale of its own (its Newton tolerance, StepSolver::fresh_solve).
 StepOutcome solve_contact_step(Equilibrium& equilibrium, const Vector& q_guess, const Vector& p_start,
                                const Vector& p_star, const ContactParams& params, int step,
                                const IterationObserver& observer, const StopRequest& stop = {},
-                               double v_previous = 0.0, bool at_rest = false);
+                               double v_previous = 0.0);
 
 }  // namespace grip
