@@ -22,8 +22,11 @@ constexpr double kStaleContraction = 0.03;
 class CevStep : public StepSolver {
  public:
   CevStep(Equilibrium& eq, const ContactParams& params, int step, const IterationObserver& obs, const StopRequest& stop,
-          double v_previous)
-      : StepSolver(eq, params, step, obs, stop), v_previous_(v_previous) {}
+          double v_previous, bool at_rest, const Vector* model_at)
+      : StepSolver(eq, params, step, obs, stop), v_previous_(v_previous) {
+    at_rest_ = at_rest;
+    if (model_at) model_q_ = *model_at;
+  }
 
  private:
   void solve(const Vector& q_guess, const Vector& p_start, const Vector& p_star) override {
@@ -41,14 +44,20 @@ class CevStep : public StepSolver {
     pass_ = out_.passes = 1;
     out_.p = p_start;
     project_to_cone(problem_, out_.p);
+    const bool rested = at_rest_;
     if (!fresh_solve(q_guess, v_previous_) || !approach_contact()) return;
+    if (!rested || eq_.counters().solves != solves_at_start_) model_q_.reset();
     while (!error_met(error_)) {
       if (!budget_left()) return;
       // Held solves leave no factorization of the body's own tangent (their springs are in
       // Newton's): its G is formed afresh at each update, where a solve under given forces hands
       // over its own (J2Contact: 46 real solves with the kept G, 24 fresh).
-      if (held()) eq_.refresh_compliance();
-      const Compliance& C = eq_.compliance(out_.state, relevant_components(), params_.sparse_compliance_from);
+      if (held() || model_q_) eq_.refresh_compliance();
+      EquilibriumState model_state;
+      if (model_q_) model_state = eq_.evaluate(*model_q_);
+      const Compliance& C =
+          eq_.compliance(model_q_ ? model_state : out_.state, relevant_components(), params_.sparse_compliance_from);
+      model_q_.reset();
       int inner = 0, halvings = 0;
       const Vector pl = predict_coulomb(C, inner, halvings);
       out_.inner_iterations += inner;
@@ -284,14 +293,19 @@ class CevStep : public StepSolver {
 
   // The previous step's first contact error: the scale of this step's first solve.
   double v_previous_ = 0.0;
+  // Where the step started at rest (load stepping: a plastic body where only obstacles moved), the
+  // displacement its first update's compliance is formed at: the last increment extrapolated,
+  // whose tangent yields where that increment yielded (at rest, a point on the yield surface
+  // answers with the elastic tangent, and the model overpredicts the forces).
+  std::optional<Vector> model_q_;
 };
 
 }  // namespace
 
 StepOutcome solve_cev_step(Equilibrium& eq, const Vector& q_guess, const Vector& p_start, const Vector& p_star,
                            const ContactParams& params, int step, const IterationObserver& observer,
-                           const StopRequest& stop, double v_previous) {
-  return CevStep(eq, params, step, observer, stop, v_previous).run(q_guess, p_start, p_star);
+                           const StopRequest& stop, double v_previous, bool at_rest, const Vector* model_at) {
+  return CevStep(eq, params, step, observer, stop, v_previous, at_rest, model_at).run(q_guess, p_start, p_star);
 }
 
 }  // namespace grip

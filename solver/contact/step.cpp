@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <optional>
 
 #include "solver/contact/acceleration.hpp"
 #include "solver/contact/coulomb_model.hpp"
@@ -242,6 +243,15 @@ bool StepSolver::bound_from_model(Vector& p_star) {
 
 bool StepSolver::fresh_solve(const Vector& q, double v_scale) {
   if (!budget_left()) return false;
+  if (at_rest_) {  // the step's first state: the last converged one, where only obstacles moved
+    at_rest_ = false;
+    if (std::optional<EquilibriumState> s = eq_.at_rest(q, out_.p)) {
+      accept(std::move(*s), out_.p);
+      m_ = 0;
+      emit(0, 0, 0, 0, 0.0);
+      return true;
+    }
+  }
   const bool loose = loosen_newton(v_scale);
   EquilibriumState s = eq_.solve(q, out_.p);
   tighten_newton();

@@ -58,7 +58,11 @@ class StepSolver {
   // v_scale > 0 (the contact error expected there), Newton stops at kInexactNewton x v_scale;
   // it is finished to the full precision where the error found is within the tolerance, and
   // to kInexactNewton x that error where it is more than 10x below v_scale.
+  // Where the step starts at rest (at_rest_: q an equilibrium under out_.p, solve_cev_step),
+  // its first call takes q as it is if Equilibrium::at_rest confirms it: no real solve, an event
+  // with no trials.
   bool fresh_solve(const Vector& q, double v_scale = 0.0);
+  bool at_rest_ = false;
   // Some normal force of p presses.
   bool presses(const Vector& p) const;
   // Coulomb's law on the linear model C at the current state, from out_.p, solved to `target`
@@ -235,10 +239,16 @@ class StepSolver {
   std::shared_ptr<const BorderedFactors> bordered_;
 };
 
-// One entry per strategy file.
+// One entry per strategy file. cev's at_rest (load stepping calls it directly for that): q_guess
+// is an equilibrium under p_start (= p_star) at the step's load factors (Equilibrium::at_rest:
+// the last converged state of a plastic body, where only obstacles moved), which cev's first
+// solve takes as it is, without a real solve, where Newton's residual test holds there; model_at
+// (with at_rest): where the step did start at rest, the displacement its first update's
+// compliance is formed at (the last increment extrapolated; docs/algorithm.md#load-stepping-and-cuts).
 StepOutcome solve_cev_step(Equilibrium& eq, const Vector& q_guess, const Vector& p_start, const Vector& p_star,
                            const ContactParams& params, int step, const IterationObserver& observer,
-                           const StopRequest& stop, double v_previous);
+                           const StopRequest& stop, double v_previous, bool at_rest = false,
+                           const Vector* model_at = nullptr);
 StepOutcome solve_uzawa_step(Equilibrium& eq, const Vector& q_guess, const Vector& p_start, const Vector& p_star,
                              const ContactParams& params, int step, const IterationObserver& observer,
                              const StopRequest& stop);

@@ -139,6 +139,22 @@ double Equilibrium::relative_residual(const Vector& q, const Vector& p) const {
   return force_scale > 0 ? scaled_free_max(r) / force_scale : 0.0;
 }
 
+std::optional<EquilibriumState> Equilibrium::at_rest(const Vector& q, const Vector& p) const {
+  if (penalty_ || held_ || problem_.rigid.count() || !extra_.empty()) return std::nullopt;
+  for (const Constraint& c : problem_.constraints)
+    if (q[c.dof] != (c.load_case < static_cast<int>(factors_.size()) ? c.at(factors_[c.load_case]) : 0.0))
+      return std::nullopt;
+  EquilibriumState state = evaluate(q);
+  double force_scale = 0.0;
+  const Vector r = residual(q, state, p, nullptr, &force_scale);
+  const double r_max = scaled_free_max(r);
+  if (!(r_max <= params_.residual_tolerance * force_scale)) return std::nullopt;
+  state.relative_residual = force_scale > 0 ? r_max / force_scale : 0.0;
+  finish(state, p);
+  if (!state.converged) return std::nullopt;
+  return state;
+}
+
 Vector Equilibrium::applied_forces(const EquilibriumState& paired, const Vector& p) const {
   Vector f = problem_.load(factors_);
   problem_.body->follower_load(paired.q, factors_, f, nullptr);

@@ -57,6 +57,12 @@ class Equilibrium {
   double stiffness_scale(const Vector& q) const;
   // The pairing and s at q, without solving (e.g. the reference configuration).
   EquilibriumState evaluate(const Vector& q) const;
+  // q as it is where it already is an equilibrium under p at the current load factors: its
+  // prescribed dofs at their values and Newton's residual test met at the current tests (one
+  // residual evaluation, no factorization, nothing counted). Not a real solve: a state that
+  // Newton would return at its first iterate without a correction. Only for given forces (no
+  // penalty or held law) and a body without rigid amplitudes (docs/algorithm.md#load-stepping-and-cuts).
+  std::optional<EquilibriumState> at_rest(const Vector& q, const Vector& p) const;
   // C = T^T K^-1 T over the given components, from the body's own tangent (symmetric), as
   // C = T_s^T G T_s: G = K^-1 restricted to the surface dofs of the candidates asked for so
   // far, one solve per surface dof with one factorization of K, and T_s the rows of T at

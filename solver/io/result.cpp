@@ -307,6 +307,7 @@ json step_json(const Problem& problem, const StepRecord& rec, const OutputOption
   j["inner_iterations"] = rec.inner_iterations;
   j["cuts"] = rec.cuts;
   if (rec.multiplier_updates) j["multiplier_updates"] = rec.multiplier_updates;
+  if (rec.restarts) j["restarts"] = rec.restarts;
   // The step checks (solver/stepping/step_checks.hpp): the worst value of each over the step.
   const StepChecks& c = rec.checks;
   j["checks"] = {{"balance", c.balance},

@@ -9,6 +9,7 @@
 
 #include "solver/contact/friction_limit.hpp"
 #include "solver/contact/held_by_contact.hpp"
+#include "solver/contact/step.hpp"
 #include "solver/problem/rigid_modes.hpp"
 #include "solver/stepping/candidate_growth.hpp"
 #include "solver/stepping/limit_load.hpp"
@@ -185,6 +186,9 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
     double done = 0.0, increment = 1.0;
     int depth = 0;
     bool from_previous_force = false;  // after a failure from the extrapolated force
+    // A plastic body's increment starts at rest where it can (below); after a failure there, the
+    // increment again from the extrapolated state.
+    bool rest_failed = false;
     // The fallback: where the increment's every attempt failed from the extrapolated state, its
     // attempts again with Newton from the last converged state (`chain`: where they began).
     bool from_converged = false;
@@ -208,15 +212,32 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
       const double ratio =
           !start_q && last > 0 ? turn(before, current, target) * distance(target, current) / last : 0.0;
       const bool repeat = again.has_value();
+      eq->set_step(target, zeta);
+      // A path-dependent (plastic) body starts the increment at rest: the last converged state
+      // under the last forces, where that still is an equilibrium at the target (only obstacles
+      // moved: Equilibrium::at_rest), which cev takes without a real solve. The forces
+      // extrapolated along the last increment are a secant's: where the body yields the
+      // load-penetration curve is concave, and they are a dead load beyond what the body carries
+      // (Prandtl's punch as a contact obstacle: Newton diverged under them in steps 2-6, each
+      // retried from the last forces, 43 real solves where the linear elastic body takes 11).
+      // Where the start at rest fails, the increment again from the extrapolated state.
+      bool rest = false;
+      if (path_dependent && !repeat && !start_q && !rest_failed && !from_converged && !by_ssn && extrapolate_forces &&
+          params.contact.method == ContactMethod::cev) {
+        couple_newton(eq->params(), newton_coupling_tolerance(params.contact), params.contact.newton_fraction,
+                      problem.body->characteristic_length());
+        rest = eq->at_rest(q, p).has_value();
+      }
       const Vector guess = repeat                            ? again->first
                            : start_q                         ? *start_q
+                           : rest                            ? q
                            : from_converged == extrapolate_q ? q
                                                              : Vector(q + (q - q_before) * ratio);
       // The contact forces start from the same extrapolation (the strategies bring it back
       // into the cone): a step then starts near its answer, not a whole increment away.
       const bool turned_back = path_dependent && ratio < 0;
       Vector p_guess = repeat ? again->second
-                       : from_previous_force || by_ssn || !extrapolate_forces || turned_back
+                       : rest || from_previous_force || by_ssn || !extrapolate_forces || turned_back
                            ? p
                            : Vector(p + (p - p_before) * ratio);
       const bool extrapolated = !repeat && p_guess != p;
@@ -228,7 +249,6 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
       if (!extrapolated && !repeat && problem.rigid.count())
         p_guess.segment(problem.rigid.first, problem.rigid.count()) +=
             amplitudes_following_supports(problem, current, target);
-      eq->set_step(target, zeta);
       // A load that no static equilibrium can carry: no cut of the increment can help.
       if (Unreachable why = unreachable_equilibrium(problem, eq->evaluate(guess), target); !why.reason.empty()) {
         rec.reason = std::move(why.reason);
@@ -257,8 +277,15 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
         continue;
       }
       const long moved = eq->counters().multiplier_updates;
-      StepOutcome out = solve_contact_step(*eq, guess, p_guess, p, by_ssn ? ssn_params : params.contact, step,
-                                           observer.iteration, observer.stop_requested, v_first);
+      // From rest, cev's first update takes its linear model at the displacement extrapolated along
+      // the last increment (the body's tangent there, yielding where the last increment yielded),
+      // not at the rest state, whose points on the yield surface answer elastically (Prandtl's
+      // punch: 30 real solves and 108 Newton iterations with the model at rest, 27 and 61).
+      const Vector q_ext = rest && ratio > 0 ? Vector(q + (q - q_before) * ratio) : Vector();
+      StepOutcome out = rest ? solve_cev_step(*eq, guess, p_guess, p, params.contact, step, observer.iteration,
+                                              observer.stop_requested, v_first, true, q_ext.size() ? &q_ext : nullptr)
+                             : solve_contact_step(*eq, guess, p_guess, p, by_ssn ? ssn_params : params.contact, step,
+                                                  observer.iteration, observer.stop_requested, v_first);
       count_attempt(rec, out);
       rec.multiplier_updates += static_cast<int>(eq->counters().multiplier_updates - moved);
       bool refused = false;  // converged, but the step checks refused the state
@@ -375,11 +402,21 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
         // no retry or cut (uzawa's fixed alpha on two cylinders spent 7 attempts of 500 real
         // solves, over 2 minutes a step; a halved increment starts its error only 2 x lower).
         const bool spent = out.budget_spent;
-        // A poor extrapolation (after the start-up step, or where contact changes) is retried
-        // from the previous force before the increment is cut: a cut changes the load path.
-        if (!out.stopped && !out.definitive && !spent && !from_previous_force && extrapolated) {
+        // A failed start at rest is retried from the extrapolated state before the increment is
+        // cut; a poor extrapolation (after the start-up step, or where contact changes) from the
+        // previous force (not after a start at rest: it started there): a cut changes the load path.
+        if (!out.stopped && !out.definitive && !spent && rest) {
+          rest_failed = true;
+          ++rec.restarts;
+          rec.notes.push_back("the start at rest failed (" + out.reason +
+                              "): the increment again from the extrapolated state");
+          continue;
+        }
+        if (!out.stopped && !out.definitive && !spent && !from_previous_force && !rest_failed && extrapolated) {
           from_previous_force = true;
           ++rec.restarts;
+          rec.notes.push_back("the start from the extrapolated forces failed (" + out.reason +
+                              "): the increment again from the last forces");
           continue;
         }
         // Every attempt of the increment failed from the extrapolated state: they run again from
@@ -446,6 +483,7 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
         increment *= 0.5;
         ++depth;
         ++rec.cuts;
+        rest_failed = false;
         continue;
       }
       if (t == 1.0) {
@@ -474,6 +512,7 @@ void step_through(Problem& problem, const std::vector<LoadStep>& steps, const St
       done = t;
       zeta = eq->zetas(out.state);
       updates = 0;
+      rest_failed = false;
       from_converged = false;
       by_ssn = false;
       chain = {increment, depth, from_previous_force};

@@ -10,7 +10,9 @@
 //   pole), and the most strained one below the surface near the axis;
 // - the plastic run's real solves against the linear elastic run's on the same scene (issue
 //   37: at most 1.5 x), printed for every strategy and asserted where met
-//   (bench/results/plasticity.md says which are not and why).
+//   (bench/results/plasticity.md says which are not and why). The diameter is lowered by a
+//   prescribed displacement, so no increment starts at rest (the start of a plastic body's
+//   increment where only obstacles moved: docs/algorithm.md#load-stepping-and-cuts).
 #include <gtest/gtest.h>
 
 #include <algorithm>

@@ -16,8 +16,13 @@
 //   `balanced`), it failed step 1 here after 5 cuts;
 // - real solves against the same scene with a linear elastic law (issue 37: within 1.5 x),
 //   asserted where met (ssn, penalty), printed where not: cev and the paper's loop take one real
-//   solve a step on the linear body (its update exact), and 2-5 on the plastic block (the
-//   plastic zone's flow, which the tangent at the state does not foresee).
+//   solve a step on the linear body (its update exact), and more on the plastic block (the
+//   plastic zone's flow, which the tangent at the state does not foresee). The plastic block's
+//   increments start at rest (docs/algorithm.md#load-stepping-and-cuts: the last converged state
+//   under the last forces, no real solve; cev's first model at the extrapolated displacement):
+//   cev 28 real solves (2-3 a step, 2.55 x), the paper's loop 87 (4.1 x); before, from the
+//   forces extrapolated along the last increment, a dead load beyond what the yielding block
+//   carries (Newton failed under it in steps 2-6), 43 (3.9 x) and 132 (6.3 x).
 #include <gtest/gtest.h>
 
 #include <cstdio>
