@@ -155,7 +155,8 @@ class CevStep : public StepSolver {
     law.stiffness = Vector::Zero(n);
     law.slip.assign(problem_.candidates.size(), 0);
     const auto spring = [&](int j) {
-      const double cjj = C.position[j] >= 0 ? C.diagonal(C.position[j]) : 0.0;
+      // |C_jj|: an indefinite C can have C_jj < 0 (coulomb_model.cpp's augmentation).
+      const double cjj = C.position[j] >= 0 ? std::abs(C.diagonal(C.position[j])) : 0.0;
       return cjj > 0 ? params_.held_stiffness / cjj : 0.0;
     };
     for (size_t i = 0; i < problem_.candidates.size(); ++i) {

@@ -37,8 +37,10 @@ class Model {
       r.xi = c.xi >= 0 ? C.position[c.xi] : -1;
       if (r.eta < 0 && r.xi < 0) continue;
       r.mu = problem.obstacles[c.obstacle].friction;
-      if (r.eta >= 0 && C.diagonal(r.eta) > 0) r.r_eta = augmentation / C.diagonal(r.eta);
-      if (r.xi >= 0 && C.diagonal(r.xi) > 0) r.r_xi = augmentation / C.diagonal(r.xi);
+      // |C_jj|: an indefinite C (Equilibrium::set_indefinite_turning) can have C_jj < 0 at a
+      // point pressed on a convex arc whose body gives way along it; its stiffness is the size.
+      if (r.eta >= 0 && std::abs(C.diagonal(r.eta)) > 0) r.r_eta = augmentation / std::abs(C.diagonal(r.eta));
+      if (r.xi >= 0 && std::abs(C.diagonal(r.xi)) > 0) r.r_xi = augmentation / std::abs(C.diagonal(r.xi));
       rows_.push_back(r);
     }
     // The rigid amplitudes' rows (docs/algorithm.md#bodies-held-only-by-contact): the body's

@@ -93,6 +93,8 @@ StepOutcome StepSolver::run(const Vector& q_guess, const Vector& p_start, const 
   newton_base_ = eq_.params();
   eq_.set_compliance_reuse(params_.reuse_compliance && params_.method == ContactMethod::cev &&
                            params_.loop == ContactLoop::inner);
+  eq_.set_indefinite_turning(params_.method == ContactMethod::cev && params_.loop == ContactLoop::inner &&
+                             params_.friction_loop == FrictionLoop::inner);
   const long solves0 = eq_.counters().solves, newton0 = eq_.counters().newton_iterations;
   solves_at_start_ = solves0;
   solve(q_guess, p_start, p_star);

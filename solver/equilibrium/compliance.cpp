@@ -130,7 +130,8 @@ const Compliance& Equilibrium::compliance(const EquilibriumState& state, const s
   const int k = static_cast<int>(components.size());
   bool tangent_ok = false;
   if (k > 0) {
-    tangent_ok = compliance_tangent(state, surface_dof_count(problem_, state, components, free_index_));
+    tangent_ok = compliance_tangent(state, surface_dof_count(problem_, state, components, free_index_),
+                                    k < sparse_from || problem_.rigid.count() > 0);
     // The border of a body held by contact stays dense (its block is indefinite).
     if (tangent_ok && k >= sparse_from && problem_.rigid.count() == 0 && body_lu_.symmetric())
       return sparse_compliance(state, components);
@@ -198,14 +199,14 @@ bool Equilibrium::newton_factor_serves(const EquilibriumState& state, int surfac
          lu_.symmetric() && state.q.size() == newton_factor_q_.size() && state.q == newton_factor_q_;
 }
 
-bool Equilibrium::compliance_tangent(const EquilibriumState& state, int surface_dofs) {
+bool Equilibrium::compliance_tangent(const EquilibriumState& state, int surface_dofs, bool dense) {
   const bool from_newton = newton_factor_serves(state, surface_dofs);
   // A G from Newton's factorization, or one with the turning contact forces' stiffness (the
   // exact linearization at its state, and only there), serves its own state only (the next
   // real solve factorizes anew); at that state it is kept while the contact zone grows.
   const bool own_state = g_from_newton_ || g_turns_;
   const bool same_state_g = g_valid_ && own_state && from_newton == g_from_newton_ && g_solve_ == counters_.solves &&
-                            (!g_turns_ || g_turns_q_ == state.q);
+                            (!g_turns_ || g_turns_q_ == state.q) && (!g_indefinite_ || (indefinite_turning_ && dense));
   if (!constant_tangent_ && !same_state_g && (!compliance_reuse_ || own_state)) g_valid_ = false;
   compliance_reused_ = g_valid_ && !constant_tangent_ && !own_state;
   if (g_valid_) return g_factor().ok();
@@ -218,7 +219,7 @@ bool Equilibrium::compliance_tangent(const EquilibriumState& state, int surface_
   g_solve_ = counters_.solves;
   if (!from_newton) {
     const bool turning = turning_ && !problem_.body->has_follower_loads() && state.p.size() == problem_.component_count;
-    if (!factorize_body_tangent(state.q, turning ? &state : nullptr)) return false;
+    if (!factorize_body_tangent(state.q, turning ? &state : nullptr, indefinite_turning_ && dense)) return false;
     if (g_turns_) g_turns_q_ = state.q;
     ++counters_.compliance_forms;
     ++tangent_version_;

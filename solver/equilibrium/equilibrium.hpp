@@ -85,6 +85,11 @@ class Equilibrium {
   void refresh_compliance() { g_valid_ = constant_tangent_ && g_valid_; }
   // The last compliance() used a G formed at an earlier state (a changing tangent only).
   bool compliance_reused() const { return compliance_reused_; }
+  // A dense G may carry the turning contact forces' stiffness where the sum with the body's
+  // tangent is not positive definite (an LU factorization of it; then C is indefinite, the
+  // exact linearization still): for cev's default loop, whose Coulomb model solves C's active
+  // blocks by LU (docs/algorithm.md#the-contact-compliance). Off: the body's own tangent there.
+  void set_indefinite_turning(bool on) { indefinite_turning_ = on; }
   // The last compliance() carries the stiffness of contact forces that turn with a curved
   // obstacle (a body stiff in its reference state): the exact linearization at its state, so
   // formed afresh at every update (docs/algorithm.md#the-contact-compliance).
@@ -189,7 +194,8 @@ class Equilibrium {
   void extend_surface_compliance(const std::vector<int>& added);
   // The body's tangent that G (or the sparse form) comes from: kept, or factorized at state.q
   // (a changing tangent without reuse). False if it is singular.
-  bool compliance_tangent(const EquilibriumState& state, int surface_dofs);
+  // `dense`: the compliance will be the dense form (then an indefinite turning sum may serve).
+  bool compliance_tangent(const EquilibriumState& state, int surface_dofs, bool dense = false);
   const Compliance& sparse_compliance(const EquilibriumState& state, const std::vector<int>& components);
 
   const Problem& problem_;
@@ -211,14 +217,18 @@ class Equilibrium {
   // Up to `updates` moves of the body's multipliers (Body::update_multipliers) at a converged
   // state, Newton continued after each; none where the constraint already holds.
   void move_multipliers(EquilibriumState& state, const Vector& p, int updates);
-  bool factorize_body_tangent(const Vector& q, const EquilibriumState* turning = nullptr);
+  // With `indefinite`, a sum with the turning terms that is not positive definite is kept where
+  // its LU factorization succeeds (g_indefinite_).
+  bool factorize_body_tangent(const Vector& q, const EquilibriumState* turning = nullptr, bool indefinite = false);
   // Adds scale x the symmetrized turning stiffness -J^T sym(df/dx) J of every candidate of
   // `state` (emitted even where zero: the pattern stays); true if some term is not zero.
   bool add_turning_stiffness(const EquilibriumState& state, TangentSink& sink, double scale) const;
-  bool multiplier_moves_ = true;  // solve() moves the body's multipliers (move_multipliers)
-  bool moves_failed_ = false;     // a Newton solve after a move failed: no more moves (move_multipliers)
-  bool turning_ = false;          // the compliance may carry the turning stiffness (factorize_body_tangent)
-  bool g_turns_ = false;          // G does (its state's: real solve g_solve_ at g_turns_q_)
+  bool multiplier_moves_ = true;     // solve() moves the body's multipliers (move_multipliers)
+  bool moves_failed_ = false;        // a Newton solve after a move failed: no more moves (move_multipliers)
+  bool turning_ = false;             // the compliance may carry the turning stiffness (factorize_body_tangent)
+  bool g_turns_ = false;             // G does (its state's: real solve g_solve_ at g_turns_q_)
+  bool indefinite_turning_ = false;  // set_indefinite_turning
+  bool g_indefinite_ = false;        // G's tangent with the turning terms is LU-factorized (not definite)
   Vector g_turns_q_;
   bool constant_tangent_ = false;
   bool has_pairs_ = false;  // a contact pair of two bodies (a deformable master)

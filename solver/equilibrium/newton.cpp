@@ -471,10 +471,11 @@ double Equilibrium::line_search(const Vector& q, const Vector& dq, const Vector&
   return a;
 }
 
-bool Equilibrium::factorize_body_tangent(const Vector& q, const EquilibriumState* turning) {
+bool Equilibrium::factorize_body_tangent(const Vector& q, const EquilibriumState* turning, bool indefinite) {
   if (constant_tangent_ && body_factorized_) return body_lu_.ok();
-  g_turns_ = false;
-  // The turning terms, then (not positive definite with them) the same pattern with zeros.
+  g_turns_ = g_indefinite_ = false;
+  // The turning terms, then (not positive definite with them, unless `indefinite` lets their LU
+  // serve) the same pattern with zeros.
   for (const double scale : {1.0, 0.0}) {
     Vector force = Vector::Zero(q.size());
     TangentSink& sink = body_lu_.assemble(free_index_, free_count_, &length_scales_);
@@ -487,8 +488,9 @@ bool Equilibrium::factorize_body_tangent(const Vector& q, const EquilibriumState
     if (constant_tangent_) body_tangent_norm_ = body_lu_.row_sum_norm();
     const bool ok = body_lu_.factorize();
     counters_.body_analyses = body_lu_.analyses();
-    if (!turns || (ok && body_lu_.symmetric())) {
+    if (!turns || (ok && (body_lu_.symmetric() || indefinite))) {
       g_turns_ = turns;
+      g_indefinite_ = turns && !body_lu_.symmetric();
       return ok;
     }
   }

@@ -219,6 +219,42 @@ TEST(Compliance, WithTheTurningContactForcesIsTheExactLinearization) {
   EXPECT_LT(miss, 0.01 * miss_body);
 }
 
+// Pressing forces large beside the beam's bending stiffness: the turning terms make the sum
+// with the body's tangent indefinite (a pressed point on a convex obstacle whose body gives way
+// along it: the filleted punch on the plastic block, bench/results/prandtl-fillet.md). For
+// cev's default loop (set_indefinite_turning) the compliance still carries them, from an LU
+// factorization: T^T K_t^-1 T, indefinite; otherwise the body's own T^T K^-1 T.
+TEST(Compliance, WithAnIndefiniteTurningSumIsStillTheExactLinearizationForCev) {
+  Problem problem = beam_over(make_circle({3, -1.3}, 1), 0.0);
+  for (int d : {1, 2}) problem.constraints.push_back({TimoshenkoBeam::node_dof(0, d), 0.0});  // clamped
+  Equilibrium eq(problem, NewtonParams{});
+  eq.set_step({0.7}, std::vector<double>(problem.candidates.size(), 0.0));
+  EquilibriumState state = eq.evaluate(Vector::Zero(problem.body->dof_count()));
+  state.p = Vector::Zero(problem.component_count);
+  std::vector<int> pressed;
+  for (const Candidate& c : problem.candidates)
+    if (state.enabled[c.eta]) {
+      state.p[c.eta] = -2.0;
+      pressed.push_back(c.eta);
+    }
+  ASSERT_GE(pressed.size(), 4u);
+  const Matrix exact = dense_compliance(problem, eq, state, pressed, &state.p);
+  const Matrix body_only = dense_compliance(problem, eq, state, pressed);
+  const Eigen::SelfAdjointEigenSolver<Matrix> modes(exact);
+  EXPECT_LT(modes.eigenvalues().minCoeff(), 0.0);                    // indefinite: no Cholesky of K_t
+  const Matrix definite_only = eq.compliance(state, pressed).block;  // the default: not indefinite
+  EXPECT_FALSE(eq.compliance_turns());
+  EXPECT_LT((definite_only - body_only).norm(), 1e-10 * body_only.norm());
+  eq.set_indefinite_turning(true);
+  const Matrix C = eq.compliance(state, pressed).block;
+  EXPECT_TRUE(eq.compliance_turns());
+  const double off_exact = (C - exact).norm() / exact.norm(), turning = (exact - body_only).norm() / exact.norm();
+  std::printf("indefinite: |C - T^T K_t^-1 T| = %.3g, the turning terms' share %.3g, smallest eigenvalue %.3g\n",
+              off_exact, turning, modes.eigenvalues().minCoeff());
+  EXPECT_LT(off_exact, 1e-10);
+  EXPECT_GT(turning, 1e-3);
+}
+
 // A constant tangent: one factorization and one G serve every call, whatever the state.
 TEST(Compliance, ConstantTangentFormsGOnce) {
   const Scene scene = coarse_half_disc("linear");
