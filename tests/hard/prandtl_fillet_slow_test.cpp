@@ -6,8 +6,8 @@
 // lets it slide along the arc: the sum of its tangent and the turning stiffness of the point's
 // force is indefinite there. Before the compliance kept those terms where the sum is
 // indefinite (docs/algorithm.md#the-contact-compliance), the updates on the arc converged
-// linearly and step 15 failed after ~200 s; now every step converges. Steps 1-14 (the node
-// still on the flat) carry the square-edged punch's load on the same mesh, and step 15 the
+// linearly and step 15 failed after ~200 s; now every step converges. Steps 8-14 (the node
+// still on the flat) carry the square-edged punch's plateau load on the same mesh, and step 15 the
 // load that ssn's semismooth Newton found on the same path (0.9175 of (2 + pi) k b,
 // bench/results/prandtl-fillet.md).
 #include <gtest/gtest.h>
@@ -129,8 +129,9 @@ TEST(PrandtlFilletSlow, CevPressesTheFilletedPunchPastTheJoin) {
       "iterations (square edge, 14 steps: %d, %d)\n",
       fillet.outermost[13], fillet.outermost[14], fillet.outermost[15], fillet.solves, fillet.newton, square.solves,
       square.newton);
-  // On the flat: the square edge's load.
-  for (size_t k = 0; k < 14; ++k) EXPECT_NEAR(fillet.load[k], square.load[k], 1e-6) << "step " << k + 1;
+  // On the flat, on the plateau: the square edge's load (to step 7 the square edge's corner node,
+  // under the fillet's arc here, still presses: 1.2 % more at step 1, 2e-6 at step 7).
+  for (size_t k = 7; k < 14; ++k) EXPECT_NEAR(fillet.load[k], square.load[k], 1e-6) << "step " << k + 1;
   EXPECT_LT(fillet.outermost[13], 1 - r);
   // Past the join, on the arc: ssn's load on the same path, then less as the node is squeezed out.
   EXPECT_GT(fillet.outermost[14], 1 - r);
