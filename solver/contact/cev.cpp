@@ -169,7 +169,8 @@ class CevStep : public StepSolver {
       if (std::abs(pl[c.xi]) < mu * -pl[c.eta] * (1 - 1e-10)) law.stiffness[c.xi] = spring(c.xi);
       else law.slip[i] = pl[c.xi] > 0 ? 1 : -1;
     }
-    // Each held component's spring against its own stiffness with the other held components
+    // The springs above mark what is held and stay where the clamped stiffness below is not
+    // positive. Each held component's spring against its own stiffness with the other held components
     // held, (C_HH^-1)_jj, where C_HH is positive there: near a limit load C_jj is the compliance
     // of the body's near-mechanism, springs c / C_jj are soft against the held points' other
     // modes, and the moves (StepSolver::move_held) left 0.95 of the stretch a move (Prandtl's

@@ -32,8 +32,9 @@ constexpr double kInexactNewton = 0.05;
 // A held trial's moves of its springs' base forces (move_held): at most this many, until the
 // springs stretch less than this fraction of the contact tolerance. J2Contact's plastic body
 // took 19 real solves without them, 16 with them (its linear elastic body 15); on Prandtl's
-// punch by contact a move left 1/3000 to 1/250 of the stretch before it while the block was
-// stiff, and still more than half near the limit load (bench/results/plasticity.md).
+// punch by contact a move left 1/3000 to 1/250 of the stretch while the block was stiff
+// (bench/results/plasticity.md; near the limit load, with springs c / C_jj, more than half:
+// cev.cpp's held_plan now makes them as stiff as their points with the others held).
 constexpr int kHeldMoves = 4;
 constexpr double kHeldStretch = 0.1;
 
@@ -505,7 +506,7 @@ bool StepSolver::line_search(const Vector& pl, const Vector& du, int& trials, co
 }
 
 // A held trial's springs leave about 1 / (1 + c) of the model's misprediction at the points they
-// hold (their stiffness c / C_jj). Their base forces are moved to the forces they carry and Newton
+// hold (their stiffness c times each point's own, cev.cpp's held_plan). Their base forces are moved to the forces they carry and Newton
 // goes on, chords from its last factorization first (Equilibrium::continue_held), until they
 // stretch less than a tenth of the contact tolerance: the trial then holds those points at the
 // model's kinematics and the update is the exact one for the active set the model predicted
