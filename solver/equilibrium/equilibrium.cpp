@@ -38,6 +38,9 @@ void Equilibrium::index_free_dofs() {
     }
     body_lu_.set_blocks(starts, params_.parallel);
     lu_.set_blocks(std::move(starts), params_.parallel);
+  } else {
+    body_lu_.set_parallel(params_.parallel);
+    lu_.set_parallel(params_.parallel);
   }
 }
 

@@ -21,6 +21,57 @@ void factorize_dissected(CholmodFactor& dissected, const Eigen::SparseMatrix<dou
   dissected.compute(matrix);
 }
 
+// Marks a separator of the block's graph (1; the rest 0): the level of a breadth-first search
+// from a pseudo-peripheral row that leaves the rows on either side most nearly equal in number.
+std::vector<int> level_separator(const Eigen::SparseMatrix<double>& m) {
+  const int n = static_cast<int>(m.rows());
+  const int* ap = m.outerIndexPtr();
+  const int* ai = m.innerIndexPtr();
+  std::vector<int> level(n), queue(n);
+  const auto search = [&](int start) {  // levels from start; returns the number of levels
+    std::fill(level.begin(), level.end(), -1);
+    int head = 0, tail = 0;
+    queue[tail++] = start;
+    level[start] = 0;
+    while (head < tail) {
+      const int v = queue[head++];
+      for (int p = ap[v]; p < ap[v + 1]; ++p)
+        if (level[ai[p]] < 0) {
+          level[ai[p]] = level[v] + 1;
+          queue[tail++] = ai[p];
+        }
+    }
+    return tail == n ? level[queue[n - 1]] + 1 : -1;  // -1: not connected
+  };
+  int start = 0, depth = search(start);
+  for (int round = 0; round < 4 && depth > 0; ++round) {
+    const int far = queue[n - 1];
+    const int d = search(far);
+    if (d <= depth) {
+      search(start);
+      break;
+    }
+    start = far;
+    depth = d;
+  }
+  std::vector<int> member(n, 0);
+  if (depth < 3) return member;
+  std::vector<int> count(depth, 0);
+  for (int v = 0; v < n; ++v) ++count[level[v]];
+  int best = -1, before = 0;
+  long gap = n;
+  for (int l = 0; l < depth; ++l) {
+    const long after = n - before - count[l];
+    if (l > 0 && l + 1 < depth && std::abs(after - before) < gap) {
+      gap = std::abs(after - before);
+      best = l;
+    }
+    before += count[l];
+  }
+  for (int v = 0; v < n; ++v) member[v] = level[v] == best ? 1 : 0;
+  return member;
+}
+
 }  // namespace
 
 TangentSink& FreeBlockSolver::assemble(const std::vector<int>& free_index, int free_count,
@@ -324,7 +375,7 @@ bool FreeBlockSolver::factorize(double near_symmetric_tolerance) {
       w[k] = m[gather_[k]] = m[transposed_[k]] = 0.5 * (w[k] + m[transposed_[k]]);
   }
   if (symmetric_) {
-    llt_.factorize_ordered(ordered_, ordered_stype_);
+    llt_.factorize_ordered(ordered_, ordered_stype_, parallel_);
     // Not positive definite, or a pivot at round-off (the supports do not hold the body):
     // (min/max diag L)^2 is the min/max of LDL^T's D.
     ok_ = llt_.info() == Eigen::Success && llt_.rcond() > 1e-14;
@@ -353,6 +404,27 @@ void FreeBlockSolver::analyse_ordered() {
   probe.analyzePattern(matrix_);
   const cholmod_factor* L = probe.factor();
   const int n = static_cast<int>(matrix_.rows());
+  // A large simplicial block: the same fill-reducing order, but with a separator of the block's
+  // graph ordered last where that costs at most 5 % more flops. The elimination tree then
+  // splits below the separator into two halves that the factorization can take at once
+  // (CholmodFactor::factorize_ordered); a thin strip's own order is nearly banded, one long
+  // path. Chosen by the pattern alone, so the factor is the same on any number of threads.
+  cholmod_factor* separated = nullptr;
+  if (!llt_dissected_ && L && !L->is_super && n >= kParallelRows) {
+    std::vector<int> member = level_separator(matrix_), perm(n);
+    cholmod_sparse A = Eigen::viewAsCholmod(matrix_);
+    A.stype = 1;
+    cholmod_common& common = probe.cholmod();
+    const double flops = common.fl;
+    if (std::count(member.begin(), member.end(), 1) > 0 &&
+        cholmod_camd(&A, nullptr, 0, member.data(), perm.data(), &common)) {
+      common.nmethods = 1;
+      common.method[0].ordering = CHOLMOD_GIVEN;
+      common.postorder = 1;
+      separated = cholmod_analyze_p(&A, perm.data(), nullptr, 0, &common);
+      if (separated && !separated->is_super && common.fl <= kSeparatedFlops * flops) L = separated;
+    }
+  }
   order_.resize(n);
   const int* perm = L ? static_cast<const int*>(L->Perm) : nullptr;
   for (int k = 0; k < n; ++k) order_.indices()[perm ? perm[k] : k] = k;
@@ -412,15 +484,154 @@ void FreeBlockSolver::analyse_ordered() {
   std::copy(inner.begin(), inner.end(), ordered_.innerIndexPtr());
   transposed_.resize(gather_.size());
   for (size_t k = 0; k < gather_.size(); ++k) transposed_[k] = mirror_[gather_[k]];
+  if (separated) cholmod_free_factor(&separated, &probe.cholmod());
   llt_.cholmod().supernodal = CHOLMOD_AUTO;
   llt_.cholmod().final_ll = 1;
   llt_.analyze_ordered(ordered_, ordered_stype_);
 }
 
+// The rows of a simplicial factor split for two threads. CHOLMOD's row factorization computes
+// row k of L from the columns of k's descendants in the elimination tree only, so two groups of
+// disjoint subtrees can be computed at once (cholmod_rowfac on row ranges: a postordered tree's
+// subtrees are ranges), each with CHOLMOD workspace of its own, and the rows above them after.
+struct CholmodFactor::Subtrees {
+  bool planned = false;  // for the current analysis
+  std::vector<std::pair<int, int>> groups[2], top;  // row ranges [begin, end)
+  // Below kMinRows a thread's hand-over (tens of microseconds) weighs against half the work.
+  static constexpr int kMinRows = 2000, kMaxTopRows = 256;
+  static constexpr double kMaxShare = 0.75;
+  cholmod_common second{};
+  bool second_started = false;
+  ~Subtrees() {
+    if (second_started) cholmod_finish(&second);
+  }
+  // From a numeric factor's pattern: each row's work is that of its updates (row k takes column
+  // j's t - 1 entries above it when k is column j's t-th entry), a subtree's the sum of its rows'.
+  // The subtrees' roots come down from the tree's roots, the largest subtree's root at a time,
+  // into the top rows, as long as the two groups' larger one (by largest first into the
+  // lighter) and the top rows together take less; kept where that is at most 0.75 of the whole.
+  void plan(const cholmod_factor& L);
+};
+
+void CholmodFactor::Subtrees::plan(const cholmod_factor& L) {
+  planned = true;
+  groups[0].clear();
+  groups[1].clear();
+  top.clear();
+  const int n = static_cast<int>(L.n);
+  if (n < kMinRows || L.is_super || L.xtype == CHOLMOD_PATTERN) return;
+  const int* lp = static_cast<const int*>(L.p);
+  const int* li = static_cast<const int*>(L.i);
+  const int* lnz = static_cast<const int*>(L.nz);
+  std::vector<int> parent(n, -1), size(n, 1), first(n);
+  std::vector<double> work(n, 1.0);
+  for (int j = 0; j < n; ++j) {
+    if (lnz[j] > 1) parent[j] = li[lp[j] + 1];
+    for (int t = 1; t < lnz[j]; ++t) work[li[lp[j] + t]] += t;
+  }
+  std::iota(first.begin(), first.end(), 0);
+  std::vector<double> subtree(work);
+  std::vector<std::vector<int>> children(n);
+  for (int j = 0; j < n; ++j)
+    if (parent[j] >= 0) {
+      if (parent[j] <= j) return;  // not an elimination tree's order
+      subtree[parent[j]] += subtree[j];
+      size[parent[j]] += size[j];
+      first[parent[j]] = std::min(first[parent[j]], first[j]);
+      children[parent[j]].push_back(j);
+    }
+  for (int j = 0; j < n; ++j)
+    if (first[j] != j - size[j] + 1) return;  // not postordered: subtrees are not ranges
+  const double total = std::accumulate(work.begin(), work.end(), 0.0);
+  const auto larger = [&](int a, int b) { return subtree[a] < subtree[b]; };
+  std::vector<int> roots;  // the candidates, as a max-heap by subtree work
+  for (int j = 0; j < n; ++j)
+    if (parent[j] < 0) roots.push_back(j);
+  std::make_heap(roots.begin(), roots.end(), larger);
+  std::vector<int> tops, best_tops, sorted, best_roots;
+  double top_work = 0.0, best = total;
+  for (int step = 0; step < kMaxTopRows && !roots.empty() && top_work < best; ++step) {
+    sorted = roots;
+    std::sort(sorted.begin(), sorted.end(), [&](int a, int b) { return subtree[a] > subtree[b]; });
+    double bins[2] = {0.0, 0.0};
+    for (int r : sorted) bins[bins[0] <= bins[1] ? 0 : 1] += subtree[r];
+    if (const double cost = std::max(bins[0], bins[1]) + top_work; cost < best) {
+      best = cost;
+      best_roots = sorted;
+      best_tops = tops;
+    }
+    std::pop_heap(roots.begin(), roots.end(), larger);
+    const int r = roots.back();
+    roots.pop_back();
+    tops.push_back(r);
+    top_work += work[r];
+    for (int c : children[r]) {
+      roots.push_back(c);
+      std::push_heap(roots.begin(), roots.end(), larger);
+    }
+  }
+  if (best > kMaxShare * total) return;
+  const auto add = [](std::vector<std::pair<int, int>>& ranges, int begin, int end) {
+    if (!ranges.empty() && ranges.back().second == begin)
+      ranges.back().second = end;
+    else
+      ranges.emplace_back(begin, end);
+  };
+  double bins[2] = {0.0, 0.0};
+  std::vector<std::pair<int, int>> assigned[2];
+  for (int r : best_roots) {
+    const int b = bins[0] <= bins[1] ? 0 : 1;
+    bins[b] += subtree[r];
+    assigned[b].emplace_back(first[r], r + 1);
+  }
+  for (int b = 0; b < 2; ++b) {
+    std::sort(assigned[b].begin(), assigned[b].end());
+    for (const auto& [begin, end] : assigned[b]) add(groups[b], begin, end);
+  }
+  std::sort(best_tops.begin(), best_tops.end());
+  for (int r : best_tops) add(top, r, r + 1);
+}
+
+CholmodFactor::CholmodFactor() { cholmod().print = 0; }
+
 CholmodFactor::~CholmodFactor() {
   cholmod_free_dense(&solve_x_, &cholmod());
   cholmod_free_dense(&solve_y_, &cholmod());
   cholmod_free_dense(&solve_e_, &cholmod());
+}
+
+bool CholmodFactor::factorize_subtrees(cholmod_sparse& A, const ParallelFor& parallel) {
+  cholmod_factor* L = m_cholmodFactor;
+  if (!parallel || L->is_super || L->xtype == CHOLMOD_PATTERN || A.stype <= 0) return false;
+  if (!subtrees_) subtrees_ = std::make_unique<Subtrees>();
+  Subtrees& plan = *subtrees_;
+  if (!plan.planned) plan.plan(*L);
+  if (plan.groups[0].empty() || plan.groups[1].empty()) return false;
+  if (!plan.second_started) {
+    cholmod_start(&plan.second);
+    plan.second.print = 0;
+    plan.second_started = true;
+  }
+  // As CHOLMOD's refactorization of all rows starts: every column holds its diagonal only.
+  const int n = static_cast<int>(L->n);
+  L->minor = L->n;
+  L->is_ll = cholmod().final_ll ? 1 : 0;
+  std::fill(static_cast<int*>(L->nz), static_cast<int*>(L->nz) + n, 1);
+  size_t minor[2] = {L->n, L->n};
+  bool ok[2] = {true, true};
+  parallel(2, [&](int b) {
+    cholmod_factor part = *L;  // L's arrays (each group writes its own columns), a minor of its own
+    cholmod_common* common = b == 0 ? &cholmod() : &plan.second;
+    for (const auto& [begin, end] : plan.groups[b])
+      ok[b] = ok[b] && cholmod_rowfac(&A, nullptr, m_shiftOffset, begin, end, &part, common);
+    minor[b] = part.minor;
+  });
+  L->minor = std::min(minor[0], minor[1]);
+  bool done = ok[0] && ok[1];
+  for (const auto& [begin, end] : plan.top)
+    done = done && cholmod_rowfac(&A, nullptr, m_shiftOffset, begin, end, L, &cholmod());
+  if (!done) L->minor = std::min(L->minor, L->n - 1);  // CHOLMOD failed: no factor
+  return true;
 }
 
 bool CholmodFactor::solve_kept(const double* b, double* x) const {
@@ -456,18 +667,22 @@ void CholmodFactor::analyze_ordered(const Eigen::SparseMatrix<double>& triangle,
   A.stype = stype;
   A.sorted = 0;  // the upper triangle's columns in cholmod_transpose_sym's order
   m_cholmodFactor = cholmod_analyze(&A, &cholmod());
+  if (subtrees_) subtrees_->planned = false;
   m_isInitialized = true;
   m_info = m_cholmodFactor ? Eigen::Success : Eigen::InvalidInput;
   m_analysisIsOk = m_cholmodFactor != nullptr;
   m_factorizationIsOk = false;
 }
 
-void CholmodFactor::factorize_ordered(const Eigen::SparseMatrix<double>& triangle, int stype) {
+void CholmodFactor::factorize_ordered(const Eigen::SparseMatrix<double>& triangle, int stype,
+                                      const ParallelFor& parallel) {
   if (!m_cholmodFactor) return;
   cholmod_sparse A = Eigen::viewAsCholmod(triangle);
   A.stype = stype;
   A.sorted = 0;
-  cholmod_factorize_p(&A, m_shiftOffset, nullptr, 0, m_cholmodFactor, &cholmod());
+  rows_split_ = factorize_subtrees(A, parallel);
+  if (!rows_split_)
+    cholmod_factorize_p(&A, m_shiftOffset, nullptr, 0, m_cholmodFactor, &cholmod());
   m_info = m_cholmodFactor->minor == m_cholmodFactor->n ? Eigen::Success : Eigen::NumericalIssue;
   m_factorizationIsOk = true;
 }

@@ -25,7 +25,7 @@ namespace grip {
 // CHOLMOD's supernodal L L^T, with its reciprocal condition estimate (min/max of diag(L))^2.
 class CholmodFactor : public Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>> {
  public:
-  CholmodFactor() { cholmod().print = 0; }  // a non-SPD block is a result, not a message
+  CholmodFactor();  // quiet: a non-SPD block is a result, not a message
   ~CholmodFactor();
   CholmodFactor(const CholmodFactor&) = delete;
   CholmodFactor& operator=(const CholmodFactor&) = delete;
@@ -36,7 +36,12 @@ class CholmodFactor : public Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<dou
   // for the simplicial one, the lower for the supernodal one. In any other form CHOLMOD
   // permutes and transposes the block at every factorization (cholmod_transpose_sym).
   void analyze_ordered(const Eigen::SparseMatrix<double>& triangle, int stype);
-  void factorize_ordered(const Eigen::SparseMatrix<double>& triangle, int stype);
+  // With `parallel`, a simplicial factor's rows in two groups of independent subtrees of the
+  // elimination tree at once, then the rows above them: the same arithmetic row by row, so the
+  // same factor to the last bit (planned once per analysis, from the first factor's pattern).
+  void factorize_ordered(const Eigen::SparseMatrix<double>& triangle, int stype, const ParallelFor& parallel = {});
+  // The last factorization took its rows in two groups at once.
+  bool rows_split() const { return rows_split_; }
   // K^-1 on the given rows, |rows|^2, as W^T W with W = L^-1 P E: each column of W is a sparse
   // forward solve that touches only the elimination-tree path of its row (CHOLMOD's partial
   // solve, on a simplicial copy of the factor), where a dense solve costs 2 nnz(L) flops per
@@ -54,6 +59,10 @@ class CholmodFactor : public Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<dou
 
  private:
   mutable cholmod_dense *solve_x_ = nullptr, *solve_y_ = nullptr, *solve_e_ = nullptr;
+  struct Subtrees;  // the rows' split for two threads, and the second thread's CHOLMOD workspace
+  std::unique_ptr<Subtrees> subtrees_;
+  bool rows_split_ = false;
+  bool factorize_subtrees(cholmod_sparse& A, const ParallelFor& parallel);
   // x = L^-1 P b for each sparse column b of `columns` (free dofs), on a simplicial copy of the
   // factor: `use(column, rows of x, values of x, count)` sees each; false from it stops.
   bool forward_solves(const Eigen::SparseMatrix<double>& columns,
@@ -93,6 +102,8 @@ class FreeBlockSolver {
   // correction), each body's block is factorized and solved on its own, the bodies' tasks run
   // through `parallel` (the solver starts no threads). Else one factorization of the whole.
   void set_blocks(std::vector<int> starts, ParallelFor parallel);
+  // One body: `parallel` serves the factorization's independent subtrees (factorize_ordered).
+  void set_parallel(ParallelFor parallel) { parallel_ = std::move(parallel); }
   Vector solve(const Vector& b) const;
   Matrix solve(const Matrix& b) const;
   // solve(b) into x, with no allocation once x and the solver's work storage are sized where the
@@ -123,6 +134,8 @@ class FreeBlockSolver {
   long analyses() const;
   // Factorized body by body (set_blocks).
   bool split() const { return split_; }
+  // One Cholesky factor whose rows were taken in two groups at once (set_parallel).
+  bool rows_split() const { return ok_ && symmetric_ && !split_ && llt_.rows_split(); }
   // Factorized by Cholesky (symmetric positive definite).
   bool symmetric() const { return ok_ && symmetric_; }
   // The free block as factorized (both triangles).
@@ -186,6 +199,7 @@ class FreeBlockSolver {
   // small beside the work (kParallelRows free rows or more), else one after another.
   void for_each_part(const std::function<void(int)>& task) const;
   static constexpr int kParallelRows = 2000;
+  static constexpr double kSeparatedFlops = 1.05;  // a separated order's flops over the block's own order's
   std::vector<int> starts_;  // body b's free rows begin at starts_[b]; empty: one body
   ParallelFor parallel_;
   std::vector<std::unique_ptr<FreeBlockSolver>> parts_;
