@@ -495,7 +495,7 @@ void FreeBlockSolver::analyse_ordered() {
 // disjoint subtrees can be computed at once (cholmod_rowfac on row ranges: a postordered tree's
 // subtrees are ranges), each with CHOLMOD workspace of its own, and the rows above them after.
 struct CholmodFactor::Subtrees {
-  bool planned = false;  // for the current analysis
+  bool planned = false;                             // for the current analysis
   std::vector<std::pair<int, int>> groups[2], top;  // row ranges [begin, end)
   // Below kMinRows a thread's hand-over (tens of microseconds) weighs against half the work.
   static constexpr int kMinRows = 2000, kMaxTopRows = 256;
@@ -572,10 +572,8 @@ void CholmodFactor::Subtrees::plan(const cholmod_factor& L) {
   }
   if (best > kMaxShare * total) return;
   const auto add = [](std::vector<std::pair<int, int>>& ranges, int begin, int end) {
-    if (!ranges.empty() && ranges.back().second == begin)
-      ranges.back().second = end;
-    else
-      ranges.emplace_back(begin, end);
+    if (!ranges.empty() && ranges.back().second == begin) ranges.back().second = end;
+    else ranges.emplace_back(begin, end);
   };
   double bins[2] = {0.0, 0.0};
   std::vector<std::pair<int, int>> assigned[2];
@@ -681,8 +679,7 @@ void CholmodFactor::factorize_ordered(const Eigen::SparseMatrix<double>& triangl
   A.stype = stype;
   A.sorted = 0;
   rows_split_ = factorize_subtrees(A, parallel);
-  if (!rows_split_)
-    cholmod_factorize_p(&A, m_shiftOffset, nullptr, 0, m_cholmodFactor, &cholmod());
+  if (!rows_split_) cholmod_factorize_p(&A, m_shiftOffset, nullptr, 0, m_cholmodFactor, &cholmod());
   m_info = m_cholmodFactor->minor == m_cholmodFactor->n ? Eigen::Success : Eigen::NumericalIssue;
   m_factorizationIsOk = true;
 }

@@ -200,7 +200,7 @@ class FreeBlockSolver {
   void for_each_part(const std::function<void(int)>& task) const;
   static constexpr int kParallelRows = 2000;
   static constexpr double kSeparatedFlops = 1.05;  // a separated order's flops over the block's own order's
-  std::vector<int> starts_;  // body b's free rows begin at starts_[b]; empty: one body
+  std::vector<int> starts_;                        // body b's free rows begin at starts_[b]; empty: one body
   ParallelFor parallel_;
   std::vector<std::unique_ptr<FreeBlockSolver>> parts_;
   std::vector<int> identity_;  // dof -> row for the parts (their triplets are in local rows)
