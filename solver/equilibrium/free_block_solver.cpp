@@ -375,7 +375,8 @@ bool FreeBlockSolver::factorize(double near_symmetric_tolerance) {
       w[k] = m[gather_[k]] = m[transposed_[k]] = 0.5 * (w[k] + m[transposed_[k]]);
   }
   if (symmetric_) {
-    llt_.factorize_ordered(ordered_, ordered_stype_, parallel_);
+    // The team from kParallelRows rows on, as for the bodies' tasks.
+    llt_.factorize_ordered(ordered_, ordered_stype_, matrix_.rows() >= kParallelRows ? parallel_ : ParallelFor());
     // Not positive definite, or a pivot at round-off (the supports do not hold the body):
     // (min/max diag L)^2 is the min/max of LDL^T's D.
     ok_ = llt_.info() == Eigen::Success && llt_.rcond() > 1e-14;
@@ -497,8 +498,7 @@ void FreeBlockSolver::analyse_ordered() {
 struct CholmodFactor::Subtrees {
   bool planned = false;                             // for the current analysis
   std::vector<std::pair<int, int>> groups[2], top;  // row ranges [begin, end)
-  // Below kMinRows a thread's hand-over (tens of microseconds) weighs against half the work.
-  static constexpr int kMinRows = 2000, kMaxTopRows = 256;
+  static constexpr int kMaxTopRows = 256;
   static constexpr double kMaxShare = 0.75;
   cholmod_common second{};
   bool second_started = false;
@@ -519,7 +519,7 @@ void CholmodFactor::Subtrees::plan(const cholmod_factor& L) {
   groups[1].clear();
   top.clear();
   const int n = static_cast<int>(L.n);
-  if (n < kMinRows || L.is_super || L.xtype == CHOLMOD_PATTERN) return;
+  if (L.is_super || L.xtype == CHOLMOD_PATTERN) return;
   const int* lp = static_cast<const int*>(L.p);
   const int* li = static_cast<const int*>(L.i);
   const int* lnz = static_cast<const int*>(L.nz);
