@@ -9,9 +9,9 @@ after a change, and GetFEM, in the same run.
   bench/results/scaling.md), which must be no slower.
 
 Each case runs RUNS times per program (one thread, or --threads N: grip solve's default is the
-machine's cores, which its element kernels and G's sums use); the table keeps the best run by CPU
-seconds (user + system of the whole process: what the load of other work inflates least) and
-shows its wall seconds too. With --kernels-bench, grip_kernels_bench gives the CPU time of one
+machine's cores, which its element kernels, G's sums and a large factorization's rows use); the
+table keeps the best run by CPU seconds (user + system of the whole process: what the load of
+other work inflates least) and shows its wall seconds too, and the medians over all runs. With --kernels-bench, grip_kernels_bench gives the CPU time of one
 numeric factorization of the strip's stiffness and of one assembly, beside the CPU time per
 Newton iteration: of the whole solve, and of Newton's own work (the CPU time inside its solves,
 without the contact loop's compliance between them). Usage:
@@ -21,6 +21,7 @@ Timing is a benchmark, never a test: no pass/fail here.
 import argparse
 import copy
 import json
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -68,7 +69,11 @@ def run_getfem(nx, ny):
 
 
 def best(runs):
-    return min(runs, key=lambda r: r["cpu"])
+    """The run with the least CPU, with the medians of all runs' CPU and wall seconds beside it."""
+    r = dict(min(runs, key=lambda r: r["cpu"]))
+    r["cpu_median"] = statistics.median(x["cpu"] for x in runs)
+    r["wall_median"] = statistics.median(x["wall"] for x in runs)
+    return r
 
 
 def main():
@@ -84,9 +89,9 @@ def main():
              ("hertz a/h 40 mu 0.3", scaling.hertz_scene(40, 0.3)),
              ("flat 2000 contact nodes", scaling.block_scene(2000, 10))]
     programs = [("after", args.grip)] + ([("before", args.before)] if args.before else [])
-    print("| case | program | cpu s (best) | wall s | real solves | Newton | steps | factorizations "
-          "(Newton + body + dissected) | per Newton iteration | tip (ux, uy) |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
+    print("| case | program | cpu s (best) | wall s | median cpu / wall s | real solves | Newton | steps | "
+          "factorizations (Newton + body + dissected) | per Newton iteration | tip (ux, uy) |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
     for label, scene in cases:
         for name, grip in programs:
             r = best([run_grip(grip, copy.deepcopy(scene), args.threads) for _ in range(args.runs)])
@@ -96,13 +101,15 @@ def main():
             per = f"{c['factorizations_per_newton_iteration']:.3f}" if "newton_factorizations" in c else \
                 f"{c['factorizations'] / max(1, c['newton_iterations']):.3f} (counted)"
             tip = f"{r['tip'][0]:.5f}, {r['tip'][1]:.5f}" if r["tip"] else ""
-            print(f"| {label} | grip {name} | {r['cpu']:.2f} | {r['wall']:.2f} | {c['equilibrium_solves']} | "
+            print(f"| {label} | grip {name} | {r['cpu']:.2f} | {r['wall']:.2f} | "
+                  f"{r['cpu_median']:.2f} / {r['wall_median']:.2f} | {c['equilibrium_solves']} | "
                   f"{c['newton_iterations']} | {r['steps']} | {split} | {per} | {tip} |", flush=True)
         if args.getfem and label.startswith("strip"):
             nx, ny = scene["body"]["mesh"]["rectangle"]["divisions"]
             g = best([run_getfem(nx, ny) for _ in range(args.runs)])
             line = g["line"]
-            print(f"| {label} | GetFEM Q2 large sliding | {g['cpu']:.2f} | {g['wall']:.2f} | | "
+            print(f"| {label} | GetFEM Q2 large sliding | {g['cpu']:.2f} | {g['wall']:.2f} | "
+                  f"{g['cpu_median']:.2f} / {g['wall_median']:.2f} | | "
                   f"{line['newton_iterations']} | 20 | | | {line['tip'][0]:.5f}, {line['tip'][1]:.5f} |", flush=True)
     if args.kernels_bench:
         for nx, ny in ((50, 2), (150, 4)):
